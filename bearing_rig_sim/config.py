@@ -1,0 +1,255 @@
+"""Validated YAML configuration.
+
+Every configuration file of the project (bearing data, rig data, test programs, node
+parameters) is read through :class:`Section`, so that every error a user can make names the
+file, the dotted key and what was allowed::
+
+    config/bearings/h7006c.yaml: geometry.ball_diameter_m: must be > 0, got -0.0063
+
+Defaults live in ``config/``, not in code: a missing key is an error unless the caller gives
+an explicit default.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, Iterator, Sequence
+
+import yaml
+
+#: Folder holding the shipped configuration files (``config/`` at the repository root, or
+#: ``share/bearing_rig_sim/config`` in an installed ROS package).
+CONFIG_DIR: Path = Path(__file__).resolve().parent.parent / "config"
+
+
+class ConfigError(ValueError):
+    """A configuration value is missing, malformed or out of range.
+
+    Attributes:
+        source: the file (or other origin) the value came from.
+        key: dotted path of the offending key (empty for the whole document).
+        problem: what is wrong, including the allowed range where there is one.
+    """
+
+    def __init__(self, source: str, key: str, problem: str) -> None:
+        self.source = source
+        self.key = key
+        self.problem = problem
+        where = f"{source}: {key}" if key else source
+        super().__init__(f"{where}: {problem}")
+
+
+def config_path(*parts: str) -> Path:
+    """Path of a shipped configuration file, e.g. ``config_path("bearings", "h7006c.yaml")``.
+
+    Looks in the source tree first, then in the installed ROS share folder.
+    """
+    local = CONFIG_DIR.joinpath(*parts)
+    if local.exists():
+        return local
+    try:
+        from ament_index_python.packages import get_package_share_directory  # noqa: PLC0415
+
+        share = Path(get_package_share_directory("bearing_rig_sim")) / "config"
+        installed = share.joinpath(*parts)
+        if installed.exists():
+            return installed
+    except Exception:  # noqa: BLE001 - ament index absent or package not installed
+        pass
+    return local
+
+
+def load_yaml(path: str | Path) -> "Section":
+    """Read a YAML file whose top level is a mapping.
+
+    Raises:
+        ConfigError: the file is missing, unreadable, not YAML, or not a mapping.
+    """
+    source = str(path)
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(source, "", f"cannot read file ({exc.strerror or exc})") from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        raise ConfigError(source, "", f"not valid YAML{at}: {getattr(exc, 'problem', exc)}") from exc
+    if not isinstance(data, dict):
+        raise ConfigError(source, "", f"top level must be a mapping, got {type(data).__name__}")
+    return Section(data, source)
+
+
+_MISSING = object()
+
+
+class Section:
+    """A mapping read from a configuration source, with typed, range-checked accessors.
+
+    Args:
+        data: the mapping.
+        source: file name (or other origin) used in error messages.
+        prefix: dotted path of this mapping inside the source.
+    """
+
+    def __init__(self, data: dict[str, Any], source: str, prefix: str = "") -> None:
+        self.data = data
+        self.source = source
+        self.prefix = prefix
+
+    # -- helpers -----------------------------------------------------------------------------
+    def key_path(self, key: str) -> str:
+        """Dotted path of ``key`` inside the source."""
+        return f"{self.prefix}.{key}" if self.prefix else key
+
+    def error(self, key: str, problem: str) -> ConfigError:
+        """A :class:`ConfigError` for ``key`` of this section."""
+        return ConfigError(self.source, self.key_path(key), problem)
+
+    def _get(self, key: str, default: Any) -> Any:
+        if key in self.data and self.data[key] is not None:
+            return self.data[key]
+        if default is _MISSING:
+            raise self.error(key, "missing (required)")
+        return default
+
+    def __contains__(self, key: str) -> bool:
+        return key in self.data
+
+    def keys(self) -> Iterator[str]:
+        """Keys of the mapping."""
+        return iter(self.data.keys())
+
+    def reject_unknown(self, allowed: Sequence[str]) -> None:
+        """Raise on keys not in ``allowed`` (catches misspelt keys)."""
+        for key in self.data:
+            if key not in allowed:
+                raise self.error(str(key), f"unknown key; allowed keys: {', '.join(sorted(allowed))}")
+
+    # -- accessors ---------------------------------------------------------------------------
+    def section(self, key: str, default: Any = _MISSING) -> "Section":
+        """A nested mapping as a :class:`Section`."""
+        value = self._get(key, default)
+        if not isinstance(value, dict):
+            raise self.error(key, f"must be a mapping, got {type(value).__name__}")
+        return Section(value, self.source, self.key_path(key))
+
+    def number(
+        self,
+        key: str,
+        *,
+        gt: float | None = None,
+        ge: float | None = None,
+        lt: float | None = None,
+        le: float | None = None,
+        default: Any = _MISSING,
+    ) -> float:
+        """A finite real number within the given bounds (``gt`` means strictly greater, ...)."""
+        value = self._get(key, default)
+        return check_number(value, self.source, self.key_path(key), gt=gt, ge=ge, lt=lt, le=le)
+
+    def integer(self, key: str, *, ge: int | None = None, le: int | None = None, default: Any = _MISSING) -> int:
+        """An integer within ``[ge, le]``."""
+        value = self._get(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key, f"must be an integer, got {value!r}")
+        if ge is not None and value < ge:
+            raise self.error(key, f"must be >= {ge}, got {value}")
+        if le is not None and value > le:
+            raise self.error(key, f"must be <= {le}, got {value}")
+        return value
+
+    def boolean(self, key: str, default: Any = _MISSING) -> bool:
+        """A YAML boolean."""
+        value = self._get(key, default)
+        if not isinstance(value, bool):
+            raise self.error(key, f"must be true or false, got {value!r}")
+        return value
+
+    def string(self, key: str, default: Any = _MISSING) -> str:
+        """A non-empty string."""
+        value = self._get(key, default)
+        if not isinstance(value, str) or not value:
+            raise self.error(key, f"must be a non-empty string, got {value!r}")
+        return value
+
+    def choice(self, key: str, allowed: Sequence[str], default: Any = _MISSING) -> str:
+        """A string out of ``allowed``."""
+        value = self._get(key, default)
+        if value not in allowed:
+            raise self.error(key, f"must be one of {', '.join(map(str, allowed))}, got {value!r}")
+        return str(value)
+
+    def number_list(
+        self, key: str, *, gt: float | None = None, ge: float | None = None, min_len: int = 1, default: Any = _MISSING
+    ) -> list[float]:
+        """A list of finite numbers, each within the bounds."""
+        value = self._get(key, default)
+        if not isinstance(value, list) or len(value) < min_len:
+            raise self.error(key, f"must be a list of at least {min_len} number(s), got {value!r}")
+        path = self.key_path(key)
+        return [check_number(v, self.source, f"{path}[{i}]", gt=gt, ge=ge) for i, v in enumerate(value)]
+
+    def sections(self, key: str) -> list["Section"]:
+        """A list of mappings, each as a :class:`Section` (``key[i]`` in error paths)."""
+        value = self._get(key, _MISSING)
+        if not isinstance(value, list) or not value:
+            raise self.error(key, "must be a non-empty list of mappings")
+        out = []
+        for i, item in enumerate(value):
+            if not isinstance(item, dict):
+                raise ConfigError(self.source, f"{self.key_path(key)}[{i}]", "must be a mapping")
+            out.append(Section(item, self.source, f"{self.key_path(key)}[{i}]"))
+        return out
+
+
+def check_number(
+    value: Any,
+    source: str,
+    key: str,
+    *,
+    gt: float | None = None,
+    ge: float | None = None,
+    lt: float | None = None,
+    le: float | None = None,
+) -> float:
+    """Check that ``value`` is a finite real number inside the bounds; return it as float.
+
+    Raises:
+        ConfigError: naming ``source``, ``key`` and the allowed range.
+    """
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ConfigError(source, key, f"must be a number, got {value!r}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ConfigError(source, key, f"must be finite, got {value!r}")
+    if gt is not None and not x > gt:
+        raise ConfigError(source, key, f"must be > {gt}, got {value!r}")
+    if ge is not None and not x >= ge:
+        raise ConfigError(source, key, f"must be >= {ge}, got {value!r}")
+    if lt is not None and not x < lt:
+        raise ConfigError(source, key, f"must be < {lt}, got {value!r}")
+    if le is not None and not x <= le:
+        raise ConfigError(source, key, f"must be <= {le}, got {value!r}")
+    return x
+
+
+def ros_parameters(doc: Section, node_name: str) -> Section:
+    """The ``node_name: ros__parameters:`` block of a ROS 2 parameter file."""
+    return doc.section(node_name).section("ros__parameters")
+
+
+RPM_TO_RAD_S: float = 2.0 * math.pi / 60.0
+"""Conversion factor from rev/min to rad/s (exact)."""
+
+
+def rpm_to_rad_s(rpm: float) -> float:
+    """Convert a speed in rev/min to rad/s (edges of the program only)."""
+    return rpm * RPM_TO_RAD_S
+
+
+def rad_s_to_rpm(omega: float) -> float:
+    """Convert a speed in rad/s to rev/min (edges of the program only)."""
+    return omega / RPM_TO_RAD_S

@@ -18,12 +18,14 @@ from typing import Any, Iterator, Sequence
 
 import yaml
 
+from bearing_rig_sim.errors import RigError
+
 #: Folder holding the shipped configuration files (``config/`` at the repository root, or
 #: ``share/bearing_rig_sim/config`` in an installed ROS package).
 CONFIG_DIR: Path = Path(__file__).resolve().parent.parent / "config"
 
 
-class ConfigError(ValueError):
+class ConfigError(RigError, ValueError):
     """A configuration value is missing, malformed or out of range.
 
     Attributes:

@@ -222,6 +222,13 @@ def check_number(
     Raises:
         ConfigError: naming ``source``, ``key`` and the allowed range.
     """
+    if isinstance(value, str):
+        # PyYAML follows YAML 1.1, which reads exponents without a sign ("2.0e9") as strings;
+        # YAML 1.2 reads them as floats, and so do we.
+        try:
+            value = float(value.strip())
+        except ValueError:
+            raise ConfigError(source, key, f"must be a number, got {value!r}") from None
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ConfigError(source, key, f"must be a number, got {value!r}")
     x = float(value)

@@ -1,0 +1,285 @@
+"""The bearing dynamics engine: state, inputs over time, integration, observations.
+
+Two formulations of the same model (see :mod:`.kernels`):
+
+* ``"reduced"`` (default): quasi-static ball-raceway normal contact solved every step, ball
+  orbit/spin and the flexible cage integrated with a linearly implicit Euler step
+  (steps of tens of microseconds, real time with margin);
+* ``"stiff"`` (reference): every body dynamic, the paper's IMPACT contacts with Hunt-Crossley
+  damping integrated explicitly (steps of a fraction of a microsecond).
+
+Inputs: the inner-ring speed follows a prescribed angular acceleration (constant over each
+call of :meth:`BearingDynamics.advance`); the axial load (N) is a time signal given per call.
+Cage speed and slip are outputs of the integration, never inputs.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.parameters import BearingParameters, DerivedGeometry, derive
+from bearing_rig_sim.errors import RigError
+
+MODELS = ("reduced", "stiff")
+MIN_AXIAL_LOAD = 1.0
+"""Smallest axial load (N) the engine accepts: an angular contact bearing with no axial load
+has no defined contact angle and the quasi-static normal problem becomes singular."""
+
+
+class DynamicsInputError(RigError):
+    """An input of the dynamics engine is not finite or out of its range."""
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """A copy of the complete engine state (restore it with :meth:`BearingDynamics.restore`)."""
+
+    model: str
+    ball: np.ndarray
+    cage: np.ndarray
+    ring: np.ndarray
+    axial_load: float
+
+
+@dataclass(frozen=True)
+class Observation:
+    """What the engine knows at one instant (SI units).
+
+    Attributes:
+        time: simulation time, s.
+        inner_ring_angle: unwrapped inner-ring (spindle) angle, rad.
+        inner_ring_speed: rad/s.
+        cage_angle: unwrapped angle of the cage segment carrying the reflective strip, rad.
+        cage_speed: mean speed of the cage segments, rad/s.
+        ball_orbit_speeds: per ball, rad/s.
+        inner_contact_loads / outer_contact_loads: per ball, N.
+        inner_contact_angles / outer_contact_angles: per ball, rad.
+        pocket_loads: per ball, signed (> 0: ball pushes the cage forward), N.
+        inner_ring_axial_displacement: m.
+        axial_load: applied axial load, N.
+    """
+
+    time: float
+    inner_ring_angle: float
+    inner_ring_speed: float
+    cage_angle: float
+    cage_speed: float
+    ball_orbit_speeds: np.ndarray
+    inner_contact_loads: np.ndarray
+    outer_contact_loads: np.ndarray
+    inner_contact_angles: np.ndarray
+    outer_contact_angles: np.ndarray
+    pocket_loads: np.ndarray
+    inner_ring_axial_displacement: float
+    axial_load: float
+
+
+@dataclass(frozen=True)
+class ChunkAverage:
+    """Time averages over one :meth:`BearingDynamics.advance` call: cage and inner-ring
+    speed (rad/s) over ``duration`` (s)."""
+
+    duration: float
+    cage_speed: float
+    inner_ring_speed: float
+
+
+def _finite(name: str, value: float, lo: float | None = None) -> float:
+    x = float(value)
+    if not math.isfinite(x):
+        raise DynamicsInputError(f"{name} must be finite, got {value!r}")
+    if lo is not None and x < lo:
+        raise DynamicsInputError(f"{name} must be >= {lo}, got {value!r}")
+    return x
+
+
+class BearingDynamics:
+    """Integrates the equations of motion of one angular contact ball bearing.
+
+    Args:
+        params: bearing data (see :class:`BearingParameters`).
+        model: ``"reduced"`` (default, real time) or ``"stiff"`` (reference).
+        time_step: integration step, s; defaults to the model's step in the bearing file.
+        strip_segment: index of the cage segment carrying the reflective strip (sensor).
+    """
+
+    def __init__(
+        self,
+        params: BearingParameters,
+        *,
+        model: str = "reduced",
+        time_step: float | None = None,
+        strip_segment: int = 0,
+    ) -> None:
+        if model not in MODELS:
+            raise DynamicsInputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
+        self.params = params
+        self.model = model
+        self.vector, self.geometry = derive(params)
+        default_dt = params.reduced_time_step if model == "reduced" else params.stiff_time_step
+        self.time_step = _finite("time_step", time_step if time_step is not None else default_dt, 1e-9)
+        z = params.ball_count
+        if not 0 <= strip_segment < z:
+            raise DynamicsInputError(f"strip_segment must be in 0..{z - 1}, got {strip_segment}")
+        self.strip_segment = strip_segment
+        self.ball = np.zeros((z, kn.NB))
+        self.cage = np.zeros((z, kn.NC))
+        self.ring = np.zeros(kn.NR)
+        self.out = np.zeros((z, kn.NO))
+        self.stats = np.zeros(kn.NS)
+        self.work = np.zeros((z, kn.NW))
+        self.record_every = 0
+        self.axial_load = 0.0
+        self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
+        self.initialise(0.0, 100.0)
+
+    # -- set-up --------------------------------------------------------------------------------
+    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0) -> None:
+        """Start from the static equilibrium under ``axial_load`` (N) with the balls and cage at
+        the kinematic (rolling) speeds for ``inner_ring_speed`` (rad/s) at the loaded contact
+        angle, each ball touching the driving side of its pocket. The dynamics then find the real
+        operating point.
+        """
+        omega = _finite("inner_ring_speed", inner_ring_speed, 0.0)
+        load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+        v, p = self.vector, self.params
+        z = p.ball_count
+        rm = v[kn.P_RM]
+        # Initial approach along the contact line: Q = F/(Z sin a0) at both contacts.
+        q0 = load / (z * max(math.sin(p.contact_angle), 0.05))
+        approach = (q0 / v[kn.P_K_IN]) ** (2 / 3) + (q0 / v[kn.P_K_OUT]) ** (2 / 3)
+        self.ring[:] = 0.0
+        self.ring[kn.R_DELTA] = approach / max(math.sin(p.contact_angle), 0.05)
+        self.ring[kn.R_OMEGA] = omega
+        self.ring[kn.R_TIME] = time
+        theta = 2.0 * math.pi * np.arange(z) / z
+        self.ball[:] = 0.0
+        self.ball[:, kn.B_THETA] = theta
+        self.ball[:, kn.B_R] = rm
+        self.ball[:, kn.B_OMEGA] = omega * p.epicyclic_ratio
+        for _ in range(3):  # speeds and loaded angle depend on each other through centrifugal force
+            if kn.solve_quasi_static(v, self.ball, self.ring, self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 4], load, 1e-11, 200) > 200:
+                raise DynamicsInputError(f"no static equilibrium found for axial load {load} N at {omega} rad/s")
+            self._set_rolling_speeds(omega)
+        # Balls just touching the driving side of their pockets (zero force): the cage is
+        # carried from the first step instead of crossing the clearance and striking the balls.
+        self.cage[:, kn.C_PHI] = theta - v[kn.P_POCKET_CLEAR] / rm
+        self.cage[:, kn.C_OMEGA] = np.mean(self.ball[:, kn.B_OMEGA])
+        self.axial_load = load
+        self.stats[:] = 0.0
+        self.out[:] = 0.0
+
+    def _set_rolling_speeds(self, omega_i: float) -> None:
+        """Ball orbit and spin speeds of pure rolling at both raceways (zero sliding)."""
+        v = self.vector
+        for j in range(self.params.ball_count):
+            rb, zb = self.ball[j, kn.B_R], self.ball[j, kn.B_Z]
+            _, nir, niz, _, _, nor, noz, _ = kn.raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA])
+            r_ci, _, _, _, aim, aia, aom, aoa, _ = kn.ball_kinematics(v, nir, niz, nor, noz, rb)
+            # s_i = 0 and s_o = 0: a 2x2 linear system in (omega_m, omega_a)
+            det = aim * aoa + aia * aom
+            self.ball[j, kn.B_OMEGA] = omega_i * r_ci * aoa / det
+            self.ball[j, kn.B_SPIN] = omega_i * r_ci * aom / det
+
+    def set_inner_ring_speed(self, omega: float) -> None:
+        """Impose the inner-ring speed (rad/s) from now on (a drive speed jump)."""
+        self.ring[kn.R_OMEGA] = _finite("inner_ring_speed", omega, 0.0)
+
+    # -- integration ---------------------------------------------------------------------------
+    def advance(self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0) -> ChunkAverage:
+        """Integrate for ``duration`` seconds (rounded to whole steps).
+
+        Args:
+            duration: s, >= 0.
+            axial_load: N applied to the inner ring during the interval (default: unchanged).
+            inner_ring_acceleration: rad/s^2, constant during the interval; the speed stops at
+                zero rather than reverse.
+
+        Returns:
+            time averages of cage and inner-ring speed over the interval.
+        """
+        duration = _finite("duration", duration, 0.0)
+        if axial_load is not None:
+            self.axial_load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+        accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
+        n = int(round(duration / self.time_step))
+        if accel < 0.0:
+            n = min(n, int(self.ring[kn.R_OMEGA] / (-accel * self.time_step)))
+        self.stats[:] = 0.0
+        if n > 0:
+            self._step(
+                self.vector, self.ball, self.cage, self.ring, self.out, self.stats, self.work, n, self.time_step, self.axial_load, accel, 0
+            )
+        if not np.all(np.isfinite(self.ball)) or not np.all(np.isfinite(self.cage)):
+            raise RigError("dynamics diverged (non-finite state); reduce the time step")
+        t = self.stats[kn.S_TIME]
+        if t <= 0.0:
+            return ChunkAverage(0.0, self.cage_speed, self.inner_ring_speed)
+        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t)
+
+    def mean_speeds(self, duration: float, *, axial_load: float | None = None, settle: float = 0.0) -> ChunkAverage:
+        """Run ``settle`` seconds, then average cage and inner speeds over ``duration`` seconds."""
+        if settle > 0.0:
+            self.advance(settle, axial_load=axial_load)
+        return self.advance(duration, axial_load=axial_load)
+
+    # -- state ---------------------------------------------------------------------------------
+    def snapshot(self) -> Snapshot:
+        """A copy of the complete state."""
+        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load)
+
+    def restore(self, snap: Snapshot) -> None:
+        """Return to a state taken by :meth:`snapshot` (same model and bearing)."""
+        if snap.model != self.model or snap.ball.shape != self.ball.shape:
+            raise DynamicsInputError("snapshot belongs to another model or bearing")
+        self.ball[:] = snap.ball
+        self.cage[:] = snap.cage
+        self.ring[:] = snap.ring
+        self.axial_load = snap.axial_load
+
+    @property
+    def time(self) -> float:
+        """Simulation time, s."""
+        return float(self.ring[kn.R_TIME])
+
+    @property
+    def inner_ring_speed(self) -> float:
+        """Inner-ring speed, rad/s."""
+        return float(self.ring[kn.R_OMEGA])
+
+    @property
+    def cage_speed(self) -> float:
+        """Mean cage-segment speed, rad/s."""
+        return float(np.mean(self.cage[:, kn.C_OMEGA]))
+
+    def energy(self) -> float:
+        """Total mechanical energy, J (meaningful for the stiff model, whose state is complete)."""
+        return float(kn.mechanical_energy(self.vector, self.ball, self.cage, self.ring, self.axial_load))
+
+    def observe(self) -> Observation:
+        """The current state as an :class:`Observation` (copies)."""
+        o = self.out
+        return Observation(
+            time=self.time,
+            inner_ring_angle=float(self.ring[kn.R_ANGLE]),
+            inner_ring_speed=self.inner_ring_speed,
+            cage_angle=float(self.cage[self.strip_segment, kn.C_PHI]),
+            cage_speed=self.cage_speed,
+            ball_orbit_speeds=self.ball[:, kn.B_OMEGA].copy(),
+            inner_contact_loads=o[:, kn.O_QI].copy(),
+            outer_contact_loads=o[:, kn.O_QO].copy(),
+            inner_contact_angles=o[:, kn.O_AI].copy(),
+            outer_contact_angles=o[:, kn.O_AO].copy(),
+            pocket_loads=o[:, kn.O_FP].copy(),
+            inner_ring_axial_displacement=float(self.ring[kn.R_DELTA]),
+            axial_load=self.axial_load,
+        )
+
+
+def derived_geometry(params: BearingParameters) -> DerivedGeometry:
+    """Derived geometry of a bearing (groove bottoms, masses, Hertz constants)."""
+    return derive(params)[1]

@@ -1,0 +1,630 @@
+"""numba kernels of the bearing dynamics. Private: use :mod:`bearing_rig_sim.dynamics.engine`.
+
+Conventions (every kernel):
+
+* float64 arrays only, no Python objects; SI units (m, kg, s, N, rad).
+* ``p``: parameter vector, indices ``P_*`` below (filled by ``parameters.derive``).
+* ``ball``: shape (Z, NB), one row per ball, columns ``B_*``: orbital angle theta (rad), orbital
+  speed omega_m (rad/s), spin omega_a (rad/s, absolute angular velocity component along the
+  ball's rolling axis), ball-centre radius r_b and axial position z_b (m), radial and axial
+  velocity (m/s; stiff model only).
+* ``cage``: shape (Z, NC), one row per cage segment (pocket), columns ``C_*``: angle phi (rad),
+  speed Omega (rad/s).
+* ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
+  (m) and axial velocity (m/s), time (s).
+* ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
+  force N, sliding velocities m/s, tractions N), written by every step.
+* ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time).
+
+Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
+direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
+Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer).
+Ball attitude: the rolling axis lies in the r-z plane at the pitch angle beta with
+tan(beta) = sin(alpha)/(cos(alpha) + gamma) (Harris and Kotzalas), alpha the mean loaded contact
+angle; gyroscopic pivoting is suppressed (the axis does not yaw).
+
+Cage slip is not computed anywhere here: the cage speed results from integrating the
+ball-pocket, rim and land forces, and the ball speeds from the raceway tractions.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# -- parameter vector layout ------------------------------------------------------------------
+P_Z = 0  # number of balls
+P_RBALL = 1  # ball radius, m
+P_RM = 2  # pitch radius, m
+P_RI_GAP = 3  # inner groove radius minus ball radius, m
+P_RO_GAP = 4  # outer groove radius minus ball radius, m
+P_CI_R = 5  # inner groove curvature centre, radial, m (delta_a = 0)
+P_CI_Z = 6  # inner groove curvature centre, axial, m (delta_a = 0)
+P_CO_R = 7  # outer groove curvature centre, radial, m
+P_CO_Z = 8  # outer groove curvature centre, axial, m
+P_K_IN = 9  # Hertz constant ball-inner, N/m^1.5
+P_K_OUT = 10  # Hertz constant ball-outer, N/m^1.5
+P_K_POCKET = 11  # Hertz constant ball-pocket, N/m^1.5
+P_POCKET_CLEAR = 12  # circumferential pocket clearance per side, m
+P_MBALL = 13  # ball mass, kg
+P_IBALL = 14  # ball moment of inertia, kg m^2
+P_JSEG = 15  # cage segment polar moment of inertia, kg m^2
+P_LINK_K = 16  # cage rim torsional stiffness between segments, N m/rad
+P_LINK_C = 17  # cage rim torsional damping, N m s/rad
+P_HC_A = 18  # Hunt-Crossley coefficient a_e, s/m
+P_HC_N = 19  # Hunt-Crossley exponent n
+P_HC_D = 20  # penetration of full damping (IMPACT STEP), m
+P_FRIC_MODEL = 21  # 0: paper's stepped Coulomb law, 1: EHL traction curve
+P_MU_S = 22  # static friction coefficient
+P_V_S = 23  # stiction transition velocity, m/s
+P_MU_D = 24  # dynamic friction coefficient
+P_V_D = 25  # friction transition velocity, m/s
+P_EHL_MU = 26  # EHL limiting traction coefficient
+P_EHL_SRR = 27  # EHL reference slide-roll ratio
+P_MU_POCKET = 28  # ball-pocket friction coefficient
+P_HYST = 29  # elastic hysteresis factor alpha_h
+P_B_IN = 30  # semi-minor axis of the inner contact at 1 N, m (b = P_B_IN Q^(1/3))
+P_B_OUT = 31  # semi-minor axis of the outer contact at 1 N, m
+P_DRAG_LIN = 32  # ball drag, linear coefficient, N s/m
+P_DRAG_QUAD = 33  # ball drag, quadratic coefficient, N s^2/m^2
+P_LAND_VISC = 34  # cage land viscous torque coefficient (whole cage), N m s/rad
+P_LAND_COULOMB = 35  # cage land boundary friction torque (whole cage), N m
+P_M_INNER = 36  # inner ring axial mass, kg (stiff model)
+P_HYST_IN = 37  # (3/16) alpha_h b(1 N) K_in^(4/3): hysteresis moment per penetration^2, N/m
+P_HYST_OUT = 38  # same for the outer contact, N/m
+P_SIZE = 39
+
+B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
+NB = 7
+C_PHI, C_OMEGA = 0, 1
+NC = 2
+R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME = 0, 1, 2, 3, 4
+NR = 5
+O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO = 0, 1, 2, 3, 4, 5, 6, 7, 8
+NO = 9
+S_CAGE, S_INNER, S_TIME = 0, 1, 2
+NS = 3
+G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
+NG = 8
+
+SPIN_SIGN_SPEED = 1.0  # rad/s, smoothing speed of the sign of resistance moments and torques
+MIN_PENETRATION_FOR_JACOBIAN = 1e-10  # m, keeps the quasi-static Jacobian regular at zero load
+
+
+@njit(cache=True)
+def step_function(x: float, x0: float, h0: float, x1: float, h1: float) -> float:
+    """The paper's STEP (digest section 5, typo corrected): cubic from h0 at x0 to h1 at x1."""
+    if x <= x0:
+        return h0
+    if x >= x1:
+        return h1
+    d = (x - x0) / (x1 - x0)
+    return h0 + (h1 - h0) * d * d * (3.0 - 2.0 * d)
+
+
+@njit(cache=True)
+def traction_coefficient(p: np.ndarray, s: float, entrainment: float) -> tuple[float, float]:
+    """Signed traction coefficient mu(s) and d mu/ds for sliding velocity s (m/s, race relative
+    to ball; the force on the ball has the sign of s).
+
+    Model 0, the paper's law (digest section 4, labels corrected): a cubic STEP through zero
+    from -mu_s to mu_s on |s| < v_s, a STEP from mu_s down to mu_d on v_s..v_d, mu_d beyond.
+    Model 1, EHL: mu = mu_max (1 - exp(-|SRR|/SRR0)) sign(s), SRR = s / entrainment speed.
+    """
+    if p[P_FRIC_MODEL] == 0.0:
+        mus, vs, mud, vd = p[P_MU_S], p[P_V_S], p[P_MU_D], p[P_V_D]
+        a = abs(s)
+        if a <= vs:
+            d = (s + vs) / (2.0 * vs)
+            return -mus + 2.0 * mus * d * d * (3.0 - 2.0 * d), 2.0 * mus * 6.0 * d * (1.0 - d) / (2.0 * vs)
+        sg = 1.0 if s > 0.0 else -1.0
+        if a < vd:
+            d = (a - vs) / (vd - vs)
+            return sg * (mus + (mud - mus) * d * d * (3.0 - 2.0 * d)), (mud - mus) * 6.0 * d * (1.0 - d) / (vd - vs)
+        return sg * mud, 0.0
+    ue = max(entrainment, 1e-3)
+    srr = abs(s) / ue
+    e = math.exp(-srr / p[P_EHL_SRR])
+    mu = p[P_EHL_MU] * (1.0 - e)
+    return (mu if s >= 0.0 else -mu), p[P_EHL_MU] * e / (p[P_EHL_SRR] * ue)
+
+
+@njit(cache=True)
+def impact_force(x: float, xdot: float, k: float, p: np.ndarray) -> tuple[float, float, float]:
+    """Normal force of the paper's IMPACT law (Eq. 1) with Hertz exponent 1.5 and Hunt-Crossley
+    damping (Eq. 5): F = K x^1.5 + STEP(x, 0, 0, d, 1) 1.5 a_e K x^n xdot, never adhesive.
+
+    Args:
+        x: penetration, m (contact when > 0).
+        xdot: penetration rate, m/s.
+        k: Hertz constant, N/m^1.5.
+
+    Returns:
+        (F, dF/dx, dF/dxdot) in N, N/m, N s/m.
+    """
+    if x <= 0.0:
+        return 0.0, 0.0, 0.0
+    sq = math.sqrt(x)
+    elastic = k * x * sq
+    xn = x * sq if p[P_HC_N] == 1.5 else x ** p[P_HC_N]
+    c = step_function(x, 0.0, 0.0, p[P_HC_D], 1.0) * 1.5 * p[P_HC_A] * k * xn
+    f = elastic + c * xdot
+    if f <= 0.0:
+        return 0.0, 0.0, 0.0
+    return f, 1.5 * k * sq, c
+
+
+@njit(cache=True)
+def pocket_force(p: np.ndarray, u: float, udot: float) -> tuple[float, float, float]:
+    """Ball-pocket contact (IMPACT law with the pocket Hertz constant).
+
+    Args:
+        u: circumferential offset of the ball centre ahead of the pocket centre at the pitch
+           radius, m.
+        udot: its rate, m/s.
+
+    Returns:
+        (Fs, dFs/du, dFs/dudot): Fs > 0 pushes the cage forward and the ball back, N.
+    """
+    clear = p[P_POCKET_CLEAR]
+    if u > clear:
+        f, kx, cx = impact_force(u - clear, udot, p[P_K_POCKET], p)
+        return f, kx, cx
+    if u < -clear:
+        f, kx, cx = impact_force(-u - clear, -udot, p[P_K_POCKET], p)
+        return -f, kx, cx
+    return 0.0, 0.0, 0.0
+
+
+@njit(cache=True)
+def raceway_geometry(p: np.ndarray, rb: float, zb: float, delta_a: float) -> tuple:
+    """Penetrations and unit normals of the two raceway contacts of a ball at (rb, zb).
+
+    Returns (di, nir, niz, dist_i, do, nor, noz, dist_o): penetrations (m), unit vectors from
+    each groove curvature centre to the ball centre, and the centre distances (m).
+    """
+    dr = rb - p[P_CI_R]
+    dz = zb - (p[P_CI_Z] + delta_a)
+    dist_i = math.sqrt(dr * dr + dz * dz)
+    nir, niz = dr / dist_i, dz / dist_i
+    er = rb - p[P_CO_R]
+    ez = zb - p[P_CO_Z]
+    dist_o = math.sqrt(er * er + ez * ez)
+    nor, noz = er / dist_o, ez / dist_o
+    return dist_i - p[P_RI_GAP], nir, niz, dist_i, dist_o - p[P_RO_GAP], nor, noz, dist_o
+
+
+@njit(cache=True)
+def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> tuple:
+    """d(-Q n)/dx for a contact force -Q(dist) n acting on the ball: returns (h_rr, h_rz, h_zz)."""
+    t = q / dist
+    return (-dq * nr * nr - t * (1.0 - nr * nr), -dq * nr * nz + t * nr * nz, -dq * nz * nz - t * (1.0 - nz * nz))
+
+
+@njit(cache=True)
+def solve_quasi_static(
+    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, axial_load: float, tol: float, max_iter: int
+) -> int:
+    """Newton solution of the normal (radial-axial) equilibrium of every ball and the axial
+    equilibrium of the inner ring under ``axial_load`` (N), with centrifugal force
+    m omega_m^2 r_b; gyroscopic moments neglected. Updates ball B_R, B_Z and ring R_DELTA, and
+    leaves in ``geo`` (Z, NG) the contact loads, normals and penetrations at the solution.
+    ``work`` is scratch of shape (Z, 4).
+
+    Returns the number of iterations used (max_iter + 1 if not converged).
+    """
+    z = ball.shape[0]
+    m = p[P_MBALL]
+    ki, ko = p[P_K_IN], p[P_K_OUT]
+    scale = tol * max(axial_load, 1.0)
+    for it in range(max_iter + 1):
+        delta_a = ring[R_DELTA]
+        g_res = axial_load
+        g_cond = 0.0
+        s_cond = 0.0
+        worst = 0.0
+        for j in range(z):
+            rb, zb = ball[j, B_R], ball[j, B_Z]
+            di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
+            sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
+            sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
+            qi = ki * di * sdi if di > 0.0 else 0.0
+            qo = ko * do * sdo if do > 0.0 else 0.0
+            geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
+            geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
+            w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
+            fr = -qi * nir - qo * nor + m * w2 * rb
+            fz = -qi * niz - qo * noz
+            worst = max(worst, abs(fr), abs(fz))
+            g_res += qi * niz
+            if it == max_iter:
+                continue
+            hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
+            horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
+            a11 = hirr + horr + m * w2
+            a12 = hirz + horz
+            a22 = hizz + hozz
+            det = a11 * a22 - a12 * a12
+            # u = J^-1 f and w = J^-1 b with b = -Hi e_z; dG/dx_j = -e_z^T Hi
+            ux = (a22 * fr - a12 * fz) / det
+            uz = (-a12 * fr + a11 * fz) / det
+            wx = (-a22 * hirz + a12 * hizz) / det
+            wz = (a12 * hirz - a11 * hizz) / det
+            work[j, 0], work[j, 1], work[j, 2], work[j, 3] = ux, uz, wx, wz
+            g_cond -= hirz * ux + hizz * uz
+            s_cond += hizz + hirz * wx + hizz * wz
+        if worst < scale and abs(g_res) < scale:
+            return it
+        if it == max_iter:
+            break
+        lim = 2e-6
+        dd = min(max((-g_res + g_cond) / s_cond, -lim), lim)
+        ring[R_DELTA] = delta_a + dd
+        for j in range(z):
+            ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd), -lim), lim)
+            ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd), -lim), lim)
+    return max_iter + 1
+
+
+@njit(cache=True)
+def ball_kinematics(p: np.ndarray, nir: float, niz: float, nor: float, noz: float, rb: float) -> tuple:
+    """Lever arms of the ball's two raceway contacts, from the contact normals.
+
+    Contact angles: cos(alpha_i) = -n_i,r, sin(alpha_i) = -n_i,z; cos(alpha_o) = n_o,r,
+    sin(alpha_o) = n_o,z. The rolling axis pitch angle beta follows
+    tan(beta) = sin(alpha)/(cos(alpha) + gamma), gamma = Dw cos(alpha)/dm with dm = 2 r_b and
+    alpha the mean of the two contact angles (Harris and Kotzalas).
+    Sliding velocities (race relative to ball, along e_t) are
+    s_i = omega_i r_ci - A_im omega_m - A_ia omega_a and s_o = -A_om omega_m + A_oa omega_a,
+    omega_a the absolute spin about the rolling axis; the rolling speed relative to the orbiting
+    frame is omega_a + cos(beta) omega_m.
+    Returns (r_ci, r_co, ci, co, A_im, A_ia, A_om, A_oa, cos_beta) with ci = cos(alpha_i - beta),
+    co = cos(alpha_o - beta).
+    """
+    r = p[P_RBALL]
+    cai, sai, cao, sao = -nir, -niz, nor, noz
+    cm, sm = cai + cao, sai + sao  # bisector of the two contact directions
+    nm = math.sqrt(cm * cm + sm * sm)
+    cm /= nm
+    sm /= nm
+    den = cm + r * cm / rb
+    h = math.sqrt(sm * sm + den * den)
+    cb, sb = den / h, sm / h
+    ci = cai * cb + sai * sb
+    co = cao * cb + sao * sb
+    r_ci = rb - r * cai
+    r_co = rb + r * cao
+    return r_ci, r_co, ci, co, r_ci + r * ci * cb, r * ci, r_co - r * co * cb, r * co, cb
+
+
+@njit(cache=True)
+def smooth_sign(x: float) -> float:
+    """Sign of x, smoothed over |x| < SPIN_SIGN_SPEED (algebraic, cheaper than tanh)."""
+    y = x / SPIN_SIGN_SPEED
+    return y / math.sqrt(1.0 + y * y)
+
+
+@njit(cache=True)
+def spin_resistance(p: np.ndarray, di: float, do: float, fpocket: float, omega_roll: float) -> float:
+    """Moment (N m) resisting the ball's rolling: elastic hysteresis (3/16) alpha_h Q b at both
+    raceways (written with the penetrations: Q b = b(1 N) K^(4/3) delta^2) plus pocket
+    friction mu_p |F_p| R, with a smoothed sign of the rolling speed."""
+    hyst = p[P_HYST_IN] * max(di, 0.0) ** 2 + p[P_HYST_OUT] * max(do, 0.0) ** 2
+    return (hyst + p[P_MU_POCKET] * abs(fpocket) * p[P_RBALL]) * smooth_sign(omega_roll)
+
+
+@njit(cache=True)
+def cyclic_tridiagonal(diag: np.ndarray, off: float, rhs: np.ndarray, out: np.ndarray, work: np.ndarray) -> None:
+    """Solve a symmetric cyclic tridiagonal system with constant off-diagonal ``off``
+    (Sherman-Morrison on the Thomas algorithm). ``diag``, ``rhs`` and ``out`` have length
+    n >= 3; ``work`` is scratch of shape (n, 4)."""
+    n = diag.shape[0]
+    gamma = -diag[0]
+    for i in range(n):
+        work[i, 0] = diag[i]  # modified diagonal
+        work[i, 2] = rhs[i]  # solution for the right-hand side
+        work[i, 3] = 0.0  # solution for the correction vector
+    work[0, 0] -= gamma
+    work[n - 1, 0] -= off * off / gamma
+    work[0, 3] = gamma
+    work[n - 1, 3] = off
+    work[0, 1] = off / work[0, 0]
+    work[0, 2] /= work[0, 0]
+    work[0, 3] /= work[0, 0]
+    for i in range(1, n):
+        den = work[i, 0] - off * work[i - 1, 1]
+        work[i, 1] = off / den
+        work[i, 2] = (work[i, 2] - off * work[i - 1, 2]) / den
+        work[i, 3] = (work[i, 3] - off * work[i - 1, 3]) / den
+    for i in range(n - 2, -1, -1):
+        work[i, 2] -= work[i, 1] * work[i + 1, 2]
+        work[i, 3] -= work[i, 1] * work[i + 1, 3]
+    fact = (work[0, 2] + off * work[n - 1, 2] / gamma) / (1.0 + work[0, 3] + off * work[n - 1, 3] / gamma)
+    for i in range(n):
+        out[i] = work[i, 2] - fact * work[i, 3]
+
+
+@njit(cache=True)
+def cage_land_torque(p: np.ndarray, omega: float, z: int) -> tuple[float, float]:
+    """Land friction torque on one cage segment (N m, resisting) and its derivative."""
+    y = omega / SPIN_SIGN_SPEED
+    q = 1.0 / math.sqrt(1.0 + y * y)
+    t = (p[P_LAND_COULOMB] * y * q + p[P_LAND_VISC] * omega) / z
+    dt = (p[P_LAND_COULOMB] * q * q * q / SPIN_SIGN_SPEED + p[P_LAND_VISC]) / z
+    return t, dt
+
+
+@njit(cache=True)
+def link_strain(cage: np.ndarray, k: int, z: int) -> float:
+    """Angular strain (rad) of the cage rim between segment k and k+1 (cyclic)."""
+    nxt = cage[0, C_PHI] + 2.0 * math.pi if k == z - 1 else cage[k + 1, C_PHI]
+    return nxt - cage[k, C_PHI] - 2.0 * math.pi / z
+
+
+@njit(cache=True)
+def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
+    """Raceway tractions of ball j (shared by both models).
+
+    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta): traction
+    forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for the
+    implicit step), sliding velocities (m/s) and the lever arms of :func:`ball_kinematics`.
+    """
+    rb = ball[j, B_R]
+    r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
+    wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+    si = omega_i * r_ci - aim * wm - aia * wa
+    so = -aom * wm + aoa * wa
+    mui, dmui = traction_coefficient(p, si, abs((omega_i - wm) * r_ci))
+    muo, dmuo = traction_coefficient(p, so, abs(wm * r_co))
+    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb
+
+
+@njit(cache=True)
+def cage_segment_torque(p: np.ndarray, cage: np.ndarray, k: int, z: int) -> tuple[float, float]:
+    """Rim (stiffness and damping) and land torques on cage segment k, N m, and the land
+    torque's derivative with respect to the segment speed, N m s/rad."""
+    km = z - 1 if k == 0 else k - 1
+    kp = 0 if k == z - 1 else k + 1
+    tl, dtl = cage_land_torque(p, cage[k, C_OMEGA], z)
+    tau = p[P_LINK_K] * (link_strain(cage, k, z) - link_strain(cage, km, z))
+    tau += p[P_LINK_C] * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
+    return tau - tl, dtl
+
+
+@njit(cache=True)
+def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float, fs: float, si: float, so: float, fi: float, fo: float) -> None:
+    """Write ball j's diagnostics into ``out`` (angles from the contact normals)."""
+    out[j, O_QI], out[j, O_QO] = qi, qo
+    out[j, O_AI], out[j, O_AO] = math.atan2(-niz, -nir), math.atan2(noz, nor)
+    out[j, O_FP], out[j, O_SI], out[j, O_SO], out[j, O_FI], out[j, O_FO] = fs, si, so, fi, fo
+
+
+@njit(cache=True)
+def step_reduced(
+    p: np.ndarray,
+    ball: np.ndarray,
+    cage: np.ndarray,
+    ring: np.ndarray,
+    out: np.ndarray,
+    stats: np.ndarray,
+    work: np.ndarray,
+    n_steps: int,
+    dt: float,
+    axial_load: float,
+    inner_acceleration: float,
+    record_every: int,
+) -> int:
+    """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
+
+    Normal contacts are quasi-static (solved every step); ball orbit and spin, and the cage
+    segments, are integrated with a linearly implicit Euler step that treats the stiff traction,
+    pocket and rim couplings implicitly (block elimination onto a cyclic tridiagonal system).
+    The inner ring turns at the prescribed speed, changing at ``inner_acceleration`` (rad/s^2).
+    ``work`` is scratch of shape (Z, NW). Diagnostics go to ``out`` on the last step and every
+    ``record_every`` steps.
+
+    Returns the largest number of quasi-static Newton iterations used.
+    """
+    z = ball.shape[0]
+    rm = p[P_RM]
+    r = p[P_RBALL]
+    m = p[P_MBALL]
+    ib = p[P_IBALL]
+    jseg = p[P_JSEG]
+    kl, cl = p[P_LINK_K], p[P_LINK_C]
+    geo = work[:, 0:NG]
+    qs_work = work[:, NG : NG + 4]
+    tri_work = work[:, NG + 4 : NG + 8]
+    w0 = NG + 8  # per-ball elimination data
+    worst_iter = 0
+    lc = cl + dt * kl
+    for step in range(n_steps):
+        omega_i_old = ring[R_OMEGA]
+        omega_i = omega_i_old + inner_acceleration * dt
+        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30)
+        worst_iter = max(worst_iter, it)
+        keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        for j in range(z):
+            rb = ball[j, B_R]
+            qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            v = rb * wm
+            fd = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
+            dfd = p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
+            rel = wm - cage[j, C_OMEGA]
+            fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm)
+            gm = rb * (fi + fo - fd) - rm * fs
+            ga = r * (ci * fi - co * fo) - mres
+            jmm = rb * (-kti * aim - kto * aom - dfd * rb)
+            jma = rb * (-kti * aia + kto * aoa)
+            jam = r * (-ci * kti * aim + co * kto * aom)
+            jaa = r * (-ci * kti * aia - co * kto * aoa)
+            e = rm * rm * (cu + dt * ku)
+            b11 = m * rb * rb - dt * jmm + dt * e
+            b12 = -dt * jma
+            b21 = -dt * jam
+            b22 = ib - dt * jaa
+            det = b11 * b22 - b12 * b21
+            i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
+            r1 = dt * (gm - dt * rm * rm * ku * rel)
+            r2 = dt * ga
+            work[j, w0 + 0] = i11
+            work[j, w0 + 1] = i21
+            work[j, w0 + 2] = i11 * r1 + i12 * r2
+            work[j, w0 + 3] = i21 * r1 + i22 * r2
+            work[j, w0 + 4] = e
+            work[j, w0 + 5] = ku
+            work[j, w0 + 6] = fs
+            if keep:
+                record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+        diag = work[:, w0 + 7]
+        rhs = work[:, w0 + 8]
+        d_omega = work[:, w0 + 9]
+        for k in range(z):
+            km = z - 1 if k == 0 else k - 1
+            kp = 0 if k == z - 1 else k + 1
+            tau, dtl = cage_segment_torque(p, cage, k, z)
+            e = work[k, w0 + 4]
+            gc = rm * work[k, w0 + 6] + tau
+            diag[k] = jseg + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
+            rhs[k] = dt * (
+                gc
+                + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
+                + dt * rm * rm * work[k, w0 + 5] * (ball[k, B_OMEGA] - cage[k, C_OMEGA])
+            ) + dt * e * work[k, w0 + 2]
+        cyclic_tridiagonal(diag, -dt * lc, rhs, d_omega, tri_work)
+        cage_sum = 0.0
+        for j in range(z):
+            coup = dt * work[j, w0 + 4] * d_omega[j]
+            ball[j, B_OMEGA] += work[j, w0 + 2] + work[j, w0 + 0] * coup
+            ball[j, B_SPIN] += work[j, w0 + 3] + work[j, w0 + 1] * coup
+            cage[j, C_OMEGA] += d_omega[j]
+            ball[j, B_THETA] += dt * ball[j, B_OMEGA]
+            cage[j, C_PHI] += dt * cage[j, C_OMEGA]
+            cage_sum += cage[j, C_OMEGA]
+        ring[R_ANGLE] += 0.5 * (omega_i_old + omega_i) * dt
+        ring[R_OMEGA] = omega_i
+        ring[R_TIME] += dt
+        stats[S_CAGE] += cage_sum / z * dt
+        stats[S_INNER] += omega_i * dt
+        stats[S_TIME] += dt
+    return worst_iter
+
+
+NW = NG + 8 + 10
+"""Columns of the reduced model's scratch array."""
+
+
+@njit(cache=True)
+def step_stiff(
+    p: np.ndarray,
+    ball: np.ndarray,
+    cage: np.ndarray,
+    ring: np.ndarray,
+    out: np.ndarray,
+    stats: np.ndarray,
+    work: np.ndarray,
+    n_steps: int,
+    dt: float,
+    axial_load: float,
+    inner_acceleration: float,
+    record_every: int,
+) -> int:
+    """Advance the stiff reference model by ``n_steps`` explicit steps of ``dt`` seconds.
+
+    Every body is dynamic: ball centres move in r, theta, z under Hertz contacts with
+    Hunt-Crossley damping (the paper's IMPACT law), the inner ring moves axially under the
+    applied load, friction and resistances as in the reduced model. Symplectic Euler in the
+    canonical polar coordinates (momenta first, then positions), so that with friction and
+    damping off the energy error stays bounded. Needs steps well below a microsecond.
+    ``work`` is scratch of shape (Z, NW). Returns 0.
+    """
+    z = ball.shape[0]
+    rm = p[P_RM]
+    r = p[P_RBALL]
+    m = p[P_MBALL]
+    ib = p[P_IBALL]
+    jseg = p[P_JSEG]
+    torque = work[:, 0]
+    for step in range(n_steps):
+        omega_i_old = ring[R_OMEGA]
+        omega_i = omega_i_old + inner_acceleration * dt
+        delta_a, vdelta = ring[R_DELTA], ring[R_VDELTA]
+        ring_force = axial_load
+        keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        for j in range(z):
+            rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
+            di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
+            qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
+            qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            v = rb * wm
+            fd = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
+            fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
+            mres = spin_resistance(p, di, do, fs, wa + cb * wm)
+            # momenta at the current positions (p_theta first: p_r's update needs it)
+            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
+            wnew = ptheta / (m * rb * rb)
+            vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
+            vz_new = vz + dt * (-qi * niz - qo * noz) / m
+            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres) / ib
+            ball[j, B_THETA] += dt * wnew
+            rb_new = rb + dt * vr_new
+            ball[j, B_R] = rb_new
+            ball[j, B_Z] = zb + dt * vz_new
+            ball[j, B_VR], ball[j, B_VZ] = vr_new, vz_new
+            ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
+            ring_force += qi * niz
+            torque[j] = rm * fs
+            if keep:
+                record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+        for k in range(z):
+            tau, _ = cage_segment_torque(p, cage, k, z)
+            torque[k] += tau
+        cage_sum = 0.0
+        for k in range(z):
+            cage[k, C_OMEGA] += dt * torque[k] / jseg
+            cage[k, C_PHI] += dt * cage[k, C_OMEGA]
+            cage_sum += cage[k, C_OMEGA]
+        vdelta_new = vdelta + dt * ring_force / p[P_M_INNER]
+        ring[R_VDELTA] = vdelta_new
+        ring[R_DELTA] = delta_a + dt * vdelta_new
+        ring[R_ANGLE] += 0.5 * (omega_i_old + omega_i) * dt
+        ring[R_OMEGA] = omega_i
+        ring[R_TIME] += dt
+        stats[S_CAGE] += cage_sum / z * dt
+        stats[S_INNER] += omega_i * dt
+        stats[S_TIME] += dt
+    return 0
+
+
+@njit(cache=True)
+def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray, axial_load: float) -> float:
+    """Total mechanical energy (J) of the stiff model: kinetic energy of balls (orbit, radial,
+    axial, spin), cage segments and the inner ring's axial motion, plus Hertz potentials
+    (2/5 K x^2.5) of raceway and pocket contacts, rim strain energy and the potential
+    -F_a delta_a of the constant axial load."""
+    z = ball.shape[0]
+    m, ib, jseg, rm = p[P_MBALL], p[P_IBALL], p[P_JSEG], p[P_RM]
+    e = 0.5 * p[P_M_INNER] * ring[R_VDELTA] ** 2 - axial_load * ring[R_DELTA]
+    clear = p[P_POCKET_CLEAR]
+    for j in range(z):
+        rb = ball[j, B_R]
+        e += 0.5 * m * (ball[j, B_VR] ** 2 + ball[j, B_VZ] ** 2 + (rb * ball[j, B_OMEGA]) ** 2)
+        e += 0.5 * ib * ball[j, B_SPIN] ** 2
+        di, _, _, _, do, _, _, _ = raceway_geometry(p, rb, ball[j, B_Z], ring[R_DELTA])
+        if di > 0.0:
+            e += 0.4 * p[P_K_IN] * di**2.5
+        if do > 0.0:
+            e += 0.4 * p[P_K_OUT] * do**2.5
+        x = abs(rm * (ball[j, B_THETA] - cage[j, C_PHI])) - clear
+        if x > 0.0:
+            e += 0.4 * p[P_K_POCKET] * x**2.5
+        e += 0.5 * jseg * cage[j, C_OMEGA] ** 2
+        e += 0.5 * p[P_LINK_K] * link_strain(cage, j, z) ** 2
+    return e

@@ -1,0 +1,329 @@
+"""Bearing parameters: read and validated from ``config/bearings/*.yaml``, then derived.
+
+:class:`BearingParameters` holds the primary data (SI units) and :func:`derive` computes
+everything the kernels need (groove geometry, Hertz constants, masses, inertias, resistance
+coefficients) into a flat float64 vector whose layout is defined in :mod:`.kernels`.
+
+Resistance models (what makes the cage slip; digest section 12), each applied in the kernels:
+
+* Ball drag in the oil-air mixture (Harris and Kotzalas, *Advanced Concepts*, ch. 7, sphere drag
+  with C_d = 24/Re + C_d,inf): F = s (3 pi eta_mix Dw v + 1/2 rho_mix C_d (pi Dw^2/4) v|v|),
+  v = ball-centre orbital speed, rho_mix and eta_mix the volume-weighted oil-air mixture.
+* Cage land friction (outer-land guided cage): a Petroff short-journal oil film
+  T_v = s_v 2 pi eta r^3 w omega_c / c plus boundary friction T_b = s_b mu m_c g r (smoothed sign).
+* Ball-pocket friction: mu_p times the pocket normal force, on the ball's spin.
+* Elastic-hysteresis rolling resistance at each raceway contact (Harris and Kotzalas ch. 7):
+  M = (3/16) alpha_h Q b, with b the semi-minor axis of the contact ellipse, on the ball's spin.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bearing_rig_sim.config import Section, config_path, load_yaml
+from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
+
+GRAVITY = 9.80665
+"""Standard gravity, m/s^2 (CGPM 1901)."""
+
+
+@dataclass(frozen=True)
+class BearingParameters:
+    """Primary bearing data, SI units. Sources: ``config/bearings/h7006c.yaml`` comments.
+
+    Geometry: ``ball_diameter`` Dw (m), ``pitch_diameter`` dm (m), ``contact_angle`` free
+    contact angle (rad), ``ball_count`` Z, groove curvature ratios f_i, f_o (1), cage inner and
+    outer diameter, width and pocket diameter (m), land radial clearance and wetted width (m),
+    cage material loss factor (1).
+    Materials: densities (kg/m^3), Young's moduli (Pa), Poisson ratios (1).
+    Contact: Hunt-Crossley coefficient a_e (s/m) and exponent n (1); full-damping penetration (m).
+    Friction: model name, mu_s, v_s (m/s), mu_d, v_d (m/s), EHL mu_max and SRR0, pocket mu.
+    Lubricant: oil and air densities (kg/m^3) and viscosities (Pa s), oil volume fraction (1).
+    Resistances: drag coefficient, scale factors (1), land friction coefficient (1),
+    hysteresis factor alpha_h (1).
+    Integration: time steps of the reduced and stiff models (s).
+    """
+
+    name: str
+    ball_diameter: float
+    pitch_diameter: float
+    contact_angle: float
+    ball_count: int
+    inner_curvature_ratio: float
+    outer_curvature_ratio: float
+    cage_inner_diameter: float
+    cage_outer_diameter: float
+    cage_width: float
+    pocket_diameter: float
+    land_clearance: float
+    land_width: float
+    cage_loss_factor: float
+    ring_density: float
+    ring_modulus: float
+    ring_poisson: float
+    ball_density: float
+    ball_modulus: float
+    ball_poisson: float
+    cage_density: float
+    cage_modulus: float
+    cage_poisson: float
+    inner_ring_axial_mass: float
+    hunt_crossley_coefficient: float
+    hunt_crossley_exponent: float
+    full_damping_penetration: float
+    friction_model: str
+    static_friction: float
+    stiction_velocity: float
+    dynamic_friction: float
+    transition_velocity: float
+    ehl_max_coefficient: float
+    ehl_reference_srr: float
+    pocket_friction: float
+    oil_density: float
+    oil_viscosity: float
+    air_density: float
+    air_viscosity: float
+    oil_volume_fraction: float
+    ball_drag_coefficient: float
+    ball_drag_scale: float
+    cage_land_viscous_scale: float
+    cage_land_friction: float
+    cage_land_boundary_torque_scale: float
+    rolling_hysteresis_factor: float
+    reduced_time_step: float
+    stiff_time_step: float
+    dynamic_load_rating: float = 13000.0
+    source: str = "<memory>"
+
+    # -- construction --------------------------------------------------------------------------
+    @classmethod
+    def from_yaml(cls, path: str | Path | None = None) -> "BearingParameters":
+        """Load and validate a bearing file (default: the shipped H7006C)."""
+        path = path or config_path("bearings", "h7006c.yaml")
+        return cls.from_section(load_yaml(path))
+
+    @classmethod
+    def from_section(cls, doc: Section) -> "BearingParameters":
+        """Validate a parsed bearing document; errors name file, key and allowed range."""
+        g, c = doc.section("geometry"), doc.section("cage")
+        mat, con, fr = doc.section("materials"), doc.section("contact"), doc.section("friction")
+        lub, res, integ = doc.section("lubricant"), doc.section("resistances"), doc.section("integration")
+        ring, ball, cagem = mat.section("ring"), mat.section("ball"), mat.section("cage")
+        dw = g.number("ball_diameter_m", gt=0.0, lt=0.1)
+        dm = g.number("pitch_diameter_m", gt=dw, lt=1.0)
+        pocket = c.number("pocket_diameter_m", gt=dw, lt=2.0 * dw)
+        c_in = c.number("inner_diameter_m", gt=0.0, lt=dm)
+        c_out = c.number("outer_diameter_m", gt=dm, lt=2.0 * dm)
+        if doc.section("cage").choice("guidance", ["outer_land"]) != "outer_land":  # pragma: no cover
+            raise c.error("guidance", "only outer_land is modelled")
+        friction_model = fr.choice("model", ["coulomb_step", "ehl_traction"])
+        v_s = fr.number("stiction_velocity_m_s", gt=0.0)
+        params = cls(
+            name=doc.section("bearing").string("name"),
+            ball_diameter=dw,
+            pitch_diameter=dm,
+            contact_angle=math.radians(g.number("contact_angle_deg", ge=0.0, lt=45.0)),
+            ball_count=g.integer("ball_count", ge=3, le=60),
+            inner_curvature_ratio=g.number("inner_groove_curvature_ratio", gt=0.5, lt=0.6),
+            outer_curvature_ratio=g.number("outer_groove_curvature_ratio", gt=0.5, lt=0.6),
+            cage_inner_diameter=c_in,
+            cage_outer_diameter=c_out,
+            cage_width=c.number("width_m", gt=pocket, lt=0.2),
+            pocket_diameter=pocket,
+            land_clearance=c.number("land_radial_clearance_m", gt=0.0, lt=0.005),
+            land_width=c.number("land_width_m", gt=0.0, lt=0.05),
+            cage_loss_factor=c.number("material_loss_factor", ge=0.0, le=1.0),
+            ring_density=ring.number("density_kg_m3", gt=0.0),
+            ring_modulus=ring.number("youngs_modulus_pa", gt=0.0),
+            ring_poisson=ring.number("poisson_ratio", ge=0.0, lt=0.5),
+            ball_density=ball.number("density_kg_m3", gt=0.0),
+            ball_modulus=ball.number("youngs_modulus_pa", gt=0.0),
+            ball_poisson=ball.number("poisson_ratio", ge=0.0, lt=0.5),
+            cage_density=cagem.number("density_kg_m3", gt=0.0),
+            cage_modulus=cagem.number("youngs_modulus_pa", gt=0.0),
+            cage_poisson=cagem.number("poisson_ratio", ge=0.0, lt=0.5),
+            inner_ring_axial_mass=doc.section("inner_ring").number("axial_mass_kg", gt=0.0),
+            hunt_crossley_coefficient=con.number("hunt_crossley_coefficient_s_m", ge=0.0, le=10.0),
+            hunt_crossley_exponent=con.number("hunt_crossley_exponent", ge=1.0, le=2.0),
+            full_damping_penetration=con.number("full_damping_penetration_m", gt=0.0, lt=1e-4),
+            friction_model=friction_model,
+            static_friction=fr.number("static_coefficient", ge=0.0, le=1.0),
+            stiction_velocity=v_s,
+            dynamic_friction=fr.number("dynamic_coefficient", ge=0.0, le=1.0),
+            transition_velocity=fr.number("transition_velocity_m_s", gt=v_s),
+            ehl_max_coefficient=fr.number("ehl_max_coefficient", ge=0.0, le=0.5),
+            ehl_reference_srr=fr.number("ehl_reference_slide_roll_ratio", gt=0.0, le=1.0),
+            pocket_friction=fr.number("pocket_coefficient", ge=0.0, le=1.0),
+            oil_density=lub.number("oil_density_kg_m3", gt=0.0),
+            oil_viscosity=lub.number("oil_viscosity_pa_s", gt=0.0),
+            air_density=lub.number("air_density_kg_m3", gt=0.0),
+            air_viscosity=lub.number("air_viscosity_pa_s", gt=0.0),
+            oil_volume_fraction=lub.number("oil_volume_fraction", ge=0.0, le=1.0),
+            ball_drag_coefficient=res.number("ball_drag_coefficient", ge=0.0, le=5.0),
+            ball_drag_scale=res.number("ball_drag_scale", ge=0.0),
+            cage_land_viscous_scale=res.number("cage_land_viscous_scale", ge=0.0),
+            cage_land_friction=res.number("cage_land_friction_coefficient", ge=0.0, le=1.0),
+            cage_land_boundary_torque_scale=res.number("cage_land_boundary_torque_scale", ge=0.0),
+            rolling_hysteresis_factor=res.number("rolling_hysteresis_factor", ge=0.0, le=0.5),
+            reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=1e-3),
+            stiff_time_step=integ.number("stiff_time_step_s", gt=0.0, le=1e-5),
+            dynamic_load_rating=doc.section("bearing").number("dynamic_load_rating_n", gt=0.0, default=13000.0),
+            source=doc.source,
+        )
+        return params
+
+    def replace(self, **changes: object) -> "BearingParameters":
+        """A copy with some fields changed (e.g. calibrated scale factors)."""
+        return dataclasses.replace(self, **changes)
+
+    def without_resistances(self) -> "BearingParameters":
+        """All slip-causing resistances off: no drag, no cage land or pocket friction, no
+        rolling hysteresis (used by the kinematic-limit test)."""
+        return self.replace(
+            ball_drag_scale=0.0,
+            cage_land_viscous_scale=0.0,
+            cage_land_boundary_torque_scale=0.0,
+            pocket_friction=0.0,
+            rolling_hysteresis_factor=0.0,
+        )
+
+    def conservative(self) -> "BearingParameters":
+        """Friction, damping and resistances off: a conservative system (energy test)."""
+        return self.without_resistances().replace(
+            static_friction=0.0,
+            dynamic_friction=0.0,
+            ehl_max_coefficient=0.0,
+            hunt_crossley_coefficient=0.0,
+            cage_loss_factor=0.0,
+        )
+
+    # -- derived -------------------------------------------------------------------------------
+    @property
+    def epicyclic_ratio(self) -> float:
+        """n_s / n_i at the free contact angle (digest Eq. 12), 1."""
+        return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+
+@dataclass(frozen=True)
+class DerivedGeometry:
+    """Quantities derived from :class:`BearingParameters` (SI units), for reports and tests."""
+
+    inner_groove_bottom_diameter: float
+    outer_groove_bottom_diameter: float
+    ball_mass: float
+    ball_inertia: float
+    cage_mass: float
+    cage_segment_inertia: float
+    cage_link_stiffness: float
+    inner_hertz_stiffness: float
+    outer_hertz_stiffness: float
+    pocket_hertz_stiffness: float
+    pocket_clearance: float
+
+
+def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
+    """Compute the kernel parameter vector and the derived geometry.
+
+    Returns:
+        (vector, geometry): the float64 vector laid out as :mod:`.kernels` ``P_*`` indices,
+        and the derived quantities.
+    """
+    dw, dm, a0, z = p.ball_diameter, p.pitch_diameter, p.contact_angle, p.ball_count
+    rball = 0.5 * dw
+    rm = 0.5 * dm
+    ri = p.inner_curvature_ratio * dw
+    ro = p.outer_curvature_ratio * dw
+    # Groove curvature centres (r, z) with zero clearance at the free contact angle.
+    ci_r, ci_z = rm + (ri - rball) * math.cos(a0), (ri - rball) * math.sin(a0)
+    co_r, co_z = rm - (ro - rball) * math.cos(a0), -(ro - rball) * math.sin(a0)
+    inner, outer = raceway_contacts(
+        dw, dm, a0, p.inner_curvature_ratio, p.outer_curvature_ratio, p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson
+    )
+    # Ball in a cylindrical pocket (axis radial): concave radius d_p/2 across, straight along.
+    pocket = point_contact(2.0 / dw, 2.0 / dw, -2.0 / p.pocket_diameter, 0.0, p.ball_modulus, p.ball_poisson, p.cage_modulus, p.cage_poisson)
+    ball_mass = p.ball_density * math.pi * dw**3 / 6.0
+    ball_inertia = 0.4 * ball_mass * rball**2
+    # Cage: annulus less the pockets; one segment per pocket; rims carry the circumferential load.
+    r_ci, r_co = 0.5 * p.cage_inner_diameter, 0.5 * p.cage_outer_diameter
+    thickness = r_co - r_ci
+    volume = math.pi * (r_co**2 - r_ci**2) * p.cage_width - z * math.pi * 0.25 * p.pocket_diameter**2 * thickness
+    cage_mass = p.cage_density * volume
+    seg_mass = cage_mass / z
+    seg_inertia = seg_mass * 0.5 * (r_co**2 + r_ci**2)
+    r_cage = 0.5 * (r_ci + r_co)
+    pitch_len = 2.0 * math.pi * r_cage / z
+    rim_area = 2.0 * 0.5 * (p.cage_width - p.pocket_diameter) * thickness
+    link_k = p.cage_modulus * rim_area / pitch_len  # N/m
+    link_kt = link_k * r_cage**2  # N m/rad
+    link_omega = math.sqrt(4.0 * link_kt / seg_inertia)
+    link_ct = p.cage_loss_factor * link_kt / link_omega
+    # Resistances.
+    rho_mix = p.oil_volume_fraction * p.oil_density + (1.0 - p.oil_volume_fraction) * p.air_density
+    eta_mix = p.oil_volume_fraction * p.oil_viscosity + (1.0 - p.oil_volume_fraction) * p.air_viscosity
+    drag_lin = p.ball_drag_scale * 3.0 * math.pi * eta_mix * dw
+    drag_quad = p.ball_drag_scale * 0.5 * rho_mix * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
+    r_land = r_co
+    land_visc = p.cage_land_viscous_scale * 2.0 * math.pi * p.oil_viscosity * r_land**3 * p.land_width / p.land_clearance
+    land_coulomb = p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_mass * GRAVITY * r_land
+    b_in = inner.semi_axes(1.0)[1]
+    b_out = outer.semi_axes(1.0)[1]
+
+    v = np.zeros(kn.P_SIZE)
+    v[kn.P_Z] = z
+    v[kn.P_RBALL] = rball
+    v[kn.P_RM] = rm
+    v[kn.P_RI_GAP] = ri - rball
+    v[kn.P_RO_GAP] = ro - rball
+    v[kn.P_CI_R], v[kn.P_CI_Z] = ci_r, ci_z
+    v[kn.P_CO_R], v[kn.P_CO_Z] = co_r, co_z
+    v[kn.P_K_IN] = inner.stiffness
+    v[kn.P_K_OUT] = outer.stiffness
+    v[kn.P_K_POCKET] = pocket.stiffness
+    v[kn.P_POCKET_CLEAR] = 0.5 * (p.pocket_diameter - dw)
+    v[kn.P_MBALL] = ball_mass
+    v[kn.P_IBALL] = ball_inertia
+    v[kn.P_JSEG] = seg_inertia
+    v[kn.P_LINK_K] = link_kt
+    v[kn.P_LINK_C] = link_ct
+    v[kn.P_HC_A] = p.hunt_crossley_coefficient
+    v[kn.P_HC_N] = p.hunt_crossley_exponent
+    v[kn.P_HC_D] = p.full_damping_penetration
+    v[kn.P_FRIC_MODEL] = 0.0 if p.friction_model == "coulomb_step" else 1.0
+    v[kn.P_MU_S] = p.static_friction
+    v[kn.P_V_S] = p.stiction_velocity
+    v[kn.P_MU_D] = p.dynamic_friction
+    v[kn.P_V_D] = p.transition_velocity
+    v[kn.P_EHL_MU] = p.ehl_max_coefficient
+    v[kn.P_EHL_SRR] = p.ehl_reference_srr
+    v[kn.P_MU_POCKET] = p.pocket_friction
+    v[kn.P_HYST] = p.rolling_hysteresis_factor
+    v[kn.P_B_IN] = b_in
+    v[kn.P_B_OUT] = b_out
+    v[kn.P_DRAG_LIN] = drag_lin
+    v[kn.P_DRAG_QUAD] = drag_quad
+    v[kn.P_LAND_VISC] = land_visc
+    v[kn.P_LAND_COULOMB] = land_coulomb
+    v[kn.P_M_INNER] = p.inner_ring_axial_mass
+    # Q b = b(1 N) Q^(4/3) = b(1 N) K^(4/3) delta^2
+    v[kn.P_HYST_IN] = 0.1875 * p.rolling_hysteresis_factor * b_in * inner.stiffness ** (4.0 / 3.0)
+    v[kn.P_HYST_OUT] = 0.1875 * p.rolling_hysteresis_factor * b_out * outer.stiffness ** (4.0 / 3.0)
+    geo = DerivedGeometry(
+        inner_groove_bottom_diameter=2.0 * (ci_r - ri),
+        outer_groove_bottom_diameter=2.0 * (co_r + ro),
+        ball_mass=ball_mass,
+        ball_inertia=ball_inertia,
+        cage_mass=cage_mass,
+        cage_segment_inertia=seg_inertia,
+        cage_link_stiffness=link_kt,
+        inner_hertz_stiffness=inner.stiffness,
+        outer_hertz_stiffness=outer.stiffness,
+        pocket_hertz_stiffness=pocket.stiffness,
+        pocket_clearance=v[kn.P_POCKET_CLEAR],
+    )
+    return v, geo

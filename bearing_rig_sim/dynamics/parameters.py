@@ -103,10 +103,18 @@ class BearingParameters:
 
     # -- construction --------------------------------------------------------------------------
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "BearingParameters":
-        """Load and validate a bearing file (default: the shipped H7006C)."""
-        path = path or config_path("bearings", "h7006c.yaml")
-        return cls.from_section(load_yaml(path))
+    def from_yaml(cls, path: str | Path | None = None, calibration: str | Path | None = None) -> "BearingParameters":
+        """Load and validate a bearing file (default: the shipped H7006C), optionally with a
+        calibration file laid over it (see :func:`overlay_calibration`)."""
+        doc = load_yaml(path or config_path("bearings", "h7006c.yaml"))
+        if calibration is not None:
+            doc = overlay_calibration(doc, load_yaml(calibration))
+        return cls.from_section(doc)
+
+    @classmethod
+    def calibrated(cls) -> "BearingParameters":
+        """The shipped H7006C with the shipped bench calibration (``config/calibration/``)."""
+        return cls.from_yaml(None, config_path("calibration", "h7006c_table3.yaml"))
 
     @classmethod
     def from_section(cls, doc: Section) -> "BearingParameters":
@@ -208,6 +216,37 @@ class BearingParameters:
     def epicyclic_ratio(self) -> float:
         """n_s / n_i at the free contact angle (digest Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+
+CALIBRATABLE: dict[str, tuple[str, str]] = {
+    "stiction_velocity": ("friction", "stiction_velocity_m_s"),
+    "static_friction": ("friction", "static_coefficient"),
+    "ball_drag_scale": ("resistances", "ball_drag_scale"),
+    "cage_land_viscous_scale": ("resistances", "cage_land_viscous_scale"),
+    "cage_land_boundary_torque_scale": ("resistances", "cage_land_boundary_torque_scale"),
+    "rolling_hysteresis_factor": ("resistances", "rolling_hysteresis_factor"),
+    "oil_volume_fraction": ("lubricant", "oil_volume_fraction"),
+}
+"""Parameters a calibration file may set: field name -> (section, key) in the bearing file."""
+
+
+def overlay_calibration(bearing: Section, calibration: Section) -> Section:
+    """Lay a calibration file over a bearing document.
+
+    A calibration file has a ``calibration:`` section (provenance: data file, fitted parameter
+    names, RMS) and, under ``parameters:``, values keyed ``section.key`` as in the bearing file
+    (e.g. ``resistances.ball_drag_scale: 3641.7``). Only the keys of :data:`CALIBRATABLE` are
+    accepted; the merged document is validated as a whole by :meth:`BearingParameters.from_section`.
+    """
+    allowed = {f"{sec}.{key}" for sec, key in CALIBRATABLE.values()}
+    values = calibration.section("parameters")
+    merged = {k: dict(v) if isinstance(v, dict) else v for k, v in bearing.data.items()}
+    for name in values.keys():
+        if name not in allowed:
+            raise values.error(name, f"not a calibratable parameter; allowed: {', '.join(sorted(allowed))}")
+        sec, key = name.split(".", 1)
+        merged.setdefault(sec, {})[key] = values.number(name, ge=0.0)
+    return Section(merged, f"{bearing.source} + {calibration.source}")
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,1 @@
+"""Benchmarks: each module exposes add_arguments(parser) and run(args) -> Iterator[dict]."""

@@ -1,0 +1,79 @@
+"""Benchmark of the dynamics engine: real-time factor per operating point and model.
+
+``bearing-rig bench dynamics --json`` prints one JSON object per line and operating point with
+keys ``rpm``, ``axial_load_n``, ``model``, ``dt_s``, ``sim_s``, ``wall_s``, ``rtf`` (simulated
+seconds per wall-clock second, median of ``--repeats`` runs, compile time excluded),
+``rtf_min``, ``compile_s`` (first-call JIT compilation or cache load) and ``cage_speed_rad_s``.
+Run on one core: the engine is single-threaded.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from typing import Iterator
+
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
+
+POINTS: tuple[tuple[float, float], ...] = ((900, 100), (2700, 100), (5000, 300), (9000, 700), (9000, 50))
+"""Operating points (rpm, N) required by issue 3."""
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``bearing-rig bench dynamics``."""
+    parser.add_argument("--sim-seconds", type=float, default=1.0, help="simulated time per run of the reduced model (s)")
+    parser.add_argument("--stiff-sim-seconds", type=float, default=0.02, help="simulated time per run of the stiff reference (s)")
+    parser.add_argument("--repeats", type=int, default=3, help="runs per point; the median is reported")
+    parser.add_argument("--models", nargs="+", default=["reduced", "stiff"], choices=["reduced", "stiff"])
+    parser.add_argument("--uncalibrated", action="store_true", help="use the clean bearing data instead of the bench calibration")
+
+
+def run(args: argparse.Namespace) -> Iterator[dict]:
+    """Measure the real-time factor of each model at each operating point."""
+    params = BearingParameters.from_yaml() if args.uncalibrated else BearingParameters.calibrated()
+    for model in args.models:
+        sim_s = args.sim_seconds if model == "reduced" else args.stiff_sim_seconds
+        t0 = time.perf_counter()
+        warm = BearingDynamics(params, model=model)
+        warm.advance(10 * warm.time_step)
+        compile_s = time.perf_counter() - t0
+        for rpm, load in POINTS:
+            engine = BearingDynamics(params, model=model)
+            rtfs = []
+            for _ in range(max(1, args.repeats)):
+                engine.initialise(rpm_to_rad_s(rpm), load)
+                start = time.perf_counter()
+                avg = engine.advance(sim_s)
+                wall = time.perf_counter() - start
+                rtfs.append(avg.duration / wall)
+            rtf = statistics.median(rtfs)
+            yield {
+                "bench": "dynamics",
+                "rpm": rpm,
+                "axial_load_n": load,
+                "model": model,
+                "dt_s": engine.time_step,
+                "sim_s": sim_s,
+                "wall_s": round(sim_s / rtf, 6),
+                "rtf": round(rtf, 3),
+                "rtf_min": round(min(rtfs), 3),
+                "compile_s": round(compile_s, 3),
+                "cage_speed_rad_s": round(avg.cage_speed, 6),
+            }
+
+
+def main() -> None:  # pragma: no cover - convenience entry point
+    """``python -m bearing_rig_sim.benchmarks.dynamics``: print JSON lines."""
+    import json
+
+    parser = argparse.ArgumentParser(description=__doc__)
+    add_arguments(parser)
+    parser.add_argument("--json", action="store_true")
+    for row in run(parser.parse_args()):
+        print(json.dumps(row))
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,264 @@
+"""Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12, digest section 6).
+
+The epicyclic (pure-rolling) cage speed is
+
+    n_s = n_i / 2 * (1 - Dw cos(alpha) / dm)
+
+and the slip rate, in **percent**, is
+
+    S_c = (1 - n_c / n_s) * 100
+
+with n_i the inner-ring speed, n_c the cage speed (both rad/s here; any common unit cancels),
+Dw the ball diameter, dm the pitch diameter (m) and alpha the contact angle (rad). The nominal
+(free) contact angle is the default; pass the loaded angle to use it instead
+(:meth:`BearingKinematics.at_contact_angle`).
+
+Speeds are SI (rad/s) and the slip rate is the one quantity kept in percent, as in the paper.
+
+:func:`whole_revolution_slip` computes the slip as the monitor does on the bench (digest
+section 8): from the time stamps of the fibre-optic sensors' light pulses, one per reflective
+strip passing, averaging over whole cage revolutions.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import NamedTuple, overload
+
+import numpy as np
+
+from bearing_rig_sim.analysis.inputs import (
+    AnalysisError,
+    FloatArray,
+    finite_array,
+    positive_int,
+    same_length,
+    strictly_increasing,
+)
+from bearing_rig_sim.config import Section, load_yaml
+
+
+@dataclass(frozen=True)
+class BearingKinematics:
+    """The bearing geometry the slip rate depends on.
+
+    Attributes:
+        ball_diameter: Dw, m (> 0).
+        pitch_diameter: dm, m (> Dw).
+        contact_angle: alpha, rad, in [0, pi/2).
+
+    Raises:
+        AnalysisError: a value is non-finite or out of range.
+    """
+
+    ball_diameter: float
+    pitch_diameter: float
+    contact_angle: float
+
+    def __post_init__(self) -> None:
+        for name in ("ball_diameter", "pitch_diameter", "contact_angle"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+                raise AnalysisError(f"{name}: must be a real number, got {value!r}")
+            if not math.isfinite(value):
+                raise AnalysisError(f"{name}: must be finite, got {value!r}")
+        if not self.ball_diameter > 0.0:
+            raise AnalysisError(f"ball_diameter: must be > 0 m, got {self.ball_diameter!r}")
+        if not self.pitch_diameter > self.ball_diameter:
+            raise AnalysisError(
+                f"pitch_diameter: must exceed the ball diameter {self.ball_diameter!r} m, got {self.pitch_diameter!r}"
+            )
+        if not 0.0 <= self.contact_angle < 0.5 * math.pi:
+            raise AnalysisError(f"contact_angle: must be in [0, pi/2) rad, got {self.contact_angle!r}")
+
+    @classmethod
+    def from_config(cls, source: Section | str | Path) -> "BearingKinematics":
+        """Read ``geometry.ball_diameter_m``, ``geometry.pitch_diameter_m`` and
+        ``geometry.contact_angle_deg`` (the nominal angle, degrees) from a bearing file.
+
+        Args:
+            source: the bearing file's path, or its top-level :class:`Section`.
+
+        Raises:
+            ConfigError: naming the file and key of a missing or out-of-range value.
+        """
+        doc = source if isinstance(source, Section) else load_yaml(source)
+        geometry = doc.section("geometry")
+        ball = geometry.number("ball_diameter_m", gt=0.0)
+        pitch = geometry.number("pitch_diameter_m", gt=0.0)
+        angle_deg = geometry.number("contact_angle_deg", ge=0.0, lt=90.0)
+        if not pitch > ball:
+            raise geometry.error("pitch_diameter_m", f"must exceed ball_diameter_m = {ball}, got {pitch}")
+        return cls(ball, pitch, math.radians(angle_deg))
+
+    def at_contact_angle(self, contact_angle: float) -> "BearingKinematics":
+        """The same bearing at another contact angle (rad), e.g. the loaded one."""
+        return replace(self, contact_angle=contact_angle)
+
+    def epicyclic_ratio(self) -> float:
+        """n_s / n_i = (1 - Dw cos(alpha) / dm) / 2, dimensionless (0.4283 for H7006C at 15 deg)."""
+        return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+    @overload
+    def cage_speed_epicyclic(self, inner_ring_speed: float) -> float: ...
+    @overload
+    def cage_speed_epicyclic(self, inner_ring_speed: FloatArray) -> FloatArray: ...
+    def cage_speed_epicyclic(self, inner_ring_speed: float | FloatArray) -> float | FloatArray:
+        """Pure-rolling cage speed (rad/s) for an inner-ring speed (rad/s); Eq. 12.
+
+        Any finite speed is accepted (the relation is linear; zero gives zero).
+
+        Raises:
+            AnalysisError: a non-finite or empty input.
+        """
+        speed, scalar = _speeds("inner_ring_speed", inner_ring_speed)
+        out = self.epicyclic_ratio() * speed
+        return float(out[0]) if scalar else out
+
+    @overload
+    def slip_rate(self, cage_speed: float, inner_ring_speed: float) -> float: ...
+    @overload
+    def slip_rate(self, cage_speed: FloatArray | float, inner_ring_speed: FloatArray | float) -> FloatArray: ...
+    def slip_rate(self, cage_speed: float | FloatArray, inner_ring_speed: float | FloatArray) -> float | FloatArray:
+        """Cage slip rate in **percent**, (1 - n_c / n_s) * 100; Eq. 11.
+
+        Args:
+            cage_speed: n_c, rad/s; any finite value (0 gives 100 %, a backwards-turning cage
+                more than 100 %).
+            inner_ring_speed: n_i, rad/s; must be > 0. The slip rate is undefined at rest, and
+                this function raises rather than return NaN, so that a stopped or reversed
+                spindle is reported where it happens instead of poisoning a fit downstream.
+                Callers sampling a run-up filter out the samples below a speed of their choice.
+
+        Either argument may be a scalar and the other an array; two arrays must have the same
+        length. Returns a float when both are scalars.
+
+        Raises:
+            AnalysisError: non-finite or empty input, mismatched lengths, or an inner-ring
+                speed <= 0 (the message gives the first offending index).
+        """
+        cage, cage_scalar = _speeds("cage_speed", cage_speed)
+        inner, inner_scalar = _speeds("inner_ring_speed", inner_ring_speed)
+        if not cage_scalar and not inner_scalar:
+            same_length(cage_speed=cage, inner_ring_speed=inner)
+        bad = np.flatnonzero(~(inner > 0.0))
+        if bad.size:
+            raise AnalysisError(
+                f"inner_ring_speed: must be > 0 rad/s for a slip rate, got {float(inner[bad[0]])!r} at index {bad[0]}"
+            )
+        out = (1.0 - cage / (self.epicyclic_ratio() * inner)) * 100.0
+        return float(out[0]) if cage_scalar and inner_scalar else out
+
+
+def _speeds(name: str, value: float | FloatArray) -> tuple[FloatArray, bool]:
+    """A speed argument as a checked 1-D array, and whether it was a scalar."""
+    scalar = np.ndim(value) == 0
+    return finite_array(name, value), scalar
+
+
+def epicyclic_cage_speed(
+    inner_ring_speed: float | FloatArray, ball_diameter: float, pitch_diameter: float, contact_angle: float
+) -> float | FloatArray:
+    """Pure-rolling cage speed n_s (rad/s); digest Eq. 12.
+
+    Args:
+        inner_ring_speed: n_i, rad/s (scalar or 1-D array, any finite value).
+        ball_diameter: Dw, m.
+        pitch_diameter: dm, m.
+        contact_angle: alpha, rad.
+
+    Raises:
+        AnalysisError: bad geometry or non-finite speed.
+    """
+    return BearingKinematics(ball_diameter, pitch_diameter, contact_angle).cage_speed_epicyclic(inner_ring_speed)
+
+
+def slip_rate(
+    cage_speed: float | FloatArray,
+    inner_ring_speed: float | FloatArray,
+    ball_diameter: float,
+    pitch_diameter: float,
+    contact_angle: float,
+) -> float | FloatArray:
+    """Cage slip rate S_c in **percent**; digest Eq. 11. See :meth:`BearingKinematics.slip_rate`.
+
+    Args:
+        cage_speed: n_c, rad/s.
+        inner_ring_speed: n_i, rad/s, > 0 (zero or negative raises).
+        ball_diameter: Dw, m.
+        pitch_diameter: dm, m.
+        contact_angle: alpha, rad.
+
+    Raises:
+        AnalysisError: bad geometry, non-finite speeds, mismatched lengths, n_i <= 0.
+    """
+    return BearingKinematics(ball_diameter, pitch_diameter, contact_angle).slip_rate(cage_speed, inner_ring_speed)
+
+
+class WindowedSlip(NamedTuple):
+    """Slip over consecutive windows of whole cage revolutions (one row per window)."""
+
+    end_time: FloatArray
+    """Time stamp of the cage pulse closing each window, s."""
+    cage_speed: FloatArray
+    """Mean cage speed over the window, rad/s."""
+    inner_ring_speed: FloatArray
+    """Mean spindle (inner-ring) speed over the same interval, rad/s."""
+    slip_pct: FloatArray
+    """Slip rate from the two mean speeds, percent."""
+
+
+def whole_revolution_slip(
+    cage_pulse_times: FloatArray,
+    cage_strips: int,
+    spindle_pulse_times: FloatArray,
+    spindle_strips: int,
+    kinematics: BearingKinematics,
+    *,
+    revolutions: int = 1,
+) -> WindowedSlip:
+    """Slip rate over windows of whole cage revolutions, from pulse time stamps.
+
+    The cage pulses are cut into consecutive, non-overlapping windows of ``revolutions`` whole
+    cage revolutions (``revolutions * cage_strips`` pulse intervals), which start and end on a
+    pulse. The mean cage speed of a window is 2 pi ``revolutions`` / duration, exact whatever the
+    spacing of the strips on the cage. The spindle's revolution count is interpolated linearly in
+    its pulse index at the window's two ends (this assumes its strips are evenly spaced; for a
+    single strip that is no assumption) and the mean inner-ring speed is its difference over the
+    same duration. Speeds that are constant over a window are recovered exactly.
+
+    Windows not fully covered by spindle pulses are dropped; if no window is complete the four
+    arrays are empty (a monitor that has just started).
+
+    Args:
+        cage_pulse_times: time stamps of the cage sensor's pulses, s, strictly increasing.
+        cage_strips: reflective strips on the cage (pulses per cage revolution), >= 1.
+        spindle_pulse_times: time stamps of the spindle sensor's pulses, s, strictly increasing.
+        spindle_strips: reflective strips on the spindle, >= 1.
+        kinematics: the bearing's geometry.
+        revolutions: whole cage revolutions per window, >= 1.
+
+    Raises:
+        AnalysisError: fewer than two pulses of either sensor, non-finite or non-increasing time
+            stamps, strip or revolution counts that are not integers >= 1.
+    """
+    cage_t = finite_array("cage_pulse_times", cage_pulse_times, min_len=2)
+    spindle_t = finite_array("spindle_pulse_times", spindle_pulse_times, min_len=2)
+    strictly_increasing("cage_pulse_times", cage_t)
+    strictly_increasing("spindle_pulse_times", spindle_t)
+    per_window = positive_int("revolutions", revolutions) * positive_int("cage_strips", cage_strips)
+    spindle_per_rev = positive_int("spindle_strips", spindle_strips)
+
+    end_idx = np.arange(per_window, cage_t.size, per_window)
+    t0, t1 = cage_t[end_idx - per_window], cage_t[end_idx]
+    covered = (t0 >= spindle_t[0]) & (t1 <= spindle_t[-1])
+    t0, t1 = t0[covered], t1[covered]
+    duration = t1 - t0
+    spindle_revs = np.arange(spindle_t.size, dtype=np.float64) / spindle_per_rev
+    turned = np.interp(t1, spindle_t, spindle_revs) - np.interp(t0, spindle_t, spindle_revs)
+    cage_speed = 2.0 * math.pi * revolutions / duration
+    inner_speed = 2.0 * math.pi * turned / duration
+    slip = kinematics.slip_rate(cage_speed, inner_speed) if t1.size else np.empty(0)
+    return WindowedSlip(t1, cage_speed, inner_speed, np.asarray(slip, dtype=np.float64))

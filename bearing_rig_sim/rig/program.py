@@ -1,0 +1,283 @@
+"""Test programs: YAML sequences of segments (speed profile, axial load, end condition).
+
+A program file (``config/programs/*.yaml``)::
+
+    name: validation
+    description: ...
+    bearing: bearings/h7006c.yaml        # bearing file, relative to config/
+    stability_criterion: time            # "time" or "axial_load" (abscissa of the slope criterion)
+    initial_speed_rpm: 0.0               # optional; the spindle's speed before the first segment
+    segments:
+      - name: n900
+        speed_rpm: 900                   # target inner-ring speed
+        ramp_s: 1.0                      # optional: STEP ramp from the previous speed (0 = jump)
+        axial_load_n: 100
+        until_stable: true               # or: dwell_s: 5.0
+        timeout_s: 10.0
+      - name: accel_20
+        speed_rpm: 1500                  # target speed ...
+        acceleration_rad_s2: 20          # ... reached at this constant angular acceleration
+        axial_load_n: 200
+        dwell_s: 5.0
+
+Each segment starts from the speed the previous one ended at. The end condition counts from the
+end of the speed change: ``dwell_s`` holds the target speed that long; ``until_stable`` ends at
+the first stable verdict of the monitor, or after ``timeout_s`` without one.
+
+Speeds are given in rpm in the file and converted to rad/s once, at load; everything returned
+is SI (rad/s, rad/s^2, s, N). The drive function is the paper's STEP (digest section 5, paper
+Eq. 10) with its typo corrected: ``D = (t - t0) / (t1 - t0)``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+
+from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rpm_to_rad_s
+
+STABILITY_CRITERIA = ("time", "axial_load")
+"""Abscissas of the slope criterion (digest section 7): slip vs time, or slip vs axial load."""
+
+SEGMENT_KEYS = ("name", "speed_rpm", "ramp_s", "acceleration_rad_s2", "axial_load_n", "dwell_s", "until_stable", "timeout_s")
+PROGRAM_KEYS = ("name", "description", "bearing", "stability_criterion", "initial_speed_rpm", "segments")
+
+
+# ---------------------------------------------------------------------------------------------
+# The STEP drive function
+# ---------------------------------------------------------------------------------------------
+def _step_fraction(t: float, t0: float, t1: float) -> float | None:
+    """D = (t - t0)/(t1 - t0) inside the ramp, None outside it."""
+    if not (math.isfinite(t) and math.isfinite(t0) and math.isfinite(t1)):
+        raise ValueError(f"STEP: times must be finite, got t={t!r}, t0={t0!r}, t1={t1!r}")
+    if t1 < t0:
+        raise ValueError(f"STEP: t1={t1!r} must not be before t0={t0!r}")
+    if t <= t0 or t >= t1:
+        return None
+    return (t - t0) / (t1 - t0)
+
+
+def step_ramp(t: float, t0: float, x0: float, t1: float, x1: float) -> float:
+    """The paper's STEP drive function (digest section 5, Eq. 10, typo corrected).
+
+    ``x0`` for ``t <= t0``; ``x1`` for ``t >= t1``; between, the cubic
+    ``x0 + (x1 - x0) D^2 (3 - 2 D)`` with ``D = (t - t0)/(t1 - t0)``: monotonic, with zero slope
+    at both ends. ``t0 == t1`` is a jump at ``t0`` (``x1`` from ``t0`` on).
+
+    Raises:
+        ValueError: a non-finite time, or ``t1 < t0``.
+    """
+    d = _step_fraction(t, t0, t1)
+    if d is None:
+        return x0 if t < t0 or (t == t0 and t1 > t0) else x1
+    return x0 + (x1 - x0) * d * d * (3.0 - 2.0 * d)
+
+
+def step_ramp_rate(t: float, t0: float, x0: float, t1: float, x1: float) -> float:
+    """Time derivative of :func:`step_ramp`: ``6 (x1 - x0) D (1 - D) / (t1 - t0)``, 0 outside
+    the ramp (and 0 for a jump, whose impulse is not represented)."""
+    d = _step_fraction(t, t0, t1)
+    if d is None:
+        return 0.0
+    return 6.0 * (x1 - x0) * d * (1.0 - d) / (t1 - t0)
+
+
+# ---------------------------------------------------------------------------------------------
+# Segments and programs
+# ---------------------------------------------------------------------------------------------
+class SpeedProfileKind(str, Enum):
+    """How a segment changes the inner-ring speed; compares equal to its string value."""
+
+    STEP = "step"
+    """Cubic STEP ramp over ``ramp_time`` (0 = jump)."""
+    CONSTANT_ACCELERATION = "constant_acceleration"
+    """Constant angular acceleration until the target speed."""
+
+    @property
+    def message_code(self) -> int:
+        """The ``PROFILE_*`` constant of SpindleCommand.msg for this kind."""
+        return 0 if self is SpeedProfileKind.STEP else 1
+
+
+@dataclass(frozen=True)
+class SegmentSpeed:
+    """The inner-ring speed of one segment as a function of time.
+
+    Args (fields):
+        start_time: when the segment starts, s.
+        start_speed: inner-ring speed at the start, rad/s.
+        target_speed: speed to reach, rad/s.
+        kind: STEP ramp or constant acceleration.
+        ramp_time: STEP ramp duration, s (STEP only).
+        acceleration: magnitude of the angular acceleration, rad/s^2 (constant acceleration only).
+    """
+
+    start_time: float
+    start_speed: float
+    target_speed: float
+    kind: SpeedProfileKind
+    ramp_time: float = 0.0
+    acceleration: float = 0.0
+
+    @property
+    def ramp_end(self) -> float:
+        """Time at which the target speed is reached, s."""
+        if self.kind is SpeedProfileKind.STEP:
+            return self.start_time + self.ramp_time
+        return self.start_time + abs(self.target_speed - self.start_speed) / self.acceleration
+
+    def at(self, t: float) -> tuple[float, float]:
+        """Inner-ring (speed in rad/s, angular acceleration in rad/s^2) at time ``t`` (s).
+
+        Before the segment's start: the start speed; after the ramp: the target speed.
+        """
+        if self.kind is SpeedProfileKind.STEP:
+            args = (t, self.start_time, self.start_speed, self.start_time + self.ramp_time, self.target_speed)
+            return step_ramp(*args), step_ramp_rate(*args)
+        change = self.target_speed - self.start_speed
+        if t <= self.start_time or change == 0.0:
+            return (self.start_speed if t <= self.start_time else self.target_speed), 0.0
+        if t >= self.ramp_end:
+            return self.target_speed, 0.0
+        signed = math.copysign(self.acceleration, change)
+        return self.start_speed + signed * (t - self.start_time), signed
+
+
+@dataclass(frozen=True)
+class Segment:
+    """One segment of a test program (SI units)."""
+
+    name: str
+    """Segment name, unique in its program."""
+    target_speed: float
+    """Inner-ring speed to reach, rad/s."""
+    profile: SpeedProfileKind
+    """How the speed changes from the previous segment's end."""
+    ramp_time: float
+    """STEP ramp duration, s (0 = jump; 0 for constant acceleration)."""
+    acceleration: float
+    """Magnitude of the angular acceleration, rad/s^2 (0 for STEP)."""
+    axial_load: float
+    """Axial-load set-point during the segment, N."""
+    dwell: float | None
+    """Time held at the target speed after the ramp, s; None with ``until_stable``."""
+    until_stable: bool
+    """End at the first stable verdict after the ramp (or at ``timeout``)."""
+    timeout: float | None
+    """With ``until_stable``: longest wait after the ramp, s; None otherwise."""
+
+    def speed_profile(self, start_time: float, start_speed: float) -> SegmentSpeed:
+        """The segment's speed against time, for a start at ``start_time`` (s) from
+        ``start_speed`` (rad/s)."""
+        return SegmentSpeed(start_time, start_speed, self.target_speed, self.profile, self.ramp_time, self.acceleration)
+
+    def ramp_duration(self, start_speed: float) -> float:
+        """Duration of the speed change from ``start_speed`` (rad/s), s."""
+        return self.speed_profile(0.0, start_speed).ramp_end
+
+    def longest_duration(self, start_speed: float) -> float:
+        """Ramp plus dwell, or ramp plus timeout for ``until_stable``, s."""
+        hold = self.dwell if self.dwell is not None else self.timeout
+        assert hold is not None
+        return self.ramp_duration(start_speed) + hold
+
+
+@dataclass(frozen=True)
+class TestProgram:
+    """A validated test program."""
+
+    __test__ = False  # not a pytest test class despite its name
+
+    name: str
+    description: str
+    bearing_file: Path
+    """Bearing data file (resolved path)."""
+    stability_criterion: str
+    """``"time"`` or ``"axial_load"``."""
+    initial_speed: float
+    """Inner-ring speed before the first segment, rad/s."""
+    segments: tuple[Segment, ...]
+    source: str
+    """File the program was read from."""
+
+    def start_speeds(self) -> list[float]:
+        """Speed at the start of each segment, rad/s (the previous segment's target)."""
+        speeds = [self.initial_speed]
+        speeds.extend(s.target_speed for s in self.segments[:-1])
+        return speeds
+
+    def longest_duration(self) -> float:
+        """Simulated time of the whole program if every ``until_stable`` segment times out, s."""
+        return sum(seg.longest_duration(v0) for seg, v0 in zip(self.segments, self.start_speeds()))
+
+
+def load_program(
+    path: str | Path, *, max_speed_rpm: float | None = None, max_axial_load_n: float | None = None
+) -> TestProgram:
+    """Read and validate a test program.
+
+    Args:
+        path: the program's YAML file.
+        max_speed_rpm: the rig's highest spindle speed, rpm; None: no upper bound.
+        max_axial_load_n: the loading chain's largest set-point, N; None: no upper bound.
+
+    Raises:
+        ConfigError: naming the file, the key (``segments[2].axial_load_n``) and what was allowed.
+    """
+    doc = load_yaml(path)
+    doc.reject_unknown(PROGRAM_KEYS)
+    bearing = doc.string("bearing")
+    bearing_file = config_path(*Path(bearing).parts) if not Path(bearing).is_absolute() else Path(bearing)
+    if not bearing_file.is_file():
+        raise doc.error("bearing", f"bearing file not found: {bearing!r} (looked for {bearing_file})")
+    initial = doc.number("initial_speed_rpm", ge=0.0, le=max_speed_rpm, default=0.0)
+    segments = tuple(_segment(s, max_speed_rpm, max_axial_load_n) for s in doc.sections("segments"))
+    seen: set[str] = set()
+    for i, seg in enumerate(segments):
+        if seg.name in seen:
+            raise ConfigError(doc.source, f"segments[{i}].name", f"duplicate segment name {seg.name!r}")
+        seen.add(seg.name)
+    description = doc.data.get("description", "")
+    if not isinstance(description, str):
+        raise doc.error("description", f"must be a string, got {description!r}")
+    return TestProgram(
+        name=doc.string("name"),
+        description=description.strip(),
+        bearing_file=bearing_file,
+        stability_criterion=doc.choice("stability_criterion", STABILITY_CRITERIA),
+        initial_speed=rpm_to_rad_s(initial),
+        segments=segments,
+        source=doc.source,
+    )
+
+
+def _segment(s: Section, max_speed_rpm: float | None, max_load_n: float | None) -> Segment:
+    """One validated segment."""
+    s.reject_unknown(SEGMENT_KEYS)
+    name = s.string("name")
+    if "speed_rpm" not in s.data:
+        raise s.error("speed_rpm", "missing (required): the target speed, with ramp_s or acceleration_rad_s2")
+    speed = rpm_to_rad_s(s.number("speed_rpm", ge=0.0, le=max_speed_rpm))
+    if "ramp_s" in s.data and "acceleration_rad_s2" in s.data:
+        raise s.error("acceleration_rad_s2", "give either ramp_s (STEP ramp) or acceleration_rad_s2, not both")
+    if "acceleration_rad_s2" in s.data:
+        profile, ramp, accel = SpeedProfileKind.CONSTANT_ACCELERATION, 0.0, s.number("acceleration_rad_s2", gt=0.0)
+    else:
+        profile, ramp, accel = SpeedProfileKind.STEP, s.number("ramp_s", ge=0.0, default=0.0), 0.0
+    load = s.number("axial_load_n", ge=0.0, le=max_load_n)
+    until_stable = s.boolean("until_stable", default=False)
+    if "until_stable" in s.data and not until_stable:
+        raise s.error("until_stable", "must be true when given; use dwell_s for a fixed duration")
+    if until_stable:
+        if "dwell_s" in s.data:
+            raise s.error("dwell_s", "give either dwell_s or until_stable, not both")
+        dwell, timeout = None, s.number("timeout_s", gt=0.0)
+    else:
+        if "timeout_s" in s.data:
+            raise s.error("timeout_s", "only with until_stable: true")
+        if "dwell_s" not in s.data:
+            raise s.error("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
+        dwell, timeout = s.number("dwell_s", gt=0.0), None
+    return Segment(name, speed, profile, ramp, accel, load, dwell, until_stable, timeout)

@@ -1,0 +1,213 @@
+"""Test programs: the STEP drive function's laws (end values, monotonicity, zero end slopes, C1
+continuity; the paper's typo form shown wrong), constant acceleration, the shipped programs, and
+errors naming file and key for malformed programs.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.rig.program import (
+    SegmentSpeed,
+    SpeedProfileKind,
+    load_program,
+    step_ramp,
+    step_ramp_rate,
+)
+
+RPM = 2.0 * math.pi / 60.0
+
+
+# -- STEP -------------------------------------------------------------------------------------
+@pytest.mark.parametrize("x0, x1", [(0.0, 94.2), (282.7, 94.2), (10.0, 10.0)])
+def test_step_end_values_and_monotonicity(x0: float, x1: float) -> None:
+    t0, t1 = 2.0, 3.5
+    assert step_ramp(t0, t0, x0, t1, x1) == x0
+    assert step_ramp(t1, t0, x0, t1, x1) == x1
+    assert step_ramp(t0 - 1.0, t0, x0, t1, x1) == x0
+    assert step_ramp(t1 + 1.0, t0, x0, t1, x1) == x1
+    values = np.array([step_ramp(t, t0, x0, t1, x1) for t in np.linspace(t0 - 0.5, t1 + 0.5, 2001)])
+    steps = np.diff(values) * math.copysign(1.0, x1 - x0)
+    assert np.all(steps >= 0.0)
+    assert values.min() >= min(x0, x1) and values.max() <= max(x0, x1)
+    assert step_ramp((t0 + t1) / 2, t0, x0, t1, x1) == pytest.approx((x0 + x1) / 2)  # point symmetry
+
+
+def test_step_zero_slope_at_both_ends_and_c1_continuity() -> None:
+    t0, x0, t1, x1 = 1.0, 50.0, 3.0, 250.0
+    args = (t0, x0, t1, x1)
+    eps = 1e-6
+    # slope -> 0 at both ends, from inside (6 A D (1 - D) / T with D ~ eps / T)
+    assert abs(step_ramp_rate(t0 + eps, *args)) <= 6.0 * (x1 - x0) * eps / (t1 - t0) ** 2 * 1.01
+    assert abs(step_ramp_rate(t1 - eps, *args)) <= 6.0 * (x1 - x0) * eps / (t1 - t0) ** 2 * 1.01
+    assert step_ramp_rate(t0 - eps, *args) == 0.0 and step_ramp_rate(t1 + eps, *args) == 0.0
+    # the largest slope is 1.5 A / T, at the middle
+    assert step_ramp_rate(2.0, *args) == pytest.approx(1.5 * (x1 - x0) / (t1 - t0))
+    # the rate is the derivative everywhere, joints included (central differences)
+    h = 1e-5
+    for t in np.concatenate([np.linspace(t0 - 0.2, t1 + 0.2, 97), [t0, t1]]):
+        numeric = (step_ramp(t + h, *args) - step_ramp(t - h, *args)) / (2 * h)
+        assert numeric == pytest.approx(step_ramp_rate(t, *args), abs=1e-3)
+    # C1 at the joints: the one-sided difference quotients differ by at most 3 A h / T^2 (the
+    # cubic's curvature), so both tend to the same slope 0; a kink would leave a constant gap
+    for joint in (t0, t1):
+        for step in (1e-3, 1e-4, 1e-5):
+            left = (step_ramp(joint, *args) - step_ramp(joint - step, *args)) / step
+            right = (step_ramp(joint + step, *args) - step_ramp(joint, *args)) / step
+            assert abs(left - right) <= 3.0 * (x1 - x0) * step / (t1 - t0) ** 2 * 1.01 + 1e-9
+
+
+def test_papers_printed_step_fraction_is_wrong() -> None:
+    # The paper prints D = (t - t0)/(t - t1): it diverges at t1 and gives x0 + 5 A mid-ramp.
+    def printed(t: float, t0: float, x0: float, t1: float, x1: float) -> float:
+        d = (t - t0) / (t - t1)
+        return x0 + (x1 - x0) * d * d * (3.0 - 2.0 * d)
+
+    t0, x0, t1, x1 = 0.0, 0.0, 1.0, 100.0
+    assert printed(0.5, t0, x0, t1, x1) == pytest.approx(x0 + 5.0 * (x1 - x0))
+    near_end = t1 - 1e-6
+    assert abs(printed(near_end, t0, x0, t1, x1) - x1) > 1e6  # does not reach x1 at t1
+    assert step_ramp(near_end, t0, x0, t1, x1) == pytest.approx(x1, abs=1e-6)
+    assert step_ramp(0.5, t0, x0, t1, x1) == pytest.approx(50.0)
+
+
+def test_step_jump_and_bad_arguments() -> None:
+    assert step_ramp(0.99, 1.0, 0.0, 1.0, 5.0) == 0.0
+    assert step_ramp(1.0, 1.0, 0.0, 1.0, 5.0) == 5.0  # zero-length ramp: a jump at t0
+    with pytest.raises(ValueError, match="t1"):
+        step_ramp(0.5, 1.0, 0.0, 0.0, 5.0)
+    with pytest.raises(ValueError, match="finite"):
+        step_ramp(math.nan, 0.0, 0.0, 1.0, 5.0)
+
+
+# -- segment speed --------------------------------------------------------------------------
+@pytest.mark.parametrize("start, target, alpha", [(0.0, 1500 * RPM, 20.0), (0.0, 1500 * RPM, 80.0), (300.0, 100.0, 40.0)])
+def test_constant_acceleration_reaches_target_at_delta_omega_over_alpha(start: float, target: float, alpha: float) -> None:
+    t_start = 3.0
+    profile = SegmentSpeed(t_start, start, target, SpeedProfileKind.CONSTANT_ACCELERATION, acceleration=alpha)
+    duration = abs(target - start) / alpha
+    sign = math.copysign(1.0, target - start)
+    assert profile.ramp_end == pytest.approx(t_start + duration)
+    assert profile.at(t_start + duration)[0] == pytest.approx(target, abs=1e-9)
+    speed, accel = profile.at(t_start + 0.5 * duration)
+    assert speed == pytest.approx((start + target) / 2) and accel == sign * alpha
+    assert abs(profile.at(t_start + 0.999 * duration)[0] - target) > 0.0
+    assert profile.at(t_start + 2 * duration) == (target, 0.0)
+    assert profile.at(t_start - 1.0) == (start, 0.0)
+
+
+def test_step_segment_speed_and_acceleration() -> None:
+    profile = SegmentSpeed(10.0, 94.2, 125.7, SpeedProfileKind.STEP, ramp_time=1.0)
+    assert profile.ramp_end == 11.0
+    for t in (10.0, 10.25, 10.5, 10.9, 11.0, 12.0):
+        speed, accel = profile.at(t)
+        assert speed == step_ramp(t, 10.0, 94.2, 11.0, 125.7)
+        assert accel == step_ramp_rate(t, 10.0, 94.2, 11.0, 125.7)
+
+
+def test_profile_kind_message_codes() -> None:
+    # SpindleCommand.msg: PROFILE_STEP=0, PROFILE_CONSTANT_ACCELERATION=1
+    assert SpeedProfileKind.STEP.message_code == 0
+    assert SpeedProfileKind.CONSTANT_ACCELERATION.message_code == 1
+
+
+# -- shipped programs ----------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["validation", "load_sweep", "acceleration"])
+def test_shipped_programs_load(name: str) -> None:
+    program = load_program(config_path("programs", f"{name}.yaml"), max_speed_rpm=12000.0, max_axial_load_n=1000.0)
+    assert program.name == name and program.bearing_file.is_file() and program.segments
+
+
+def test_validation_program_matches_the_papers_table_3_conditions() -> None:
+    program = load_program(config_path("programs", "validation.yaml"))
+    speeds = [s.target_speed for s in program.segments if s.target_speed > 0]
+    np.testing.assert_allclose(speeds, [n * RPM for n in range(900, 2701, 300)])
+    assert {s.axial_load for s in program.segments} == {100.0}
+    assert all(s.profile is SpeedProfileKind.STEP for s in program.segments)
+    assert program.longest_duration() < 100.0  # well under 2 minutes even if every segment times out
+
+
+def test_load_sweep_and_acceleration_programs_cover_the_papers_ranges() -> None:
+    sweep = load_program(config_path("programs", "load_sweep.yaml"))
+    assert sweep.stability_criterion == "axial_load"
+    assert {round(s.target_speed / RPM) for s in sweep.segments} == {1000, 3000, 5000, 7000, 9000}
+    loads = [s.axial_load for s in sweep.segments]
+    assert min(loads) == 50.0 and max(loads) == 700.0
+    accel = load_program(config_path("programs", "acceleration.yaml"))
+    ramps = [s for s in accel.segments if s.profile is SpeedProfileKind.CONSTANT_ACCELERATION]
+    assert [s.acceleration for s in ramps] == [20.0, 40.0, 60.0, 80.0]
+    assert {s.axial_load for s in accel.segments} == {200.0}
+    starts = dict(zip([s.name for s in accel.segments], accel.start_speeds()))
+    assert all(starts[s.name] == 0.0 for s in ramps)  # each run from rest
+
+
+# -- malformed programs ------------------------------------------------------------------------
+GOOD = """
+name: probe
+description: a small program
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: a, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, dwell_s: 2.0}
+  - {name: b, speed_rpm: 1500, acceleration_rad_s2: 40, axial_load_n: 100, until_stable: true, timeout_s: 5}
+"""
+
+
+def test_good_probe_program_loads_in_si_units(tmp_path: Path) -> None:
+    path = tmp_path / "probe.yaml"
+    path.write_text(GOOD)
+    program = load_program(path)
+    a, b = program.segments
+    assert a.target_speed == pytest.approx(900 * RPM) and a.ramp_time == 1.0 and a.dwell == 2.0
+    assert b.profile is SpeedProfileKind.CONSTANT_ACCELERATION and b.until_stable and b.timeout == 5.0
+    assert program.longest_duration() == pytest.approx(1.0 + 2.0 + (600 * RPM) / 40.0 + 5.0)
+
+
+@pytest.mark.parametrize(
+    "old, new, key, problem",
+    [
+        ("axial_load_n: 100, dwell_s", "dwell_s", "segments[0].axial_load_n", "missing"),
+        ("axial_load_n: 100, dwell_s", "axial_load_n: -5, dwell_s", "segments[0].axial_load_n", ">= 0"),
+        ("speed_rpm: 900, ramp_s", "speed_rps: 15, ramp_s", "segments[0].speed_rps", "unknown key"),
+        ("speed_rpm: 900, ramp_s", "ramp_s", "segments[0].speed_rpm", "missing"),
+        ("speed_rpm: 900", "speed_rpm: .nan", "segments[0].speed_rpm", "finite"),
+        ("ramp_s: 1.0", "ramp_s: 1.0, acceleration_rad_s2: 5", "segments[0].acceleration_rad_s2", "not both"),
+        ("acceleration_rad_s2: 40", "acceleration_rad_s2: 0", "segments[1].acceleration_rad_s2", "> 0"),
+        ("dwell_s: 2.0}", "dwell_s: 2.0, until_stable: true, timeout_s: 3}", "segments[0].dwell_s", "not both"),
+        (", timeout_s: 5", "", "segments[1].timeout_s", "missing"),
+        (", dwell_s: 2.0", "", "segments[0].dwell_s", "missing"),
+        ("name: b,", "name: a,", "segments[1].name", "duplicate"),
+        ("stability_criterion: time", "stability_criterion: speed", "stability_criterion", "one of"),
+        ("bearings/h7006c.yaml", "bearings/nope.yaml", "bearing", "not found"),
+        ("name: probe", "name: probe\nauthor: me", "author", "unknown key"),
+    ],
+)
+def test_malformed_programs_name_file_and_key(tmp_path: Path, old: str, new: str, key: str, problem: str) -> None:
+    assert old in GOOD
+    path = tmp_path / "bad.yaml"
+    path.write_text(GOOD.replace(old, new, 1))
+    with pytest.raises(ConfigError) as info:
+        load_program(path)
+    assert info.value.source == str(path)
+    assert info.value.key == key
+    assert problem in info.value.problem
+
+
+def test_rig_limits_and_yaml_syntax_errors(tmp_path: Path) -> None:
+    path = tmp_path / "probe.yaml"
+    path.write_text(GOOD)
+    with pytest.raises(ConfigError) as info:
+        load_program(path, max_axial_load_n=50.0)
+    assert info.value.key == "segments[0].axial_load_n" and "<= 50" in info.value.problem
+    with pytest.raises(ConfigError) as info:
+        load_program(path, max_speed_rpm=1000.0)
+    assert info.value.key == "segments[1].speed_rpm"
+    path.write_text(GOOD + "  - {name: c, speed_rpm: [\n")
+    with pytest.raises(ConfigError, match="not valid YAML") as info:
+        load_program(path)
+    assert info.value.source == str(path)

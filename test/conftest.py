@@ -1,0 +1,234 @@
+"""Shared fixtures: an isolated ROS graph per test.
+
+``ros_graph`` gives each test its own DDS domain so tests never see each other's topics, nor
+those of another test run on the same machine:
+
+* ``ROS_DOMAIN_ID`` is taken from 1..101 (0, the default domain, is left to users) and held
+  for the test by an exclusive lock file under the system temp folder
+  (``bearing_rig_sim-ros-domains/<id>.lock``), so parallel test runs (CI jobs, pytest-xdist
+  workers, two checkouts) on one host never share a domain. Within a run each test gets an
+  id no earlier test used until all 101 have been used.
+* ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``: discovery stays on this host.
+
+Both variables are set in ``os.environ`` for the test (undone afterwards) and in
+:attr:`RosGraph.env` for subprocesses. Contexts, nodes, executors and subprocesses made
+through the fixture are shut down, destroyed or killed at teardown, in that order of
+dependency, whatever the test's outcome.
+
+Example::
+
+    @pytest.mark.ros
+    def test_talk(ros_graph):
+        node = ros_graph.node("listener")
+        peer = ros_graph.spawn_python("-c", "import rclpy; ...")
+        ros_graph.spin_until(lambda: received, timeout=10.0, nodes=[node])
+"""
+
+from __future__ import annotations
+
+import fcntl
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import IO, Any, Callable, Iterator, Sequence
+
+import pytest
+
+#: Domain ids handed out to tests (inclusive). 0 is the ROS default domain and is avoided.
+DOMAIN_IDS: range = range(1, 102)
+
+#: Folder of the per-domain lock files shared by every test run on this host.
+LOCK_DIR: Path = Path(tempfile.gettempdir()) / "bearing_rig_sim-ros-domains"
+
+REPO_ROOT: Path = Path(__file__).resolve().parent.parent
+
+_used_this_session: set[int] = set()
+
+
+class DomainLease:
+    """An exclusive claim on one ROS domain id, held through a ``flock`` on a lock file."""
+
+    def __init__(self, domain_id: int, handle: IO[str]) -> None:
+        self.domain_id = domain_id
+        self._handle = handle
+
+    def release(self) -> None:
+        """Give the domain id back (closing the file drops the lock)."""
+        if not self._handle.closed:
+            fcntl.flock(self._handle, fcntl.LOCK_UN)
+            self._handle.close()
+
+
+def lease_domain(timeout: float = 60.0) -> DomainLease:
+    """Claim a free domain id from :data:`DOMAIN_IDS`, preferring ids unused in this session.
+
+    Raises:
+        RuntimeError: every id stayed claimed by other processes for ``timeout`` seconds.
+    """
+    if not LOCK_DIR.is_dir():
+        LOCK_DIR.mkdir(parents=True, exist_ok=True)
+        try:
+            LOCK_DIR.chmod(0o1777)  # shared by every user's test runs, like /tmp itself
+        except OSError:
+            pass
+    deadline = time.monotonic() + timeout
+    ids = list(DOMAIN_IDS)
+    while True:
+        start = random.randrange(len(ids))
+        ordered = ids[start:] + ids[:start]
+        fresh = [i for i in ordered if i not in _used_this_session]
+        for domain_id in fresh + [i for i in ordered if i in _used_this_session]:
+            handle = open(LOCK_DIR / f"{domain_id}.lock", "a+", encoding="utf-8")  # noqa: SIM115
+            try:
+                fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                handle.close()
+                continue
+            _used_this_session.add(domain_id)
+            if len(_used_this_session) == len(ids):
+                _used_this_session.clear()
+                _used_this_session.add(domain_id)
+            return DomainLease(domain_id, handle)
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"no free ROS domain id in {DOMAIN_IDS} after {timeout} s (see {LOCK_DIR})")
+        time.sleep(0.2)
+
+
+class RosGraph:
+    """One test's private ROS graph: its domain id, environment and the ROS objects to clean up.
+
+    Attributes:
+        domain_id: the test's ``ROS_DOMAIN_ID``.
+        env: environment for subprocesses (``os.environ`` plus the isolation variables).
+    """
+
+    def __init__(self, domain_id: int) -> None:
+        self.domain_id = domain_id
+        env = dict(os.environ)
+        for name in ("ROS_LOCALHOST_ONLY", "ROS_STATIC_PEERS", "FASTRTPS_DEFAULT_PROFILES_FILE"):
+            env.pop(name, None)
+        env.update(
+            ROS_DOMAIN_ID=str(domain_id),
+            ROS_AUTOMATIC_DISCOVERY_RANGE="LOCALHOST",
+            PYTHONUNBUFFERED="1",
+        )
+        self.env = env
+        self._contexts: list[Any] = []
+        self._nodes: list[Any] = []
+        self._executors: list[Any] = []
+        self._processes: list[subprocess.Popen[str]] = []
+
+    # -- rclpy in the test process -----------------------------------------------------------
+    def context(self) -> Any:
+        """A new ``rclpy.Context`` initialised on this graph's domain (shut down at teardown)."""
+        import rclpy  # noqa: PLC0415 - only ROS tests need rclpy
+
+        context = rclpy.Context()
+        rclpy.init(args=[], context=context, domain_id=self.domain_id)
+        self._contexts.append(context)
+        return context
+
+    def node(self, name: str, context: Any = None, **kwargs: Any) -> Any:
+        """A new ``rclpy.node.Node`` in ``context`` (a fresh one by default), destroyed at teardown."""
+        from rclpy.node import Node  # noqa: PLC0415
+
+        node = Node(name, context=context if context is not None else self.context(), **kwargs)
+        self._nodes.append(node)
+        return node
+
+    def executor(self, nodes: Sequence[Any]) -> Any:
+        """A ``SingleThreadedExecutor`` over ``nodes`` (all in one context), shut down at teardown.
+
+        Jazzy's ``MultiThreadedExecutor`` starves timers and subscriptions; do not use it.
+        """
+        from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
+
+        if not nodes:
+            raise ValueError("executor() needs at least one node")
+        executor = SingleThreadedExecutor(context=nodes[0].context)
+        for node in nodes:
+            executor.add_node(node)
+        self._executors.append(executor)
+        return executor
+
+    def spin_until(
+        self, condition: Callable[[], bool], timeout: float, nodes: Sequence[Any] = (), executor: Any = None
+    ) -> bool:
+        """Spin ``executor`` (or a new one over ``nodes``) until ``condition()`` or ``timeout`` s.
+
+        Returns:
+            Whether the condition became true in time.
+        """
+        if executor is None:
+            executor = self.executor(nodes)
+        deadline = time.monotonic() + timeout
+        while not condition():
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                return False
+            executor.spin_once(timeout_sec=min(0.05, remaining))
+        return True
+
+    # -- other processes ---------------------------------------------------------------------
+    def spawn_python(self, *args: str, cwd: str | Path | None = None) -> subprocess.Popen[str]:
+        """Start ``python args...`` (this interpreter) in this graph's environment.
+
+        stdout and stderr are pipes in text mode; the process is killed at teardown if still
+        running. Use ``communicate(timeout=...)`` to read them.
+        """
+        process = subprocess.Popen(
+            [sys.executable, *args],
+            env=self.env,
+            cwd=str(cwd) if cwd is not None else str(REPO_ROOT),
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        self._processes.append(process)
+        return process
+
+    # -- teardown ----------------------------------------------------------------------------
+    def close(self) -> None:
+        """Stop processes, then shut down executors, destroy nodes, shut down contexts."""
+        for process in self._processes:
+            if process.poll() is None:
+                process.terminate()
+        for process in self._processes:
+            try:
+                process.communicate(timeout=5.0)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.communicate()
+        for executor in self._executors:
+            executor.shutdown(timeout_sec=1.0)
+        for node in self._nodes:
+            node.destroy_node()
+        for context in self._contexts:
+            context.try_shutdown()
+        self._processes.clear()
+        self._executors.clear()
+        self._nodes.clear()
+        self._contexts.clear()
+
+
+@pytest.fixture
+def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
+    """An isolated ROS graph for one test (see the module docstring)."""
+    lease = lease_domain()
+    graph = RosGraph(lease.domain_id)
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(lease.domain_id))
+    monkeypatch.setenv("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+    monkeypatch.delenv("ROS_LOCALHOST_ONLY", raising=False)
+    monkeypatch.delenv("ROS_STATIC_PEERS", raising=False)
+    try:
+        yield graph
+    finally:
+        try:
+            graph.close()
+        finally:
+            lease.release()

@@ -1,0 +1,147 @@
+"""Both packages build in a colcon workspace, as they would in a full ROS 2 Jazzy install.
+
+The repository is copied into a temporary workspace as ``src/bearing-rig-sim`` and built with
+the virtual environment as the underlay (``AMENT_PREFIX_PATH=CMAKE_PREFIX_PATH=$VENV``).
+colcon does not descend into a package's subfolders, so both package paths are named:
+``colcon build --paths src/bearing-rig-sim src/bearing-rig-sim/msg_defs``. Then, in the
+environment of the workspace's ``install/setup.bash`` (what ``ros2 run`` sees), the
+interfaces and the package must load from the workspace, not from the venv.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+VENV = Path(sys.prefix)
+SOURCES = ("setup.py", "setup.cfg", "package.xml", "resource", "bearing_rig_sim", "config", "msg_defs")
+IGNORE = shutil.ignore_patterns("__pycache__", "*.pyc", "*.nbi", "*.nbc", "*.egg-info")
+
+
+def _relative_files(folder: Path) -> set[str]:
+    return {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.fixture(scope="module")
+def workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A colcon workspace with both packages built and installed (built once for the module)."""
+    ws = tmp_path_factory.mktemp("colcon_ws")
+    source = ws / "src" / "bearing-rig-sim"
+    source.mkdir(parents=True)
+    for name in SOURCES:
+        origin = REPO_ROOT / name
+        if origin.is_dir():
+            shutil.copytree(origin, source / name, ignore=IGNORE)
+        else:
+            shutil.copy2(origin, source / name)
+    env = dict(os.environ)
+    env.update(
+        PATH=f"{VENV / 'bin'}{os.pathsep}{env.get('PATH', '')}",
+        AMENT_PREFIX_PATH=str(VENV),
+        CMAKE_PREFIX_PATH=str(VENV),
+        COLCON_HOME=str(ws / ".colcon"),
+    )
+    env.pop("COLCON_DEFAULTS_FILE", None)
+    command = [
+        str(VENV / "bin" / "colcon"),
+        "build",
+        "--paths",
+        "src/bearing-rig-sim",
+        "src/bearing-rig-sim/msg_defs",
+        "--event-handlers",
+        "console_direct-",
+        "--cmake-args",
+        f"-DPython3_EXECUTABLE={VENV / 'bin' / 'python'}",
+        "-DBUILD_TESTING=OFF",
+    ]
+    result = subprocess.run(command, cwd=ws, env=env, capture_output=True, text=True, timeout=900)
+    assert result.returncode == 0, f"colcon build failed:\n{result.stdout[-4000:]}\n{result.stderr[-4000:]}"
+    for package in ("bearing_rig_msgs", "bearing_rig_sim"):
+        assert f"Finished <<< {package}" in result.stdout, result.stdout[-2000:]
+    return ws
+
+
+def _in_workspace(ws: Path, *argv: str) -> subprocess.CompletedProcess[str]:
+    """Run ``argv`` in the workspace after sourcing its install/setup.bash."""
+    env = dict(os.environ)
+    env["PATH"] = f"{VENV / 'bin'}{os.pathsep}{env.get('PATH', '')}"
+    env["AMENT_PREFIX_PATH"] = str(VENV)
+    env.pop("PYTHONPATH", None)
+    return subprocess.run(
+        ["bash", "-c", 'source install/setup.bash && exec "$@"', "bash", *argv],
+        cwd=ws,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+@pytest.mark.slow
+def test_interface_package_is_installed(workspace: Path) -> None:
+    prefix = workspace / "install" / "bearing_rig_msgs"
+    assert (prefix / "share" / "bearing_rig_msgs" / "package.xml").is_file()
+    assert (prefix / "share" / "ament_index" / "resource_index" / "packages" / "bearing_rig_msgs").is_file()
+    interfaces = (prefix / "share" / "ament_index" / "resource_index" / "rosidl_interfaces" / "bearing_rig_msgs")
+    listed = set(interfaces.read_text(encoding="utf-8").split())
+    for definition in (REPO_ROOT / "msg_defs").glob("*/*.*"):
+        if definition.suffix in (".msg", ".srv"):
+            assert f"{definition.parent.name}/{definition.name}" in listed
+    assert (prefix / "lib" / "libbearing_rig_msgs__rosidl_typesupport_c.so").is_file()
+    assert (prefix / "lib" / "libbearing_rig_msgs__rosidl_typesupport_fastrtps_c.so").is_file()
+    site = prefix / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
+    assert (site / "bearing_rig_msgs" / "msg" / "_slip_status.py").is_file()
+
+
+@pytest.mark.slow
+def test_python_package_is_installed_the_ament_way(workspace: Path) -> None:
+    prefix = workspace / "install" / "bearing_rig_sim"
+    script = prefix / "lib" / "bearing_rig_sim" / "bearing-rig"
+    assert script.is_file() and os.access(script, os.X_OK), "console script not in lib/bearing_rig_sim"
+    assert (prefix / "share" / "ament_index" / "resource_index" / "packages" / "bearing_rig_sim").is_file()
+    assert (prefix / "share" / "bearing_rig_sim" / "package.xml").is_file()
+    installed_config = _relative_files(prefix / "share" / "bearing_rig_sim" / "config")
+    assert installed_config == _relative_files(REPO_ROOT / "config")
+    assert installed_config, "config/ is empty"
+
+
+@pytest.mark.slow
+def test_workspace_packages_load_from_the_workspace(workspace: Path) -> None:
+    code = (
+        "import json\n"
+        "import bearing_rig_msgs.msg as m, bearing_rig_sim\n"
+        "from rclpy.serialization import serialize_message, deserialize_message\n"
+        "from ament_index_python.packages import get_package_share_directory\n"
+        "msg = m.FibreOpticPulse(sensor_id='cage', revolution=12)\n"
+        "back = deserialize_message(serialize_message(msg), m.FibreOpticPulse)\n"
+        "assert back == msg, back\n"
+        "libs = [l.split()[-1] for l in open('/proc/self/maps') if 'libbearing_rig_msgs__' in l]\n"
+        "print(m.__file__); print(bearing_rig_sim.__file__)\n"
+        "print(get_package_share_directory('bearing_rig_sim'))\n"
+        "print(json.dumps(sorted(set(libs))))\n"
+    )
+    result = _in_workspace(workspace, "python", "-c", code)
+    assert result.returncode == 0, result.stderr
+    msgs_file, sim_file, share, libs = result.stdout.strip().splitlines()[-4:]
+    install = str(workspace / "install")
+    assert msgs_file.startswith(install), msgs_file
+    assert sim_file.startswith(install), sim_file
+    assert share == str(workspace / "install" / "bearing_rig_sim" / "share" / "bearing_rig_sim")
+    loaded = json.loads(libs)
+    assert loaded and all(path.startswith(install) for path in loaded), loaded
+
+
+@pytest.mark.slow
+def test_console_script_runs_from_the_workspace(workspace: Path) -> None:
+    result = _in_workspace(workspace, "install/bearing_rig_sim/lib/bearing_rig_sim/bearing-rig", "--version")
+    assert result.returncode == 0, result.stderr
+    from bearing_rig_sim import __version__  # noqa: PLC0415
+
+    assert result.stdout.strip() == f"bearing-rig {__version__}"

@@ -1,0 +1,234 @@
+"""The slope criterion: when has the slip reached its stable state? (paper Eq. 14, digest 7).
+
+The paper fits a curve to the slip (percent) against axial load (N) or time (s) and computes the
+slope between successive points of the fitted curve, k_n = (s_n - s_(n-1)) / (x_n - x_(n-1)).
+Where the slope is **at or above** a critical value (less steep a fall than k) the bearing is
+*stable*; where it is **below** (a steeper fall) it is *slipping*. The slope of the fitted curve
+is used here at a point (the limit of Eq. 14 for close points), analytically for a
+:class:`~bearing_rig_sim.analysis.gaussian.GaussianFit`, by a central difference otherwise.
+
+**Onset of the stable state** over a range [x_start, x_end]: the smallest x* such that the slope
+is >= k at every x in [x*, x_end], i.e. the start of the stable stretch that lasts to the end of
+the range. If the slope is non-monotonic and the curve is stable for a while, then falls steeply
+again, the earlier stretch is not the onset: only the last stretch counts, because a bearing
+that slips again was not stable. If the slope at x_end is below k the stable state is "not
+reached" (onset ``None``); if it is >= k on the whole range the onset is x_start and
+``stable_from_start`` is set (the true onset may lie before the range).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+from typing import Any, Callable, Sequence
+
+import numpy as np
+import numpy.typing as npt
+from scipy.optimize import brentq
+
+from bearing_rig_sim.analysis.inputs import (
+    AnalysisError,
+    FloatArray,
+    finite_array,
+    finite_number,
+    same_length,
+    strictly_increasing,
+)
+
+K1_AXIAL_LOAD: float = -5e-6
+"""Critical slope of slip against axial load, read as **percent per newton** (%/N).
+
+The paper gives k1 = -5e-6 without a unit (digest section 7). Its slip is in percent and its loads
+in newtons (50-700 N), so the slope of its fitted curves is in %/N; a fall of 5e-6 %/N is 0.0035 %
+over the whole 700 N sweep, i.e. "the curve has flattened out". Read as a fraction per newton it
+would be 100 times steeper, which is not consistent with the time constant below.
+"""
+
+K2_TIME: float = -3e-2
+"""Critical slope of slip against time under acceleration, read as **percent per second** (%/s).
+
+The paper gives k2 = -3e-2 without a unit (digest section 7). Read as %/s, with slip in percent
+and time in seconds as in its Table 7 fits y = lambda exp(-((t - k)/d)^2), it reproduces the
+stable-onset times the paper's data imply: 1.67, 1.41, 1.23 and 0.97 s for 20, 40, 60 and
+80 rad/s^2 (digest section 11). Read as a fraction per second (3 %/s) it would put every onset
+before 0.6 s.
+"""
+
+
+class SlipState(StrEnum):
+    """State of the bearing by the slope criterion; values compare equal to plain strings."""
+
+    UNKNOWN = "unknown"
+    SLIPPING = "slipping"
+    STABLE = "stable"
+
+
+SlipCurve = Callable[[Any], Any]
+"""A fitted slip curve: a :class:`GaussianFit` (analytic slope) or any callable y(x)."""
+
+
+def successive_slopes(x: FloatArray | Sequence[float], y: FloatArray | Sequence[float]) -> FloatArray:
+    """Paper Eq. 14: k_n = (y_n - y_(n-1)) / (x_n - x_(n-1)) for n = 1 .. len(x) - 1.
+
+    Args:
+        x: abscissa, N or s, strictly increasing, at least 2 values.
+        y: slip, percent, same length.
+
+    Returns:
+        len(x) - 1 slopes, percent per unit of x (%/N or %/s).
+
+    Raises:
+        AnalysisError: non-finite or mismatched data, fewer than 2 points, x not increasing.
+    """
+    xs = finite_array("x", x, min_len=2)
+    ys = finite_array("y", y, min_len=2)
+    same_length(x=xs, y=ys)
+    strictly_increasing("x", xs)
+    return np.diff(ys) / np.diff(xs)
+
+
+def slope_function(curve: SlipCurve, step: float) -> Callable[[FloatArray], FloatArray]:
+    """The slope of ``curve`` as a vectorised function of x (percent per unit of x).
+
+    A curve with a ``slope`` method (a :class:`GaussianFit`) gives its analytic derivative;
+    any other callable the central difference (y(x + step/2) - y(x - step/2)) / step, which is
+    Eq. 14 between two points ``step`` apart.
+    """
+    analytic = getattr(curve, "slope", None)
+    if callable(analytic):
+        return lambda x: np.asarray(analytic(np.asarray(x, dtype=np.float64)), dtype=np.float64)
+    if not callable(curve):
+        raise AnalysisError(f"curve: must be a fitted curve or a callable y(x), got {type(curve).__name__}")
+    h = float(step)
+
+    def central(x: FloatArray) -> FloatArray:
+        xa = np.asarray(x, dtype=np.float64)
+        hi = np.asarray(curve(xa + 0.5 * h), dtype=np.float64)
+        lo = np.asarray(curve(xa - 0.5 * h), dtype=np.float64)
+        return (hi - lo) / h
+
+    return central
+
+
+def classify(
+    x: FloatArray | Sequence[float], curve: SlipCurve, critical_slope: float, *, step: float | None = None
+) -> npt.NDArray[np.str_]:
+    """State of each sample point by the slope of the fitted curve there.
+
+    Args:
+        x: sample points, N or s.
+        curve: the fitted slip curve (percent against x).
+        critical_slope: k, percent per unit of x (e.g. :data:`K2_TIME` for time).
+        step: difference step for a plain callable (unit of x); default 1e-6 of the span of x
+            (or 1e-6 if x has a single point).
+
+    Returns:
+        Array of "stable" (slope >= k) or "slipping" (slope < k), one per point.
+
+    Raises:
+        AnalysisError: non-finite x or critical slope, or a curve giving a non-finite slope.
+    """
+    xs = finite_array("x", x)
+    k = finite_number("critical_slope", critical_slope)
+    h = step if step is not None else (1e-6 * float(np.ptp(xs)) or 1e-6)
+    slopes = slope_function(curve, h)(xs)
+    if not np.all(np.isfinite(slopes)):
+        raise AnalysisError("curve: gives a non-finite slope")
+    return np.where(slopes >= k, SlipState.STABLE.value, SlipState.SLIPPING.value)
+
+
+@dataclass(frozen=True)
+class StabilityResult:
+    """Where the slope criterion finds the stable state on [x_start, x_end].
+
+    Attributes:
+        onset: start of the final stable stretch (N or s), or None if not reached.
+        critical_slope: k used, percent per unit of x.
+        x_start: start of the range examined (N or s).
+        x_end: end of the range examined (N or s).
+        slope_at_end: slope of the curve at x_end, percent per unit of x.
+        stable_from_start: True if the slope is >= k on the whole range (onset = x_start, and the
+            true onset may lie before the range).
+        stable_intervals: every stretch (from, to) of the range where slope >= k, in order; more
+            than one means the slope is non-monotonic (only the last one can give the onset).
+    """
+
+    onset: float | None
+    critical_slope: float
+    x_start: float
+    x_end: float
+    slope_at_end: float
+    stable_from_start: bool
+    stable_intervals: tuple[tuple[float, float], ...]
+
+    @property
+    def reached(self) -> bool:
+        """Whether the stable state holds at the end of the range."""
+        return self.onset is not None
+
+
+def stable_onset(
+    curve: SlipCurve,
+    x_start: float,
+    x_end: float,
+    critical_slope: float,
+    resolution: float | None = None,
+) -> StabilityResult:
+    """Find the onset of the stable state of a fitted slip curve (see the module docstring).
+
+    The slope is sampled on a uniform grid of spacing ``resolution``; each change of state between
+    grid points is refined by Brent's method to 1e-9 of the range. A stretch narrower than the
+    grid spacing can be missed.
+
+    Args:
+        curve: the fitted slip curve (percent against x), e.g. a :class:`GaussianFit`.
+        x_start: start of the range, N or s.
+        x_end: end of the range, N or s, > x_start.
+        critical_slope: k, percent per unit of x (:data:`K1_AXIAL_LOAD`, :data:`K2_TIME`).
+        resolution: grid spacing in the unit of x; default (x_end - x_start) / 2000.
+
+    Raises:
+        AnalysisError: non-finite or empty range, bad resolution, non-finite slope.
+    """
+    x0 = finite_number("x_start", x_start)
+    x1 = finite_number("x_end", x_end)
+    k = finite_number("critical_slope", critical_slope)
+    if not x1 > x0:
+        raise AnalysisError(f"x_end: must be > x_start = {x0!r}, got {x1!r}")
+    span = x1 - x0
+    step = span / 2000.0 if resolution is None else finite_number("resolution", resolution)
+    if not 0.0 < step <= span:
+        raise AnalysisError(f"resolution: must be in (0, {span!r}], got {step!r}")
+    slope = slope_function(curve, min(step, span * 1e-6))
+    grid = np.linspace(x0, x1, int(math.ceil(span / step)) + 1)
+    margin = slope(grid) - k
+    if not np.all(np.isfinite(margin)):
+        raise AnalysisError("curve: gives a non-finite slope on the range")
+    stable = margin >= 0.0
+
+    def crossing(i: int) -> float:
+        """x where the slope crosses k between grid[i] and grid[i + 1]."""
+        return float(brentq(lambda v: float(slope(np.array([v]))[0]) - k, grid[i], grid[i + 1], xtol=span * 1e-9))
+
+    intervals: list[tuple[float, float]] = []
+    begin = x0 if stable[0] else None
+    for i in np.flatnonzero(stable[1:] != stable[:-1]):
+        at = crossing(int(i))
+        if stable[i + 1]:
+            begin = at
+        else:
+            intervals.append((float(begin), at))  # type: ignore[arg-type]
+            begin = None
+    if begin is not None:
+        intervals.append((float(begin), x1))
+    onset = intervals[-1][0] if stable[-1] else None
+    return StabilityResult(
+        onset=onset,
+        critical_slope=k,
+        x_start=x0,
+        x_end=x1,
+        slope_at_end=float(margin[-1] + k),
+        stable_from_start=bool(np.all(stable)),
+        stable_intervals=tuple(intervals),
+    )

@@ -313,7 +313,8 @@ class ShaftSensorParams(ParameterRecord):
     """The strips and sensor on one shaft (``sensors.spindle`` or ``sensors.cage``)."""
 
     strip_count: int = bounded(ge=1, le=MAX_STRIP_COUNT)
-    """Reflective strips on the shaft (1). Source: config/rig.yaml (assumption there)."""
+    """Reflective strips on the shaft (1). Not in the paper: the assumption and its reason are in
+    ``config/rig.yaml``, section ``sensors``."""
     phase_rad: float = bounded(ge=0.0, lt=TWO_PI)
     """Shaft angle at which strip 0 passes the sensor, rad."""
     seed: int = bounded(ge=0)

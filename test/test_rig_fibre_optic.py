@@ -48,7 +48,7 @@ def test_constant_speed_pulses_at_analytic_times_several_per_step() -> None:
     assert [p.pulse_index for p in pulses] == list(range(len(pulses)))
     assert [p.strip_id for p in pulses] == [j % strips for j in range(first, first + len(pulses))]
     assert [p.revolution for p in pulses] == [i // strips for i in range(len(pulses))]
-    assert all(p.strip_count == strips for p in pulses)
+    assert all(p.strip_count == strips and p.sensor_id == "spindle" for p in pulses)
     per_step = np.bincount([int(p.time // h) for p in pulses])
     assert per_step.max() >= 3  # several strips within one step, all emitted in order
 

@@ -61,6 +61,8 @@ class Pulse:
     pulse_index: int
     """Strip passages since the sensor started, counting dropped pulses (1); a jump in this
     index tells the receiver that pulses were lost."""
+    sensor_id: str = ""
+    """Which shaft's sensor gave the pulse (``"spindle"`` or ``"cage"``); empty if unknown."""
 
 
 def _require_finite(owner: str, **values: float) -> None:
@@ -203,6 +205,7 @@ class FibreOpticSensor:
             strip_count=self.strip_count,
             revolution=index // self.strip_count,
             pulse_index=index,
+            sensor_id=self.sensor_id,
         )
 
 

@@ -1,0 +1,113 @@
+"""What every node of the rig shares: QoS profiles, time stamps, diagnostics, the main shell.
+
+The QoS profiles are the ones of the interface table (README, docs/interfaces.md). Nodes are
+thin shells: each wires publishers, subscriptions, timers and parameters around a ROS-free core
+and starts through :func:`run_node`, which uses a ``SingleThreadedExecutor`` (the
+``MultiThreadedExecutor`` of Jazzy's rclpy drops to a few hertz with several nodes).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
+
+import rclpy
+from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+from bearing_rig_sim.config import config_path
+
+SENSOR_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
+)
+"""Sensor streams (pulses, speeds, load cell, truth): best effort, keep last 100."""
+
+RELIABLE_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
+)
+"""Commands, set-points, /clock, /diagnostics, the force to the simulator: reliable, depth 10."""
+
+STATUS_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
+)
+"""Latched state (slip status, spindle command): reliable, transient local, depth 10."""
+
+OK, WARN, ERROR, STALE = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR, DiagnosticStatus.STALE
+
+
+def to_stamp(seconds: float) -> Time:
+    """A ``builtin_interfaces/Time`` for a time in seconds (>= 0)."""
+    sec = math.floor(seconds)
+    nanosec = int(round((seconds - sec) * 1e9))
+    if nanosec >= 1_000_000_000:
+        sec, nanosec = sec + 1, nanosec - 1_000_000_000
+    return Time(sec=int(sec), nanosec=nanosec)
+
+
+def from_stamp(stamp: Time) -> float:
+    """Seconds of a ``builtin_interfaces/Time``."""
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def diagnostic_status(name: str, level: bytes | int, message: str, values: Mapping[str, object], hardware_id: str = "bearing_rig") -> DiagnosticStatus:
+    """One ``DiagnosticStatus`` with ``values`` as key/value strings."""
+    lvl = level if isinstance(level, bytes) else bytes([level])
+    return DiagnosticStatus(
+        level=lvl, name=name, message=message, hardware_id=hardware_id, values=[KeyValue(key=str(k), value=str(v)) for k, v in values.items()]
+    )
+
+
+def diagnostic_array(stamp: Time, statuses: Sequence[DiagnosticStatus]) -> DiagnosticArray:
+    """A ``DiagnosticArray`` for ``/diagnostics``."""
+    msg = DiagnosticArray()
+    msg.header.stamp = stamp
+    msg.status = list(statuses)
+    return msg
+
+
+def default_params_file(node_name: str) -> Path:
+    """The shipped parameter file of a node: ``config/<node_name>.yaml``."""
+    return config_path(f"{node_name}.yaml")
+
+
+def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[str]:
+    """Command-line arguments for ``rclpy.init``: the given ones, plus the shipped parameter
+    file when the user gave none (``--params-file`` or ``-p`` after ``--ros-args``)."""
+    args = list(sys.argv if argv is None else argv)
+    if "--params-file" in args:
+        return args
+    path = default_params_file(node_name)
+    if not path.exists():
+        return args
+    if "--ros-args" in args:
+        i = args.index("--ros-args")
+        return args[: i + 1] + ["--params-file", str(path)] + args[i + 1 :]
+    return args + ["--ros-args", "--params-file", str(path)]
+
+
+def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
+    """Initialise rclpy (with the node's shipped parameter file), spin the node made by
+    ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
+    Returns the process exit status."""
+    rclpy.init(args=ros_args_with_defaults(node_name, argv))
+    node = None
+    try:
+        node = factory()
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            close = getattr(node, "close", None)
+            if callable(close):
+                close()
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

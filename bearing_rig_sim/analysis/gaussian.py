@@ -162,7 +162,9 @@ class GaussianFit:
         n_points: number of data points fitted.
         x_range: (smallest, largest) x of the data, unit of x.
         covariance: (3 n_terms, 3 n_terms) estimated covariance of the parameters in the order
-            (a_1, b_1, c_1, a_2, ...): rmse^2 (J^T J)^+ at the optimum.
+            (a_1, b_1, c_1, a_2, ...): rmse^2 (J^T J)^-1 at the optimum, J the Jacobian of the
+            model. Entries are inf or nan where J is singular (parameter combinations the data
+            do not determine, e.g. a term far from every point).
     """
 
     params: FloatArray
@@ -174,6 +176,7 @@ class GaussianFit:
     n_points: int
     x_range: tuple[float, float]
     covariance: FloatArray = field(repr=False)
+    _directions: FloatArray = field(repr=False)  # rows rmse v_i / s_i from the SVD of J
 
     @overload
     def __call__(self, x: float) -> float: ...
@@ -197,11 +200,14 @@ class GaussianFit:
     def slope_standard_error(self, x: FloatArray | Sequence[float]) -> FloatArray: ...
     def slope_standard_error(self, x: float | FloatArray | Sequence[float]) -> float | FloatArray:
         """Standard error of :meth:`slope` at x from the parameter covariance (delta method),
-        same unit as the slope."""
+        same unit as the slope; inf where the slope depends on parameters the data do not
+        determine."""
         xs = finite_array("x", x)
         g = _slope_gradient(xs, self.params)
-        var = np.einsum("ij,jk,ik->i", g, self.covariance, g)
-        se = np.sqrt(np.maximum(var, 0.0))
+        with np.errstate(invalid="ignore", over="ignore"):
+            proj = g @ self._directions.T
+        proj[np.isnan(proj)] = np.inf  # inf times a zero component of g
+        se = np.sqrt(np.sum(proj * proj, axis=1))
         return float(se[0]) if np.ndim(x) == 0 else se
 
 
@@ -230,8 +236,11 @@ def fit_gaussians(
         n_terms: number of Gaussian terms, >= 1.
         starts: extra starting points, each (n_terms, 3) rows (a, b, c) in the data's units (e.g.
             the previous fit when refitting a growing series).
-        multistart: False tries only ``starts`` (or, if there are none, the peeling start): one
-            short run instead of five or more, for warm refits of a growing series.
+        multistart: False, with ``starts`` given, is a warm refit of a growing series: one run
+            per start, of at most 25 evaluations per term, and no polishing run (the result may
+            be short of convergence; the next warm refit continues from it). Without ``starts``
+            it tries the peeling start (and the (n_terms - 1)-term based ones when
+            :func:`select_gaussian_fit` has that fit).
 
     Raises:
         AnalysisError: non-finite, mismatched or too few data, x all equal, bad n_terms/starts.
@@ -270,13 +279,14 @@ def _fit(
     for s in candidates:
         if s.shape[0] != n_terms:
             raise AnalysisError(f"starts: each start must have {n_terms} rows, got {s.shape[0]}")
-    if multistart or not candidates:
+    warm = bool(candidates) and not multistart
+    if not warm:
         candidates.append(_peel(z, w, np.zeros((0, 3)), n_terms))
     if multistart:
         candidates += _spread_starts(z, w, n_terms)
         if n_terms >= 2 and fewer is None:
             fewer = _fit(x, y, n_terms - 1, (), True, None)
-    if fewer is not None:
+    if fewer is not None and not warm:
         base = to_norm(fewer.params)
         candidates.append(_peel(z, w, base, 1))
         candidates.append(np.vstack([base, [0.0, 0.5, 0.5]]))
@@ -298,9 +308,11 @@ def _fit(
 
     # Every start gets a short run; the best continues to convergence (a start crawling along a
     # degenerate valley towards a bound would otherwise cost hundreds of evaluations).
+    # A warm refit gets the short run only: if it has not converged, the next refit of the growing
+    # series continues from where it stopped, which bounds the cost of each refit.
     screened = [solve(start.ravel(), _SCREEN_NFEV * n_terms) for start in candidates]
     best = min(screened, key=lambda r: r.cost)
-    if best.status == 0:  # evaluation budget exhausted, not converged
+    if best.status == 0 and not warm:  # evaluation budget exhausted, not converged
         best = solve(best.x, _POLISH_NFEV * n_terms)
     pn = best.x.reshape(-1, 3)
     params = np.column_stack([pn[:, 0] * sy, x0 + pn[:, 1] * sx, pn[:, 2] * sx])
@@ -316,11 +328,12 @@ def _summary(x: FloatArray, y: FloatArray, params: FloatArray) -> GaussianFit:
     rmse = math.sqrt(sse / dof)
     jac = _jacobian(x, params)
     _, sv, vt = np.linalg.svd(jac, full_matrices=False)
-    keep = sv > sv[0] * 1e-12 if sv.size and sv[0] > 0 else np.zeros(sv.shape, bool)
-    inv = (vt[keep].T / sv[keep] ** 2) @ vt[keep]
-    params.setflags(write=False)
-    cov = rmse**2 * inv
-    cov.setflags(write=False)
+    with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+        directions = rmse * vt / sv[:, None]
+        cov = directions.T @ directions
+    directions[np.isnan(directions)] = np.inf  # a zero singular value with rmse = 0
+    for arr in (params, cov, directions):
+        arr.setflags(write=False)
     return GaussianFit(
         params=params,
         n_terms=params.shape[0],
@@ -331,6 +344,7 @@ def _summary(x: FloatArray, y: FloatArray, params: FloatArray) -> GaussianFit:
         n_points=x.size,
         x_range=(float(x.min()), float(x.max())),
         covariance=cov,
+        _directions=directions,
     )
 
 

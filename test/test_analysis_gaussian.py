@@ -96,30 +96,21 @@ def test_bad_params(params: object, message: str) -> None:
 
 # -- recovering known parameters -----------------------------------------------------------------
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_one_term_fit_recovers_table7_parameters(seed: int) -> None:
-    sigma = 0.01
-    t = np.linspace(0.0, 3.0, 200)
-    y = model(t, TABLE7_20) + np.random.default_rng(seed).normal(0.0, sigma, t.size)
-    fit = fit_gaussians(t, y, 1)
-    se = expected_standard_errors(t, TABLE7_20, sigma)
-    assert np.all(np.abs(fit.params - TABLE7_20) < 4.0 * se), (fit.params, se)
+@pytest.mark.parametrize(
+    ("true", "x", "sigma"),
+    [(TABLE7_20, np.linspace(0.0, 3.0, 200), 0.01), (TWO_PEAKS, np.linspace(0.0, 10.0, 150), 0.02)],
+    ids=["1-term Table 7", "2-term peaks"],
+)
+def test_fit_recovers_known_parameters(true: np.ndarray, x: np.ndarray, sigma: float, seed: int) -> None:
+    y = model(x, true) + np.random.default_rng(seed).normal(0.0, sigma, x.size)
+    fit = fit_gaussians(x, y, true.shape[0])
+    se = expected_standard_errors(x, true, sigma)
+    assert np.all(np.abs(fit.params - true) < 4.0 * se), (fit.params, se)
     assert fit.rmse == pytest.approx(sigma, rel=0.2)
-    assert fit.r_square > 1.0 - 1.3 * t.size * sigma**2 / np.sum((y - y.mean()) ** 2)
+    assert fit.r_square > 1.0 - 1.3 * x.size * sigma**2 / np.sum((y - y.mean()) ** 2)
     # the reported covariance agrees with the noise-level standard errors
     reported = np.sqrt(np.diag(fit.covariance)).reshape(-1, 3)
     np.testing.assert_allclose(reported, se, rtol=0.25)
-
-
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_two_term_fit_recovers_separated_peaks(seed: int) -> None:
-    sigma = 0.02
-    x = np.linspace(0.0, 10.0, 150)
-    y = model(x, TWO_PEAKS) + np.random.default_rng(seed).normal(0.0, sigma, x.size)
-    fit = fit_gaussians(x, y, 2)
-    se = expected_standard_errors(x, TWO_PEAKS, sigma)
-    assert np.all(np.abs(fit.params - TWO_PEAKS) < 4.0 * se), (fit.params, se)
-    assert fit.r_square > 1.0 - 1.3 * x.size * sigma**2 / np.sum((y - y.mean()) ** 2)
-    assert fit.rmse == pytest.approx(sigma, rel=0.2)
 
 
 def test_noise_free_fits_are_exact() -> None:

@@ -103,17 +103,3 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
             "final_state": monitor.verdict().state.value,
         }
 
-
-def main() -> None:  # pragma: no cover - convenience entry point
-    """``python -m bearing_rig_sim.benchmarks.analysis``: print JSON lines."""
-    import json
-
-    parser = argparse.ArgumentParser(description=__doc__)
-    add_arguments(parser)
-    parser.add_argument("--json", action="store_true")
-    for row in run(parser.parse_args()):
-        print(json.dumps(row))
-
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

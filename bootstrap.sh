@@ -29,7 +29,7 @@ log() { printf 'bootstrap: %s\n' "$*" >&2; }
 die() { printf 'bootstrap: error: %s\n' "$*" >&2; exit 1; }
 
 usage() {
-    sed -n '2,13p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//' >&2
+    awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "${BASH_SOURCE[0]}" >&2
     exit 2
 }
 
@@ -175,6 +175,10 @@ setup() {
     step_patch_wheels
     step_messages
     step_package
+    # Release the lock: the command run after set-up (a rig session, pytest) must not hold it.
+    if command -v flock >/dev/null; then
+        exec 9>&-
+    fi
 }
 
 cmd="${1:-}"

@@ -72,11 +72,14 @@ class BagLayout:
     ros_distro: str = ROS_DISTRO
     compression_mode: str = ""
     compression_format: str = ""
+    stated_message_count: int | None = None
+    """The top-level ``message_count`` of a ``metadata.yaml`` that was read (None when built)."""
 
     @property
     def message_count(self) -> int:
-        """Messages in all files."""
-        return sum(f.message_count for f in self.files)
+        """Messages in all files (the stated count when the files section lacks them)."""
+        counted = sum(f.message_count for f in self.files)
+        return counted if counted or self.stated_message_count is None else self.stated_message_count
 
     @property
     def start_ns(self) -> int:
@@ -264,6 +267,7 @@ def read_layout(bag_dir: Path) -> BagLayout:
         ros_distro=str(info.get("ros_distro") or ""),
         compression_mode="",
         compression_format="",
+        stated_message_count=int(info.get("message_count") or 0),
     )
 
 

@@ -17,7 +17,7 @@ import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Iterable, Sequence
+from typing import Callable, Iterable, Sequence
 
 import numpy as np
 import yaml
@@ -133,19 +133,32 @@ def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyStat
 
 
 def steady_states(
-    params: BearingParameters, points: Iterable[tuple[float, float]], workers: int | None = None, pool: ProcessPoolExecutor | None = None
+    params: BearingParameters,
+    points: Iterable[tuple[float, float]],
+    workers: int | None = None,
+    pool: ProcessPoolExecutor | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> list[SteadyState]:
     """Steady states of many (inner-ring speed rad/s, axial load N) points, on ``pool`` or on
     ``workers`` new processes (default: all cores). Order is kept; results do not depend on
-    the number of processes."""
+    the number of processes. ``progress(done, total)`` is called as points complete."""
     jobs = [(params, float(w), float(f)) for w, f in points]
-    if pool is not None:
-        return list(pool.map(_steady_state_job, jobs))
     workers = workers or os.cpu_count() or 1
-    if workers <= 1 or len(jobs) <= 1:
-        return [_steady_state_job(j) for j in jobs]
+    if pool is None and (workers <= 1 or len(jobs) <= 1):
+        return _collect(map(_steady_state_job, jobs), len(jobs), progress)
+    if pool is not None:
+        return _collect(pool.map(_steady_state_job, jobs), len(jobs), progress)
     with process_pool(min(workers, len(jobs))) as new_pool:
-        return list(new_pool.map(_steady_state_job, jobs))
+        return _collect(new_pool.map(_steady_state_job, jobs), len(jobs), progress)
+
+
+def _collect(results: Iterable[SteadyState], total: int, progress: Callable[[int, int], None] | None) -> list[SteadyState]:
+    out = []
+    for item in results:
+        out.append(item)
+        if progress is not None:
+            progress(len(out), total)
+    return out
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:

@@ -12,7 +12,7 @@ them with digest Eq. 11-12 at the nominal contact angle, as on the bench.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Sequence
+from typing import Callable, Sequence
 
 import numpy as np
 
@@ -51,9 +51,15 @@ class AccelerationSeries:
     slip_pct: np.ndarray
 
 
-def validation_table(params: BearingParameters, speeds_rpm: Sequence[float] = VALIDATION_RPM, load: float = VALIDATION_LOAD_N, workers: int | None = None) -> list[SteadyState]:
+def validation_table(
+    params: BearingParameters,
+    speeds_rpm: Sequence[float] = VALIDATION_RPM,
+    load: float = VALIDATION_LOAD_N,
+    workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[SteadyState]:
     """Steady slip at ``load`` (N) for each inner-ring speed (rpm at the edge)."""
-    return steady_states(params, [(rpm_to_rad_s(n), load) for n in speeds_rpm], workers)
+    return steady_states(params, [(rpm_to_rad_s(n), load) for n in speeds_rpm], workers, progress=progress)
 
 
 def load_sweep(
@@ -61,9 +67,10 @@ def load_sweep(
     speeds_rpm: Sequence[float] = SWEEP_RPM,
     loads: Sequence[float] = SWEEP_LOADS_N,
     workers: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> dict[float, list[SteadyState]]:
     """Steady slip for every (speed, load) pair; keyed by speed in rpm."""
-    flat = steady_states(params, [(rpm_to_rad_s(n), f) for n in speeds_rpm for f in loads], workers)
+    flat = steady_states(params, [(rpm_to_rad_s(n), f) for n in speeds_rpm for f in loads], workers, progress=progress)
     k = len(loads)
     return {float(n): flat[i * k : (i + 1) * k] for i, n in enumerate(speeds_rpm)}
 

@@ -22,7 +22,9 @@ from typing import Any, Iterable, TextIO
 
 from bearing_rig_sim.errors import RigError
 
-BENCHMARKS: dict[str, str] = {}
+BENCHMARKS: dict[str, str] = {
+    "dynamics": "bearing_rig_sim.benchmarks.dynamics",
+}
 """Benchmark name -> module path (``bearing_rig_sim.benchmarks.<name>``)."""
 
 

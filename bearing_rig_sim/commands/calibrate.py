@@ -1,0 +1,45 @@
+"""``bearing-rig calibrate DATA.csv``: fit the engine's uncertain resistances to bench slip data."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+from typing import Any
+
+from bearing_rig_sim.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
+from bearing_rig_sim.config import config_path, rad_s_to_rpm
+from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
+
+
+def register(subparsers: Any) -> None:
+    """Add ``calibrate`` to the ``bearing-rig`` parser."""
+    p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
+    p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
+    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
+    p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")
+    p.add_argument("--out", type=Path, default=None, help="calibration file to write (default: config/calibration/<data>.yaml)")
+    p.add_argument("--json", action="store_true", help="print the result as one JSON object")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Calibrate, write the calibration file, print the RMS difference."""
+    points = read_bench_csv(args.data)
+    result = calibrate(BearingParameters.from_yaml(args.bearing), points, fitted=tuple(args.fit))
+    out = args.out or config_path("calibration", args.data.stem + ".yaml")
+    write_calibration(result, out, args.data.name)
+    if args.json:
+        print(json.dumps({"fitted": result.fitted, "fixed": result.fixed, "rms_slip_pct": result.rms_pct, "file": str(out)}))
+        return 0
+    print(f"{'rpm':>8} {'load N':>8} {'bench %':>8} {'twin %':>8} {'diff pp':>8}")
+    for p, s in zip(result.points, result.predicted):
+        print(f"{rad_s_to_rpm(p.inner_ring_speed):8.0f} {p.axial_load:8.1f} {p.slip_pct:8.3f} {s.slip_pct:8.3f} {s.slip_pct - p.slip_pct:8.3f}")
+    for name, value in result.fitted.items():
+        print(f"fitted {name} = {value:.6g}")
+    for name, value in result.fixed.items():
+        print(f"fixed  {name} = {value:.6g}")
+    print(f"RMS difference: {result.rms_pct:.3f} percentage points ({result.evaluations} model evaluations)")
+    print(f"written: {out}")
+    return 0

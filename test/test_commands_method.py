@@ -1,0 +1,60 @@
+"""The method's command line: ``calibrate``, ``predict`` and ``reproduce`` (issue 4)."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import pytest
+
+from bearing_rig_sim.cli import main
+from bearing_rig_sim.config import config_path
+from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.reproduce import PAPER_TABLE3
+
+
+def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["predict", "--rpm", "1200", "2400", "--load", "100", "--json"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [r["rpm"] for r in rows] == [1200.0, 2400.0]
+    assert set(rows[0]) == {"rpm", "axial_load_n", "cage_rpm", "slip_pct"}
+    for r in rows:  # cage speed and slip are consistent with Eq. 11-12 at the nominal angle
+        ratio = BearingParameters.from_yaml().epicyclic_ratio
+        assert r["slip_pct"] == pytest.approx((1 - r["cage_rpm"] / (ratio * r["rpm"])) * 100, abs=2e-3)
+
+
+@pytest.mark.parametrize("argv,needle", [(["--rpm", "1000", "--load", "nan"], "--load"), (["--rpm", "-5", "--load", "100"], "--rpm"), (["--rpm", "1000", "2000", "--load", "1", "2", "3"], "one per speed")])
+def test_predict_refuses_bad_values(capsys: pytest.CaptureFixture[str], argv: list[str], needle: str) -> None:
+    assert main(["predict", *argv]) == 2
+    err = capsys.readouterr().err
+    assert needle in err and len(err.strip().splitlines()) == 1
+
+
+def test_calibrate_writes_a_usable_file_and_prints_the_rms(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    out = tmp_path / "cal.yaml"
+    assert main(["calibrate", str(config_path("calibration", "h7006c_table3.csv")), "--out", str(out), "--json"]) == 0
+    result = json.loads(capsys.readouterr().out)
+    assert result["rms_slip_pct"] < 0.15 and set(result["fitted"]) == {"cage_land_viscous_scale", "ball_drag_scale"}
+    params = BearingParameters.from_yaml(None, out)
+    assert params.ball_drag_scale == pytest.approx(result["fitted"]["ball_drag_scale"], rel=1e-5)
+
+
+def test_reproduce_writes_csvs_figures_and_report_then_reuses_its_cache(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["reproduce", "--out", str(tmp_path), "--quiet"]) == 0
+    assert "ran the experiments" in capsys.readouterr().out
+    for name in ("validation.csv", "load_sweep.csv", "acceleration.csv", "report.md"):
+        assert (tmp_path / name).stat().st_size > 100
+    for k in range(5, 11):
+        png = next(tmp_path.glob(f"fig{k:02d}_*.png"))
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
+    with (tmp_path / "validation.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [round(float(r["rpm"])) for r in rows] == [900, 1200, 1500, 1800, 2100, 2400, 2700]
+    report = (tmp_path / "report.md").read_text()
+    for rpm, (bench, paper) in PAPER_TABLE3.items():  # the paper's numbers stand beside the twin's
+        assert f"| {rpm} | {bench:.3g} | {paper:.3g} |" in report
+    with (tmp_path / "acceleration.csv").open() as fh:
+        assert {float(r["acceleration_rad_s2"]) for r in csv.DictReader(fh)} == {20.0, 40.0, 60.0, 80.0}
+    assert main(["reproduce", "--out", str(tmp_path), "--quiet"]) == 0
+    assert "reused cached results" in capsys.readouterr().out

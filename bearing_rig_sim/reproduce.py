@@ -234,21 +234,11 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
     ax.plot([r["rpm"] for r in rows], [r["slip_pct"] for r in rows], "o-", label="twin")
     ax.plot(list(PAPER_TABLE3), [v[0] for v in PAPER_TABLE3.values()], "s", label="bench (paper Table 3)")
     ax.plot(list(PAPER_TABLE3), [v[1] for v in PAPER_TABLE3.values()], "x", label="paper's model")
-    ax.set_xlabel("inner-ring speed n_i (rpm)")
-    ax.set_ylabel("cage slip rate S_c (%)")
-    ax.set_title("Fig. 5 analogue: slip at 100 N")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    files.append(_save(fig, out / "fig05_validation_slip.png"))
+    files.append(_finish(ax, fig, out / "fig05_validation_slip.png", "inner-ring speed n_i (rpm)", "cage slip rate S_c (%)", "Fig. 5 analogue: slip at 100 N"))
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot([r["rpm"] for r in rows], [r["cage_rpm"] for r in rows], "o-", label="twin cage speed")
     ax.plot([r["rpm"] for r in rows], [params.epicyclic_ratio * r["rpm"] for r in rows], "--", label="epicyclic n_s (Eq. 12)")
-    ax.set_xlabel("inner-ring speed n_i (rpm)")
-    ax.set_ylabel("cage speed n_c (rpm)")
-    ax.set_title("Fig. 6 analogue: cage speed at 100 N")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    files.append(_save(fig, out / "fig06_validation_cage_speed.png"))
+    files.append(_finish(ax, fig, out / "fig06_validation_cage_speed.png", "inner-ring speed n_i (rpm)", "cage speed n_c (rpm)", "Fig. 6 analogue: cage speed at 100 N"))
 
     # -- 2. load sweep ----------------------------------------------------------------------
     path = out / "load_sweep.csv"
@@ -295,18 +285,8 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
     lines += ["", f"The paper (Table 4, fits pooled): 1-term SSE {PAPER_TABLE4[1][0]}, R^2 {PAPER_TABLE4[1][1]}, RMSE {PAPER_TABLE4[1][2]}; "
               f"2-term SSE {PAPER_TABLE4[2][0]}, R^2 {PAPER_TABLE4[2][1]}, RMSE {PAPER_TABLE4[2][2]} (2 terms kept). "
               f"Table 5 at 1000 rpm: a1 {a[0]}, a2 {a[1]}, b1 {a[2]}, b2 {a[3]}, c1 {a[4]}, c2 {a[5]}; its other rows are garbled in the source.", ""]
-    for ax, fig, name, ylabel, title in (
-        (ax7, fig7, "fig07_load_sweep_cage_speed.png", "cage speed n_c (rpm)", "Fig. 7 analogue: cage speed against axial load"),
-        (ax8, fig8, "fig08_load_sweep_slip.png", "cage slip rate S_c (%)", "Fig. 8 analogue: slip against load (x: skid; lines: fits)"),
-    ):
-        ax.set_xlabel("axial load F_a (N)")
-        ax.set_ylabel(ylabel)
-        ax.set_title(title)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        if "slip" in name and all(v > 0 for line in ax.lines for v in np.asarray(line.get_ydata(), dtype=float)):
-            ax.set_yscale("log")
-        files.append(_save(fig, out / name))
+    files.append(_finish(ax7, fig7, out / "fig07_load_sweep_cage_speed.png", "axial load F_a (N)", "cage speed n_c (rpm)", "Fig. 7 analogue: cage speed against axial load"))
+    files.append(_finish(ax8, fig8, out / "fig08_load_sweep_slip.png", "axial load F_a (N)", "cage slip rate S_c (%)", "Fig. 8 analogue: slip against load (x: skid; lines: fits)", log_if_positive=True))
 
     # -- 3. acceleration sweep --------------------------------------------------------------
     path = out / "acceleration.csv"
@@ -348,16 +328,8 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         )
     lines += ["", f"The paper (Table 6): 1-term SSE {PAPER_TABLE6[1][0]}, R^2 {PAPER_TABLE6[1][1]}, RMSE {PAPER_TABLE6[1][2]}; "
               f"2-term SSE {PAPER_TABLE6[2][0]}, R^2 {PAPER_TABLE6[2][1]}, RMSE {PAPER_TABLE6[2][2]} (1 term kept).", ""]
-    for ax, fig, name, ylabel, title in (
-        (ax9, fig9, "fig09_acceleration_cage_speed.png", "cage speed n_c (rpm)", "Fig. 9 analogue: cage speed under constant acceleration"),
-        (ax10, fig10, "fig10_acceleration_slip.png", "cage slip rate S_c (%)", "Fig. 10 analogue: slip under constant acceleration (lines: 1-term fit)"),
-    ):
-        ax.set_xlabel("time t (s)")
-        ax.set_ylabel(ylabel)
-        ax.set_title(title)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-        files.append(_save(fig, out / name))
+    files.append(_finish(ax9, fig9, out / "fig09_acceleration_cage_speed.png", "time t (s)", "cage speed n_c (rpm)", "Fig. 9 analogue: cage speed under constant acceleration"))
+    files.append(_finish(ax10, fig10, out / "fig10_acceleration_slip.png", "time t (s)", "cage slip rate S_c (%)", "Fig. 10 analogue: slip under constant acceleration (lines: 1-term fit)"))
     plt.close("all")
 
     report = out / "report.md"
@@ -374,6 +346,18 @@ def _write_csv(path: Path, header: list[str], rows: list[list[Any]]) -> None:
         w.writerow(header)
         for row in rows:
             w.writerow([f"{v:.6g}" if isinstance(v, float) else v for v in row])
+
+
+def _finish(ax: Any, fig: Any, path: Path, xlabel: str, ylabel: str, title: str, log_if_positive: bool = False) -> Path:
+    """Label, grid and legend a figure's axes, then save it as PNG."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    if log_if_positive and all(v > 0 for line in ax.lines for v in np.asarray(line.get_ydata(), dtype=float)):
+        ax.set_yscale("log")
+    return _save(fig, path)
 
 
 def _save(fig: Any, path: Path) -> Path:

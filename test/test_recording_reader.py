@@ -273,8 +273,21 @@ def test_not_a_bag(tmp_path: Path, traffic_bag: tuple[Path, int]) -> None:
         open_bag(tmp_path / "notes.txt")
     stub = tmp_path / "stub.mcap"
     stub.write_bytes(b"\x89MC")
-    with pytest.raises(BagError, match="not an MCAP file"):
+    with pytest.raises(BagError, match="nothing readable: stub.mcap: file ends after 3 bytes, before its header"):
         open_bag(stub)
+
+
+def test_empty_file_of_a_split_bag_is_reported(tmp_path: Path, traffic_bag: tuple[Path, int]) -> None:
+    """A recorder killed just as it opened its next file leaves that file empty."""
+    bag = tmp_path / "traffic"
+    shutil.copytree(traffic_bag[0], bag)
+    (bag / "traffic_1.mcap").write_bytes(b"")
+    layout = yaml.safe_load((bag / "metadata.yaml").read_text())
+    layout["rosbag2_bagfile_information"]["relative_file_paths"].append("traffic_1.mcap")
+    (bag / "metadata.yaml").write_text(yaml.safe_dump(layout))
+    with pytest.warns(BagWarning, match="traffic_1.mcap: file ends after 0 bytes, before its header"):
+        reader = open_bag(bag)
+    assert sum(1 for _ in reader.messages()) == traffic_bag[1]
 
 
 @pytest.mark.parametrize(

@@ -185,6 +185,43 @@ def test_lost_metadata_yaml_is_rebuilt_identically(tmp_path: Path) -> None:
         assert reader.complete
 
 
+def test_corrupt_chunk_is_dropped_by_the_repair(tmp_path: Path) -> None:
+    bag = tmp_path / "run"
+    record_traffic(bag)
+    file = bag / "run_0.mcap"
+    chunks = chunk_bounds(file)
+    start, end, lost = chunks[2]
+    with open(file, "r+b") as stream:
+        stream.seek(end - 32)
+        stream.write(bytes(32))
+    total = sum(n for _s, _e, n in chunks)
+
+    report = repair_bag(bag)
+
+    assert report.files[0].action == "rebuilt"
+    assert any(f"chunk at offset {start}" in p for p in report.files[0].problems)
+    assert report.messages_recovered == total - lost
+    with AnyReader([bag]) as reader:
+        assert sum(1 for _ in reader.messages()) == total - lost
+
+
+def test_empty_file_left_at_a_rollover_gets_the_topics(tmp_path: Path) -> None:
+    bag = tmp_path / "run"
+    record_traffic(bag)
+    (bag / "run_1.mcap").write_bytes(b"")  # killed as the recorder opened its next file
+
+    report = repair_bag(bag)
+
+    assert [(f.name, f.action, f.messages_recovered) for f in report.files] == [("run_0.mcap", "intact", report.messages_recovered), ("run_1.mcap", "rebuilt", 0)]
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["relative_file_paths"] == ["run_0.mcap", "run_1.mcap"]
+    with open(bag / "run_1.mcap", "rb") as stream:
+        channels = make_reader(stream).get_summary().channels.values()
+    assert {c.topic for c in channels} == set(RIG_TRAFFIC_TOPICS)
+    with AnyReader([bag]) as reader:
+        assert sum(1 for _ in reader.messages()) == report.messages_recovered
+
+
 def test_file_that_is_not_mcap_is_moved_aside(tmp_path: Path) -> None:
     bag = tmp_path / "run"
     record_traffic(bag)

@@ -121,6 +121,7 @@ class FileIndex:
     Attributes:
         path: the file.
         indexed: True when the file had a valid summary (it was finished properly).
+        has_header: False when the file ends before its header record (nothing readable).
         profile / library: from the header record.
         schemas / channels: by id.
         chunks: message groups, in file order.
@@ -134,6 +135,7 @@ class FileIndex:
 
     path: Path
     indexed: bool = False
+    has_header: bool = False
     profile: str = ""
     library: str = ""
     schemas: dict[int, Schema] = field(default_factory=dict)
@@ -266,11 +268,11 @@ def _index_from_summary(stream: BinaryIO, index: FileIndex) -> bool:
         summary = SeekingReader(stream).get_summary()
     except (McapError, struct.error, ValueError, UnicodeDecodeError, EOFError):
         return False
-    if summary is None or summary.statistics is None or not summary.channels:
+    if summary is None or summary.statistics is None:
         return False
     stats = summary.statistics
-    if stats.message_count and not summary.chunk_indexes:
-        return False  # messages outside chunks: only a scan finds them
+    if stats.message_count and (not summary.chunk_indexes or not summary.channels):
+        return False  # messages outside chunks, or definitions not repeated: only a scan finds them
     for chunk in summary.chunk_indexes:
         if chunk.chunk_start_offset + chunk.chunk_length > index.file_size:
             return False
@@ -430,27 +432,49 @@ def index_file(path: Path) -> FileIndex:
     with stream:
         index.file_size = stream.seek(0, io.SEEK_END)
         stream.seek(0)
-        if stream.read(len(MAGIC)) != MAGIC:
+        magic = stream.read(len(MAGIC))
+        if magic != MAGIC[: len(magic)]:
             raise BagError(f"{path}: not an MCAP file (its first bytes are not the MCAP magic)")
-        head = stream.read(9)
-        if len(head) == 9 and head[0] == OP_HEADER:
-            (length,) = struct.unpack_from("<Q", head, 1)
-            try:
-                header = ReadDataStream(io.BytesIO(stream.read(min(length, 1 << 20))))
-                index.profile = header.read_prefixed_string()
-                index.library = header.read_prefixed_string()
-            except (McapError, struct.error, UnicodeDecodeError):
-                raise BagError(f"{path}: the MCAP header record is damaged") from None
-        elif len(head) < 9:
-            index.readable_bytes = len(MAGIC)
-            index.problems.append(f"{path.name}: file ends after the MCAP magic: no header, no data")
-            return index
-        else:
+        head = stream.read(9) if len(magic) == len(MAGIC) else b""
+        if len(head) == 9 and head[0] != OP_HEADER:
             raise BagError(f"{path}: not an MCAP file (no header record after the magic)")
+        length = struct.unpack_from("<Q", head, 1)[0] if len(head) == 9 else 0
+        body = stream.read(min(length, 1 << 20)) if len(head) == 9 else b""
+        if len(head) < 9 or len(body) < length:
+            index.problems.append(
+                f"{path.name}: file ends after {index.file_size} bytes, before its header is complete "
+                "(recording interrupted as it started?): no data"
+            )
+            return index
+        try:
+            header = ReadDataStream(io.BytesIO(body))
+            index.profile = header.read_prefixed_string()
+            index.library = header.read_prefixed_string()
+        except (McapError, struct.error, UnicodeDecodeError):
+            raise BagError(f"{path}: the MCAP header record is damaged") from None
+        index.has_header = True
+        index.readable_bytes = stream.tell()
         if _footer_ok(stream, index.file_size) and _index_from_summary(stream, index):
             return index
         _scan(stream, index)
+        if not index.problems:
+            index.problems.append(
+                f"{path.name}: no valid summary (index) at the end of the file; all "
+                f"{index.message_count} messages are readable, `repair_bag` restores the index"
+            )
     return index
+
+
+def check_chunks(index: FileIndex) -> list[str]:
+    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk."""
+    problems = []
+    with open(index.path, "rb") as stream:
+        for ref in index.chunks:
+            try:
+                read_chunk_messages(stream, ref)
+            except DamagedRecord as exc:
+                problems.append(f"{index.path.name}: chunk at offset {ref.offset}: {exc}")
+    return problems
 
 
 def _lazy_chunk(

@@ -141,11 +141,14 @@ class BagReader:
         else:
             files = [self.path]
         self._indexes: list[FileIndex] = [index_file(f) for f in files]
+        if self._indexes and not any(i.has_header for i in self._indexes):
+            raise BagError(f"{self.path}: nothing readable: " + "; ".join(p for i in self._indexes for p in i.problems))
         for index in self._indexes:
             for problem in index.problems:
                 self._report(problem)
         self._store = self._build_typestore()
         self._decoders: dict[str, Callable[[bytes], object]] = {}
+        self._channel_topics: list[dict[int, str]] = []
         self._topics = self._collect_topics()
         self._check_layout()
 
@@ -295,7 +298,6 @@ class BagReader:
 
     def _collect_topics(self) -> dict[str, TopicInfo]:
         found = layout_from_indexes(self._indexes, self.layout, self._report)
-        self._channel_topics: list[dict[int, str]] = []
         types = {t.name: t.msgtype for t in found.topics}
         for index in self._indexes:
             self._channel_topics.append(

@@ -5,7 +5,7 @@ possibly ending inside a chunk, and a ``metadata.yaml`` with stale counts. The p
 already reads such a bag up to its last complete chunk; other tools (rosbags, ``ros2 bag``,
 Foxglove's indexed loading) need the index back. :func:`repair_bag` rebuilds it:
 
-1. every storage file is indexed; a finished one is left alone;
+1. every storage file is indexed and its chunks checked; a finished, undamaged one is left alone;
 2. a damaged one is read up to its last complete chunk (damaged chunks in the middle are
    skipped) and rewritten as a finished MCAP file with summary and indexes; the original is kept
    beside it as ``<name>.mcap.orig``; a file that is not MCAP at all is moved aside the same way;
@@ -36,7 +36,7 @@ from bearing_rig_sim.recording.layout import (
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.recording.mcapfile import CountingSink, FileIndex, index_file, iter_file_messages
+from bearing_rig_sim.recording.mcapfile import CountingSink, FileIndex, check_chunks, index_file, iter_file_messages
 from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore
 from bearing_rig_sim.recording.writer import DEFAULT_CHUNK_SIZE
 
@@ -199,6 +199,8 @@ def repair_bag(path: str | Path) -> RepairReport:
             os.replace(file, backup)
             report.files.append(FileRepair(file.name, "removed", backup=backup, problems=[str(exc)]))
             continue
+        if index.indexed and not index.problems:
+            index.problems.extend(check_chunks(index))
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)

@@ -54,46 +54,6 @@ class DamagedRecord(Exception):
     """A chunk or record cannot be used (truncated, bad checksum, undecompressable)."""
 
 
-class CountingSink:
-    """Unbuffered output file that knows how many bytes were written.
-
-    Each write goes straight to the operating system, so every chunk the MCAP writer has finished
-    survives a kill of the recording process; :attr:`position` lets the writer split files by
-    size without a system call.
-    """
-
-    def __init__(self, path: Path) -> None:
-        try:
-            self._file = open(path, "xb", buffering=0)  # noqa: SIM115 - closed by close()
-        except FileExistsError:
-            raise BagError(f"{path}: exists already, not overwriting") from None
-        except OSError as exc:
-            raise BagError(f"{path}: cannot create ({exc.strerror or exc})") from None
-        self.path = path
-        self.position = 0
-
-    def write(self, data: bytes | bytearray | memoryview) -> int:
-        """Write everything (looping over partial writes); returns the byte count."""
-        view = memoryview(data)
-        total = len(view)
-        while view:
-            written = self._file.write(view)
-            view = view[written:]
-        self.position += total
-        return total
-
-    def tell(self) -> int:
-        """Bytes written so far."""
-        return self.position
-
-    def flush(self) -> None:
-        """Nothing to do: writes are not buffered."""
-
-    def close(self) -> None:
-        """Close the file."""
-        self._file.close()
-
-
 @dataclass(frozen=True)
 class ChunkRef:
     """Where a group of messages lies in a file.

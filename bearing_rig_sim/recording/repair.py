@@ -36,9 +36,9 @@ from bearing_rig_sim.recording.layout import (
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.recording.mcapfile import CountingSink, FileIndex, check_chunks, index_file, iter_file_messages
+from bearing_rig_sim.recording.mcapfile import FileIndex, check_chunks, index_file, iter_file_messages
 from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore
-from bearing_rig_sim.recording.writer import DEFAULT_CHUNK_SIZE
+from bearing_rig_sim.recording.writer import DEFAULT_CHUNK_SIZE, CountingSink
 
 BACKUP_SUFFIX = ".orig"
 """Appended to the name of a file the repair replaced (``run_0.mcap.orig``)."""

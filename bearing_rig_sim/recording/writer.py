@@ -47,7 +47,6 @@ from bearing_rig_sim.recording.layout import (
     storage_file_name,
     write_layout,
 )
-from bearing_rig_sim.recording.mcapfile import CountingSink
 from bearing_rig_sim.recording.qos import QosSpec, qos_spec
 from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore, type_hash
 
@@ -66,6 +65,46 @@ def normalise_msgtype(msgtype: str) -> str:
     if len(parts) == 2:
         return f"{parts[0]}/msg/{parts[1]}"
     return msgtype
+
+
+class CountingSink:
+    """Unbuffered output file that knows how many bytes were written.
+
+    Each write goes straight to the operating system, so every chunk the MCAP writer has finished
+    survives a kill of the recording process; :attr:`position` lets the writer split files by
+    size without a system call.
+    """
+
+    def __init__(self, path: Path) -> None:
+        try:
+            self._file = open(path, "xb", buffering=0)  # noqa: SIM115 - closed by close()
+        except FileExistsError:
+            raise BagError(f"{path}: exists already, not overwriting") from None
+        except OSError as exc:
+            raise BagError(f"{path}: cannot create ({exc.strerror or exc})") from None
+        self.path = path
+        self.position = 0
+
+    def write(self, data: bytes | bytearray | memoryview) -> int:
+        """Write everything (looping over partial writes); returns the byte count."""
+        view = memoryview(data)
+        total = len(view)
+        while view:
+            written = self._file.write(view)
+            view = view[written:]
+        self.position += total
+        return total
+
+    def tell(self) -> int:
+        """Bytes written so far."""
+        return self.position
+
+    def flush(self) -> None:
+        """Nothing to do: writes are not buffered."""
+
+    def close(self) -> None:
+        """Close the file."""
+        self._file.close()
 
 
 @dataclass

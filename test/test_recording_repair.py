@@ -15,6 +15,7 @@ from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
 from bearing_rig_sim.recording import BagError, BagWarning, BagWriter, open_bag, repair_bag
+from bearing_rig_sim.recording.repair import main as repair_main
 from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, rig_traffic
 
 REPO = Path(__file__).resolve().parents[1]
@@ -247,3 +248,14 @@ def test_repair_refuses_what_is_not_a_bag(tmp_path: Path) -> None:
     assert not repair_bag(intact).changed
     assert {p.name: p.read_bytes() for p in intact.iterdir()} == before
     shutil.rmtree(intact)
+
+
+def test_repair_from_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bag = tmp_path / "run"
+    record_traffic(bag)
+    (bag / "metadata.yaml").unlink()
+    assert repair_main([str(bag), str(tmp_path / "missing")]) == 2
+    out, err = capsys.readouterr()
+    assert "metadata.yaml: rebuilt from the files" in out
+    assert err.startswith("error: ") and "missing: not a bag directory" in err
+    assert (bag / "metadata.yaml").exists()

@@ -12,12 +12,15 @@ Foxglove's indexed loading) need the index back. :func:`repair_bag` rebuilds it:
 3. ``metadata.yaml`` is rebuilt from what the files hold (the old one, if any and different, is
    kept as ``metadata.yaml.orig``).
 
-Repairing a bag that needs nothing changes nothing.
+Repairing a bag that needs nothing changes nothing. From a shell, until the ``bearing-rig``
+command has its ``bag repair`` sub-command: ``python -m bearing_rig_sim.recording repair BAG...``.
 """
 
 from __future__ import annotations
 
+import argparse
 import os
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
@@ -226,3 +229,18 @@ def repair_bag(path: str | Path) -> RepairReport:
         write_layout(bag_dir, layout)
         report.metadata_rewritten = True
     return report
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Repair each bag named in ``argv`` and say what was done; exit status 2 if a path is not
+    a bag (``python -m bearing_rig_sim.recording repair BAG...``)."""
+    parser = argparse.ArgumentParser(description="Restore the index of bags whose recording was interrupted.")
+    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="bag directory")
+    status = 0
+    for bag in parser.parse_args(argv).bags:
+        try:
+            print(repair_bag(bag).summary())
+        except BagError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            status = 2
+    return status

@@ -58,6 +58,8 @@ setup(
             # ROS 2 node executables (`ros2 run bearing_rig_sim <name>`) are added here with the
             # nodes themselves, e.g. "simulator = bearing_rig_sim.nodes.simulator:main",
             # "load_controller = ...", "monitor = ...".
+            "load_controller = bearing_rig_sim.nodes.load_controller:main",
+            "bearing-rig-load-controller = bearing_rig_sim.nodes.load_controller:main",
         ],
     },
 )

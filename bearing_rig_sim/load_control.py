@@ -1,0 +1,322 @@
+"""The load controller's operation of the axial loading chain on the simulation clock (no ROS).
+
+:class:`AxialLoadOperation` is what the ``load_controller`` node does, without the node: it owns a
+:class:`~bearing_rig_sim.rig.loading.LoadingChain`, takes axial-load set-point requests from any
+source (topic, service, parameter), answers each with accepted/refused and a reason, steps the
+chain by the simulation time elapsed between two clock readings, says when the state and the
+diagnostics are due, and keeps the health shown on ``/diagnostics``.
+
+Policies (the node's documentation repeats them):
+
+* **Stepping.** :meth:`AxialLoadOperation.advance_to` steps the chain by the sim time elapsed
+  since the last call, in sub-steps of at most ``max_substep_s`` (1 ms), so the chain keeps up
+  however many clock ticks arrive at once when the simulator runs faster than real time. The
+  first clock reading only starts the count. A clock that goes back (a simulator restart, a
+  replay that loops) restarts the count without stepping; a forward gap longer than
+  ``max_clock_gap_s`` (a paused process, a clock jump) is stepped as ``max_clock_gap_s`` only.
+* **Set-points.** A request that is not a finite number, is negative or is above the chain's
+  ``max_setpoint_n`` is refused: the previous set-point stays, the reason is returned and the
+  health turns WARN until the next accepted set-point (or a fault reset).
+* **Interlocks** (load limit, rate limit, clutch slip; :class:`~bearing_rig_sim.rig.loading.LoadingChain`)
+  latch a fault: the brake is de-energised and the health is ERROR with the interlock's reason.
+  **A fault is cleared only by** :meth:`AxialLoadOperation.reset_fault` (the node's
+  ``reset_fault`` service), and only once its cause is gone: the load cell reads at or below the
+  load limit, the clutch no longer slips, and the set-point in force is below the clutch's
+  holding force (else it would slip again at once). A set-point given while a fault is latched is
+  accepted and stored, and takes effect after the reset; it does not clear the fault by itself
+  (a latched interlock wants an explicit acknowledgement).
+
+Units: N, s throughout.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import Enum
+
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.rig.loading import ClutchState, LoadChainState, LoadingChain, LoadingChainConfig, SetpointError
+
+__all__ = [
+    "AdvanceResult",
+    "AxialLoadOperation",
+    "Health",
+    "HealthLevel",
+    "Reply",
+    "SetpointSource",
+    "closed_loop_time_constant",
+    "settle_time_bound",
+]
+
+
+class SetpointSource(str, Enum):
+    """Where a set-point request came from; compares equal to its string value."""
+
+    TOPIC = "topic"
+    SERVICE = "service"
+    PARAMETER = "parameter"
+
+
+class HealthLevel(str, Enum):
+    """Level of the load controller's diagnostic status; compares equal to its string value."""
+
+    OK = "ok"
+    WARN = "warn"
+    ERROR = "error"
+
+
+@dataclass(frozen=True)
+class Health:
+    """What ``/diagnostics`` says about the load controller."""
+
+    level: HealthLevel
+    message: str
+
+
+@dataclass(frozen=True)
+class Reply:
+    """Answer to a request (set-point, fault reset, clutch command)."""
+
+    accepted: bool
+    message: str
+    """Why it was refused, or what is now in force."""
+
+
+@dataclass(frozen=True)
+class AdvanceResult:
+    """What one clock reading did (see :meth:`AxialLoadOperation.advance_to`)."""
+
+    time: float
+    """Simulation time now, s."""
+    stepped: float
+    """Chain time advanced, s (0 for the first reading or a clock that went back)."""
+    state: LoadChainState
+    """The chain's state after the step."""
+    state_due: bool
+    """The state message is due (one per ``state_period_s`` of sim time)."""
+    diagnostics_due: bool
+    """The diagnostics are due: their period of sim time elapsed, or the health changed since
+    last reported (the caller publishes them; the health counts as reported)."""
+    tripped: str
+    """The interlock reason if a fault latched during this step, else empty."""
+    clock_note: str
+    """Why the clock was not stepped as read (went back, gap capped); empty normally."""
+
+
+class AxialLoadOperation:
+    """Set-point requests, fault latch and reset, and clock-driven stepping of a loading chain.
+
+    Args:
+        chain: the loading chain to operate (its clutch is engaged here when ``engage`` is True).
+        state_period_s: sim time between two state messages, s (> 0).
+        diagnostics_period_s: sim time between two periodic diagnostics, s (> 0).
+        max_clock_gap_s: longest clock advance stepped at once, s (> 0).
+        engage: engage the clutch at start.
+
+    Raises:
+        RigError: a period or gap that is not a finite number > 0.
+    """
+
+    def __init__(
+        self,
+        chain: LoadingChain,
+        *,
+        state_period_s: float = 0.01,
+        diagnostics_period_s: float = 1.0,
+        max_clock_gap_s: float = 1.0,
+        engage: bool = True,
+    ) -> None:
+        for name, value in (
+            ("state_period_s", state_period_s),
+            ("diagnostics_period_s", diagnostics_period_s),
+            ("max_clock_gap_s", max_clock_gap_s),
+        ):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0.0:
+                raise RigError(f"load controller: {name} must be a finite number > 0 s, got {value!r}")
+        self.chain = chain
+        self.state_period = float(state_period_s)
+        self.diagnostics_period = float(diagnostics_period_s)
+        self.max_clock_gap = float(max_clock_gap_s)
+        self._time: float | None = None
+        self._next_state = 0.0
+        self._next_diagnostics = 0.0
+        self._refusal = ""
+        self._reported: Health | None = None
+        if engage:
+            chain.engage()
+
+    @classmethod
+    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> "AxialLoadOperation":
+        """An operation of a new chain built from ``config`` (options as in the constructor)."""
+        return cls(LoadingChain(config), **options)  # type: ignore[arg-type]
+
+    # -- requests ---------------------------------------------------------------------------------
+    @property
+    def time(self) -> float | None:
+        """Simulation time of the last clock reading, s; None before the first."""
+        return self._time
+
+    @property
+    def setpoint(self) -> float:
+        """Set-point in force, N."""
+        return self.chain.setpoint
+
+    def request_setpoint(self, force_n: object, source: SetpointSource | str) -> Reply:
+        """Ask for an axial load of ``force_n`` N.
+
+        Returns:
+            Accepted (the set-point in force, noting a latched fault), or refused with the reason
+            (the previous set-point stays; the health turns WARN until the next accepted one).
+        """
+        origin = SetpointSource(source).value
+        try:
+            self.chain.set_setpoint(force_n)  # type: ignore[arg-type]
+        except SetpointError as exc:
+            self._refusal = f"set-point by {origin} refused: {exc}"
+            return Reply(False, self._refusal)
+        self._refusal = ""
+        message = f"axial-load set-point {self.chain.setpoint:g} N (by {origin})"
+        if self.chain.fault:
+            message += f"; interlock fault latched ({self.chain.fault_reason}): takes effect after reset_fault"
+        return Reply(True, message)
+
+    def fault_cause_present(self) -> str:
+        """Why a latched fault cannot be reset yet; empty when its cause is gone."""
+        state = self.chain.state()
+        limit = self.chain.config.interlocks.max_force_n
+        if state.load_cell_force > limit:
+            return f"the load cell still reads {state.load_cell_force:.1f} N > max_force_n {limit:g} N"
+        if state.clutch_state is ClutchState.SLIPPING:
+            return "the clutch is still slipping"
+        holding = self.chain.config.clutch.holding_force_n
+        if self.chain.setpoint >= holding:
+            return f"the set-point {self.chain.setpoint:g} N would make the clutch slip (holding force {holding:g} N): lower it first"
+        return ""
+
+    def reset_fault(self) -> Reply:
+        """Clear a latched interlock fault once its cause is gone (see the module documentation).
+
+        Returns:
+            Accepted (fault cleared, or none was latched), or refused with what still persists.
+        """
+        if not self.chain.fault:
+            self._refusal = ""
+            return Reply(True, "no interlock fault latched")
+        cause = self.fault_cause_present()
+        if cause:
+            return Reply(False, f"fault not reset ({self.chain.fault_reason}): {cause}")
+        reason = self.chain.fault_reason
+        self.chain.reset_fault()
+        self._refusal = ""
+        return Reply(True, f"fault reset ({reason}); set-point {self.chain.setpoint:g} N in force")
+
+    def set_clutch(self, engage: bool) -> Reply:
+        """Engage (True) or release (False) the magnet clutch."""
+        if engage:
+            self.chain.engage()
+            return Reply(True, "clutch engaged")
+        self.chain.release()
+        return Reply(True, "clutch released: no axial load reaches the bearing")
+
+    # -- clock ----------------------------------------------------------------------------------
+    def advance_to(self, sim_time: float) -> AdvanceResult:
+        """Step the chain to the simulation time ``sim_time`` (s) (see the module documentation).
+
+        Raises:
+            RigError: ``sim_time`` is not a finite number >= 0.
+        """
+        if isinstance(sim_time, bool) or not isinstance(sim_time, (int, float)) or not math.isfinite(sim_time) or sim_time < 0.0:
+            raise RigError(f"load controller: clock time must be a finite number >= 0 s, got {sim_time!r}")
+        was_faulted = self.chain.fault
+        previous = self._time
+        note = ""
+        stepped = 0.0
+        if previous is None:
+            self._schedule_from(sim_time)
+        elif sim_time < previous:
+            note = f"clock went back from {previous:.6f} s to {sim_time:.6f} s: restarting the step count"
+            self._schedule_from(sim_time)
+        elif sim_time > previous:
+            stepped = sim_time - previous
+            if stepped > self.max_clock_gap:
+                note = f"clock advanced {stepped:.3f} s at once: stepping {self.max_clock_gap:g} s (max_clock_gap_s)"
+                stepped = self.max_clock_gap
+            self.chain.step(stepped)
+        self._time = float(sim_time)
+        state = self.chain.state()
+        state_due = sim_time >= self._next_state - 1e-9
+        if state_due:
+            self._next_state = _next_multiple(sim_time, self.state_period)
+        health = self.health()
+        diagnostics_due = sim_time >= self._next_diagnostics - 1e-9 or health != self._reported
+        if diagnostics_due:  # the caller publishes them now
+            self._next_diagnostics = sim_time + self.diagnostics_period
+            self._reported = health
+        tripped = state.fault_reason if state.fault and not was_faulted else ""
+        return AdvanceResult(float(sim_time), stepped, state, state_due, diagnostics_due, tripped, note)
+
+    def _schedule_from(self, sim_time: float) -> None:
+        self._next_state = sim_time
+        self._next_diagnostics = sim_time
+
+    # -- health -----------------------------------------------------------------------------------
+    def health(self) -> Health:
+        """ERROR while an interlock fault is latched, WARN after a refused set-point, else OK.
+
+        The message changes only with the condition (not with the measured force), so "the
+        health changed" means something happened; the live values go beside it."""
+        chain = self.chain
+        if chain.fault:
+            return Health(HealthLevel.ERROR, f"interlock: {chain.fault_reason}")
+        if self._refusal:
+            return Health(HealthLevel.WARN, self._refusal)
+        if chain.clutch.state is ClutchState.RELEASED:
+            return Health(HealthLevel.OK, f"clutch released; set-point {chain.setpoint:g} N")
+        return Health(HealthLevel.OK, f"controlling the axial load; set-point {chain.setpoint:g} N")
+
+    def mark_reported(self, health: Health) -> None:
+        """Note that ``health`` was published (diagnostics are due again when it changes)."""
+        self._reported = health
+
+    def health_changed(self) -> bool:
+        """The health differs from the one last reported."""
+        return self.health() != self._reported
+
+
+def _next_multiple(t: float, period: float) -> float:
+    """The first multiple of ``period`` after ``t``."""
+    return (math.floor(t / period + 1e-9) + 1) * period
+
+
+def closed_loop_time_constant(config: LoadingChainConfig, force_n: float) -> float:
+    """Time constant of the closed force loop near ``force_n`` N, s.
+
+    The PI controller with Ti = Kp/Ki = L/R cancels the coil's pole, leaving a first-order loop
+    ``tau = (L/R) / (Kp K)``, K the plant gain d(bearing force)/d(voltage) at that force:
+    ``K = k_f (1 - (F_b/F_sat)^2) r / R`` (tanh saturation of the brake, lever ratio r; the
+    mechanics, some hundred hertz, is much faster and left out).
+    """
+    brake, controller = config.brake, config.controller
+    brake_force = force_n / config.lever.force_ratio
+    slope = brake.force_constant_n_per_a * max(0.0, 1.0 - (brake_force / brake.saturation_force_n) ** 2)
+    gain = slope * config.lever.force_ratio / brake.resistance_ohm
+    return (brake.inductance_h / brake.resistance_ohm) / (controller.proportional_gain_v_per_n * gain)
+
+
+def settle_time_bound(config: LoadingChainConfig, start_n: float, target_n: float, band: float = 0.02) -> float:
+    """Longest time for the bearing force to settle within ``band`` (fraction) of ``target_n``
+    after a set-point step from a settled ``start_n``, s.
+
+    The set-point ramps at ``setpoint_rate_n_per_s`` (``|target - start| / rate``); a first-order
+    loop following a ramp lags by ``rate * tau``, which then decays to ``band * target`` in
+    ``tau ln(rate tau / (band target))``; 2 tau more cover what the first-order picture leaves
+    out (the coil pole not exactly cancelled away from the working point, the load cell's filter,
+    one control period of delay). tau is the slower of the two ends
+    (:func:`closed_loop_time_constant`).
+    """
+    if target_n <= 0.0 or not 0.0 < band < 1.0:
+        raise RigError(f"settle_time_bound: need target_n > 0 N and 0 < band < 1, got {target_n!r}, {band!r}")
+    rate = config.controller.setpoint_rate_n_per_s
+    tau = max(closed_loop_time_constant(config, f) for f in (start_n, target_n))
+    return abs(target_n - start_n) / rate + tau * max(0.0, math.log(rate * tau / (band * target_n))) + 2.0 * tau

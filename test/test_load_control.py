@@ -1,0 +1,159 @@
+"""The load controller's operation of the loading chain, without ROS: stepping by elapsed sim time
+(batched ticks give the same chain as single ticks; a clock that goes back or jumps), the state
+and diagnostics schedule, set-point refusals and the health they leave, the fault latch and its
+reset policy, and the stated settle-time bound.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, SetpointSource, settle_time_bound
+from bearing_rig_sim.rig.loading import LoadingChainConfig
+
+
+@pytest.fixture(scope="module")
+def config() -> LoadingChainConfig:
+    return LoadingChainConfig.from_yaml()
+
+
+def weak_clutch(config: LoadingChainConfig, holding: float = 300.0) -> LoadingChainConfig:
+    return dataclasses.replace(config, clutch=dataclasses.replace(config.clutch, holding_force_n=holding))
+
+
+def drive(op: AxialLoadOperation, start: float, stop: float, tick: float) -> list:
+    """Clock readings every ``tick`` s from ``start`` (exclusive) to ``stop``; the results."""
+    n = int(round((stop - start) / tick))
+    return [op.advance_to(start + (k + 1) * tick) for k in range(n)]
+
+
+def test_first_reading_starts_the_count_and_later_ones_step_the_elapsed_time(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config)
+    first = op.advance_to(5.0)
+    assert first.stepped == 0.0 and op.chain.time == 0.0
+    later = op.advance_to(5.004)
+    assert later.stepped == pytest.approx(0.004) and op.chain.time == pytest.approx(0.004)
+
+
+def test_batched_ticks_step_the_same_chain_as_single_ticks(config: LoadingChainConfig) -> None:
+    """A simulator faster than real time delivers ticks in bursts; the node takes the latest:
+    the chain must end where 1 ms ticks take it (sub-steps of max_substep_s)."""
+    single, batched = AxialLoadOperation.from_config(config), AxialLoadOperation.from_config(config)
+    for op in (single, batched):
+        op.advance_to(0.0)
+        assert op.request_setpoint(400.0, SetpointSource.TOPIC).accepted
+    drive(single, 0.0, 0.3, 0.001)
+    drive(batched, 0.0, 0.3, 0.010)
+    a, b = single.chain.state(), batched.chain.state()
+    assert a.bearing_force == pytest.approx(b.bearing_force, rel=1e-9)
+    assert a.load_cell_force == pytest.approx(b.load_cell_force, rel=1e-9)
+    assert a.time == pytest.approx(0.3) and b.time == pytest.approx(0.3)
+
+
+def test_clock_going_back_restarts_the_count_and_a_jump_is_capped(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config, max_clock_gap_s=0.5)
+    drive(op, 0.0, 1.0, 0.01)
+    back = op.advance_to(0.2)
+    assert back.stepped == 0.0 and "went back" in back.clock_note
+    assert op.chain.time == pytest.approx(1.0 - 0.01)  # first reading of drive() did not step
+    jump = op.advance_to(100.0)
+    assert jump.stepped == pytest.approx(0.5) and "max_clock_gap_s" in jump.clock_note
+    assert op.advance_to(100.001).clock_note == ""
+
+
+@pytest.mark.parametrize("tick", [0.001, 0.003, 0.010])
+def test_state_is_due_at_its_rate_of_sim_time_whatever_the_tick(config: LoadingChainConfig, tick: float) -> None:
+    op = AxialLoadOperation.from_config(config, state_period_s=0.01, diagnostics_period_s=0.25)
+    op.advance_to(0.0)
+    results = drive(op, 0.0, 1.0, tick)
+    assert sum(r.state_due for r in results) == pytest.approx(100, abs=1)
+    periodic = [r.time for r in results if r.diagnostics_due]
+    assert len(periodic) == pytest.approx(4, abs=1)  # health unchanged: only the period
+
+
+def test_refused_setpoints_keep_the_previous_one_and_warn_until_the_next_accepted(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config)
+    assert op.request_setpoint(150.0, "service").accepted
+    for bad, word in ((math.nan, "finite"), (-1.0, ">= 0"), (1e4, "<= 1000"), ("ten", "number"), (True, "number")):
+        reply = op.request_setpoint(bad, SetpointSource.PARAMETER)
+        assert not reply.accepted and word in reply.message and "by parameter" in reply.message
+        assert op.setpoint == 150.0
+        health = op.health()
+        assert health.level is HealthLevel.WARN and word in health.message
+    assert op.request_setpoint(0, SetpointSource.TOPIC).accepted
+    assert op.health().level is HealthLevel.OK
+
+
+def test_health_change_makes_diagnostics_due_at_once(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config, diagnostics_period_s=10.0)
+    assert op.advance_to(0.0).diagnostics_due  # the first reading reports
+    assert not op.advance_to(0.001).diagnostics_due
+    op.request_setpoint(-3.0, SetpointSource.TOPIC)
+    assert op.health_changed() and op.advance_to(0.002).diagnostics_due
+
+
+def test_fault_latches_and_resets_only_once_its_cause_is_gone(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(weak_clutch(config))
+    op.advance_to(0.0)
+    op.request_setpoint(500.0, SetpointSource.SERVICE)
+    results = drive(op, 0.0, 0.3, 0.001)
+    tripped = [r for r in results if r.tripped]
+    assert len(tripped) == 1 and tripped[0].tripped.startswith("clutch slip")
+    assert op.health().level is HealthLevel.ERROR
+    refused = op.reset_fault()
+    assert not refused.accepted and "holding force 300 N" in refused.message
+    stored = op.request_setpoint(200.0, SetpointSource.TOPIC)
+    assert stored.accepted and "after reset_fault" in stored.message
+    drive(op, 0.3, 0.6, 0.001)
+    assert op.chain.fault and op.chain.state().bearing_force < 5.0  # a set-point does not clear it
+    assert op.reset_fault().accepted
+    drive(op, 0.6, 1.2, 0.001)
+    state = op.chain.state()
+    assert not state.fault and state.bearing_force == pytest.approx(200.0, rel=0.02)
+    assert op.health().level is HealthLevel.OK
+
+
+def test_reset_is_refused_while_the_load_cell_is_over_the_limit(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config)
+    op.advance_to(0.0)
+    op.chain.set_manual_voltage(config.brake.voltage_limit_v)  # a runaway: the rate limit trips
+    results = drive(op, 0.0, 0.05, 0.001)
+    assert any(r.tripped.startswith("rate limit") for r in results)
+    assert op.reset_fault().accepted  # the brake is off and the force falls: nothing persists
+    assert op.reset_fault().message == "no interlock fault latched"
+
+
+def test_clutch_release_and_engage(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation.from_config(config, engage=False)
+    assert op.chain.state().clutch_state == "released"
+    op.request_setpoint(300.0, SetpointSource.TOPIC)
+    op.advance_to(0.0)
+    drive(op, 0.0, 0.3, 0.001)
+    assert op.chain.state().bearing_force == 0.0 and "clutch released" in op.health().message
+    assert op.set_clutch(True).accepted
+    drive(op, 0.3, 0.9, 0.001)
+    assert op.chain.state().bearing_force == pytest.approx(300.0, rel=0.02)
+
+
+def test_settle_time_bound_grows_with_the_step_and_states_the_chain_under_a_quarter_second(
+    config: LoadingChainConfig,
+) -> None:
+    small, large = settle_time_bound(config, 0.0, 100.0), settle_time_bound(config, 0.0, 1000.0)
+    assert small < large
+    assert settle_time_bound(config, 0.0, 500.0) < 0.25
+    with pytest.raises(RigError):
+        settle_time_bound(config, 0.0, 0.0)
+
+
+@pytest.mark.parametrize("option", ["state_period_s", "diagnostics_period_s", "max_clock_gap_s"])
+@pytest.mark.parametrize("bad", [0.0, -1.0, math.nan, math.inf])
+def test_bad_options_and_clock_times_are_refused(config: LoadingChainConfig, option: str, bad: float) -> None:
+    with pytest.raises(RigError, match=option):
+        AxialLoadOperation.from_config(config, **{option: bad})
+    op = AxialLoadOperation.from_config(config)
+    with pytest.raises(RigError, match="clock time"):
+        op.advance_to(bad if bad != 0.0 else -0.5)

@@ -60,6 +60,10 @@ setup(
             # "load_controller = ...", "monitor = ...".
             "load_controller = bearing_rig_sim.nodes.load_controller:main",
             "bearing-rig-load-controller = bearing_rig_sim.nodes.load_controller:main",
+            "simulator = bearing_rig_sim.nodes.simulator:main",
+            "bearing-rig-simulator = bearing_rig_sim.nodes.simulator:main",
+            "monitor = bearing_rig_sim.nodes.monitor:main",
+            "bearing-rig-monitor = bearing_rig_sim.nodes.monitor:main",
         ],
     },
 )

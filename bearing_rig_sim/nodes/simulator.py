@@ -1,0 +1,311 @@
+"""The simulator node: the rig's digital twin on the bench's topics (a thin shell around
+:class:`~bearing_rig_sim.simulation.twin.RigTwin`).
+
+Publishes (interface table, docs/interfaces.md):
+
+* ``/clock`` (rosgraph_msgs/Clock, reliable, depth 10): the simulated time, once per chunk
+  (1 kHz simulated with 1 ms chunks), so the other nodes can run on ``use_sim_time``;
+* ``/rig/spindle/pulses``, ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse, sensor data):
+  one per strip passage, stamped with the pulse time on the simulated clock;
+* ``/rig/speeds`` (sensor_msgs/JointState, sensor data, ``speeds_rate_hz`` simulated): names
+  ``inner_ring`` and ``cage``, velocity from the pulse counters (rad/s), position the
+  pulse-counted angle (rad), effort empty;
+* ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, sensor data, ``truth_rate_hz`` simulated):
+  the engine's ground truth with the achieved real-time factor and the overrun count;
+* ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
+  on every change of level (see :mod:`bearing_rig_sim.simulation.health`).
+
+Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
+and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable). Bad input
+is refused with a logged reason and an ERROR on /diagnostics; the node goes on.
+
+One timer on the steady clock drives the loop (no threads): in real time it runs the chunks the
+wall clock asks for (:class:`~bearing_rig_sim.simulation.pacing.RealTimePacer`), otherwise a
+batch of ``max_batch_chunks`` per call, as fast as possible. ``simulator --no-realtime`` sets
+the parameter ``realtime`` to false.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from typing import Any, Sequence
+
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import JointState
+
+from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SpindleCommand as SpindleCommandMsg
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.nodes.common import (
+    RELIABLE_QOS,
+    SENSOR_QOS,
+    STATUS_QOS,
+    diagnostic_array,
+    diagnostic_status,
+    from_stamp,
+    run_node,
+    to_stamp,
+)
+from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
+from bearing_rig_sim.simulation.health import Health, HealthLevel, SimulatorHealth
+from bearing_rig_sim.simulation.pacing import RealTimePacer
+from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
+from bearing_rig_sim.simulation.twin import RigTwin, TickOutput
+
+NO_REALTIME_FLAG = "--no-realtime"
+"""Command-line flag: run as fast as possible (parameter ``realtime`` false)."""
+
+MAX_UINT32 = 2**32 - 1
+
+
+class SimulatorNode(Node):
+    """The simulator node (see the module docstring).
+
+    Raises:
+        ConfigError: a parameter or a configuration file it names is malformed.
+    """
+
+    def __init__(self, **node_options: Any) -> None:
+        super().__init__(NODE_NAME, **node_options)
+        values = declare_and_read(self, shipped_parameters())
+        s = SimulatorSettings.from_values(values, f"{NODE_NAME} parameters")
+        self.settings = s
+        self.twin = RigTwin.from_files(
+            s.bearing_file,
+            s.calibration_file,
+            s.rig_file,
+            model=s.model,
+            chunk=s.chunk_s,
+            initial_speed=s.initial_speed_rad_s,
+            initial_axial_load=s.initial_axial_load_n,
+            counter_timeout=s.counter_timeout_s,
+            max_speed=s.max_spindle_speed_rad_s,
+            max_acceleration=s.max_spindle_acceleration_rad_s2,
+            max_command_lead=s.max_command_lead_s,
+        )
+        self.pacer = RealTimePacer(
+            s.chunk_s,
+            loop_period=s.loop_period_s,
+            realtime=s.realtime,
+            rate=s.rate,
+            overrun_margin=s.overrun_margin_s,
+            rtf_window=s.rtf_window_s,
+            max_batch=s.max_batch_chunks,
+            resync_lag=s.resync_lag_s,
+        )
+        self.health = SimulatorHealth(s.fault_hold_s)
+        self._speeds_every = max(1, round(1.0 / (s.speeds_rate_hz * s.chunk_s)))
+        self._truth_every = max(1, round(1.0 / (s.truth_rate_hz * s.chunk_s)))
+        self._chunks = 0
+        self._pulses = {"spindle": 0, "cage": 0}
+        self._last_level: HealthLevel | None = None
+
+        self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_QOS)
+        self._pulse_pubs = {
+            "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
+            "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
+        }
+        self._speeds_pub = self.create_publisher(JointState, "/rig/speeds", SENSOR_QOS)
+        self._truth_pub = self.create_publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
+        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
+        self.create_subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
+        self.create_subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)
+
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        period = s.loop_period_s if s.realtime else 0.0
+        self._loop_timer = self.create_timer(period, self._on_loop, clock=steady)
+        self._diag_timer = self.create_timer(1.0 / s.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
+        self._speeds_msg = JointState(name=["inner_ring", "cage"])
+        self._clock_msg = ClockMsg()
+        mode = f"real time x{s.rate:g}" if s.realtime else "as fast as possible"
+        self.get_logger().info(
+            f"simulating {s.bearing_file.name} ({s.model} model, {s.chunk_s * 1e3:g} ms chunks, {mode}); "
+            f"spindle {s.initial_speed_rad_s:g} rad/s, axial load {self.twin.axial_load:g} N"
+        )
+
+    def close(self) -> None:
+        """Before ``destroy_node``: let the executor release the node's handles."""
+        release_executor(self)
+
+    # -- the loop ------------------------------------------------------------------------------
+    @survives_shutdown
+    def _on_loop(self) -> None:
+        if self.health.halted:
+            return
+        if not self.pacer.started:
+            self.pacer.start(self.twin.time)
+        for _ in range(self.pacer.due_chunks(self.twin.time)):
+            try:
+                out = self.twin.tick(with_truth=(self._chunks + 1) % self._truth_every == 0)
+            except RigError as exc:
+                self.health.halt(str(exc))
+                self.get_logger().error(f"simulation stopped: {exc}")
+                break
+            self._publish_chunk(out)
+        self.pacer.record(self.twin.time)
+        self._publish_diagnostics_on_change()
+
+    def _publish_chunk(self, out: TickOutput) -> None:
+        self._chunks += 1
+        stamp = to_stamp(out.time)
+        self._clock_msg.clock = stamp
+        self._clock_pub.publish(self._clock_msg)
+        for shaft, pulses in (("spindle", out.spindle_pulses), ("cage", out.cage_pulses)):
+            for pulse in pulses:
+                self._pulse_pubs[shaft].publish(pulse_message(pulse))
+            self._pulses[shaft] += len(pulses)
+        if self._chunks % self._speeds_every == 0:
+            m = out.measured
+            msg = self._speeds_msg
+            msg.header.stamp = stamp
+            msg.position = [m.inner_ring_angle, m.cage_angle]
+            msg.velocity = [m.inner_ring_speed, m.cage_speed]
+            self._speeds_pub.publish(msg)
+        if out.truth is not None:
+            self._truth_pub.publish(self._truth_message(out))
+
+    def _truth_message(self, out: TickOutput) -> SimulatorTruth:
+        t = out.truth
+        assert t is not None
+        msg = SimulatorTruth(
+            inner_ring_speed=t.inner_ring_speed,
+            inner_ring_acceleration=t.inner_ring_acceleration,
+            cage_speed=t.cage_speed,
+            theoretical_cage_speed=t.theoretical_cage_speed,
+            slip_rate=t.slip_rate,
+            axial_load=t.axial_load,
+            inner_contact_load_mean=t.inner_contact_load_mean,
+            inner_contact_load_max=t.inner_contact_load_max,
+            outer_contact_load_mean=t.outer_contact_load_mean,
+            outer_contact_load_max=t.outer_contact_load_max,
+            pocket_load_max=t.pocket_load_max,
+            inner_contact_angle=t.inner_contact_angle,
+            outer_contact_angle=t.outer_contact_angle,
+            inner_ring_axial_displacement=t.inner_ring_axial_displacement,
+            real_time_factor=float(self.pacer.real_time_factor),
+            step_count=t.step_count,
+            overruns=min(self.pacer.overruns, MAX_UINT32),
+        )
+        msg.header.stamp = to_stamp(t.time)
+        msg.header.frame_id = "bearing"
+        return msg
+
+    # -- inputs --------------------------------------------------------------------------------
+    @survives_shutdown
+    def _on_command(self, msg: SpindleCommandMsg) -> None:
+        try:
+            stamp = from_stamp(msg.header.stamp)
+            command = SpindleCommand(
+                target_speed=msg.target_speed,
+                profile=profile_from_code(msg.profile),
+                ramp_time=msg.ramp_time,
+                acceleration=msg.acceleration,
+                time=stamp if stamp > 0.0 else None,
+            )
+            self.twin.command_spindle(command)
+        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+            self._refuse("spindle command", str(exc))
+            return
+        when = "now" if command.time is None or command.time <= self.twin.time else f"at t = {command.time:.6g} s"
+        self.get_logger().info(
+            f"spindle command accepted: {command.target_speed:g} rad/s by {command.profile.value} "
+            f"(ramp {command.ramp_time:g} s, acceleration {command.acceleration:g} rad/s^2), {when} "
+            f"(rig clock {self.twin.time:.6g} s)"
+        )
+
+    @survives_shutdown
+    def _on_force(self, msg: WrenchStamped) -> None:
+        try:
+            self.twin.set_axial_load(msg.wrench.force.z)
+        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+            self._refuse("axial force", str(exc))
+
+    def _refuse(self, kind: str, reason: str) -> None:
+        self.get_logger().error(f"{kind} refused: {reason}", throttle_duration_sec=1.0)
+        self.health.refuse(kind, reason, time.monotonic())
+        self._publish_diagnostics_on_change()
+
+    # -- diagnostics ---------------------------------------------------------------------------
+    def _assess(self) -> Health:
+        return self.health.assess(time.monotonic(), self.pacer.overruns, self.twin.load_clamped, MIN_AXIAL_LOAD)
+
+    def _publish_diagnostics_on_change(self) -> None:
+        health = self._assess()
+        if health.level != self._last_level:
+            self._publish_diagnostics(health)
+
+    @survives_shutdown
+    def _on_diagnostics_timer(self) -> None:
+        self._publish_diagnostics(self._assess())
+        self.health.reported(self.pacer.overruns)
+
+    def _publish_diagnostics(self, health: Health) -> None:
+        self._last_level = health.level
+        twin, pacer = self.twin, self.pacer
+        measured = twin.measured()
+        profile = twin.drive.profile
+        values = {
+            "sim_time_s": f"{twin.time:.6f}",
+            "realtime": str(pacer.realtime).lower(),
+            "real_time_factor": f"{pacer.real_time_factor:.4g}",
+            "overruns": pacer.overruns,
+            "resyncs": pacer.resyncs,
+            "step_count": twin.step_count,
+            "target_speed_rad_s": f"{profile.target_speed:.6g}",
+            "inner_ring_speed_rad_s": f"{measured.inner_ring_speed:.6g}",
+            "cage_speed_rad_s": f"{measured.cage_speed:.6g}",
+            "axial_load_n": f"{twin.axial_load:.6g}",
+            "requested_axial_load_n": f"{twin.requested_axial_load:.6g}",
+            "spindle_pulses": self._pulses["spindle"],
+            "cage_pulses": self._pulses["cage"],
+            "refused_inputs": self.health.refused,
+        }
+        status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)
+        self._diag_pub.publish(diagnostic_array(to_stamp(max(twin.time, 0.0)), [status]))
+
+
+def pulse_message(pulse: Pulse) -> FibreOpticPulse:
+    """A FibreOpticPulse for a sensor pulse, stamped with the pulse time (s)."""
+    msg = FibreOpticPulse(
+        sensor_id=pulse.sensor_id,
+        strip_id=pulse.strip_id,
+        strip_count=pulse.strip_count,
+        revolution=pulse.revolution,
+        pulse_index=pulse.pulse_index,
+    )
+    msg.header.stamp = to_stamp(pulse.time)
+    msg.header.frame_id = f"{pulse.sensor_id}_sensor"
+    return msg
+
+
+def node_arguments(argv: Sequence[str]) -> list[str]:
+    """The command line for rclpy: ``--no-realtime`` becomes ``-p realtime:=false``."""
+    args = [a for a in argv if a != NO_REALTIME_FLAG]
+    if len(args) != len(argv):
+        args += ["--ros-args", "-p", "realtime:=false"]
+    return args
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``simulator`` / ``bearing-rig-simulator``: spin the node until Ctrl-C.
+
+    ``--no-realtime`` runs as fast as possible; ROS arguments (``--ros-args -p name:=value``,
+    ``--params-file``) set the parameters of ``config/simulator.yaml``.
+    """
+    args = node_arguments(list(sys.argv if argv is None else argv))
+    try:
+        return run_node(NODE_NAME, SimulatorNode, args)
+    except RigError as exc:
+        print(f"{NODE_NAME}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

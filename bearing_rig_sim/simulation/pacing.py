@@ -1,0 +1,178 @@
+"""Simulated time locked to the wall clock: how many chunks are due, overruns, real-time factor.
+
+In real time the simulated time follows the wall clock::
+
+    target(wall) = sim_start + (wall - wall_start) * rate
+
+and the loop (one timer of period ``loop_period``) runs the chunks whose end is not after the
+target. A call normally finds the simulation about one loop period behind; when it finds it
+behind by more than ``loop_period + overrun_margin`` wall seconds (late by more than timer
+jitter), that call counts one **overrun**; the loop then catches up in batches of at most ``max_batch`` chunks per call, so that
+the node still services its subscriptions in between. When it is behind by more than
+``resync_lag`` wall seconds, the debt is dropped (the start is re-anchored to now; one
+``resync`` is counted): a simulation slower than real time then runs as fast as it can instead of
+bursting to catch up ever larger debts.
+
+Without real time (``realtime=False``, the command line's ``--no-realtime``) every call is
+given ``max_batch`` chunks: as fast as possible, still in batches.
+
+The achieved real-time factor is simulated seconds per wall second over a sliding window of
+``rtf_window`` wall seconds, from the (wall, sim) pairs given to :meth:`RealTimePacer.record`.
+
+The wall clock is injected (``clock``, default :func:`time.monotonic`), so the arithmetic is
+tested with a fake clock.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import deque
+from typing import Callable
+
+from bearing_rig_sim.errors import RigError
+
+CHUNK_EPSILON = 1e-9
+"""Tolerance, in chunks, when counting due chunks (float round-off of sums of chunk lengths)."""
+
+
+class PacerError(RigError):
+    """A pacer option out of range, or a call before :meth:`RealTimePacer.start`."""
+
+
+def _positive(name: str, value: float, *, allow_inf: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value):
+        raise PacerError(f"{name}: must be a number > 0, got {value!r}")
+    if not value > 0.0 or (math.isinf(value) and not allow_inf):
+        raise PacerError(f"{name}: must be > 0{' (inf allowed)' if allow_inf else ' and finite'}, got {value!r}")
+    return float(value)
+
+
+class RealTimePacer:
+    """Locks simulated time to the wall clock (see the module docstring).
+
+    Args:
+        chunk: simulated length of one chunk, s (> 0).
+        loop_period: wall period of the loop's timer, s (> 0; default: one chunk).
+        realtime: lock to the wall clock (True) or run as fast as possible (False).
+        rate: simulated seconds per wall second in real time (1 = real time; > 0).
+        overrun_margin: lateness beyond one loop period, wall s, that counts as an overrun (> 0).
+        rtf_window: length of the sliding window of the real-time factor, wall s (> 0).
+        max_batch: most chunks given to one call (>= 1).
+        resync_lag: lag, in wall seconds, beyond which the debt is dropped (> 0; inf: never).
+        clock: the wall clock, s (monotonic).
+
+    Raises:
+        PacerError: an option out of range.
+    """
+
+    def __init__(
+        self,
+        chunk: float,
+        *,
+        loop_period: float | None = None,
+        realtime: bool = True,
+        rate: float = 1.0,
+        overrun_margin: float = 0.005,
+        rtf_window: float = 1.0,
+        max_batch: int = 50,
+        resync_lag: float = 0.5,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.chunk = _positive("chunk", chunk)
+        self.rate = _positive("rate", rate)
+        self.loop_period = self.chunk / self.rate if loop_period is None else _positive("loop_period", loop_period)
+        self.overrun_margin = _positive("overrun_margin", overrun_margin)
+        self.rtf_window = _positive("rtf_window", rtf_window)
+        self.resync_lag = _positive("resync_lag", resync_lag, allow_inf=True)
+        if isinstance(max_batch, bool) or not isinstance(max_batch, int) or max_batch < 1:
+            raise PacerError(f"max_batch: must be an integer >= 1, got {max_batch!r}")
+        if not isinstance(realtime, bool):
+            raise PacerError(f"realtime: must be true or false, got {realtime!r}")
+        self.realtime = realtime
+        self.max_batch = max_batch
+        self._clock = clock
+        self._wall_start: float | None = None
+        self._sim_start = 0.0
+        self._samples: deque[tuple[float, float]] = deque()
+        self.overruns = 0
+        """Calls that found the simulation behind by more than ``overrun_margin`` (1)."""
+        self.resyncs = 0
+        """Times the debt was dropped because the lag exceeded ``resync_lag`` (1)."""
+        self.behind = False
+        """Whether the latest call found the simulation late by more than the margin."""
+
+    @property
+    def started(self) -> bool:
+        """Whether :meth:`start` has been called."""
+        return self._wall_start is not None
+
+    def start(self, sim_time: float) -> None:
+        """Anchor the simulated time ``sim_time`` (s) to the wall clock now; clears the counters."""
+        now = self._clock()
+        self._wall_start = now
+        self._sim_start = float(sim_time)
+        self._samples = deque([(now, float(sim_time))])
+        self.overruns = 0
+        self.resyncs = 0
+        self.behind = False
+
+    def target(self) -> float:
+        """The simulated time the wall clock asks for now, s (real time only)."""
+        if self._wall_start is None:
+            raise PacerError("call start() first")
+        return self._sim_start + (self._clock() - self._wall_start) * self.rate
+
+    def lag(self, sim_time: float) -> float:
+        """How far the simulation at ``sim_time`` is behind the wall clock, wall s (< 0: ahead);
+        0 without real time."""
+        if not self.realtime:
+            return 0.0
+        return (self.target() - sim_time) / self.rate
+
+    def due_chunks(self, sim_time: float) -> int:
+        """Chunks to run now, from the simulated time ``sim_time`` (s) reached so far.
+
+        Counts an overrun when behind by more than one loop period plus the margin, re-anchors
+        when behind by more than ``resync_lag``; at most ``max_batch``.
+        """
+        if self._wall_start is None:
+            raise PacerError("call start() first")
+        if not self.realtime:
+            return self.max_batch
+        lag = self.lag(sim_time)
+        self.behind = lag > self.loop_period + self.overrun_margin
+        if self.behind:
+            self.overruns += 1
+        if lag > self.resync_lag:
+            self.resyncs += 1
+            self._wall_start = self._clock()
+            self._sim_start = float(sim_time)
+            return 1
+        due = math.floor(lag * self.rate / self.chunk + CHUNK_EPSILON)
+        return max(0, min(due, self.max_batch))
+
+    def next_due_in(self, sim_time: float) -> float:
+        """Wall seconds until the next chunk is due (0 if it is already; 0 without real time)."""
+        if not self.realtime:
+            return 0.0
+        return max(0.0, (self.chunk - self.lag(sim_time) * self.rate) / self.rate)
+
+    # -- real-time factor ----------------------------------------------------------------------
+    def record(self, sim_time: float) -> None:
+        """Note the simulated time (s) reached now, for the real-time factor."""
+        now = self._clock()
+        self._samples.append((now, float(sim_time)))
+        while len(self._samples) > 2 and now - self._samples[1][0] >= self.rtf_window:
+            self._samples.popleft()
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated seconds per wall second over the last ``rtf_window`` wall seconds (or since
+        the start, if shorter); NaN before any time has passed."""
+        if len(self._samples) < 2:
+            return math.nan
+        (w0, s0), (w1, s1) = self._samples[0], self._samples[-1]
+        if not w1 > w0:
+            return math.nan
+        return (s1 - s0) / (w1 - w0)

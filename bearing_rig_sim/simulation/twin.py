@@ -1,0 +1,376 @@
+"""The rig's digital twin, one chunk at a time: engine, spindle drive, axial load, speed sensors.
+
+:class:`RigTwin` advances the dynamics engine by one chunk (1 ms by default) at the current axial
+load, with the inner-ring acceleration the :class:`~bearing_rig_sim.simulation.drive.SpindleDrive`
+asks for, then shows the motion to the two fibre-optic sensors of the bench (digest section 8):
+
+* spindle sensor: the inner-ring angle (the spindle carries the inner ring);
+* cage sensor: the angle of the cage segment carrying the reflective strip
+  (``Observation.cage_angle``).
+
+Each sensor emits one pulse per strip passage, its time interpolated inside the chunk, with its
+timing jitter (:class:`~bearing_rig_sim.rig.fibre_optic.FibreOpticSensor`). The measured speeds
+come from the pulses alone, through the bench's counter
+(:class:`~bearing_rig_sim.rig.fibre_optic.PulseCounter`): never from the engine's true speed.
+The ground truth (true speeds, slip, contact loads) is reported beside them, for the truth topic.
+
+A counter's estimate is the mean speed over its last window of whole revolutions, so it lags a
+changing speed. When the pulses stop coming (a shaft slowing to rest), the counter's last
+estimate would freeze; the twin instead reports no more than one strip spacing over the time
+since the last pulse (the shaft cannot have been faster, or the next strip would have passed),
+and 0 once no pulse has come for ``counter_timeout`` seconds, as a bench counter's display falls
+to zero.
+
+Units: s, rad, rad/s, rad/s^2, N, m; slip in percent.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.config import config_path
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Observation
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
+from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
+
+CHUNK_STEP_TOLERANCE = 1e-6
+"""How close (in engine steps) the chunk length must be to a whole number of engine steps (1)."""
+
+
+class TwinError(RigError):
+    """A twin option out of range (chunk length, timeout, initial state)."""
+
+
+class AxialLoadError(RigError):
+    """An axial force the twin refuses (non-finite or negative); the load stays as it was."""
+
+
+@dataclass(frozen=True)
+class MeasuredSpeeds:
+    """What the bench's pulse counters show at the end of a chunk.
+
+    Attributes:
+        inner_ring_speed: spindle speed from the spindle pulses, rad/s (0 before the first
+            whole-revolution window and after ``counter_timeout`` without pulses).
+        cage_speed: cage speed from the cage pulses, rad/s (same rules).
+        inner_ring_angle: spindle angle counted by pulses since its first pulse,
+            ``2 pi pulse_index / strip_count`` of the latest pulse, rad (0 before any).
+        cage_angle: cage angle counted the same way, rad.
+    """
+
+    inner_ring_speed: float
+    cage_speed: float
+    inner_ring_angle: float
+    cage_angle: float
+
+
+@dataclass(frozen=True)
+class TruthSummary:
+    """The engine's ground truth at the end of a chunk (fields of SimulatorTruth.msg, without the
+    pacing figures ``real_time_factor`` and ``overruns``, which belong to the node's loop).
+
+    Speeds rad/s, acceleration rad/s^2, loads N, angles rad, displacement m, slip percent.
+    ``slip_rate`` is NaN while the inner ring is at rest (the slip rate is undefined there).
+    Contact angles are means over the balls with a non-zero contact load (NaN if none).
+    """
+
+    time: float
+    inner_ring_speed: float
+    inner_ring_acceleration: float
+    cage_speed: float
+    theoretical_cage_speed: float
+    slip_rate: float
+    axial_load: float
+    inner_contact_load_mean: float
+    inner_contact_load_max: float
+    outer_contact_load_mean: float
+    outer_contact_load_max: float
+    pocket_load_max: float
+    inner_contact_angle: float
+    outer_contact_angle: float
+    inner_ring_axial_displacement: float
+    step_count: int
+
+
+@dataclass(frozen=True)
+class TickOutput:
+    """Everything one chunk produced.
+
+    Attributes:
+        start_time: simulated time at the chunk's start, s.
+        time: simulated time at its end, s.
+        spindle_pulses: pulses of the spindle sensor inside the chunk, in time order.
+        cage_pulses: pulses of the cage sensor inside the chunk, in time order.
+        measured: the counters' speeds and pulse-counted angles at the chunk's end.
+        truth: the engine's ground truth at the chunk's end (None if not asked for).
+    """
+
+    start_time: float
+    time: float
+    spindle_pulses: list[Pulse]
+    cage_pulses: list[Pulse]
+    measured: MeasuredSpeeds
+    truth: TruthSummary | None
+
+
+def counted_speed(counter: PulseCounter, strip_count: int, now: float, timeout: float) -> float:
+    """The speed a bench counter shows at ``now`` (s), rad/s.
+
+    The counter's latest whole-revolution estimate, capped at one strip spacing over the time
+    since the latest pulse (the shaft cannot have turned faster since, or the next strip would
+    have passed), and 0 before the first estimate or after ``timeout`` s without a pulse.
+    """
+    speed = counter.speed
+    last = counter.last_pulse_time
+    if speed is None or last is None:
+        return 0.0
+    silent = now - last
+    if silent > timeout:
+        return 0.0
+    if silent > 0.0:
+        speed = min(speed, TWO_PI / strip_count / silent)
+    return speed
+
+
+def _mean_where_loaded(values: np.ndarray, loads: np.ndarray) -> float:
+    mask = loads > 0.0
+    return float(np.mean(values[mask])) if np.any(mask) else math.nan
+
+
+class RigTwin:
+    """The engine, the spindle drive, the axial load and the two fibre-optic sensors.
+
+    Args:
+        engine: the dynamics engine; initialised here at ``initial_speed`` and
+            ``initial_axial_load``.
+        sensors: both sensors and the counter (``sensors`` section of ``config/rig.yaml``).
+        kinematics: the bearing's geometry for the truth's theoretical cage speed and slip
+            (nominal contact angle).
+        chunk: default chunk length, s; a whole number of engine time steps.
+        initial_speed: spindle speed at the start, rad/s (>= 0).
+        initial_axial_load: axial load at the start, N (finite, >= 0; below the engine's
+            minimum it is raised to it and flagged, see :meth:`set_axial_load`).
+        counter_timeout: a counter shows 0 after this long without a pulse, s (> 0).
+        max_speed: highest spindle target speed, rad/s (see :class:`SpindleDrive`).
+        max_acceleration: highest spindle acceleration, rad/s^2.
+        max_command_lead: how far ahead a command's time may lie, s.
+
+    Raises:
+        TwinError: an option out of range.
+        AxialLoadError: a bad initial load.
+        SpindleCommandError: a bad initial speed or limit.
+    """
+
+    def __init__(
+        self,
+        engine: BearingDynamics,
+        sensors: FibreOpticConfig,
+        kinematics: BearingKinematics,
+        *,
+        chunk: float = 1e-3,
+        initial_speed: float = 0.0,
+        initial_axial_load: float = 100.0,
+        counter_timeout: float = 1.0,
+        max_speed: float = math.inf,
+        max_acceleration: float = math.inf,
+        max_command_lead: float = math.inf,
+    ) -> None:
+        self.engine = engine
+        self.kinematics = kinematics
+        self.chunk = self._check_chunk(chunk)
+        if isinstance(counter_timeout, bool) or not isinstance(counter_timeout, (int, float)) or not counter_timeout > 0.0:
+            raise TwinError(f"counter_timeout: must be > 0 s, got {counter_timeout!r}")
+        self.counter_timeout = float(counter_timeout)
+        self.drive = SpindleDrive(
+            initial_speed, 0.0, max_speed=max_speed, max_acceleration=max_acceleration, max_lead=max_command_lead
+        )
+        self.load_clamped = False
+        """Whether the latest axial force asked for was below the engine's minimum
+        (:data:`~bearing_rig_sim.dynamics.MIN_AXIAL_LOAD`) and was raised to it."""
+        self.requested_axial_load = 0.0
+        """The latest axial force asked for, N (before raising it to the minimum)."""
+        self._load = self._checked_load(initial_axial_load)
+        engine.initialise(self.drive.speed_at(0.0), self._load, time=0.0)
+        self.spindle_sensor: FibreOpticSensor = sensors.sensor("spindle")
+        self.cage_sensor: FibreOpticSensor = sensors.sensor("cage")
+        self.spindle_counter: PulseCounter = sensors.counter("spindle")
+        self.cage_counter: PulseCounter = sensors.counter("cage")
+        self._last_index: dict[str, int | None] = {"spindle": None, "cage": None}
+        self.step_count = 0
+        """Engine integration steps since the start (1)."""
+        self._acceleration = 0.0
+        self._observation = engine.observe()
+
+    @classmethod
+    def from_files(
+        cls,
+        bearing_file: str | Path | None = None,
+        calibration_file: str | Path | None = None,
+        rig_file: str | Path | None = None,
+        *,
+        model: str = "reduced",
+        **options: float,
+    ) -> "RigTwin":
+        """A twin from a bearing file, an optional calibration overlay and a rig file.
+
+        Args:
+            bearing_file: bearing data (default: the shipped ``config/bearings/h7006c.yaml``).
+            calibration_file: calibration laid over it (None: none).
+            rig_file: rig data with the ``sensors`` section (default: ``config/rig.yaml``).
+            model: the engine's model, ``"reduced"`` (real time) or ``"stiff"``.
+            options: the keyword options of :class:`RigTwin`.
+
+        Raises:
+            ConfigError: a file is missing or malformed (naming the file and key).
+        """
+        bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
+        params = BearingParameters.from_yaml(bearing, calibration_file)
+        engine = BearingDynamics(params, model=model)
+        sensors = FibreOpticConfig.from_yaml(rig_file)
+        return cls(engine, sensors, BearingKinematics.from_config(bearing), **options)
+
+    def _check_chunk(self, chunk: float) -> float:
+        if isinstance(chunk, bool) or not isinstance(chunk, (int, float)) or not math.isfinite(chunk) or not chunk > 0.0:
+            raise TwinError(f"chunk: must be a finite number > 0 s, got {chunk!r}")
+        steps = chunk / self.engine.time_step
+        if steps < 1.0 - CHUNK_STEP_TOLERANCE or abs(steps - round(steps)) > CHUNK_STEP_TOLERANCE:
+            raise TwinError(
+                f"chunk: {chunk!r} s is not a whole number of engine time steps ({self.engine.time_step!r} s)"
+            )
+        return float(chunk)
+
+    # -- inputs --------------------------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        """Simulated time, s."""
+        return self.engine.time
+
+    @property
+    def axial_load(self) -> float:
+        """The axial load the engine applies, N (at least the engine's minimum)."""
+        return self._load
+
+    def _checked_load(self, force_n: float) -> float:
+        if isinstance(force_n, bool) or not isinstance(force_n, (int, float)) or not math.isfinite(force_n):
+            raise AxialLoadError(f"axial force: must be a finite number of newtons, got {force_n!r}")
+        if force_n < 0.0:
+            raise AxialLoadError(f"axial force: must be >= 0 N (the loading chain pulls, it cannot push), got {force_n!r}")
+        self.requested_axial_load = float(force_n)
+        self.load_clamped = force_n < MIN_AXIAL_LOAD
+        return max(float(force_n), MIN_AXIAL_LOAD)
+
+    def set_axial_load(self, force_n: float) -> float:
+        """Apply the axial force ``force_n`` (N) from the next chunk on; returns the force applied.
+
+        A force below the engine's minimum (:data:`~bearing_rig_sim.dynamics.MIN_AXIAL_LOAD`,
+        1 N) is raised to it and :attr:`load_clamped` is set (cleared by the next force at or
+        above the minimum).
+
+        Raises:
+            AxialLoadError: a non-finite or negative force; the load stays as it was.
+        """
+        self._load = self._checked_load(force_n)
+        return self._load
+
+    def command_spindle(self, command: SpindleCommand) -> None:
+        """Give the spindle drive a speed command (see :meth:`SpindleDrive.submit`).
+
+        Raises:
+            SpindleCommandError: an invalid command; the drive keeps its previous one.
+        """
+        self.drive.submit(command, self.engine.time, self.engine.inner_ring_speed)
+
+    # -- one chunk -----------------------------------------------------------------------------
+    def tick(self, h: float | None = None, *, with_truth: bool = True) -> TickOutput:
+        """Advance the engine by one chunk of ``h`` seconds (default :attr:`chunk`).
+
+        Args:
+            h: chunk length, s; a whole number of engine steps.
+            with_truth: also summarise the ground truth (about a third of a chunk's cost in
+                Python; the node asks for it only when it publishes the truth).
+
+        Returns:
+            The pulses of the chunk, the counters' speeds and the ground truth at its end.
+
+        Raises:
+            TwinError: ``h`` not a whole number of engine steps.
+            RigError: the engine diverged (non-finite state); the twin cannot continue.
+        """
+        h = self.chunk if h is None else self._check_chunk(h)
+        engine = self.engine
+        before = self._observation
+        t0 = engine.time
+        steps = int(round(h / engine.time_step))
+        t_end = t0 + steps * engine.time_step
+        accel = self.drive.chunk_acceleration(t0, h, engine.inner_ring_speed)
+        engine.advance(h, axial_load=self._load, inner_ring_acceleration=accel)
+        remaining = t_end - engine.time
+        if remaining > 0.5 * engine.time_step:
+            # A deceleration that reaches rest inside the chunk: the engine stops integrating
+            # there rather than reverse; the rest of the chunk is spent at the profile's speed.
+            engine.set_inner_ring_speed(max(self.drive.speed_at(t_end), 0.0))
+            engine.advance(remaining, axial_load=self._load)
+        self.step_count += steps
+        self._acceleration = accel
+        after = engine.observe()
+        self._observation = after
+        t1 = after.time
+        spindle = self.spindle_sensor.update(t0, before.inner_ring_angle, t1, after.inner_ring_angle)
+        cage = self.cage_sensor.update(t0, before.cage_angle, t1, after.cage_angle)
+        for pulse in spindle:
+            self.spindle_counter.add(pulse)
+        for pulse in cage:
+            self.cage_counter.add(pulse)
+        if spindle:
+            self._last_index["spindle"] = spindle[-1].pulse_index
+        if cage:
+            self._last_index["cage"] = cage[-1].pulse_index
+        truth = self._truth(after) if with_truth else None
+        return TickOutput(t0, t1, spindle, cage, self.measured(t1), truth)
+
+    def measured(self, now: float | None = None) -> MeasuredSpeeds:
+        """The counters' speeds and pulse-counted angles at ``now`` (s; default: the twin's time)."""
+        t = self.engine.time if now is None else now
+        spindle_n = self.spindle_sensor.strip_count
+        cage_n = self.cage_sensor.strip_count
+        spindle_i, cage_i = self._last_index["spindle"], self._last_index["cage"]
+        return MeasuredSpeeds(
+            inner_ring_speed=counted_speed(self.spindle_counter, spindle_n, t, self.counter_timeout),
+            cage_speed=counted_speed(self.cage_counter, cage_n, t, self.counter_timeout),
+            inner_ring_angle=0.0 if spindle_i is None else TWO_PI * spindle_i / spindle_n,
+            cage_angle=0.0 if cage_i is None else TWO_PI * cage_i / cage_n,
+        )
+
+    def truth(self) -> TruthSummary:
+        """The ground truth now (see :class:`TruthSummary`)."""
+        return self._truth(self._observation)
+
+    def _truth(self, obs: Observation) -> TruthSummary:
+        inner = obs.inner_ring_speed
+        kin = self.kinematics
+        slip = kin.slip_rate(obs.cage_speed, inner) if inner > 0.0 else math.nan
+        qi, qo = obs.inner_contact_loads, obs.outer_contact_loads
+        return TruthSummary(
+            time=obs.time,
+            inner_ring_speed=inner,
+            inner_ring_acceleration=self._acceleration,
+            cage_speed=obs.cage_speed,
+            theoretical_cage_speed=kin.epicyclic_ratio() * inner,
+            slip_rate=slip,
+            axial_load=obs.axial_load,
+            inner_contact_load_mean=float(np.mean(qi)),
+            inner_contact_load_max=float(np.max(qi)),
+            outer_contact_load_mean=float(np.mean(qo)),
+            outer_contact_load_max=float(np.max(qo)),
+            pocket_load_max=float(np.max(np.abs(obs.pocket_loads))),
+            inner_contact_angle=_mean_where_loaded(obs.inner_contact_angles, qi),
+            outer_contact_angle=_mean_where_loaded(obs.outer_contact_angles, qo),
+            inner_ring_axial_displacement=obs.inner_ring_axial_displacement,
+            step_count=self.step_count,
+        )

@@ -1,0 +1,332 @@
+"""The slip monitor on synthetic pulse trains: exact slip for known speeds, the verdict's state
+sequence, sensor loss, a stop, lost pulses, clock jumps, out-of-order and malformed pulses.
+
+Pulse times are computed here from the shaft's angle (crossings of equally spaced strips), and
+the expected slip from the bearing file's geometry with the paper's formula (digest Eq. 11-12),
+independently of the monitor and of the analysis module.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Callable, Iterable
+
+import numpy as np
+import pytest
+import yaml
+
+from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonitor
+from bearing_rig_sim.rig.fibre_optic import Pulse
+
+TWO_PI = 2.0 * math.pi
+
+
+def ratio() -> float:
+    """n_s / n_i for the shipped bearing at its nominal angle, from the file's numbers."""
+    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
+
+
+def expected_slip(inner: float, cage: float) -> float:
+    return (1.0 - cage / (ratio() * inner)) * 100.0
+
+
+def train(
+    times: Iterable[float], strips: int, sensor: str, *, first_index: int = 0, first_strip: int = 0
+) -> list[Pulse]:
+    """Pulses at the given times (strip ids cycling from ``first_strip``)."""
+    out = []
+    for i, t in enumerate(times):
+        index = first_index + i
+        out.append(Pulse(float(t), (first_strip + i) % strips, strips, index // strips, index, sensor))
+    return out
+
+
+def constant(speed: float, strips: int, t0: float, t1: float, phase: float = 0.0) -> np.ndarray:
+    """Crossing times of a shaft at constant ``speed`` (rad/s) in (t0, t1]; ``phase`` in rad."""
+    spacing = TWO_PI / strips
+    k0 = math.floor((speed * t0 - phase) / spacing) + 1
+    k1 = math.floor((speed * t1 - phase) / spacing)
+    return (phase + spacing * np.arange(k0, k1 + 1)) / speed
+
+
+def decelerating(speed: float, decel: float, strips: int, t0: float, phase: float = 0.0) -> np.ndarray:
+    """Crossing times of a shaft slowing from ``speed`` at t0 to rest at ``decel`` (rad/s^2)."""
+    spacing = TWO_PI / strips
+    total = speed * speed / (2.0 * decel)  # angle turned until rest
+    angles = spacing * np.arange(1, math.floor(total / spacing) + 1) - phase % spacing
+    angles = angles[angles > 0.0]
+    return t0 + (speed - np.sqrt(speed * speed - 2.0 * decel * angles)) / decel
+
+
+def settings(**changes: object) -> MonitorSettings:
+    return dataclasses.replace(MonitorSettings.from_yaml(), **changes)
+
+
+def make(**changes: object) -> SlipMonitor:
+    s = settings(**changes)
+    return SlipMonitor(s.kinematics(), s)
+
+
+def feed(monitor: SlipMonitor, *trains: list[Pulse], check_every: float | None = 0.1, on_check: Callable | None = None) -> None:
+    """Give the pulses of all trains in time order, calling check() every ``check_every`` s."""
+    merged = sorted((p.time, p.sensor_id, p) for tr in trains for p in tr)
+    next_check = merged[0][0] if merged else 0.0
+    for t, shaft, pulse in merged:
+        monitor.add_pulse(shaft, pulse)
+        if check_every is not None and t >= next_check:
+            monitor.check(t)
+            next_check = t + check_every
+            if on_check is not None:
+                on_check(monitor.status())
+
+
+INNER = 1500 * math.pi / 30.0  # 157.08 rad/s
+CAGE = 0.41 * INNER  # slip of about 4.3 %
+
+
+def test_settings_shipped_and_refused():
+    s = MonitorSettings.from_yaml()
+    assert (s.window_revolutions, s.critical_slope_pct_per_s) == (1, -0.03)
+    assert s.kinematics().contact_angle == pytest.approx(math.radians(15.0))
+    assert settings(contact_angle_deg=20.0).kinematics().contact_angle == pytest.approx(math.radians(20.0))
+    values = yaml.safe_load(config_path("monitor.yaml").read_text())["monitor"]["ros__parameters"]
+    with pytest.raises(ConfigError, match="window_revolutions: must be >= 1"):
+        MonitorSettings.from_values(values | {"window_revolutions": 0})
+    with pytest.raises(ConfigError, match="loss_period_factor: must be > 1"):
+        MonitorSettings.from_values(values | {"loss_period_factor": 0.5})
+
+
+@pytest.mark.parametrize("revolutions", [1, 3])
+def test_exact_slip_for_known_constant_speeds(revolutions):
+    monitor = make(window_revolutions=revolutions)
+    spindle = train(constant(INNER, 4, 0.0, 2.0, phase=0.3), 4, "spindle", first_strip=2)
+    cage = train(constant(CAGE, 3, 0.0, 2.0, phase=1.1), 3, "cage", first_strip=1)
+    feed(monitor, spindle, cage)
+    status = monitor.status()
+    assert status.inner_ring_speed == pytest.approx(INNER, rel=1e-11)
+    assert status.cage_speed == pytest.approx(CAGE, rel=1e-11)
+    assert status.theoretical_cage_speed == pytest.approx(ratio() * INNER, rel=1e-11)
+    assert status.slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+    assert status.window_revolutions == revolutions
+    assert status.criterion == "time" and status.critical_slope == -0.03
+    # windows of whole cage revolutions, the last ending on a cage pulse
+    revs = CAGE * 2.0 / TWO_PI
+    assert monitor.windows == pytest.approx(revs / revolutions, abs=1.5)
+    assert status.time in {p.time for p in cage}
+
+
+def test_state_goes_from_unknown_to_stable_at_constant_speed():
+    rng = np.random.default_rng(5)
+    jitter = lambda t: t + rng.normal(0.0, 1e-6, t.size)  # noqa: E731 - the sensors' 1 us jitter
+    monitor = make()
+    states: list[MonitorState] = []
+    feed(
+        monitor,
+        train(jitter(constant(INNER, 4, 0.0, 8.0)), 4, "spindle"),
+        train(jitter(constant(CAGE, 4, 0.0, 8.0, phase=0.4)), 4, "cage"),
+        on_check=lambda s: states.append(s.state),
+    )
+    assert states[0] is MonitorState.UNKNOWN
+    assert MonitorState.FAULT not in states
+    assert states[-1] is MonitorState.STABLE
+    status = monitor.status()
+    assert status.fitted_slope >= -0.03
+    assert status.slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=0.01)
+
+
+def test_sensor_loss_is_a_fault_with_the_reason_and_clears_when_pulses_return():
+    monitor = make()
+    feed(monitor, train(constant(INNER, 4, 0.0, 2.0), 4, "spindle"), train(constant(CAGE, 4, 0.0, 2.0), 4, "cage"))
+    last = monitor.last_pulse_time()
+    assert last is not None
+    monitor.check(last + 0.3)  # below the 0.5 s minimum timeout
+    assert monitor.status().state is not MonitorState.FAULT
+    monitor.check(last + 1.0)  # silent: suspected ...
+    assert monitor.status().state is not MonitorState.FAULT
+    monitor.check(last + 1.1)  # ... and confirmed at the next check
+    status = monitor.status()
+    assert status.state is MonitorState.FAULT
+    assert any(f.startswith("spindle: no pulse for") and f.endswith("sensor loss") for f in status.faults)
+    assert any(f.startswith("cage: no pulse for") for f in status.faults)
+    assert "sensor loss" in status.detail and status.confidence == 0.0
+    spindle_n = len(constant(INNER, 4, 0.0, 2.0))
+    cage_n = len(constant(CAGE, 4, 0.0, 2.0))
+    feed(
+        monitor,
+        train(constant(INNER, 4, 3.0, 4.0), 4, "spindle", first_index=spindle_n + 50),
+        train(constant(CAGE, 4, 3.0, 4.0), 4, "cage", first_index=cage_n + 20),
+        check_every=None,
+    )
+    monitor.check(4.0)
+    assert not any("sensor loss" in f for f in monitor.status().faults)
+
+
+def test_a_monitor_held_up_itself_does_not_report_sensor_loss():
+    """After a stall of the monitor its timer may run before the backlog of pulses: one silent
+    check is only a suspicion; the pulses taken in before the next check clear it."""
+    monitor = make()
+    spindle = train(constant(INNER, 4, 0.0, 3.0), 4, "spindle")
+    cage = train(constant(CAGE, 4, 0.0, 3.0), 4, "cage")
+    feed(monitor, [p for p in spindle if p.time <= 2.0], [p for p in cage if p.time <= 2.0])
+    monitor.check(2.8)  # 0.8 s with no pulse taken in: suspected, not yet a fault
+    assert monitor.status().faults == ()
+    feed(monitor, [p for p in spindle if p.time > 2.0], [p for p in cage if p.time > 2.0], check_every=None)
+    monitor.check(2.9)
+    assert monitor.status().faults == ()
+
+
+def test_one_silent_shaft_is_lost_while_the_other_turns():
+    monitor = make()
+    feed(monitor, train(constant(INNER, 4, 0.0, 3.0), 4, "spindle"), train(constant(CAGE, 4, 0.0, 1.0), 4, "cage"))
+    monitor.check(3.0)
+    monitor.check(3.1)
+    faults = monitor.status().faults
+    assert len(faults) == 1 and faults[0].startswith("cage: no pulse for")
+
+
+def test_a_shaft_silent_since_the_start_is_lost():
+    monitor = make()
+    feed(monitor, train(constant(INNER, 4, 0.0, 1.0), 4, "spindle"))  # 25 revolutions, no cage pulse
+    monitor.check(1.0)
+    assert monitor.status().faults == ("cage: no pulse since the start while the spindle turned 25 revolutions: sensor loss",)
+
+
+def test_a_stop_is_not_a_sensor_loss():
+    monitor = make()
+    spindle = list(constant(INNER, 4, 0.0, 2.0)) + list(decelerating(INNER, 100.0, 4, 2.0))
+    cage = list(constant(CAGE, 4, 0.0, 2.0)) + list(decelerating(CAGE, 41.0, 4, 2.0))
+    feed(monitor, train(spindle, 4, "spindle"), train(cage, 4, "cage"))
+    monitor.check(2.0 + INNER / 100.0 + 2.0)  # 2 s after both came to rest
+    monitor.check(2.0 + INNER / 100.0 + 2.1)
+    status = monitor.status()
+    assert status.state is MonitorState.UNKNOWN and status.faults == ()
+    assert "stopped" in status.detail
+
+
+def test_lost_pulses_are_a_fault_held_for_a_while_and_the_slip_stays_exact():
+    monitor = make(fault_hold_s=1.0)
+    cage = train(constant(CAGE, 4, 0.0, 4.0), 4, "cage")
+    lost = {p.pulse_index for p in cage[20:23]}
+    kept = [p for p in cage if p.pulse_index not in lost]
+    seen: list[tuple[float, MonitorState, tuple[str, ...]]] = []
+    feed(
+        monitor,
+        train(constant(INNER, 4, 0.0, 4.0), 4, "spindle"),
+        kept,
+        on_check=lambda s: seen.append((monitor.last_pulse_time() or 0.0, s.state, s.faults)),
+    )
+    t_gap = cage[23].time
+    gap_reason = "cage: 3 pulse(s) lost before pulse_index 23 (gap in pulse_index)"
+    during = [(state, faults) for t, state, faults in seen if t_gap <= t < t_gap + 0.9]
+    assert during and all(state is MonitorState.FAULT and faults == (gap_reason,) for state, faults in during)
+    # held for fault_hold_s of rig time, then cleared while pulses keep coming
+    assert all(state is not MonitorState.FAULT for t, state, _ in seen if t > t_gap + 1.2)
+    assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+
+
+def test_a_clock_jump_back_resets_to_unknown():
+    monitor = make()
+    feed(monitor, train(constant(INNER, 4, 0.0, 3.0), 4, "spindle"), train(constant(CAGE, 4, 0.0, 3.0), 4, "cage"))
+    assert monitor.windows > 10
+    # the source restarts: times and indices from the start again
+    feed(monitor, train(constant(INNER, 4, 0.0, 0.05), 4, "spindle"), train(constant(CAGE, 4, 0.0, 0.05), 4, "cage"))
+    status = monitor.status()
+    assert status.state is MonitorState.UNKNOWN
+    assert monitor.windows == 0 and monitor.stability.n_points == 0 and status.time is None
+    assert any("clock jumped back" in note for note in status.notes)
+    # and it measures again afterwards
+    feed(monitor, train(constant(INNER, 4, 0.05, 1.0), 4, "spindle", first_index=50), train(constant(CAGE, 4, 0.05, 1.0), 4, "cage", first_index=50))
+    assert monitor.windows > 3
+    assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+    monitor.clock_jump(1.0, 0.2)
+    assert monitor.windows == 0 and monitor.status().notes == ("reset: the clock jumped back from 1 s to 0.2 s",)
+
+
+def test_out_of_order_pulses_restart_their_shaft_without_crashing():
+    monitor = make(fault_hold_s=1.0)
+    spindle = train(constant(INNER, 4, 0.0, 2.0), 4, "spindle")
+    spindle[40], spindle[41] = spindle[41], spindle[40]  # index 41 arrives before index 40
+    cage = train(constant(CAGE, 4, 0.0, 2.0), 4, "cage")
+    arrival = [spindle[i - 1].time + 1e-7 if i == 41 else p.time for i, p in enumerate(spindle)]
+    merged = sorted([(p.time, p) for p in cage] + list(zip(arrival, spindle)), key=lambda x: x[0])
+    for _, p in merged:
+        monitor.add_pulse(p.sensor_id, p)
+    status = monitor.status()
+    assert any("out-of-order" in n and "index 40" in n for n in status.notes)
+    # 41 after 39 looked like a lost pulse: a held fault, gone once the hold has passed
+    assert status.faults == ("spindle: 1 pulse(s) lost before pulse_index 41 (gap in pulse_index)",)
+    monitor.check(2.0)
+    status = monitor.status()
+    assert status.faults == () and status.state is not MonitorState.FAULT
+    assert status.time is not None and status.time > 1.5  # windows went on after the restart
+    assert status.slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+
+
+@pytest.mark.parametrize(
+    ("pulse", "problem"),
+    [
+        (Pulse(1.0, 5, 4, 0, 7, "cage"), "strip_id 5 is not below strip_count 4"),
+        (Pulse(math.nan, 1, 4, 0, 7, "cage"), "time nan is not a finite number"),
+        (Pulse(1.0, 0, 0, 0, 7, "cage"), "strip_count is 0"),
+        (Pulse(1.0, 0, 4, 0, -2, "cage"), "pulse_index -2 is not an integer >= 0"),
+    ],
+)
+def test_malformed_pulses_are_a_fault_not_an_exception(pulse, problem):
+    monitor = make()
+    monitor.add_pulse("cage", pulse)
+    monitor.add_pulse("bearing", pulse)  # an unknown shaft is noted and ignored
+    status = monitor.status()
+    assert status.state is MonitorState.FAULT
+    assert status.faults == (f"cage: invalid pulse discarded ({problem})",)
+
+
+def test_strip_ids_inconsistent_with_the_indices_are_a_fault():
+    monitor = make()
+    good = train(constant(CAGE, 4, 0.0, 0.5), 4, "cage")
+    for p in good:
+        monitor.add_pulse("cage", p)
+    wrong = dataclasses.replace(good[-1], time=good[-1].time + 0.02, pulse_index=good[-1].pulse_index + 1, strip_id=good[-1].strip_id)
+    monitor.add_pulse("cage", wrong)
+    assert any("inconsistent" in f for f in monitor.status().faults)
+
+
+def test_no_slip_point_below_the_minimum_spindle_speed():
+    monitor = make()
+    feed(monitor, train(constant(5.0, 4, 0.0, 10.0), 4, "spindle"), train(constant(2.0, 4, 0.0, 10.0), 4, "cage"))
+    status = monitor.status()
+    assert status.inner_ring_speed == pytest.approx(5.0, rel=1e-9)
+    assert math.isnan(status.slip_rate) and monitor.stability.n_points == 0
+
+
+def test_the_slip_series_restarts_at_the_start_and_end_of_a_speed_change():
+    """Steady at 100 rad/s, a linear ramp to 150 rad/s, steady again: the series held at the end
+    covers only the last steady stretch."""
+
+    def angle(t: np.ndarray) -> np.ndarray:  # 100 rad/s to 2 s, +25 rad/s^2 to 4 s, then 150 rad/s
+        a = np.where(t < 2.0, 100 * t, 200 + 100 * (t - 2) + 12.5 * (t - 2) ** 2)
+        return np.where(t < 4.0, a, 450 + 150 * (t - 4))
+
+    def crossings(scale: float, strips: int, t_end: float) -> np.ndarray:
+        grid = np.linspace(0.0, t_end, 2_000_001)
+        turned = scale * angle(grid)
+        levels = TWO_PI / strips * np.arange(1, math.floor(turned[-1] / (TWO_PI / strips)) + 1)
+        return np.interp(levels, turned, grid)
+
+    monitor = make()
+    notes: set[str] = set()
+    feed(
+        monitor,
+        train(crossings(1.0, 4, 7.0), 4, "spindle"),
+        train(crossings(0.41, 4, 7.0), 4, "cage"),
+        on_check=lambda s: notes.update(s.notes),
+    )
+    assert any("spindle speed changing" in n for n in notes)
+    assert any("spindle speed steady at" in n for n in notes)
+    x, _ = monitor.stability.points()
+    # series restarted at the end of the ramp (t = 4 s): it spans at most the last 3 s
+    assert x[-1] - x[0] <= 3.0 + 0.1
+    assert monitor.stability.n_points < monitor.windows
+    assert monitor.status().slip_rate == pytest.approx(expected_slip(150.0, 0.41 * 150.0), abs=1e-6)

@@ -1,0 +1,243 @@
+"""The simulator and monitor nodes, each in its own process on the test's isolated ROS domain.
+
+The simulator runs with ``--no-realtime`` (as fast as it can), so simulated seconds pass in
+fractions of a wall second. Published messages are checked field by field against expectations
+computed here (the bearing's epicyclic ratio from its file, the strip count from config/rig.yaml,
+the engine's 40 us step), not against the nodes' own code. Every wait is bounded.
+"""
+
+from __future__ import annotations
+
+import math
+import signal
+import subprocess
+from typing import Any
+
+import pytest
+import yaml
+
+pytestmark = pytest.mark.ros
+rclpy = pytest.importorskip("rclpy")
+
+from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+from rosgraph_msgs.msg import Clock  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+
+from bearing_rig_sim.config import config_path  # noqa: E402
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS, from_stamp  # noqa: E402
+
+RPM = math.pi / 30.0
+WAIT = 60.0
+"""Longest wait for any one condition, wall s (node start-up takes a few seconds)."""
+
+
+def epicyclic_ratio() -> float:
+    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
+
+
+def rig_strips() -> tuple[int, int]:
+    sensors = yaml.safe_load(config_path("rig.yaml").read_text())["sensors"]
+    return sensors["spindle"]["strip_count"], sensors["cage"]["strip_count"]
+
+
+def start(ros_graph: Any, module: str, *params: str, flags: tuple[str, ...] = ()) -> subprocess.Popen[str]:
+    args = ["-m", f"bearing_rig_sim.nodes.{module}", *flags]
+    if params:
+        args.append("--ros-args")
+        for p in params:
+            args += ["-p", p]
+    return ros_graph.spawn_python(*args)
+
+
+class Probe:
+    """A test node recording what the nodes publish."""
+
+    def __init__(self, ros_graph: Any) -> None:
+        self.node = ros_graph.node("probe")
+        self.executor = ros_graph.executor([self.node])
+        self.graph = ros_graph
+        self.clock: list[float] = []
+        self.speeds: list[JointState] = []
+        self.pulses: dict[str, list[FibreOpticPulse]] = {"spindle": [], "cage": []}
+        self.truth: list[SimulatorTruth] = []
+        self.status: list[SlipStatus] = []
+        self.diagnostics: dict[str, list[DiagnosticStatus]] = {}
+        n = self.node
+        n.create_subscription(Clock, "/clock", lambda m: self.clock.append(from_stamp(m.clock)), RELIABLE_QOS)
+        n.create_subscription(JointState, "/rig/speeds", self.speeds.append, SENSOR_QOS)
+        n.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", self.pulses["spindle"].append, SENSOR_QOS)
+        n.create_subscription(FibreOpticPulse, "/rig/cage/pulses", self.pulses["cage"].append, SENSOR_QOS)
+        n.create_subscription(SimulatorTruth, "/rig/truth", self.truth.append, SENSOR_QOS)
+        n.create_subscription(SlipStatus, "/rig/slip_status", self.status.append, STATUS_QOS)
+        n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, RELIABLE_QOS)
+        self.command = n.create_publisher(SpindleCommand, "/rig/spindle/command", STATUS_QOS)
+        self.force = n.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS)
+
+    def _on_diagnostics(self, msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            self.diagnostics.setdefault(status.name.split(":")[0], []).append(status)
+
+    def wait(self, condition: Any, what: str, timeout: float = WAIT) -> None:
+        assert self.graph.spin_until(condition, timeout, executor=self.executor), f"timed out waiting for {what}"
+
+    def diag(self, node: str) -> list[DiagnosticStatus]:
+        return self.diagnostics.get(node, [])
+
+    def send_command(self, target: float, ramp: float) -> None:
+        self.command.publish(SpindleCommand(target_speed=target, profile=SpindleCommand.PROFILE_STEP, ramp_time=ramp))
+
+    def send_force(self, newtons: float) -> None:
+        self.wait(lambda: self.force.get_subscription_count() > 0, "the simulator's force subscription")
+        msg = WrenchStamped()
+        msg.wrench.force.z = newtons
+        self.force.publish(msg)
+
+    def truth_time(self) -> float:
+        return from_stamp(self.truth[-1].header.stamp) if self.truth else -1.0
+
+
+def test_simulator_publishes_the_documented_topics(ros_graph):
+    speed = 1500 * RPM
+    process = start(ros_graph, "simulator", f"initial_speed_rad_s:={speed!r}", flags=("--no-realtime",))
+    probe = Probe(ros_graph)
+    probe.wait(
+        lambda: probe.truth_time() >= 1.0 and len(probe.pulses["cage"]) >= 8 and probe.diag("simulator") and len(probe.speeds) > 100,
+        "a simulated second of every topic",
+    )
+    assert process.poll() is None
+
+    # /clock: 1 ms steps of simulated time, increasing
+    steps = [b - a for a, b in zip(probe.clock, probe.clock[1:])]
+    assert steps and all(s > 0 for s in steps)
+    assert all(abs(s / 1e-3 - round(s / 1e-3)) < 1e-6 for s in steps)
+
+    # /rig/speeds: the counters' speeds and pulse-counted angles
+    late = [m for m in probe.speeds if from_stamp(m.header.stamp) > 0.5]
+    assert late
+    for m in late:
+        assert list(m.name) == ["inner_ring", "cage"] and len(m.velocity) == 2 and len(m.position) == 2
+        assert len(m.effort) == 0
+        assert m.velocity[0] == pytest.approx(speed, rel=1e-3)
+        assert 0.90 * epicyclic_ratio() < m.velocity[1] / m.velocity[0] < epicyclic_ratio()  # a few % of slip
+    spindle_strips, cage_strips = rig_strips()
+    strips_turned = late[-1].position[0] / (2 * math.pi / spindle_strips)
+    assert strips_turned == pytest.approx(round(strips_turned), abs=1e-9)
+    assert late[-1].position[0] > late[0].position[0]
+
+    # pulses: strip counts of config/rig.yaml, consistent indices, one strip spacing apart in time
+    for shaft, strips in (("spindle", spindle_strips), ("cage", cage_strips)):
+        pulses = probe.pulses[shaft]
+        for p in pulses:
+            assert (p.sensor_id, p.strip_count, p.header.frame_id) == (shaft, strips, f"{shaft}_sensor")
+            assert p.strip_id < strips and p.revolution == p.pulse_index // strips
+        stamps = [from_stamp(p.header.stamp) for p in pulses]
+        assert all(b > a for a, b in zip(stamps, stamps[1:]))
+    spindle = probe.pulses["spindle"]
+    period = [
+        from_stamp(b.header.stamp) - from_stamp(a.header.stamp)
+        for a, b in zip(spindle, spindle[1:])
+        if b.pulse_index == a.pulse_index + 1
+    ]
+    assert period and all(p == pytest.approx(2 * math.pi / spindle_strips / speed, abs=1e-5) for p in period)
+
+    # /rig/truth: the engine's truth, 100 Hz of simulated time
+    truth = probe.truth[-1]
+    stamp = from_stamp(truth.header.stamp)
+    assert round(stamp / 0.01) == pytest.approx(stamp / 0.01, abs=1e-6)
+    assert truth.inner_ring_speed == pytest.approx(speed, rel=1e-12)
+    assert truth.theoretical_cage_speed == pytest.approx(epicyclic_ratio() * speed, rel=1e-9)
+    assert truth.slip_rate == pytest.approx((1 - truth.cage_speed / (epicyclic_ratio() * speed)) * 100, abs=1e-9)
+    assert 2.0 < truth.slip_rate < 8.0
+    assert truth.axial_load == 100.0  # initial_axial_load_n of config/simulator.yaml
+    assert truth.step_count == round(stamp / 40e-6)
+    assert truth.real_time_factor > 0.0 and truth.overruns == 0
+    assert truth.inner_contact_load_max > 0.0 and truth.pocket_load_max >= 0.0
+
+    # /diagnostics: the simulator is healthy
+    diag = probe.diag("simulator")[-1]
+    assert diag.level == DiagnosticStatus.OK and diag.message == "running"
+    values = {kv.key: kv.value for kv in diag.values}
+    assert values["realtime"] == "false" and float(values["axial_load_n"]) == 100.0
+
+
+def test_simulator_follows_commands_and_refuses_bad_input(ros_graph):
+    start(ros_graph, "simulator", flags=("--no-realtime",))
+    probe = Probe(ros_graph)
+    probe.wait(lambda: probe.truth_time() > 0.1, "the simulator")
+    assert probe.truth[-1].inner_ring_speed == 0.0
+
+    target = 2100 * RPM
+    probe.send_command(target, 0.5)
+    probe.wait(lambda: abs(probe.truth[-1].inner_ring_speed - target) < 1e-9, "the spindle at 2100 rpm")
+    reached = probe.truth_time()
+    probe.wait(lambda: probe.truth_time() > reached + 0.3, "a hold at 2100 rpm")
+    assert probe.speeds[-1].velocity[0] == pytest.approx(target, rel=1e-3)
+
+    def error_with(text: str) -> bool:
+        return any(d.level == DiagnosticStatus.ERROR and text in d.message for d in probe.diag("simulator"))
+
+    probe.send_command(math.nan, 0.5)
+    probe.wait(lambda: error_with("spindle command refused: target_speed: must be finite"), "ERROR for a NaN command")
+    probe.send_command(100.0, 0.2)  # it still answers
+    probe.wait(lambda: abs(probe.truth[-1].inner_ring_speed - 100.0) < 1e-9, "the spindle at 100 rad/s")
+
+    probe.send_force(math.nan)
+    probe.wait(lambda: error_with("axial force refused: axial force: must be a finite number"), "ERROR for a NaN force")
+    probe.send_force(-20.0)
+    probe.wait(lambda: error_with("must be >= 0 N"), "ERROR for a negative force")
+    probe.send_force(250.0)
+    probe.wait(lambda: probe.truth[-1].axial_load == 250.0, "the bearing loaded with 250 N")
+    probe.send_force(0.2)  # below the engine's 1 N: applied as 1 N, a warning
+    probe.wait(lambda: probe.truth[-1].axial_load == 1.0, "the load raised to 1 N")
+    probe.wait(
+        lambda: any(d.level == DiagnosticStatus.WARN and "1 N applied" in d.message for d in probe.diag("simulator")),
+        "WARN for the raised load",
+    )
+
+
+def test_monitor_finds_stable_slip_close_to_the_truth(ros_graph):
+    speed = 1500 * RPM
+    start(ros_graph, "simulator", f"initial_speed_rad_s:={speed!r}", flags=("--no-realtime",))
+    start(ros_graph, "monitor")
+    probe = Probe(ros_graph)
+    probe.wait(lambda: any(s.state == SlipStatus.STATE_STABLE for s in probe.status), "a stable verdict")
+    stable = next(s for s in probe.status if s.state == SlipStatus.STATE_STABLE)
+    truth = min(probe.truth, key=lambda t: abs(from_stamp(t.header.stamp) - from_stamp(stable.header.stamp)))
+    assert stable.slip_rate == pytest.approx(truth.slip_rate, abs=0.1)
+    assert stable.inner_ring_speed == pytest.approx(speed, rel=1e-3)
+    assert stable.theoretical_cage_speed == pytest.approx(epicyclic_ratio() * stable.inner_ring_speed, rel=1e-9)
+    assert stable.slip_rate == pytest.approx((1 - stable.cage_speed / stable.theoretical_cage_speed) * 100, abs=1e-9)
+    assert (stable.criterion, stable.critical_slope, stable.window_revolutions) == ("time", -0.03, 1)
+    assert stable.fitted_slope >= stable.critical_slope
+    assert 0.0 <= stable.confidence <= 1.0
+    probe.wait(lambda: any(d.level == DiagnosticStatus.OK for d in probe.diag("monitor")), "monitor diagnostics OK")
+
+
+def test_monitor_reports_error_when_the_pulses_stop(ros_graph):
+    simulator = start(ros_graph, "simulator", f"initial_speed_rad_s:={1200 * RPM!r}", flags=("--no-realtime",))
+    start(ros_graph, "monitor")
+    probe = Probe(ros_graph)
+    probe.wait(lambda: any(math.isfinite(s.slip_rate) for s in probe.status), "a first slip window")
+    simulator.send_signal(signal.SIGSTOP)  # the source freezes: no pulses, no /clock
+    try:
+        probe.wait(
+            lambda: any(d.level == DiagnosticStatus.ERROR and "sensor loss" in d.message for d in probe.diag("monitor")),
+            "ERROR for sensor loss",
+            timeout=20.0,
+        )
+        probe.wait(
+            lambda: any("spindle: no pulse for" in s.detail and "cage: no pulse for" in s.detail for s in probe.status),
+            "both shafts reported lost",
+            timeout=5.0,
+        )
+        assert all(s.state == SlipStatus.STATE_FAULT for s in probe.status if "sensor loss" in s.detail)
+    finally:
+        simulator.send_signal(signal.SIGCONT)
+    count = len(probe.status)
+    probe.wait(
+        lambda: any(s.state != SlipStatus.STATE_FAULT for s in probe.status[count:]),
+        "the monitor back from the fault once the pulses return",
+    )

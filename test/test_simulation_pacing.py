@@ -1,0 +1,126 @@
+"""The real-time pacer's arithmetic on a fake wall clock: due chunks, overruns, resyncs, the
+achieved real-time factor, and the as-fast-as-possible mode."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from bearing_rig_sim.simulation.pacing import PacerError, RealTimePacer
+
+
+class FakeClock:
+    """A wall clock the test moves by hand (s)."""
+
+    def __init__(self, start: float = 1000.0) -> None:
+        self.now = start
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def pacer(clock: FakeClock, **options: object) -> RealTimePacer:
+    defaults: dict[str, object] = {"loop_period": 1e-3, "overrun_margin": 5e-3, "max_batch": 50, "resync_lag": 0.5}
+    defaults.update(options)
+    return RealTimePacer(1e-3, clock=clock, **defaults)  # type: ignore[arg-type]
+
+
+def test_due_chunks_follow_the_wall_clock():
+    clock = FakeClock()
+    p = pacer(clock)
+    p.start(2.0)
+    assert p.due_chunks(2.0) == 0
+    clock.now += 0.0035  # 3.5 ms later: three whole chunks are due
+    assert p.due_chunks(2.0) == 3
+    clock.now += 0.0006  # 4.1 ms: the simulation ran its three chunks, one more is due
+    assert p.due_chunks(2.003) == 1
+    assert p.due_chunks(2.004) == 0
+    assert p.lag(2.004) == pytest.approx(0.0001)
+    assert p.next_due_in(2.004) == pytest.approx(0.0009)
+    assert p.overruns == 0
+
+
+def test_rate_scales_the_simulated_time():
+    clock = FakeClock()
+    p = pacer(clock, rate=2.0)
+    p.start(0.0)
+    clock.now += 0.010
+    assert p.target() == pytest.approx(0.020)
+    assert p.due_chunks(0.0) == 20
+    assert p.lag(0.0) == pytest.approx(0.010)  # wall seconds
+
+
+def test_batches_are_capped():
+    clock = FakeClock()
+    p = pacer(clock, max_batch=4, overrun_margin=1.0)
+    p.start(0.0)
+    clock.now += 0.1
+    assert p.due_chunks(0.0) == 4
+    assert p.due_chunks(0.004) == 4
+
+
+def test_a_call_later_than_one_period_plus_the_margin_is_an_overrun():
+    clock = FakeClock()
+    p = pacer(clock)  # period 1 ms, margin 5 ms
+    p.start(0.0)
+    clock.now += 0.0059  # 5.9 ms behind: within period + margin
+    p.due_chunks(0.0)
+    assert (p.overruns, p.behind) == (0, False)
+    clock.now += 0.0002  # 6.1 ms behind
+    p.due_chunks(0.0)
+    assert (p.overruns, p.behind) == (1, True)
+    p.due_chunks(0.0)  # still behind at the next call: a second overrun
+    assert p.overruns == 2
+    p.due_chunks(0.006)  # caught up
+    assert (p.overruns, p.behind) == (2, False)
+
+
+def test_a_large_debt_is_dropped_and_counted_as_a_resync():
+    clock = FakeClock()
+    p = pacer(clock)
+    p.start(0.0)
+    clock.now += 0.8  # a stall of 0.8 s > resync_lag 0.5 s
+    assert p.due_chunks(0.010) == 1
+    assert (p.resyncs, p.overruns) == (1, 1)
+    assert p.target() == pytest.approx(0.010)  # re-anchored at the simulation's time
+    clock.now += 0.002
+    assert p.due_chunks(0.011) == 1
+
+
+def test_as_fast_as_possible_gives_full_batches_and_no_overruns():
+    clock = FakeClock()
+    p = pacer(clock, realtime=False, max_batch=20)
+    p.start(0.0)
+    clock.now += 10.0
+    assert p.due_chunks(0.0) == 20
+    assert (p.overruns, p.lag(0.0), p.next_due_in(0.0)) == (0, 0.0, 0.0)
+
+
+def test_real_time_factor_over_a_sliding_window():
+    clock = FakeClock()
+    p = pacer(clock, rtf_window=1.0)
+    p.start(0.0)
+    assert math.isnan(p.real_time_factor)
+    sim = 0.0
+    for _ in range(100):  # 1 s of wall time at twice real time
+        clock.now += 0.01
+        sim += 0.02
+        p.record(sim)
+    assert p.real_time_factor == pytest.approx(2.0)
+    for _ in range(300):  # then 3 s at half real time: the window forgets the fast second
+        clock.now += 0.01
+        sim += 0.005
+        p.record(sim)
+    assert p.real_time_factor == pytest.approx(0.5, rel=0.02)
+
+
+def test_bad_options_and_calls_before_start_are_refused():
+    clock = FakeClock()
+    for bad in ({"rate": 0.0}, {"overrun_margin": -1.0}, {"max_batch": 0}, {"rtf_window": math.nan}, {"loop_period": 0.0}):
+        with pytest.raises(PacerError):
+            pacer(clock, **bad)
+    with pytest.raises(PacerError, match="chunk"):
+        RealTimePacer(0.0, clock=clock)
+    with pytest.raises(PacerError, match="start"):
+        pacer(clock).due_chunks(0.0)

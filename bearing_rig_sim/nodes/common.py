@@ -96,9 +96,9 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
     Returns the process exit status."""
     rclpy.init(args=ros_args_with_defaults(node_name, argv))
     node = None
+    executor = SingleThreadedExecutor()
     try:
         node = factory()
-        executor = SingleThreadedExecutor()
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -108,6 +108,10 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             close = getattr(node, "close", None)
             if callable(close):
                 close()
+        # Release the executor's hold on the node's handles first: Jazzy's destroy_node waits
+        # for them forever if a callback failed during shutdown.
+        executor.shutdown(timeout_sec=1.0)
+        if node is not None:
             node.destroy_node()
         rclpy.try_shutdown()
     return 0

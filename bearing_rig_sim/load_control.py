@@ -17,6 +17,13 @@ Policies (the node's documentation repeats them):
 * **Set-points.** A request that is not a finite number, is negative or is above the chain's
   ``max_setpoint_n`` is refused: the previous set-point stays, the reason is returned and the
   health turns WARN until the next accepted set-point (or a fault reset).
+* **Zero load de-energises the brake.** At a set-point of 0 N the brake is driven open loop at
+  0 V (:meth:`~bearing_rig_sim.rig.loading.LoadingChain.set_manual_voltage`) instead of being
+  regulated around zero force: a rope cannot push, so below zero force the loop has no feedback,
+  the integrator walks on the load cell's noise and drives the plunger back to its slack stop
+  (over 2 mm in 2.6 s at the shipped values); the next set-point then slams the rope taut and
+  trips the rate interlock. Any set-point above 0 N returns to closed loop (bumpless, from the
+  load cell's reading).
 * **Interlocks** (load limit, rate limit, clutch slip; :class:`~bearing_rig_sim.rig.loading.LoadingChain`)
   latch a fault: the brake is de-energised and the health is ERROR with the interlock's reason.
   **A fault is cleared only by** :meth:`AxialLoadOperation.reset_fault` (the node's
@@ -124,7 +131,7 @@ class AxialLoadOperation:
         *,
         state_period_s: float = 0.01,
         diagnostics_period_s: float = 1.0,
-        max_clock_gap_s: float = 1.0,
+        max_clock_gap_s: float = 5.0,
         engage: bool = True,
     ) -> None:
         for name, value in (
@@ -145,6 +152,7 @@ class AxialLoadOperation:
         self._reported: Health | None = None
         if engage:
             chain.engage()
+        self._apply_zero_load_rule()
 
     @classmethod
     def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> "AxialLoadOperation":
@@ -176,10 +184,15 @@ class AxialLoadOperation:
             self._refusal = f"set-point by {origin} refused: {exc}"
             return Reply(False, self._refusal)
         self._refusal = ""
+        self._apply_zero_load_rule()
         message = f"axial-load set-point {self.chain.setpoint:g} N (by {origin})"
         if self.chain.fault:
             message += f"; interlock fault latched ({self.chain.fault_reason}): takes effect after reset_fault"
         return Reply(True, message)
+
+    def _apply_zero_load_rule(self) -> None:
+        """Brake de-energised (open loop, 0 V) at a 0 N set-point, closed loop otherwise."""
+        self.chain.set_manual_voltage(0.0 if self.chain.setpoint == 0.0 else None)
 
     def fault_cause_present(self) -> str:
         """Why a latched fault cannot be reset yet; empty when its cause is gone."""
@@ -208,6 +221,7 @@ class AxialLoadOperation:
             return Reply(False, f"fault not reset ({self.chain.fault_reason}): {cause}")
         reason = self.chain.fault_reason
         self.chain.reset_fault()
+        self._apply_zero_load_rule()  # a trip leaves the chain's manual mode
         self._refusal = ""
         return Reply(True, f"fault reset ({reason}); set-point {self.chain.setpoint:g} N in force")
 
@@ -273,6 +287,8 @@ class AxialLoadOperation:
             return Health(HealthLevel.WARN, self._refusal)
         if chain.clutch.state is ClutchState.RELEASED:
             return Health(HealthLevel.OK, f"clutch released; set-point {chain.setpoint:g} N")
+        if chain.setpoint == 0.0:
+            return Health(HealthLevel.OK, "set-point 0 N: brake de-energised")
         return Health(HealthLevel.OK, f"controlling the axial load; set-point {chain.setpoint:g} N")
 
     def mark_reported(self, health: Health) -> None:

@@ -127,6 +127,23 @@ def test_reset_is_refused_while_the_load_cell_is_over_the_limit(config: LoadingC
     assert op.reset_fault().message == "no interlock fault latched"
 
 
+def test_a_long_wait_at_zero_load_does_not_trip_the_next_set_point(config: LoadingChainConfig) -> None:
+    """Regulating around 0 N lets the plunger drift to the slack stop (a rope cannot push), and the
+    next set-point then slams the rope taut: the brake is de-energised at 0 N instead."""
+    op = AxialLoadOperation.from_config(config)
+    op.advance_to(0.0)
+    drive(op, 0.0, 3.0, 0.001)
+    assert "de-energised" in op.health().message
+    assert abs(op.chain.plunger_position) < 0.2e-3  # m: no drift to the slack stop (-5 mm)
+    op.request_setpoint(100.0, SetpointSource.TOPIC)
+    results = drive(op, 3.0, 4.0, 0.001)
+    assert not any(r.tripped for r in results)
+    assert op.chain.state().bearing_force == pytest.approx(100.0, rel=0.02)
+    op.request_setpoint(0.0, SetpointSource.TOPIC)  # and back to zero: unloads, brake off
+    drive(op, 4.0, 4.5, 0.001)
+    assert op.chain.state().bearing_force < 1.0 and op.chain.brake.voltage == 0.0
+
+
 def test_clutch_release_and_engage(config: LoadingChainConfig) -> None:
     op = AxialLoadOperation.from_config(config, engage=False)
     assert op.chain.state().clutch_state == "released"

@@ -24,6 +24,7 @@ from bearing_rig_sim.errors import RigError
 
 BENCHMARKS: dict[str, str] = {
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
+    "rig": "bearing_rig_sim.benchmarks.rig",
 }
 """Benchmark name -> module path (``bearing_rig_sim.benchmarks.<name>``)."""
 

@@ -7,9 +7,12 @@ parameters from ``config/load_controller.yaml``.
 
 Interfaces (README, interface table):
 
-* subscribes ``/clock`` (rosgraph_msgs/Clock): each advance of the simulation clock steps the
-  chain by the sim time elapsed, in sub-steps of at most 1 ms (ticks that queued up while the
-  node was busy are taken together, so it keeps up with a simulator faster than real time);
+* follows ``/clock`` (rosgraph_msgs/Clock) through the node's own sim-time clock
+  (``use_sim_time`` must be true): a jump handler on that clock steps the chain at each advance
+  by the sim time elapsed, in sub-steps of at most 1 ms. rclpy's time source keeps only the
+  latest tick (best effort, depth 1), so ticks that came while the node was busy are taken
+  together and the node keeps up with a simulator faster than real time; and ``/clock`` is
+  dispatched once per tick, not twice (the time source's and a subscription of our own);
 * subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable);
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
@@ -47,15 +50,17 @@ from bearing_rig_msgs.srv import SetAxialLoad
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rclpy.clock import JumpThreshold
+from rclpy.duration import Duration
+from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.load_control import AdvanceResult, AxialLoadOperation, HealthLevel, Reply, SetpointSource
+from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, Reply, SetpointSource
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
@@ -91,7 +96,7 @@ class LoadControllerNode(Node):
         engage = bool(self.declare_parameter("engage_clutch_on_start", True, read_only).value)
         state_rate = float(self.declare_parameter("state_rate_hz", 100.0, read_only).value)
         diagnostics_period = float(self.declare_parameter("diagnostics_period_s", 1.0, read_only).value)
-        max_gap = float(self.declare_parameter("max_clock_gap_s", 1.0, read_only).value)
+        max_gap = float(self.declare_parameter("max_clock_gap_s", 5.0, read_only).value)
         if not (math.isfinite(state_rate) and state_rate > 0.0):
             raise RigError(f"{NODE_NAME}: state_rate_hz must be a finite number > 0 Hz, got {state_rate!r}")
         rig_path = Path(rig_file) if rig_file else config_path("rig.yaml")
@@ -104,12 +109,14 @@ class LoadControllerNode(Node):
             engage=engage,
         )
         self._mirroring = False
-        self._last_result: AdvanceResult | None = None
 
-        self._force_pub = self.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS)
-        self._load_cell_pub = self.create_publisher(WrenchStamped, "/rig/axial_load/force", SENSOR_QOS)
-        self._state_pub = self.create_publisher(AxialLoadState, "/rig/axial_load/state", RELIABLE_QOS)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
+        # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
+        # walks on every wake-up (about 1000 a second here); an incompatible QoS goes unlogged.
+        quiet = PublisherEventCallbacks(use_default_callbacks=False)
+        self._force_pub = self.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS, event_callbacks=quiet)
+        self._load_cell_pub = self.create_publisher(WrenchStamped, "/rig/axial_load/force", SENSOR_QOS, event_callbacks=quiet)
+        self._state_pub = self.create_publisher(AxialLoadState, "/rig/axial_load/state", RELIABLE_QOS, event_callbacks=quiet)
+        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS, event_callbacks=quiet)
 
         descriptor = ParameterDescriptor(
             description="axial-load set-point, N (finite, >= 0, <= max_setpoint_n of the rig file)",
@@ -120,8 +127,20 @@ class LoadControllerNode(Node):
         self._apply(self.operation.request_setpoint(_as_number(initial), SetpointSource.PARAMETER))
         self._mirror_setpoint()
 
-        self._clock_sub = self.create_subscription(Clock, "/clock", self._on_clock, RELIABLE_QOS)
-        self.create_subscription(Float64, "/rig/axial_load/setpoint", self._on_setpoint, RELIABLE_QOS)
+        if not self.get_parameter("use_sim_time").value:
+            raise RigError(f"{NODE_NAME}: steps the loading chain on the simulation clock: use_sim_time must be true")
+        self._bearing_msg = WrenchStamped()
+        self._bearing_msg.header.frame_id = "bearing"
+        self._load_cell_msg = WrenchStamped()
+        self._load_cell_msg.header.frame_id = "load_cell"
+        self._jump_handle = self.get_clock().create_jump_callback(
+            JumpThreshold(min_forward=Duration(nanoseconds=1), min_backward=Duration(nanoseconds=-1)),
+            post_callback=self._on_clock,
+        )
+        self.create_subscription(
+            Float64, "/rig/axial_load/setpoint", self._on_setpoint, RELIABLE_QOS,
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+        )
         self.create_service(SetAxialLoad, "/rig/axial_load/set", self._on_set_service)
         self.create_service(Trigger, "/rig/axial_load/reset_fault", self._on_reset_fault)
         self.create_service(SetBool, "/rig/axial_load/clutch", self._on_clutch)
@@ -131,15 +150,10 @@ class LoadControllerNode(Node):
         )
 
     # -- clock ------------------------------------------------------------------------------------
-    def _on_clock(self, msg: Clock) -> None:
-        latest = msg.clock
-        handle = self._clock_sub.handle
-        with handle:  # ticks that queued up while we were busy: only the latest matters
-            while (taken := handle.take_message(Clock, False)) is not None:
-                latest = taken[0].clock
-        stamp = latest
+    def _on_clock(self, _jump: object = None) -> None:
+        """The sim-time clock moved (forward or back): step the chain to it and publish."""
+        stamp = self.get_clock().now().to_msg()
         result = self.operation.advance_to(stamp.sec + stamp.nanosec * 1e-9)
-        self._last_result = result
         if result.clock_note:
             self.get_logger().warning(result.clock_note)
         if result.tripped:
@@ -151,14 +165,11 @@ class LoadControllerNode(Node):
             self._publish_diagnostics()
 
     def _publish_forces(self, stamp: object, state: LoadChainState) -> None:
-        bearing = WrenchStamped()
+        bearing, cell = self._bearing_msg, self._load_cell_msg
         bearing.header.stamp = stamp
-        bearing.header.frame_id = "bearing"
         bearing.wrench.force.z = state.bearing_force
         self._force_pub.publish(bearing)
-        cell = WrenchStamped()
         cell.header.stamp = stamp
-        cell.header.frame_id = "load_cell"
         cell.wrench.force.z = state.load_cell_force
         self._load_cell_pub.publish(cell)
 

@@ -1,0 +1,18 @@
+"""A rig session (``bearing-rig run``): the nodes as processes, a test program run on the
+simulation clock, recorded to a bag, shown live and summarised.
+
+* :mod:`.processes`: finding, starting, watching and stopping the node processes; the private
+  ROS domain (no ROS).
+* :mod:`.runner`: the program runner's segment and end-condition logic (no ROS).
+* :mod:`.recorder`: the recorded topics and the log-time rule (no ROS).
+* :mod:`.progress`: the live progress line and the summary table (no ROS).
+* :mod:`.context`: run id and the run context stored in the bag (no ROS).
+* :mod:`.node`: the session's ROS node (commands, recorder subscriptions).
+* :mod:`.session`: :func:`run_session`, which puts it all together.
+
+Importing this package does not import ROS; :func:`run_session` does, when it starts.
+"""
+
+from bearing_rig_sim.session.session import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, SessionOptions, run_session
+
+__all__ = ["EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]

@@ -1,0 +1,84 @@
+"""A run's identity and the context recorded with it (no ROS).
+
+The run id is the UTC start time and the program's name, ``20250612T093015Z-validation``; the
+bag goes to ``<bag dir>/<run id>/``. The context (:func:`run_context`) travels in the bag's
+metadata as string key/value pairs, so a bag says how it was made:
+
+* ``program``, ``program_file``: the test program's text and where it was read;
+* ``bearing``, ``bearing_file``: the bearing data file's text and path;
+* ``calibration/<file>``: every file of ``config/calibration/`` named after the bearing file
+  (``h7006c_*``: the calibration the simulator applies, with its data);
+* ``rig``: ``config/rig.yaml`` (loading chain, sensors);
+* ``parameters/<node>``: each node's parameter file (``config/<node>.yaml``) when present;
+* ``command_line``, ``run_id``, ``started_utc``, ``ros_domain_id``, ``realtime``;
+* the recorder adds ``project_version``.
+"""
+
+from __future__ import annotations
+
+import re
+import shlex
+from datetime import datetime, timezone
+from pathlib import Path
+from typing import Mapping, Sequence
+
+from bearing_rig_sim.config import config_path
+from bearing_rig_sim.rig.program import TestProgram
+
+__all__ = ["NODE_PARAMETER_FILES", "make_run_id", "run_context"]
+
+NODE_PARAMETER_FILES = ("simulator", "load_controller", "monitor")
+"""Nodes whose ``config/<node>.yaml`` is recorded."""
+
+
+def make_run_id(program_name: str, start: datetime) -> str:
+    """``<UTC start, basic ISO 8601>-<program name>``, with characters other than letters, digits,
+    ``-``, ``_`` and ``.`` in the name replaced by ``_``.
+
+    Raises:
+        ValueError: ``start`` has no time zone.
+    """
+    if start.tzinfo is None:
+        raise ValueError("make_run_id: the start time needs a time zone")
+    name = re.sub(r"[^A-Za-z0-9._-]", "_", program_name) or "program"
+    return f"{start.astimezone(timezone.utc):%Y%m%dT%H%M%SZ}-{name}"
+
+
+def _text(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        return f"<unreadable: {exc}>"
+
+
+def run_context(
+    program: TestProgram,
+    *,
+    run_id: str,
+    start: datetime,
+    command_line: Sequence[str],
+    extra: Mapping[str, str] | None = None,
+) -> dict[str, str]:
+    """The run context of the module documentation, as string key/value pairs."""
+    program_file = Path(program.source)
+    context = {
+        "run_id": run_id,
+        "started_utc": start.astimezone(timezone.utc).isoformat(),
+        "command_line": shlex.join(command_line),
+        "program_file": str(program_file),
+        "program": _text(program_file),
+        "bearing_file": str(program.bearing_file),
+        "bearing": _text(program.bearing_file),
+        "rig": _text(config_path("rig.yaml")),
+    }
+    calibration = config_path("calibration")
+    if calibration.is_dir():
+        for path in sorted(calibration.glob(f"{program.bearing_file.stem}_*")):
+            if path.is_file():
+                context[f"calibration/{path.name}"] = _text(path)
+    for node in NODE_PARAMETER_FILES:
+        path = config_path(f"{node}.yaml")
+        if path.is_file():
+            context[f"parameters/{node}"] = _text(path)
+    context.update(extra or {})
+    return context

@@ -1,0 +1,267 @@
+"""The session's ROS side: recorder subscriptions, the program runner's commands, what the
+progress line and the summary read. A thin shell around :mod:`.runner`, :mod:`.recorder` and
+:mod:`.progress`.
+
+**Recording without losing messages.** About 4-5 kHz of messages reach the session (``/clock``,
+speeds and both forces at 1 kHz each, the rest slower), and several times that without real
+time. Dispatching each through the executor costs some 100 us in rclpy, most of a core; so the
+recorder's subscriptions live on a second node, ``<name>_recorder``, that is *not* added to the
+executor, with deep reader queues (:data:`RECORDER_DEPTH`), and a timer of the session node
+takes every queued message every :data:`DRAIN_PERIOD_S` (about 10 us each) and hands them, in
+order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the whole session.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
+from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
+from rclpy.context import Context
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.serialization import deserialize_message
+from rosgraph_msgs.msg import Clock
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64
+
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
+from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
+from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
+
+__all__ = ["DRAIN_PERIOD_S", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
+
+DRAIN_PERIOD_S = 0.02
+"""Wall time between two takes of the recorder's queues, s."""
+
+RECORDER_DEPTH = 5000
+"""Reader queue depth of each recorded topic: 5 s of a 1 kHz topic in real time, 1 s at 5x."""
+
+MESSAGE_TYPES: dict[str, type] = {
+    "rosgraph_msgs/msg/Clock": Clock,
+    "bearing_rig_msgs/msg/SpindleCommand": SpindleCommand,
+    "bearing_rig_msgs/msg/FibreOpticPulse": FibreOpticPulse,
+    "sensor_msgs/msg/JointState": JointState,
+    "bearing_rig_msgs/msg/SimulatorTruth": SimulatorTruth,
+    "std_msgs/msg/Float64": Float64,
+    "bearing_rig_msgs/msg/AxialLoadState": AxialLoadState,
+    "geometry_msgs/msg/WrenchStamped": WrenchStamped,
+    "bearing_rig_msgs/msg/SlipStatus": SlipStatus,
+    "diagnostic_msgs/msg/DiagnosticArray": DiagnosticArray,
+}
+"""The rclpy class of each recorded type."""
+
+_LEVEL_NAMES = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
+
+
+def reader_qos(topic: RecordedTopic) -> QoSProfile:
+    """The recorder's subscription QoS: compatible with the publisher's offered profile, deep."""
+    best_effort = topic.qos == "sensor_data"
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=RECORDER_DEPTH,
+        reliability=ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if topic.qos == "transient_local" else DurabilityPolicy.VOLATILE,
+    )
+
+
+@dataclass
+class LiveValues:
+    """The latest values the progress line shows (SI)."""
+
+    inner_ring_speed: float | None = None
+    cage_speed: float | None = None
+    speeds_raw: bytes | None = field(default=None, repr=False)
+    state_count: int = 0
+    """AxialLoadState messages seen (the load controller is stepping)."""
+
+    def decode_speeds(self) -> None:
+        """Decode the last ``/rig/speeds`` message (names ``inner_ring``, ``cage``)."""
+        if self.speeds_raw is None:
+            return
+        msg = deserialize_message(self.speeds_raw, JointState)
+        velocities = list(msg.velocity)
+        for name, value in zip(msg.name, velocities):
+            if name == "inner_ring":
+                self.inner_ring_speed = value
+            elif name == "cage":
+                self.cage_speed = value
+
+
+class SessionNode(Node):
+    """Publishes the runner's commands; records every rig topic; feeds the runner.
+
+    Args:
+        recorder: where recorded messages go.
+        runner: the program runner to feed (statuses, truth, bearing force).
+        context: the rclpy context.
+        on_event: called with a line of text for notable events (diagnostics changes).
+        name: node name (the recorder's node is ``<name>_recorder``).
+    """
+
+    def __init__(
+        self,
+        recorder: SessionRecorder,
+        runner: ProgramRunner,
+        *,
+        context: Context,
+        on_event: Callable[[str], None] = lambda _line: None,
+        name: str = "bearing_rig_session",
+    ) -> None:
+        super().__init__(name, context=context)
+        self.recorder = recorder
+        self.runner = runner
+        self.on_event = on_event
+        self.live = LiveValues()
+        self._spindle = self.create_publisher(SpindleCommand, "/rig/spindle/command", STATUS_QOS)
+        self._setpoint = self.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
+        self.tap = Node(f"{name}_recorder", context=context)
+        self._recorded = [
+            (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
+            for topic in recorder.topics.values()
+        ]
+        self._diagnostic_levels: dict[str, int] = {}
+        self._pending: list[tuple[str, bytes]] = []
+        self.sim_time_ns = 0
+        """Stamp of the last ``/clock`` taken, ns."""
+        self.clock_count = 0
+        """``/clock`` messages taken."""
+        self.taken = 0
+        """Messages taken from the recorder's queues so far."""
+
+    def close(self) -> None:
+        """Destroy the recorder's node (the session node is destroyed by its owner)."""
+        self.tap.destroy_node()
+
+    # -- commands ---------------------------------------------------------------------------------
+    def send(self, plan: SegmentPlan) -> None:
+        """Command a segment: the spindle's speed profile and the axial-load set-point."""
+        command = SpindleCommand()
+        command.header.stamp = to_stamp(plan.start_time)
+        command.header.frame_id = plan.segment.name
+        command.target_speed = plan.segment.target_speed
+        command.profile = plan.segment.profile.message_code
+        command.ramp_time = plan.segment.ramp_time
+        command.acceleration = plan.segment.acceleration
+        self._spindle.publish(command)
+        self._setpoint.publish(Float64(data=plan.segment.axial_load))
+
+    # -- readiness --------------------------------------------------------------------------------
+    def subscribers_besides_recorder(self, topic: str) -> int:
+        """Subscriptions to ``topic`` other than the recorder's."""
+        return sum(1 for info in self.get_subscriptions_info_by_topic(topic) if info.node_name != self.tap.get_name())
+
+    def missing(self) -> dict[str, str]:
+        """Which node is not ready yet, and what is missing (empty when all are ready)."""
+        missing = {}
+        if self.clock_count == 0:
+            missing["simulator"] = "no /clock received"
+        elif self.subscribers_besides_recorder("/rig/spindle/command") == 0:
+            missing["simulator"] = "nobody subscribes /rig/spindle/command"
+        if self.live.state_count == 0:
+            missing["load_controller"] = "no /rig/axial_load/state received"
+        elif self.subscribers_besides_recorder("/rig/axial_load/setpoint") == 0:
+            missing["load_controller"] = "nobody subscribes /rig/axial_load/setpoint"
+        if self.count_publishers("/rig/slip_status") == 0:
+            missing["monitor"] = "nobody publishes /rig/slip_status"
+        elif self.subscribers_besides_recorder("/rig/cage/pulses") == 0:
+            missing["monitor"] = "nobody subscribes /rig/cage/pulses"
+        return missing
+
+    # -- recording --------------------------------------------------------------------------------
+    def take(self) -> int:
+        """Take every queued message, in order of arrival: feed the runner and the live values,
+        follow ``/clock``, and keep them for :meth:`record_pending`. Returns the number taken.
+
+        Taking and recording are separate so that the runner decides on the freshest sim time
+        before the bag's writing (a chunk being compressed) can hold the session up."""
+        batch: list[tuple[int, int, str, bytes, type]] = []
+        for topic, msgtype, subscription in self._recorded:
+            handle = subscription.handle
+            with handle:
+                while (taken := handle.take_message(msgtype, True)) is not None:
+                    raw, info = taken
+                    batch.append((info.get("received_timestamp") or 0, len(batch), topic.name, raw, msgtype))
+        if not batch:
+            return 0
+        batch.sort(key=lambda item: (item[0], item[1]))
+        for _, _, name, raw, msgtype in batch:
+            if name == "/clock":
+                stamp = header_stamp_ns(raw)
+                if stamp is not None:
+                    self.sim_time_ns = stamp
+                    self.clock_count += 1
+            else:
+                self._observe(name, raw, msgtype)
+        self._pending.extend((name, raw) for _, _, name, raw, _ in batch)
+        self.taken += len(batch)
+        return len(batch)
+
+    def record_pending(self) -> None:
+        """Write what :meth:`take` took to the recorder."""
+        if self._pending:
+            pending, self._pending = self._pending, []
+            self.recorder.record_batch(pending)
+
+    def drain(self) -> int:
+        """:meth:`take`, then :meth:`record_pending`; returns the number taken."""
+        count = self.take()
+        self.record_pending()
+        return count
+
+    @property
+    def sim_time(self) -> float:
+        """Sim time of the last ``/clock`` taken, s (0 before the first)."""
+        return self.sim_time_ns * 1e-9
+
+    def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
+        if name == "/rig/speeds":
+            self.live.speeds_raw = raw
+        elif name == "/rig/slip_status":
+            msg = deserialize_message(raw, msgtype)
+            self.runner.observe_status(
+                SlipObservation(
+                    time=from_stamp(msg.header.stamp),
+                    state=StatusState(msg.state) if msg.state in StatusState._value2member_map_ else StatusState.UNKNOWN,
+                    slip_rate=msg.slip_rate,
+                    inner_ring_speed=msg.inner_ring_speed,
+                    cage_speed=msg.cage_speed,
+                    window_revolutions=msg.window_revolutions,
+                )
+            )
+        elif name == "/rig/truth":
+            msg = deserialize_message(raw, msgtype)
+            self.runner.observe_truth(from_stamp(msg.header.stamp), msg.slip_rate)
+        elif name == "/rig/axial_load/state":
+            msg = deserialize_message(raw, msgtype)
+            self.live.state_count += 1
+            self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
+        elif name == "/diagnostics":
+            self._diagnostics_events(deserialize_message(raw, msgtype))
+
+    def _diagnostics_events(self, msg: Any) -> None:
+        """An event line when a component's diagnostic level changes to or from WARN/ERROR."""
+        for status in msg.status:
+            level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
+            previous = self._diagnostic_levels.get(status.name, 0)
+            self._diagnostic_levels[status.name] = level
+            if level != previous and (level > 0 or previous > 0):
+                self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {status.message}")
+
+
+def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun
+    """Callback of the recorder's subscriptions; their queues are taken by ``drain``."""
+
+
+def wall_now() -> float:
+    """Monotonic wall time, s."""
+    return time.monotonic()
+
+
+def finite_or_none(value: float | None) -> float | None:
+    """``value`` when it is a finite number, else None."""
+    return value if value is not None and math.isfinite(value) else None

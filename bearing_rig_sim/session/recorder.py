@@ -1,0 +1,173 @@
+"""What the session records, and the log-time rule (no ROS).
+
+Every topic of the interface table (README) is recorded as the serialized CDR the publisher sent
+(:data:`RECORDED_TOPICS`), into anything with ``add_topic`` and ``write`` (the project's
+:class:`~bearing_rig_sim.recording.BagWriter`, or a fake in tests).
+
+**Log time** (the bag's timeline; the MCAP ``log_time``), simulation time in ns:
+
+1. the message's own stamp when it has one (``header.stamp``; ``clock`` for ``/clock``): the first
+   ``builtin_interfaces/Time`` after the 4-byte CDR encapsulation header, read without decoding;
+2. else (``std_msgs/Float64`` set-points), or when the stamp is zero (not set) or more than
+   :data:`PLAUSIBLE_SPAN_NS` away from the last ``/clock`` (a wall-clock stamp from some other
+   publisher), the time of the last ``/clock`` received before it;
+3. strictly increasing over the bag: messages taken together (one drain of the subscriptions) are
+   ordered by that time (ties keep their arrival order), and a time not after the previous one
+   becomes previous + 1 ns. A stamp earlier than the last message written (a pulse interpolated
+   inside a step that arrives after the next ``/clock``) is so moved forward, by at most the time
+   between two drains; its header keeps the exact stamp.
+"""
+
+from __future__ import annotations
+
+import struct
+from dataclasses import dataclass
+from typing import Iterable, Protocol, Sequence
+
+__all__ = [
+    "PLAUSIBLE_SPAN_NS",
+    "RECORDED_TOPICS",
+    "LogTimeRule",
+    "MessageWriter",
+    "RecordedTopic",
+    "SessionRecorder",
+    "header_stamp_ns",
+]
+
+PLAUSIBLE_SPAN_NS = 10_000_000_000
+"""A stamp more than 10 s from the last ``/clock`` is not sim time: the clock's time is used."""
+
+
+@dataclass(frozen=True)
+class RecordedTopic:
+    """A topic the session records."""
+
+    name: str
+    msgtype: str
+    """``pkg/msg/Name``."""
+    qos: str
+    """The publisher's offered profile: ``"reliable"``, ``"sensor_data"`` or ``"transient_local"``."""
+    stamped: bool
+    """The message starts with a time stamp (``header.stamp``, or ``clock``)."""
+
+
+RECORDED_TOPICS: tuple[RecordedTopic, ...] = (
+    RecordedTopic("/clock", "rosgraph_msgs/msg/Clock", "reliable", True),
+    RecordedTopic("/rig/spindle/command", "bearing_rig_msgs/msg/SpindleCommand", "transient_local", True),
+    RecordedTopic("/rig/spindle/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data", True),
+    RecordedTopic("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data", True),
+    RecordedTopic("/rig/speeds", "sensor_msgs/msg/JointState", "sensor_data", True),
+    RecordedTopic("/rig/truth", "bearing_rig_msgs/msg/SimulatorTruth", "sensor_data", True),
+    RecordedTopic("/rig/axial_load/setpoint", "std_msgs/msg/Float64", "reliable", False),
+    RecordedTopic("/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", True),
+    RecordedTopic("/rig/axial_load/force", "geometry_msgs/msg/WrenchStamped", "sensor_data", True),
+    RecordedTopic("/rig/bearing/axial_force", "geometry_msgs/msg/WrenchStamped", "reliable", True),
+    RecordedTopic("/rig/slip_status", "bearing_rig_msgs/msg/SlipStatus", "transient_local", True),
+    RecordedTopic("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", True),
+)
+"""Every topic of the interface table (the service ``/rig/axial_load/set`` is not a topic)."""
+
+CLOCK_TOPIC = "/clock"
+
+
+class MessageWriter(Protocol):
+    """What the recorder writes into (:class:`~bearing_rig_sim.recording.BagWriter`'s methods)."""
+
+    def add_topic(self, name: str, msgtype: str, qos: str) -> None: ...
+
+    def write(self, topic: str, log_time_ns: int, data: bytes) -> None: ...
+
+
+def header_stamp_ns(data: bytes | bytearray | memoryview) -> int | None:
+    """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
+    short or its encapsulation is not plain CDR (big or little endian)."""
+    if len(data) < 12:
+        return None
+    kind = bytes(data[:2])
+    if kind == b"\x00\x01":
+        sec, nanosec = struct.unpack_from("<iI", data, 4)
+    elif kind == b"\x00\x00":
+        sec, nanosec = struct.unpack_from(">iI", data, 4)
+    else:
+        return None
+    return sec * 1_000_000_000 + nanosec
+
+
+class LogTimeRule:
+    """Rules 1 and 2 of the module documentation: the sim time a message belongs to."""
+
+    def __init__(self, plausible_span_ns: int = PLAUSIBLE_SPAN_NS) -> None:
+        self.plausible_span_ns = plausible_span_ns
+        self.last_clock_ns = 0
+        """Time of the last ``/clock`` seen, ns (0 before the first)."""
+        self.clock_count = 0
+        """``/clock`` messages seen."""
+
+    def sim_time_ns(self, topic: RecordedTopic, data: bytes | bytearray | memoryview) -> int:
+        """The message's sim time, ns; a ``/clock`` message also advances the rule's clock."""
+        stamp = header_stamp_ns(data) if topic.stamped else None
+        if topic.name == CLOCK_TOPIC:
+            if stamp is not None and stamp >= 0:
+                self.last_clock_ns = stamp
+                self.clock_count += 1
+            return self.last_clock_ns
+        if stamp is None or stamp <= 0 or abs(stamp - self.last_clock_ns) > self.plausible_span_ns:
+            return self.last_clock_ns
+        return stamp
+
+
+class SessionRecorder:
+    """Declares the recorded topics on a writer and writes messages with their log time.
+
+    Args:
+        writer: where messages go (``add_topic`` is called for every topic here).
+        topics: the topics to record.
+    """
+
+    def __init__(self, writer: MessageWriter, topics: Sequence[RecordedTopic] = RECORDED_TOPICS) -> None:
+        self.writer = writer
+        self.topics = {t.name: t for t in topics}
+        self.rule = LogTimeRule()
+        self.last_log_ns = -1
+        """Log time of the last message written, ns."""
+        self.counts: dict[str, int] = {t.name: 0 for t in topics}
+        """Messages written per topic."""
+        self.moved = 0
+        """Messages whose log time was moved forward to keep the timeline strictly increasing."""
+        for topic in topics:
+            writer.add_topic(topic.name, topic.msgtype, topic.qos)
+
+    @property
+    def sim_time(self) -> float:
+        """Time of the last ``/clock`` recorded, s."""
+        return self.rule.last_clock_ns * 1e-9
+
+    def record_batch(self, messages: Iterable[tuple[str, bytes]]) -> list[int]:
+        """Write ``(topic, serialized message)`` pairs given in arrival order (rule 3).
+
+        Returns:
+            The log times written, ns, in the order written.
+
+        Raises:
+            KeyError: a topic that is not recorded.
+        """
+        timed = []
+        for order, (name, data) in enumerate(messages):
+            topic = self.topics[name]
+            timed.append((self.rule.sim_time_ns(topic, data), order, name, data))
+        timed.sort(key=lambda item: (item[0], item[1]))
+        written = []
+        for candidate, _order, name, data in timed:
+            log_time = candidate
+            if log_time <= self.last_log_ns:
+                log_time = self.last_log_ns + 1
+                self.moved += 1
+            self.writer.write(name, log_time, data)
+            self.last_log_ns = log_time
+            self.counts[name] += 1
+            written.append(log_time)
+        return written
+
+    def record(self, name: str, data: bytes) -> int:
+        """Write one message; returns its log time, ns."""
+        return self.record_batch([(name, data)])[0]

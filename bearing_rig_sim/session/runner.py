@@ -1,0 +1,345 @@
+"""The program runner's logic: which segment runs, what to command, when it ends (no ROS).
+
+:class:`ProgramRunner` walks a :class:`~bearing_rig_sim.rig.program.TestProgram` on the
+simulation clock. The ROS side (:mod:`bearing_rig_sim.session.node`) feeds it the clock, the
+monitor's slip statuses, the simulator's ground truth and the load controller's force, and sends
+the commands it returns.
+
+Rules (simulation time throughout, s):
+
+* A segment starts when the runner notices the previous one ended (the first at
+  :meth:`ProgramRunner.start`); its speed profile starts there from the previous segment's
+  target speed; its ramp ends at ``start + ramp duration``
+  (:meth:`~bearing_rig_sim.rig.program.Segment.ramp_duration`).
+* ``dwell_s``: the segment ends at ``ramp end + dwell``. Its verdict is the monitor's last state
+  within the segment (stable, slipping, fault; unknown when no status came).
+* ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
+  new operating point: its slip window (``window_revolutions`` cage revolutions ending at its
+  stamp) lies entirely after the ramp end, and, when the segment changes the speed, the monitor
+  has reported some other state (unknown, slipping) in a status stamped after the ramp end
+  before it. The monitor restarts its slip series for a new speed and needs a dozen windows
+  before a verdict, so this second rule keeps a verdict fitted on the ramp's own points (slip
+  rising during a run-up has a slope above the critical one: "stable") or carried over from the
+  previous speed from ending the segment; a speed change too small for the monitor to restart
+  then ends in "timeout" rather than in a false "stable". Verdict "stable", time to stable =
+  that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".
+* Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
+  last status of the segment. Truth slip: the mean of the simulator's true slip over the same
+  window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
+  two are compared over the same stretch of time. Bearing force: mean of the load controller's
+  bearing force after the ramp end.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass, field
+from enum import Enum, IntEnum
+
+from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
+
+__all__ = [
+    "ProgramRunner",
+    "SegmentOutcome",
+    "SegmentPlan",
+    "SlipObservation",
+    "StatusState",
+    "Verdict",
+]
+
+TRUTH_HISTORY = 6000
+"""True-slip samples kept (60 s at the simulator's 100 Hz): enough for any status window."""
+
+
+class StatusState(IntEnum):
+    """The ``STATE_*`` constants of SlipStatus.msg."""
+
+    UNKNOWN = 0
+    SLIPPING = 1
+    STABLE = 2
+    FAULT = 3
+
+
+class Verdict(str, Enum):
+    """How a segment ended; compares equal to its string value."""
+
+    STABLE = "stable"
+    """Stable slip: ``until_stable`` reached, or the monitor said stable at the end of a dwell."""
+    TIMEOUT = "timeout"
+    """``until_stable`` without a stable verdict within ``timeout_s``."""
+    SLIPPING = "slipping"
+    """End of a dwell with the monitor saying the slip still changes."""
+    FAULT = "fault"
+    """End of a dwell with the monitor reporting a sensor fault."""
+    UNKNOWN = "unknown"
+    """End of a dwell with no verdict from the monitor (no status, or not enough data)."""
+    INTERRUPTED = "interrupted"
+    """The session stopped during the segment."""
+
+
+_DWELL_VERDICTS = {
+    StatusState.STABLE: Verdict.STABLE,
+    StatusState.SLIPPING: Verdict.SLIPPING,
+    StatusState.FAULT: Verdict.FAULT,
+    StatusState.UNKNOWN: Verdict.UNKNOWN,
+}
+
+
+@dataclass(frozen=True)
+class SlipObservation:
+    """One slip status of the monitor, as the runner uses it."""
+
+    time: float
+    """Stamp: end of the evaluation window, s of sim time."""
+    state: StatusState
+    slip_rate: float
+    """Measured slip, %."""
+    inner_ring_speed: float
+    """rad/s."""
+    cage_speed: float
+    """rad/s."""
+    window_revolutions: int
+    """Whole cage revolutions in the slip window."""
+
+    @property
+    def window_duration(self) -> float:
+        """Time span of the slip window, s (0 when the cage speed does not give one)."""
+        if self.cage_speed <= 0.0 or not math.isfinite(self.cage_speed) or self.window_revolutions <= 0:
+            return 0.0
+        return self.window_revolutions * 2.0 * math.pi / self.cage_speed
+
+
+@dataclass(frozen=True)
+class SegmentPlan:
+    """A segment as started: what to command and when it may end."""
+
+    index: int
+    """0-based position in the program."""
+    segment: Segment
+    profile: SegmentSpeed
+    """Speed against time from the start (start time, start speed, target...)."""
+
+    @property
+    def start_time(self) -> float:
+        """s of sim time."""
+        return self.profile.start_time
+
+    @property
+    def ramp_end(self) -> float:
+        """When the target speed is reached, s of sim time."""
+        return self.profile.ramp_end
+
+    @property
+    def deadline(self) -> float:
+        """Latest end: ramp end + dwell, or ramp end + timeout, s of sim time."""
+        hold = self.segment.dwell if self.segment.dwell is not None else self.segment.timeout
+        assert hold is not None
+        return self.ramp_end + hold
+
+
+@dataclass(frozen=True)
+class SegmentOutcome:
+    """How a segment went (a row of the summary table); SI units, slip in %."""
+
+    index: int
+    name: str
+    target_speed: float
+    """rad/s."""
+    axial_load: float
+    """Set-point, N."""
+    verdict: Verdict
+    start_time: float
+    ramp_end: float
+    end_time: float
+    time_to_stable: float | None
+    """Stable stamp - ramp end, s; None without a stable verdict after the ramp."""
+    measured_slip: float | None
+    """Monitor's slip rate, %."""
+    truth_slip: float | None
+    """Simulator's true slip over the same window, %."""
+    bearing_force: float | None
+    """Mean axial force on the bearing after the ramp end, N."""
+
+
+@dataclass
+class _SegmentData:
+    plan: SegmentPlan
+    stable: SlipObservation | None = None
+    last_status: SlipObservation | None = None
+    force_sum: float = 0.0
+    force_count: int = 0
+    force_sum_all: float = 0.0
+    force_count_all: int = 0
+    statuses: int = field(default=0)
+    unsettled_after_ramp: bool = False
+    """A status other than stable, stamped after the ramp end, has come."""
+
+
+class ProgramRunner:
+    """Walks a test program on the simulation clock (see the module documentation).
+
+    Typical use::
+
+        runner = ProgramRunner(program)
+        send(runner.start(now))                 # command the first segment
+        ...                                     # feed observe_status / observe_truth / observe_load
+        for plan in runner.update(now):         # segments started by this update
+            send(plan)
+        if runner.finished: ...                 # runner.outcomes holds one row per segment
+    """
+
+    def __init__(self, program: TestProgram) -> None:
+        self.program = program
+        self.outcomes: list[SegmentOutcome] = []
+        self._data: _SegmentData | None = None
+        self._truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_HISTORY)
+        self._start_speeds = program.start_speeds()
+        self._finished = False
+        self.latest_status: SlipObservation | None = None
+        """The last status received, whatever its segment."""
+
+    # -- state ------------------------------------------------------------------------------------
+    @property
+    def current(self) -> SegmentPlan | None:
+        """The segment running, None before :meth:`start` and after the end."""
+        return self._data.plan if self._data is not None else None
+
+    @property
+    def started(self) -> bool:
+        return self._data is not None or self._finished
+
+    @property
+    def finished(self) -> bool:
+        """Every segment ended (or the run was interrupted)."""
+        return self._finished
+
+    @property
+    def segment_count(self) -> int:
+        return len(self.program.segments)
+
+    # -- driving ----------------------------------------------------------------------------------
+    def start(self, now: float) -> SegmentPlan:
+        """Start the first segment at ``now`` (s of sim time); returns its plan.
+
+        Raises:
+            RuntimeError: already started.
+        """
+        if self.started:
+            raise RuntimeError("the program runner was started already")
+        return self._begin(0, now)
+
+    def _begin(self, index: int, now: float) -> SegmentPlan:
+        segment = self.program.segments[index]
+        plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
+        self._data = _SegmentData(plan)
+        return plan
+
+    def update(self, now: float) -> list[SegmentPlan]:
+        """Check the running segment's end condition at ``now`` (s of sim time); end it and start
+        the next when it is met. Returns the plans of the segments started (at most one)."""
+        data = self._data
+        if data is None:
+            return []
+        plan = data.plan
+        verdict: Verdict | None = None
+        if plan.segment.until_stable:
+            if data.stable is not None:
+                verdict = Verdict.STABLE
+            elif now >= plan.deadline:
+                verdict = Verdict.TIMEOUT
+        elif now >= plan.deadline:
+            last = data.last_status
+            verdict = _DWELL_VERDICTS[last.state] if last is not None else Verdict.UNKNOWN
+        if verdict is None:
+            return []
+        self._end(verdict, now)
+        if plan.index + 1 < self.segment_count:
+            return [self._begin(plan.index + 1, now)]
+        self._finished = True
+        return []
+
+    def interrupt(self, now: float) -> SegmentOutcome | None:
+        """Stop: the running segment ends as "interrupted" (returned), the program as finished."""
+        outcome = self._end(Verdict.INTERRUPTED, now) if self._data is not None else None
+        self._finished = True
+        return outcome
+
+    def _end(self, verdict: Verdict, now: float) -> SegmentOutcome:
+        data = self._data
+        assert data is not None
+        plan = data.plan
+        decisive = data.stable if data.stable is not None else data.last_status
+        if data.stable is not None:
+            time_to_stable: float | None = data.stable.time - plan.ramp_end
+        else:
+            time_to_stable = None
+        if data.force_count:
+            force: float | None = data.force_sum / data.force_count
+        elif data.force_count_all:
+            force = data.force_sum_all / data.force_count_all
+        else:
+            force = None
+        outcome = SegmentOutcome(
+            index=plan.index,
+            name=plan.segment.name,
+            target_speed=plan.segment.target_speed,
+            axial_load=plan.segment.axial_load,
+            verdict=verdict,
+            start_time=plan.start_time,
+            ramp_end=plan.ramp_end,
+            end_time=now,
+            time_to_stable=time_to_stable,
+            measured_slip=decisive.slip_rate if decisive is not None else None,
+            truth_slip=self.truth_slip_over(decisive) if decisive is not None else None,
+            bearing_force=force,
+        )
+        self.outcomes.append(outcome)
+        self._data = None
+        return outcome
+
+    # -- observations -----------------------------------------------------------------------------
+    def observe_status(self, status: SlipObservation) -> None:
+        """A slip status of the monitor (any order relative to :meth:`update`)."""
+        self.latest_status = status
+        data = self._data
+        if data is None or status.time < data.plan.start_time:
+            return
+        data.last_status = status
+        data.statuses += 1
+        plan = data.plan
+        if status.time < plan.ramp_end or data.stable is not None:
+            return
+        if status.state is not StatusState.STABLE:
+            data.unsettled_after_ramp = True
+            return
+        window_after_ramp = status.time - status.window_duration >= plan.ramp_end
+        changes_speed = plan.profile.target_speed != plan.profile.start_speed
+        if window_after_ramp and (data.unsettled_after_ramp or not changes_speed):
+            data.stable = status
+
+    def observe_truth(self, time: float, slip_rate: float) -> None:
+        """The simulator's true slip rate (%) at ``time`` (s of sim time)."""
+        if math.isfinite(slip_rate):
+            self._truth.append((time, slip_rate))
+
+    def observe_load(self, time: float, bearing_force: float) -> None:
+        """The axial force on the bearing (N) at ``time`` (s of sim time)."""
+        data = self._data
+        if data is None or time < data.plan.start_time or not math.isfinite(bearing_force):
+            return
+        data.force_sum_all += bearing_force
+        data.force_count_all += 1
+        if time >= data.plan.ramp_end:
+            data.force_sum += bearing_force
+            data.force_count += 1
+
+    def truth_slip_over(self, status: SlipObservation) -> float | None:
+        """Mean true slip (%) over the window of ``status``; the last sample at or before its
+        stamp when the window holds none; None without any sample."""
+        start = status.time - status.window_duration
+        inside = [s for t, s in self._truth if start <= t <= status.time]
+        if inside:
+            return sum(inside) / len(inside)
+        before = [s for t, s in self._truth if t <= status.time]
+        return before[-1] if before else None

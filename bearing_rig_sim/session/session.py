@@ -1,0 +1,358 @@
+"""A rig session: the three nodes as processes, the program run, recorded, shown, summarised.
+
+:func:`run_session` is ``bearing-rig run``:
+
+1. reads the program (errors name the file and the key), makes the run id and the bag
+   directory ``<bag dir>/<run id>/`` with the run context in its metadata;
+2. starts the simulator, load controller and monitor as separate processes on a private
+   ``ROS_DOMAIN_ID`` (unless the user set one), discovery limited to this host (unless set),
+   the session's Fast DDS transport profile (deeper shared-memory buffers, unless the user gave
+   a profile; :mod:`.processes`), each node 5 steps nicer than the session process (the recorder
+   comes first), their output in ``<bag dir>/<run id>/logs/<node>.log``;
+3. waits, up to ``startup_timeout_s``, for each to come up: the simulator's first ``/clock`` and
+   its command subscription, the load controller's first state and its set-point subscription,
+   the monitor's status publisher and pulse subscription; otherwise stops with the name of the
+   process that did not, and the tail of its output;
+4. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
+   clock while recording every rig topic and printing progress;
+5. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node dies: stops the runner, stops the
+   nodes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag, prints the summary so far.
+
+Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died.
+Everything ROS in the session process runs in one ``SingleThreadedExecutor``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import signal
+import sys
+import time
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from enum import Enum
+from pathlib import Path
+from types import FrameType
+from typing import Sequence, TextIO
+
+from bearing_rig_sim.config import rad_s_to_rpm
+from bearing_rig_sim.recording import BagWriter
+from bearing_rig_sim.rig.loading import LoadingChainConfig
+from bearing_rig_sim.rig.program import TestProgram, load_program
+from bearing_rig_sim.session.context import make_run_id, run_context
+from bearing_rig_sim.session.processes import (
+    NODES,
+    NodeProcess,
+    apply_transport_profile,
+    node_command,
+    own_ros_environment,
+    session_environment,
+    stop_all,
+)
+from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, RealTimeFactor, format_progress, format_summary
+from bearing_rig_sim.session.recorder import SessionRecorder
+from bearing_rig_sim.session.runner import ProgramRunner, SegmentOutcome, SegmentPlan
+
+__all__ = ["EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
+
+EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
+
+CHUNK_SIZE = 256 * 1024
+"""Uncompressed bytes per bag chunk: about 0.5 s of the rig's traffic, the most a killed session
+loses, and a chunk compressed in some 15 ms, a short hold-up of the session's loop."""
+
+
+@dataclass(frozen=True)
+class SessionOptions:
+    """Options of a session (``bearing-rig run``)."""
+
+    program: Path
+    """Test program file."""
+    realtime: bool = True
+    """Lock the simulator to the wall clock; False: as fast as it goes."""
+    bag_dir: Path = Path("bags")
+    """Folder of the run's bag directory."""
+    quiet: bool = False
+    """No live progress or event lines (the summary is printed anyway)."""
+    startup_timeout_s: float = 60.0
+    """Longest wait for the nodes to come up, s of wall time."""
+    command_line: Sequence[str] = field(default_factory=tuple)
+    """The command line, for the run context."""
+
+
+class _Phase(Enum):
+    STARTING = "starting"
+    RUNNING = "running"
+    ENDED = "ended"
+
+
+def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO | None = None) -> int:
+    """Run a session (see the module documentation); returns the exit status.
+
+    Raises:
+        RigError: a malformed program or configuration, a bag directory that cannot be made, a
+            node executable that cannot be found.
+    """
+    out = out if out is not None else sys.stdout
+    err = err if err is not None else sys.stderr
+    chain = LoadingChainConfig.from_yaml()
+    program = load_program(options.program, max_axial_load_n=chain.max_setpoint_n)
+    commands = {name: node_command(spec) for name, spec in NODES.items()}
+    if not options.realtime:
+        commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
+    start = datetime.now(timezone.utc)
+    run_id = make_run_id(program.name, start)
+    bag_path = _fresh_path(Path(options.bag_dir) / run_id)
+    env, lease = session_environment(os.environ)
+    context = run_context(
+        program,
+        run_id=run_id,
+        start=start,
+        command_line=options.command_line or sys.argv,
+        extra={"ros_domain_id": env["ROS_DOMAIN_ID"], "realtime": str(options.realtime).lower()},
+    )
+    try:
+        writer = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE)
+        apply_transport_profile(env, writer.path / "logs")
+        session = _Session(options, program, writer, env, commands, out, err)
+        return session.run()
+    finally:
+        lease.release()
+
+
+def _fresh_path(path: Path) -> Path:
+    """``path``, or ``path-2``, ``path-3``... when it exists (two runs in the same second)."""
+    candidate, n = path, 1
+    while candidate.exists():
+        n += 1
+        candidate = path.with_name(f"{path.name}-{n}")
+    return candidate
+
+
+class _Session:
+    """One session's state; :meth:`run` does it all."""
+
+    def __init__(
+        self,
+        options: SessionOptions,
+        program: TestProgram,
+        writer: BagWriter,
+        env: dict[str, str],
+        commands: dict[str, list[str]],
+        out: TextIO,
+        err: TextIO,
+    ) -> None:
+        self.options = options
+        self.program = program
+        self.writer = writer
+        self.env = env
+        self.out = out
+        self.err = err
+        self.printer = ProgressPrinter(out, quiet=options.quiet)
+        self.runner = ProgramRunner(program)
+        self.recorder = SessionRecorder(writer)
+        self.rtf = RealTimeFactor()
+        logs = writer.path / "logs"
+        self.children = [NodeProcess(name, commands[name], logs / f"{name}.log") for name in NODES]
+        self.phase = _Phase.STARTING
+        self.status: int | None = None
+        self.failure = ""
+        self.signal_received: int | None = None
+        self.node = None
+        self.deadline = 0.0
+
+    # -- main -------------------------------------------------------------------------------------
+    def run(self) -> int:
+        import rclpy  # noqa: PLC0415 - ROS is needed only once the session really starts
+        from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
+        from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
+
+        from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode  # noqa: PLC0415
+
+        segments = len(self.program.segments)
+        self._event(
+            f"run {self.writer.path.name}: program {self.program.name} ({segments} segments, "
+            f"{'real time' if self.options.realtime else 'no real time'}), ROS_DOMAIN_ID {self.env['ROS_DOMAIN_ID']}, "
+            f"bag {self.writer.path}"
+        )
+        previous_handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+        context = rclpy.Context()
+        executor = None
+        try:
+            for sig in previous_handlers:
+                signal.signal(sig, self._on_signal)
+            for child in self.children:  # before rclpy: no middleware threads while forking
+                child.start(self.env)
+            with own_ros_environment(self.env):
+                rclpy.init(args=[], context=context, domain_id=int(self.env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
+                self.node = SessionNode(self.recorder, self.runner, context=context, on_event=self._event)
+            executor = SingleThreadedExecutor(context=context)
+            executor.add_node(self.node)
+            self.node.create_timer(DRAIN_PERIOD_S, self._tick)
+            self.node.create_timer(1.0, self._show_progress)
+            self.deadline = time.monotonic() + self.options.startup_timeout_s
+            while self.phase is not _Phase.ENDED:
+                executor.spin_once(timeout_sec=0.1)
+                if self.signal_received is not None and self.phase is not _Phase.ENDED:
+                    self._end(EXIT_INTERRUPTED, f"stopped by {signal.Signals(self.signal_received).name}")
+        except KeyboardInterrupt:  # a second Ctrl-C while stopping
+            self._end(EXIT_INTERRUPTED, "stopped by a second SIGINT")
+        finally:
+            self._shut_down(context, executor)
+            for sig, handler in previous_handlers.items():
+                signal.signal(sig, handler)
+        return self._report()
+
+    def _on_signal(self, signum: int, _frame: FrameType | None) -> None:
+        if self.signal_received is not None and signum == signal.SIGINT:
+            raise KeyboardInterrupt
+        self.signal_received = signum
+
+    def _end(self, status: int, reason: str = "") -> None:
+        if self.phase is _Phase.ENDED:
+            return
+        self.phase = _Phase.ENDED
+        self.status = status
+        self.failure = reason
+
+    # -- the timer ------------------------------------------------------------------------------------
+    def _tick(self) -> None:
+        if self.phase is _Phase.ENDED or self.node is None:
+            return
+        node = self.node
+        node.take()
+        try:
+            self._step(node.sim_time)
+        finally:
+            node.record_pending()
+
+    def _step(self, now: float) -> None:
+        """Watch the children; start the program once every node is up; run it."""
+        assert self.node is not None
+        if self.node.clock_count:
+            self.rtf.add(time.monotonic(), now)
+        for child in self.children:
+            if child.poll() is not None and not child.stop_requested:
+                when = "during start-up" if self.phase is _Phase.STARTING else "during the run"
+                self._end(EXIT_FAILED, f"the {child.name} node stopped {when}: {child.describe_exit()}")
+                return
+        if self.phase is _Phase.STARTING:
+            missing = self.node.missing()
+            if not missing:
+                self.phase = _Phase.RUNNING
+                self._start_segment(self.runner.start(now))
+            elif time.monotonic() > self.deadline:
+                name, what = next(iter(missing.items()))
+                child = next(c for c in self.children if c.name == name)
+                others = "; ".join(f"{n}: {w}" for n, w in list(missing.items())[1:])
+                self._end(
+                    EXIT_FAILED,
+                    f"the {name} node did not come up within {self.options.startup_timeout_s:g} s ({what})"
+                    + (f"; also {others}" if others else "")
+                    + f"; the end of its output ({child.log_path}):\n{child.output_tail()}",
+                )
+            return
+        done = len(self.runner.outcomes)
+        started = self.runner.update(now)
+        for outcome in self.runner.outcomes[done:]:
+            self._segment_ended(outcome)
+        for plan in started:
+            self._start_segment(plan)
+        if self.runner.finished:
+            self._end(EXIT_OK)
+
+    def _start_segment(self, plan: SegmentPlan) -> None:
+        assert self.node is not None
+        self.node.send(plan)
+        seg = plan.segment
+        hold = f"until stable (at most {seg.timeout:g} s)" if seg.until_stable else f"dwell {seg.dwell:g} s"
+        self._event(
+            f"segment {plan.index + 1}/{self.runner.segment_count} {seg.name}: {rad_s_to_rpm(seg.target_speed):.0f} rpm, "
+            f"{seg.axial_load:g} N, speed change {plan.ramp_end - plan.start_time:.2f} s, {hold}"
+        )
+
+    def _segment_ended(self, outcome: SegmentOutcome) -> None:
+        slip = f", slip {outcome.measured_slip:.3f} %" if outcome.measured_slip is not None and math.isfinite(outcome.measured_slip) else ""
+        stable = f" {outcome.time_to_stable:.2f} s after the ramp" if outcome.time_to_stable is not None else ""
+        self._event(f"segment {outcome.index + 1}/{self.runner.segment_count} {outcome.name}: {outcome.verdict.value}{stable}{slip}")
+
+    def _event(self, line: str) -> None:
+        if not self.options.quiet:
+            self.printer.message(line)
+
+    def _show_progress(self) -> None:
+        if self.phase is _Phase.ENDED or self.node is None or self.options.quiet:
+            return
+        live = self.node.live
+        live.decode_speeds()
+        plan = self.runner.current
+        now = self.node.sim_time
+        status = self.runner.latest_status
+        if plan is None:
+            number, name, phase = 0, "-", "starting" if self.phase is _Phase.STARTING else "done"
+        else:
+            number, name = plan.index + 1, plan.segment.name
+            phase = "ramp" if now < plan.ramp_end else "hold"
+        self.printer.show(
+            format_progress(
+                ProgressSnapshot(
+                    segment_number=number,
+                    segment_count=self.runner.segment_count,
+                    segment_name=name,
+                    phase=phase,
+                    sim_time=now,
+                    inner_ring_speed=live.inner_ring_speed,
+                    cage_speed=live.cage_speed,
+                    slip_rate=status.slip_rate if status is not None else None,
+                    slip_state=status.state if status is not None else None,
+                    real_time_factor=self.rtf.value,
+                )
+            )
+        )
+
+    # -- the end ----------------------------------------------------------------------------------
+    def _shut_down(self, context: object, executor: object) -> None:
+        """Stop the runner and the nodes, take what is still queued, finalise the bag."""
+        if self.phase is not _Phase.ENDED:  # an exception got us here
+            self._end(EXIT_FAILED, "the session stopped on an error")
+        node = self.node
+        if not self.runner.finished and self.runner.started:
+            self.runner.interrupt(node.sim_time if node is not None else 0.0)
+        try:
+            if node is not None:
+                node.drain()
+            stop_all(self.children)
+            if node is not None:
+                time.sleep(0.2)  # the nodes' last messages
+                node.drain()
+        finally:
+            try:
+                self.writer.close()
+            finally:
+                if executor is not None:
+                    executor.shutdown(timeout_sec=1.0)  # type: ignore[attr-defined]
+                if node is not None:
+                    node.close()
+                    node.destroy_node()
+                context.try_shutdown()  # type: ignore[attr-defined]
+
+    def _report(self) -> int:
+        self.printer.done()
+        status = EXIT_FAILED if self.status is None else self.status
+        if status == EXIT_FAILED:
+            self.err.write(f"bearing-rig run: {self.failure}\n")
+        elif status == EXIT_INTERRUPTED:
+            self.err.write(f"bearing-rig run: {self.failure}; the summary so far and the bag are complete to this point\n")
+        heading = {EXIT_OK: "summary", EXIT_INTERRUPTED: "summary (interrupted)", EXIT_FAILED: "summary (failed)"}[status]
+        self.out.write(f"\n{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n")
+        self.out.write(format_summary(self.runner.outcomes) + "\n")
+        counts = self.recorder.counts
+        total = sum(counts.values())
+        self.out.write(
+            f"\nbag: {self.writer.path} ({total} messages; /clock {counts.get('/clock', 0)}, /rig/speeds "
+            f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "
+            f"{self.writer.path / 'logs'}\n"
+        )
+        self.out.flush()
+        return status

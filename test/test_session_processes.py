@@ -1,0 +1,117 @@
+"""Node processes without ROS: a child that dies is described with its status and output tail; a
+child that ignores SIGINT is still stopped; CPU time from /proc; the session's private domain and
+environment; executables found next to the interpreter or refused with a clear error; run id and
+run context.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from datetime import datetime, timedelta, timezone
+from pathlib import Path
+
+import pytest
+
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.rig.program import load_program
+from bearing_rig_sim.config import config_path
+from bearing_rig_sim.session.context import make_run_id, run_context
+from bearing_rig_sim.session.processes import (
+    NODES,
+    NodeProcess,
+    NodeSpec,
+    lease_domain,
+    node_command,
+    process_cpu_seconds,
+    session_environment,
+    stop_all,
+)
+
+
+def python_child(tmp_path: Path, name: str, code: str) -> NodeProcess:
+    return NodeProcess(name, [sys.executable, "-c", code], tmp_path / "logs" / f"{name}.log")
+
+
+def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Path) -> None:
+    child = python_child(
+        tmp_path, "simulator", "import sys\nfor i in range(40): print('line', i, file=sys.stderr)\nsys.exit(3)"
+    )
+    child.start(os.environ)
+    assert child.wait(20.0) == 3 and not child.running
+    text = child.describe_exit(lines=5)
+    assert text.startswith("simulator exited with status 3")
+    assert "line 39" in text and "line 35" in text and "line 34" not in text
+    stop_all([child])
+
+
+def test_stop_all_stops_a_child_that_ignores_sigint(tmp_path: Path) -> None:
+    stubborn = python_child(
+        tmp_path, "monitor", "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nprint('up', flush=True)\ntime.sleep(60)"
+    )
+    polite = python_child(
+        tmp_path, "load_controller", "import time\nprint('up', flush=True)\ntry:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    pass"
+    )
+    for child in (stubborn, polite):
+        child.start(os.environ)
+    for _ in range(200):  # until both have started (and the stubborn one ignores SIGINT)
+        if all("up" in child.output_tail() for child in (stubborn, polite)):
+            break
+        stubborn.wait(0.05)
+    stop_all([stubborn, polite], timeout=1.0)
+    assert polite.poll() == 0  # SIGINT: a clean exit
+    assert stubborn.poll() is not None and stubborn.poll() < 0  # SIGTERM after the timeout
+    assert stubborn.stop_requested and polite.stop_requested
+
+
+def test_cpu_seconds_of_a_busy_child(tmp_path: Path) -> None:
+    busy = python_child(tmp_path, "busy", "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass\ntime.sleep(30)")
+    busy.start(os.environ)
+    try:
+        for _ in range(100):
+            used = busy.cpu_seconds()
+            if used is not None and used >= 0.3:
+                break
+            busy.wait(0.05)
+        assert used is not None and used >= 0.3
+    finally:
+        stop_all([busy])
+    assert process_cpu_seconds(2**22 + 12345) is None  # no such process
+
+
+def test_session_environment_keeps_the_users_domain_or_leases_a_private_one() -> None:
+    env, lease = session_environment({"ROS_DOMAIN_ID": "42", "PATH": "/bin"})
+    assert env["ROS_DOMAIN_ID"] == "42" and env["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "LOCALHOST"
+    lease.release()
+    env, lease = session_environment({"ROS_AUTOMATIC_DISCOVERY_RANGE": "SUBNET"})
+    try:
+        assert 102 <= int(env["ROS_DOMAIN_ID"]) <= 232 and env["ROS_AUTOMATIC_DISCOVERY_RANGE"] == "SUBNET"
+        other = lease_domain()  # a second session meanwhile gets another domain
+        assert other.domain_id != lease.domain_id
+        other.release()
+    finally:
+        lease.release()
+    with pytest.raises(RigError, match="whole number"):
+        session_environment({"ROS_DOMAIN_ID": "seven"})
+
+
+def test_node_executables_are_found_or_refused_by_name() -> None:
+    command = node_command(NODES["load_controller"])
+    assert Path(command[0]).name == "bearing-rig-load-controller" and os.access(command[0], os.X_OK)
+    with pytest.raises(RigError, match="no-such-node-script"):
+        node_command(NodeSpec("phantom", "no-such-node-script"))
+
+
+def test_run_id_and_run_context() -> None:
+    start = datetime(2025, 6, 12, 11, 30, 15, tzinfo=timezone(timedelta(hours=2)))
+    assert make_run_id("validation", start) == "20250612T093015Z-validation"
+    assert make_run_id("my test/1", start).endswith("-my_test_1")
+    with pytest.raises(ValueError):
+        make_run_id("x", datetime(2025, 1, 1))
+    program = load_program(config_path("programs", "validation.yaml"))
+    context = run_context(program, run_id="r", start=start, command_line=["bearing-rig", "run", "a b"], extra={"k": "v"})
+    assert "segments:" in context["program"] and context["program_file"].endswith("validation.yaml")
+    assert "geometry" in context["bearing"] and "loading_chain:" in context["rig"]
+    assert any(key.startswith("calibration/h7006c_") for key in context)
+    assert context["command_line"] == "bearing-rig run 'a b'" and context["k"] == "v"
+    assert all(isinstance(v, str) for v in context.values())

@@ -1,0 +1,126 @@
+"""``bearing-rig run`` end to end: the three nodes as processes on the test's isolated domain, a
+shortened validation program without real time, recorded into tmp_path. It runs to the end with a
+stable verdict and a bag that both readers decode; SIGINT in the middle leaves a complete,
+readable bag, the summary so far and exit status 130.
+"""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+pytest.importorskip("rclpy")
+
+from mcap.reader import make_reader  # noqa: E402
+from mcap_ros2.decoder import DecoderFactory  # noqa: E402
+from rosbags.highlevel import AnyReader  # noqa: E402
+
+from bearing_rig_sim.recording import open_bag, rig_typestore  # noqa: E402
+
+pytestmark = [pytest.mark.ros, pytest.mark.slow]
+
+SHORT_PROGRAM = """
+name: short_validation
+description: two speeds of the validation program, short holds
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, until_stable: true, timeout_s: 8.0}
+  - {name: n1500, speed_rpm: 1500, ramp_s: 1.0, axial_load_n: 100, until_stable: true, timeout_s: 8.0}
+"""
+
+SENSOR_TOPICS = ("/rig/speeds", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/slip_status")
+
+
+def start_session(ros_graph: Any, tmp_path: Path, *extra: str) -> subprocess.Popen[str]:
+    program = tmp_path / "short_validation.yaml"
+    program.write_text(SHORT_PROGRAM, encoding="utf-8")
+    return subprocess.Popen(
+        [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), *extra],
+        env=ros_graph.env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def the_bag(tmp_path: Path) -> Path:
+    (bag,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
+    return bag
+
+
+def check_bag_decodes(bag: Path) -> dict[str, int]:
+    """Every message decodes with rosbags' AnyReader and with mcap + mcap_ros2; counts per topic."""
+    counts: dict[str, int] = {}
+    with AnyReader([bag], default_typestore=rig_typestore()) as reader:
+        for connection, _time, raw in reader.messages():
+            reader.deserialize(raw, connection.msgtype)
+            counts[connection.topic] = counts.get(connection.topic, 0) + 1
+    decoded = 0
+    for path in sorted(bag.glob("*.mcap")):
+        with open(path, "rb") as stream:
+            for _schema, _channel, _message, _ros in make_reader(stream, decoder_factories=[DecoderFactory()]).iter_decoded_messages():
+                decoded += 1
+    assert decoded == sum(counts.values())
+    return counts
+
+
+def summary_rows(stdout: str) -> list[list[str]]:
+    lines = stdout.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("summary"))
+    rows = []
+    for line in lines[start + 3 :]:
+        if not line.strip():
+            break
+        rows.append(line.split())
+    return rows
+
+
+def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ros_graph: Any, tmp_path: Path) -> None:
+    session = start_session(ros_graph, tmp_path)
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    rows = summary_rows(out)
+    assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
+    assert rows[-1][7] == "stable", out[-3000:]
+    assert "segment 2/3 n0900" in out and "[3/3 n1500" in out  # events and progress lines
+    bag = the_bag(tmp_path)
+    counts = check_bag_decodes(bag)
+    for topic in (*SENSOR_TOPICS, "/clock", "/rig/axial_load/state", "/rig/bearing/axial_force", "/rig/truth", "/diagnostics"):
+        assert counts.get(topic, 0) > 0, f"no {topic} in {counts}"
+    assert counts["/rig/spindle/command"] == 3 and counts["/rig/axial_load/setpoint"] == 3
+    with open_bag(bag) as reader:
+        context = reader.run_metadata
+        assert "n1500" in context["program"] and "loading_chain:" in context["rig"]
+        assert context["ros_domain_id"] == str(ros_graph.domain_id) and context["realtime"] == "false"
+    assert (bag / "logs" / "simulator.log").is_file()
+
+
+def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_path: Path) -> None:
+    session = start_session(ros_graph, tmp_path)
+    assert session.stdout is not None
+    seen = []
+    deadline = time.monotonic() + 90
+    for line in session.stdout:  # progress prints at least a line a second
+        seen.append(line)
+        if line.startswith("segment 2/3 n0900:") or time.monotonic() > deadline:
+            break
+    assert any(line.startswith("segment 2/3 n0900:") for line in seen), "".join(seen)[-3000:]
+    time.sleep(1.0)
+    session.send_signal(signal.SIGINT)
+    rest, err = session.communicate(timeout=60)
+    out = "".join(seen) + rest
+    assert session.returncode == 130, f"{out[-3000:]}\n{err[-3000:]}"
+    assert "summary (interrupted)" in out and "stopped by SIGINT" in err
+    rows = summary_rows(out)
+    assert rows[0][1] == "load_up" and rows[-1][1] == "n0900" and rows[-1][7] == "interrupted"
+    counts = check_bag_decodes(the_bag(tmp_path))
+    for topic in SENSOR_TOPICS[:3]:
+        assert counts.get(topic, 0) > 0, f"no {topic} in {counts}"

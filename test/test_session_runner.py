@@ -1,0 +1,182 @@
+"""The program runner without ROS, on a fake clock with fake monitor statuses: dwell counted from
+the end of the speed change (STEP ramp and constant acceleration), until-stable (a stable verdict
+from the ramp or the previous speed does not count), the timeout, the dwell verdict, measured
+against true slip over the same window, the mean bearing force, interruption.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.rig.program import TestProgram, load_program
+from bearing_rig_sim.session.runner import ProgramRunner, SlipObservation, StatusState, Verdict
+
+PROGRAM = """
+name: short
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 1.0}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.5, axial_load_n: 100, until_stable: true, timeout_s: 4.0}
+  - {name: n1200, speed_rpm: 1200, ramp_s: 1.0, axial_load_n: 150, until_stable: true, timeout_s: 3.0}
+  - {name: accel, speed_rpm: 1500, acceleration_rad_s2: 20, axial_load_n: 200, dwell_s: 2.0}
+"""
+
+
+@pytest.fixture
+def program(tmp_path: Path) -> TestProgram:
+    path = tmp_path / "short.yaml"
+    path.write_text(PROGRAM, encoding="utf-8")
+    return load_program(path)
+
+
+def status(t: float, state: StatusState, slip: float = 3.0, cage: float = 40.0, revolutions: int = 1) -> SlipObservation:
+    return SlipObservation(time=t, state=state, slip_rate=slip, inner_ring_speed=94.0, cage_speed=cage, window_revolutions=revolutions)
+
+
+def run_until(runner: ProgramRunner, t0: float, t1: float, dt: float = 0.01) -> list:
+    """Update every ``dt`` from t0 to t1 (fake clock); the plans started."""
+    started = []
+    for k in range(int(round((t1 - t0) / dt)) + 1):
+        started.extend(runner.update(t0 + k * dt))
+    return started
+
+
+def test_dwell_counts_from_the_end_of_the_speed_change(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    first = runner.start(10.0)
+    assert first.segment.name == "load_up" and first.ramp_end == 10.0 and first.deadline == 11.0
+    assert runner.update(10.999) == []
+    (second,) = runner.update(11.0)
+    assert second.segment.name == "n0900" and second.start_time == 11.0
+    assert second.profile.start_speed == 0.0 and second.profile.target_speed == pytest.approx(rpm_to_rad_s(900))
+    assert second.ramp_end == pytest.approx(12.5) and second.deadline == pytest.approx(16.5)
+
+
+def test_constant_acceleration_dwell_starts_when_the_target_speed_is_reached(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)  # -> n0900
+    runner.update(1.5 + 1.0 + 4.0)  # n0900 times out -> n1200 at 6.5
+    (accel,) = runner.update(6.5 + 1.0 + 3.0)  # n1200 times out -> accel at 10.5
+    ramp = (rpm_to_rad_s(1500) - rpm_to_rad_s(1200)) / 20.0
+    assert accel.ramp_end == pytest.approx(10.5 + ramp)
+    assert runner.update(10.5 + ramp + 1.99) == []
+    assert runner.update(10.5 + ramp + 2.0) == [] and runner.finished
+    assert [o.verdict for o in runner.outcomes] == [Verdict.UNKNOWN, Verdict.TIMEOUT, Verdict.TIMEOUT, Verdict.UNKNOWN]
+
+
+def test_until_stable_needs_a_stable_verdict_stamped_after_the_ramp(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    (plan,) = runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
+    runner.observe_status(status(2.0, StatusState.STABLE))  # during the ramp: ignored
+    assert runner.update(2.6) == []
+    runner.observe_status(status(2.7, StatusState.SLIPPING, slip=3.4))
+    runner.observe_status(status(3.3, StatusState.STABLE, slip=3.2))
+    (nxt,) = runner.update(3.31)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "n0900" and outcome.verdict is Verdict.STABLE
+    assert outcome.time_to_stable == pytest.approx(3.3 - plan.ramp_end)
+    assert outcome.measured_slip == 3.2 and outcome.end_time == pytest.approx(3.31)
+    assert nxt.segment.name == "n1200" and nxt.start_time == pytest.approx(3.31)
+
+
+def test_stable_verdict_of_the_previous_speed_does_not_end_the_next_segment(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    runner.observe_status(status(2.6, StatusState.SLIPPING))
+    runner.observe_status(status(3.0, StatusState.STABLE))
+    (n1200,) = runner.update(3.0)  # ramp 3.0 .. 4.0
+    runner.observe_status(status(3.0, StatusState.STABLE))  # stamped at the segment start: the old speed
+    assert run_until(runner, 3.0, 6.99) == []  # nothing after the ramp: waits until the timeout
+    assert runner.update(7.0) and runner.outcomes[-1].verdict is Verdict.TIMEOUT
+    assert runner.outcomes[-1].time_to_stable is None
+
+
+def test_a_stable_verdict_fitted_on_the_ramp_does_not_count(program: TestProgram) -> None:
+    """The monitor's first fit after a run-up can say "stable" from the ramp's rising slip: the
+    window reaching into the ramp, or no other state reported after the ramp, rules it out."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    (plan,) = runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
+    runner.observe_status(status(2.2, StatusState.UNKNOWN))  # collecting points during the ramp
+    cage = 2.0 * math.pi / 0.1  # a 0.1 s window
+    runner.observe_status(status(2.55, StatusState.STABLE, cage=cage))  # window starts at 2.45: in the ramp
+    runner.observe_status(status(2.7, StatusState.STABLE, cage=cage))  # window after, but no restart seen
+    assert runner.update(2.8) == []
+    runner.observe_status(status(2.8, StatusState.UNKNOWN))  # the series restarted for the new speed
+    runner.observe_status(status(3.9, StatusState.STABLE, slip=3.3, cage=cage))
+    assert runner.update(3.9) and runner.outcomes[-1].time_to_stable == pytest.approx(3.9 - plan.ramp_end)
+
+
+def test_without_a_speed_change_the_first_stable_window_after_the_start_counts(tmp_path: Path) -> None:
+    path = tmp_path / "load_step.yaml"
+    path.write_text(
+        "name: load_step\nbearing: bearings/h7006c.yaml\nstability_criterion: axial_load\ninitial_speed_rpm: 900\n"
+        "segments:\n  - {name: f200, speed_rpm: 900, axial_load_n: 200, until_stable: true, timeout_s: 5.0}\n",
+        encoding="utf-8",
+    )
+    runner = ProgramRunner(load_program(path))
+    plan = runner.start(10.0)
+    assert plan.ramp_end == 10.0
+    runner.observe_status(status(10.1, StatusState.STABLE, cage=2.0 * math.pi / 0.2))  # window from 9.9: before
+    runner.observe_status(status(10.3, StatusState.STABLE, cage=2.0 * math.pi / 0.2))
+    runner.update(10.3)
+    assert runner.finished and runner.outcomes[-1].verdict is Verdict.STABLE
+    assert runner.outcomes[-1].time_to_stable == pytest.approx(0.3)
+
+
+def test_dwell_verdict_is_the_monitors_last_state_in_the_segment(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_status(status(0.5, StatusState.SLIPPING))
+    runner.observe_status(status(0.9, StatusState.FAULT))
+    runner.update(1.0)
+    assert runner.outcomes[-1].verdict is Verdict.FAULT
+
+
+def test_measured_and_true_slip_compare_over_the_same_window(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    for k in range(400):  # truth at 100 Hz: 3.0 % until 3.0 s, then 3.5 %
+        t = k * 0.01
+        runner.observe_truth(t, 3.0 if t < 3.0 else 3.5)
+    cage = 2.0 * math.pi / 0.5  # one cage revolution takes 0.5 s
+    runner.observe_status(status(2.6, StatusState.UNKNOWN))
+    runner.observe_status(status(3.45, StatusState.STABLE, slip=3.49, cage=cage))
+    runner.update(3.5)
+    outcome = runner.outcomes[-1]
+    # window 2.95 .. 3.45 s: 5 samples at 3.0 %, 45 at 3.5 % (samples 2.95 .. 3.45 inclusive)
+    inside = [3.0 if k * 0.01 < 3.0 else 3.5 for k in range(295, 346)]
+    assert outcome.truth_slip == pytest.approx(sum(inside) / len(inside))
+    assert outcome.measured_slip == 3.49
+
+
+def test_mean_bearing_force_counts_after_the_ramp(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)  # n0900 ramp 1.0 .. 2.5
+    runner.observe_load(0.5, 1000.0)  # previous segment: not counted
+    runner.observe_load(2.0, 50.0)  # during the ramp: not counted
+    for t in (2.5, 2.6, 2.7):
+        runner.observe_load(t, 100.0 + (t - 2.5) * 10)
+    runner.update(6.5)
+    assert runner.outcomes[-1].bearing_force == pytest.approx(101.0)
+
+
+def test_interrupt_ends_the_running_segment(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    outcome = runner.interrupt(1.7)
+    assert outcome is not None and outcome.verdict is Verdict.INTERRUPTED and outcome.end_time == 1.7
+    assert runner.finished and runner.current is None and runner.update(9.0) == []
+    with pytest.raises(RuntimeError):
+        runner.start(10.0)

@@ -57,6 +57,9 @@ MESSAGE_TYPES: dict[str, type] = {
 
 _LEVEL_NAMES = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 
+EVENT_WIDTH = 100
+"""Longest diagnostic message shown in an event line (the bag keeps it whole)."""
+
 
 def reader_qos(topic: RecordedTopic) -> QoSProfile:
     """The recorder's subscription QoS: compatible with the publisher's offered profile, deep."""
@@ -250,7 +253,8 @@ class SessionNode(Node):
             previous = self._diagnostic_levels.get(status.name, 0)
             self._diagnostic_levels[status.name] = level
             if level != previous and (level > 0 or previous > 0):
-                self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {status.message}")
+                message = status.message if len(status.message) <= EVENT_WIDTH else status.message[: EVENT_WIDTH - 3] + "..."
+                self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {message}")
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun

@@ -223,3 +223,18 @@ def test_interlock_trip_refused_reset_then_reset(ros_graph: Any, tmp_path: Path)
     samples = rig.run(0.6)
     assert samples[-1][1] == pytest.approx(200.0, rel=0.02)
     assert not rig.states[-1].fault
+
+
+@pytest.mark.parametrize(
+    "ros_args, expected",
+    [
+        (["-p", "use_sim_time:=false"], "use_sim_time must be true"),
+        (["-p", "rig_file:=/nonexistent/rig.yaml"], "/nonexistent/rig.yaml"),
+        (["-p", "state_rate_hz:=0.0"], "state_rate_hz must be a finite number > 0"),
+    ],
+)
+def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, ros_args: list[str], expected: str) -> None:
+    process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--ros-args", *ros_args)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 2, err[-2000:]
+    assert "load_controller: error:" in err and expected in err and "Traceback" not in err

@@ -1,11 +1,13 @@
 """``bearing-rig run`` end to end: the three nodes as processes on the test's isolated domain, a
 shortened validation program without real time, recorded into tmp_path. It runs to the end with a
 stable verdict and a bag that both readers decode; SIGINT in the middle leaves a complete,
-readable bag, the summary so far and exit status 130.
+readable bag, the summary so far and exit status 130; a node killed in the middle is named, with
+the bag finalised and exit status 1.
 """
 
 from __future__ import annotations
 
+import os
 import signal
 import subprocess
 import sys
@@ -103,16 +105,36 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
     assert (bag / "logs" / "simulator.log").is_file()
 
 
-def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_path: Path) -> None:
-    session = start_session(ros_graph, tmp_path)
+def read_until(session: subprocess.Popen[str], prefix: str, seconds: float = 90.0) -> list[str]:
+    """The session's output lines up to the first starting with ``prefix`` (progress prints at
+    least a line a second, so the loop keeps coming back to the deadline)."""
     assert session.stdout is not None
     seen = []
-    deadline = time.monotonic() + 90
-    for line in session.stdout:  # progress prints at least a line a second
+    deadline = time.monotonic() + seconds
+    for line in session.stdout:
         seen.append(line)
-        if line.startswith("segment 2/3 n0900:") or time.monotonic() > deadline:
+        if line.startswith(prefix) or time.monotonic() > deadline:
             break
-    assert any(line.startswith("segment 2/3 n0900:") for line in seen), "".join(seen)[-3000:]
+    assert any(line.startswith(prefix) for line in seen), "".join(seen)[-3000:]
+    return seen
+
+
+def child_pid(parent: int, script: str) -> int:
+    """The process id of ``parent``'s child running ``script``."""
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+            cmdline = (stat.parent / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+        except (OSError, IndexError):
+            continue
+        if int(fields[1]) == parent and script in cmdline:
+            return int(stat.parent.name)
+    raise AssertionError(f"no child of {parent} runs {script}")
+
+
+def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_path: Path) -> None:
+    session = start_session(ros_graph, tmp_path)
+    seen = read_until(session, "segment 2/3 n0900:")
     time.sleep(1.0)
     session.send_signal(signal.SIGINT)
     rest, err = session.communicate(timeout=60)
@@ -124,3 +146,16 @@ def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_p
     counts = check_bag_decodes(the_bag(tmp_path))
     for topic in SENSOR_TOPICS[:3]:
         assert counts.get(topic, 0) > 0, f"no {topic} in {counts}"
+
+
+def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_path: Path) -> None:
+    session = start_session(ros_graph, tmp_path)
+    seen = read_until(session, "segment 2/3 n0900:")
+    os.kill(child_pid(session.pid, "bearing-rig-monitor"), signal.SIGKILL)
+    rest, err = session.communicate(timeout=60)
+    out = "".join(seen) + rest
+    assert session.returncode == 1, f"{out[-3000:]}\n{err[-3000:]}"
+    assert "the monitor node stopped during the run: monitor was killed by signal SIGKILL" in err
+    assert "monitor.log" in err and "summary (failed)" in out
+    counts = check_bag_decodes(the_bag(tmp_path))
+    assert counts.get("/rig/speeds", 0) > 0

@@ -313,3 +313,24 @@ def test_monitor_on_a_replay_reaches_the_recorded_verdict(ros_graph, tmp_path: P
     changes = [(round(at - last_pulse[-1], 3), state) for (at, state), (_a, before) in zip(statuses[1:], statuses) if state != before]
     assert final[-1] == recorded[-1], f"monitor state changes (s after the last pulse, state): {changes}"
     assert monitor.poll() is None
+
+
+@pytest.mark.ros
+def test_ctrl_c_stops_a_looping_replay_cleanly(ros_graph, tmp_path: Path) -> None:
+    import signal
+
+    from bearing_rig_msgs.msg import FibreOpticPulse
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+    write_pulse_bag(tmp_path / "bag", TIMES_NS)
+    node = ros_graph.node("listener")
+    received: list[int] = []
+    node.create_subscription(FibreOpticPulse, CAGE, lambda m: received.append(m.pulse_index), QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT))
+    process = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--loop", "--rate", "4", "--wait-for-subscribers", "--delay", "20")
+    executor = ros_graph.executor([node])
+    # a second pass has begun: pulse_index 0 came again after the last one
+    assert ros_graph.spin_until(lambda: received.count(0) >= 2, timeout=30.0, executor=executor), f"received {len(received)} pulses"
+    process.send_signal(signal.SIGINT)
+    out, err = process.communicate(timeout=10.0)
+    assert process.returncode == 130, err
+    assert "replay interrupted" in err and "Traceback" not in err

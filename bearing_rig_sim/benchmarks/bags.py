@@ -14,12 +14,24 @@ prints one JSON object per line:
   memory of that process) and ``baseline_rss_mb`` (after imports and opening the bag, before
   reading). The long bag is one hour (``--quick``: 4 minutes); the short one a quarter of it:
   equal peaks show that memory does not grow with the bag's length.
+* ``case: "analyse"``, one per bag length: a bag at the rig's rates (speeds 1 kHz, truth 100 Hz
+  (:func:`rig_traffic`, steady content), fibre-optic pulses of 4 strips per shaft with 1 us
+  jitter and slip status at 10 Hz (:func:`program_traffic`: the validation program's speeds,
+  900-2700 rpm, held ``HOLD_S`` each with 1 s STEP ramps and a decaying slip transient after
+  each step, over and over) is analysed offline as ``bearing-rig analyze`` does, in a fresh
+  process: ``analyse_s`` (the monitor run over every pulse, the series and CSV files), of it
+  ``monitor_s`` (inside the monitor's own ``add_pulse``, ``check`` and ``status``: its slip
+  windows, Gaussian refits and verdicts), ``report_s`` (plots and markdown), ``target_s`` (60 for an hour, pro rata), ``peak_rss_mb``,
+  ``baseline_rss_mb``, and the counts (pulses, windows, status rows).
 """
 
 from __future__ import annotations
 
 import argparse
+import heapq
+import math
 import multiprocessing
+import random
 import resource
 import shutil
 import statistics
@@ -29,11 +41,30 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Iterator
 
-from bearing_rig_sim.recording import BagWriter, open_bag
-from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, SPEEDS_TOPIC, rig_traffic
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.recording import BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.recording.synthetic import (
+    CAGE_PULSES_TOPIC,
+    RIG_TRAFFIC_TOPICS,
+    SPEEDS_TOPIC,
+    SPINDLE_PULSES_TOPIC,
+    rig_traffic,
+)
 
 TARGET_MSGS_PER_S = 20_000
 """Recorder throughput required by issue 6 (messages/s)."""
+
+TARGET_ANALYSE_S_PER_HOUR = 60.0
+"""Offline analysis of a one-hour bag required by issue 6 (s)."""
+
+PROGRAM_RPM = (900.0, 1200.0, 1500.0, 1800.0, 2100.0, 2400.0, 2700.0)
+"""Inner-ring speeds of :func:`program_traffic`: the validation program's (rpm)."""
+HOLD_S = 30.0
+"""Time each speed is held in :func:`program_traffic` (s)."""
+STRIPS = 4
+"""Reflective strips per shaft (config/rig.yaml)."""
+STATUS_TOPIC = "/rig/slip_status"
+CASES = ("record", "read", "analyse")
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,6 +74,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--messages", type=int, default=200_000, help="messages per recorder throughput run")
     parser.add_argument("--repeats", type=int, default=3, help="recorder throughput runs; the median is reported")
     parser.add_argument("--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed)")
+    parser.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES), help="cases to run (default: all)")
 
 
 def _record_speeds(folder: Path, count: int) -> tuple[float, int]:
@@ -72,6 +104,127 @@ def _record_traffic(folder: Path, minutes: float) -> tuple[float, int, int]:
     return elapsed, count, sum(f.stat().st_size for f in folder.iterdir())
 
 
+def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0) -> Iterator[tuple[str, int, bytes]]:
+    """Fibre-optic pulses and slip status of a speed program, in time order: (topic, time in ns,
+    CDR bytes); see the module documentation. The cage turns at the epicyclic speed of H7006C
+    (0.4283 n_i) less a slip of 1-1.5 % plus 2 % decaying with a 2 s time constant after each
+    speed change."""
+    from bearing_rig_sim.rig.program import step_ramp  # noqa: PLC0415
+
+    store = rig_typestore()
+    types = store.types
+    rng = random.Random(seed)
+    period = HOLD_S + 1.0
+    speeds = [rpm_to_rad_s(rpm) for rpm in PROGRAM_RPM]
+
+    def state(t: float) -> tuple[float, float]:
+        k = int(t // period)
+        t0 = k * period
+        before, after = speeds[(k - 1) % len(speeds)] if k else speeds[0], speeds[k % len(speeds)]
+        inner = step_ramp(t, t0, before, t0 + 1.0, after)
+        slip = 1.0 + 0.5 * after / speeds[-1] + transient_pct * math.exp(-max(t - t0 - 1.0, 0.0) / 2.0)
+        return inner, inner * 0.4283 * (1.0 - slip / 100.0)
+
+    def stamp(time_ns: int) -> object:
+        return types["builtin_interfaces/msg/Time"](sec=time_ns // 10**9, nanosec=time_ns % 10**9)
+
+    def pulse(time_ns: int, shaft: str, index: int) -> bytes:
+        header = types["std_msgs/msg/Header"](stamp=stamp(time_ns), frame_id="rig")
+        message = types["bearing_rig_msgs/msg/FibreOpticPulse"](
+            header=header, sensor_id=shaft, strip_id=index % STRIPS, strip_count=STRIPS, revolution=index // STRIPS, pulse_index=index
+        )
+        return bytes(store.serialize_cdr(message, "bearing_rig_msgs/msg/FibreOpticPulse"))
+
+    spacing = 2 * math.pi / STRIPS
+    angles = {SPINDLE_PULSES_TOPIC: 0.0, CAGE_PULSES_TOPIC: 0.0}
+    counts = {SPINDLE_PULSES_TOPIC: 0, CAGE_PULSES_TOPIC: 0}
+    shafts = {SPINDLE_PULSES_TOPIC: "spindle", CAGE_PULSES_TOPIC: "cage"}
+    status = store.types["bearing_rig_msgs/msg/SlipStatus"](
+        header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
+        theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
+        confidence=0.9, window_revolutions=1, detail="1-term Gaussian fit of 300 points; slope -0.001 %/s >= k = -0.03 %/s",
+    )
+    dt = 1e-3
+    for step in range(int(round(duration_s / dt))):
+        t = step * dt
+        inner, cage = state(t + 0.5 * dt)
+        out = []
+        for topic, speed in ((SPINDLE_PULSES_TOPIC, inner), (CAGE_PULSES_TOPIC, cage)):
+            start, end = angles[topic], angles[topic] + speed * dt
+            while (counts[topic] + 1) * spacing <= end:
+                crossing = t + ((counts[topic] + 1) * spacing - start) / (end - start) * dt
+                counts[topic] += 1
+                time_ns = int(round((crossing + max(-4e-6, min(4e-6, rng.gauss(0.0, 1e-6)))) * 1e9))
+                out.append((max(time_ns, step * 1_000_000), topic, counts[topic]))
+            angles[topic] = end
+        for time_ns, topic, index in sorted(out):
+            yield topic, time_ns, pulse(time_ns, shafts[topic], index)
+        if step % 100 == 0:
+            status.header.stamp = stamp(step * 1_000_000)
+            status.inner_ring_speed, status.cage_speed = inner, cage
+            yield STATUS_TOPIC, step * 1_000_000, bytes(store.serialize_cdr(status, "bearing_rig_msgs/msg/SlipStatus"))
+
+
+def _record_rig_bag(folder: Path, minutes: float) -> tuple[float, int, int]:
+    """Seconds to generate and record ``minutes`` of the rig's traffic for the analysis (see the
+    module documentation), messages and bytes."""
+    start = time.perf_counter()
+    steady = ((topic, t, data) for topic, t, data in rig_traffic(minutes * 60.0) if topic not in (SPINDLE_PULSES_TOPIC, CAGE_PULSES_TOPIC))
+    with BagWriter(folder, metadata={"test_program": f"validation speeds over and over, {minutes} min (benchmark)"}) as bag:
+        for topic, (msgtype, qos) in RIG_TRAFFIC_TOPICS.items():
+            bag.add_topic(topic, msgtype, qos)
+        bag.add_topic(STATUS_TOPIC, "bearing_rig_msgs/msg/SlipStatus", "transient_local")
+        write = bag.write
+        for topic, time_ns, data in heapq.merge(steady, program_traffic(minutes * 60.0), key=lambda m: m[1]):
+            write(topic, time_ns, data)
+        count = bag.message_count
+    return time.perf_counter() - start, count, sum(f.stat().st_size for f in folder.iterdir())
+
+
+def measure_analysis(path: str, out: str) -> dict:
+    """``bearing-rig analyze`` of a bag (CSV, plots and report into ``out``); runs in a fresh
+    process. Returns seconds of each part, counts, peak and baseline resident memory (MB)."""
+    import matplotlib.pyplot  # noqa: F401, PLC0415 - imported before the baseline, as analyse_bag's modules
+
+    from bearing_rig_sim.monitoring import SlipMonitor  # noqa: PLC0415
+    from bearing_rig_sim.recording.offline import analyse_bag  # noqa: PLC0415
+    from bearing_rig_sim.recording.report import write_report  # noqa: PLC0415
+
+    spent = [0.0]
+
+    def timed(method):  # noqa: ANN001, ANN202 - the monitor's time, apart from the analysis' own
+        def wrapper(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+            begin = time.perf_counter()
+            try:
+                return method(*args, **kwargs)
+            finally:
+                spent[0] += time.perf_counter() - begin
+
+        return wrapper
+
+    for name in ("add_pulse", "check", "status"):
+        setattr(SlipMonitor, name, timed(getattr(SlipMonitor, name)))
+    baseline = _current_rss_mb()
+    start = time.perf_counter()
+    result = analyse_bag(path, csv_dir=out)
+    analysed = time.perf_counter()
+    write_report(result, out)
+    done = time.perf_counter()
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return {
+        "analyse_s": analysed - start,
+        "monitor_s": spent[0],
+        "report_s": done - analysed,
+        "pulses": sum(result.pulses.values()),
+        "windows": result.windows,
+        "status_rows": result.status_rows,
+        "segments": len(result.segments),
+        "complete": result.complete,
+        "peak_rss_mb": peak,
+        "baseline_rss_mb": baseline,
+    }
+
+
 def _current_rss_mb() -> float:
     with open("/proc/self/statm", encoding="ascii") as statm:
         pages = int(statm.read().split()[1])
@@ -93,27 +246,29 @@ def measure_read(path: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
-    """Measure recorder throughput, then read-back time and memory for two bag lengths."""
+    """Measure recorder throughput, then read-back and analysis time and memory for two bag
+    lengths (the cases of ``--cases``)."""
     long_minutes = args.minutes if args.minutes is not None else (4.0 if args.quick else 60.0)
     workdir = Path(tempfile.mkdtemp(prefix="bench-bags-")) if args.workdir is None else args.workdir
     workdir.mkdir(parents=True, exist_ok=True)
+    context = multiprocessing.get_context("spawn")
     try:
-        runs = [_record_speeds(workdir / f"record-{i}", args.messages) for i in range(max(1, args.repeats))]
-        rates = [args.messages / elapsed for elapsed, _size in runs]
-        median = statistics.median(rates)
-        yield {
-            "bench": "bags",
-            "case": "record",
-            "messages": args.messages,
-            "msgs_per_s": round(median),
-            "msgs_per_s_min": round(min(rates)),
-            "target_msgs_per_s": TARGET_MSGS_PER_S,
-            "meets_target": median >= TARGET_MSGS_PER_S,
-            "bytes_per_msg": round(runs[0][1] / args.messages, 1),
-            "compression": "zstd",
-        }
-        context = multiprocessing.get_context("spawn")
-        for minutes in (long_minutes / 4, long_minutes):
+        if "record" in args.cases:
+            runs = [_record_speeds(workdir / f"record-{i}", args.messages) for i in range(max(1, args.repeats))]
+            rates = [args.messages / elapsed for elapsed, _size in runs]
+            median = statistics.median(rates)
+            yield {
+                "bench": "bags",
+                "case": "record",
+                "messages": args.messages,
+                "msgs_per_s": round(median),
+                "msgs_per_s_min": round(min(rates)),
+                "target_msgs_per_s": TARGET_MSGS_PER_S,
+                "meets_target": median >= TARGET_MSGS_PER_S,
+                "bytes_per_msg": round(runs[0][1] / args.messages, 1),
+                "compression": "zstd",
+            }
+        for minutes in (long_minutes / 4, long_minutes) if "read" in args.cases else ():
             folder = workdir / f"traffic-{minutes:g}min"
             write_s, count, size = _record_traffic(folder, minutes)
             with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
@@ -132,6 +287,33 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "baseline_rss_mb": round(read["baseline_rss_mb"], 1),
             }
             shutil.rmtree(folder)
+        for minutes in (long_minutes / 4, long_minutes) if "analyse" in args.cases else ():
+            folder = workdir / f"rig-{minutes:g}min"
+            write_s, count, size = _record_rig_bag(folder, minutes)
+            with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
+                analysis = pool.submit(measure_analysis, str(folder), str(workdir / f"report-{minutes:g}min")).result()
+            target = TARGET_ANALYSE_S_PER_HOUR * minutes / 60.0
+            yield {
+                "bench": "bags",
+                "case": "analyse",
+                "sim_minutes": minutes,
+                "messages": count,
+                "bag_mb": round(size / 2**20, 1),
+                "write_s": round(write_s, 2),
+                "analyse_s": round(analysis["analyse_s"], 2),
+                "monitor_s": round(analysis["monitor_s"], 2),
+                "report_s": round(analysis["report_s"], 2),
+                "target_s": round(target, 2),
+                "meets_target": analysis["analyse_s"] + analysis["report_s"] <= target,
+                "pulses": analysis["pulses"],
+                "windows": analysis["windows"],
+                "status_rows": analysis["status_rows"],
+                "segments": analysis["segments"],
+                "peak_rss_mb": round(analysis["peak_rss_mb"], 1),
+                "baseline_rss_mb": round(analysis["baseline_rss_mb"], 1),
+            }
+            shutil.rmtree(folder)
+            shutil.rmtree(workdir / f"report-{minutes:g}min", ignore_errors=True)
     finally:
         if args.workdir is None:
             shutil.rmtree(workdir, ignore_errors=True)

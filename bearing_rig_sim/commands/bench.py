@@ -23,6 +23,7 @@ from typing import Any, Iterable, TextIO
 from bearing_rig_sim.errors import RigError
 
 BENCHMARKS: dict[str, str] = {
+    "bags": "bearing_rig_sim.benchmarks.bags",
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
     "rig": "bearing_rig_sim.benchmarks.rig",
 }

@@ -406,3 +406,33 @@ def test_segments_of_a_program_and_stretches_of_a_bench_run() -> None:
     assert [first.name, second.name] == ["stretch 1", "stretch 2"]
     assert first.inner_ring_speed == pytest.approx(100.0) and second.inner_ring_speed == pytest.approx(120.0)
     assert second.start_time == pytest.approx(3.9) and second.end_time == pytest.approx(8.8)
+
+
+def test_recorded_stamps_on_another_clock_are_placed_on_the_pulse_clock(tmp_path: Path) -> None:
+    """A monitor stamps its status with its own clock before the first window (the system
+    clock, about 1.7e9 s): such a stamp is placed at the log time before the first pulse, at the
+    pulse clock after it."""
+    store = rig_typestore()
+    path = tmp_path / "stamps"
+    wall = 1_700_000_000
+
+    def status(sec: int, nanosec: int, state: int) -> object:
+        message = sample_message("bearing_rig_msgs/msg/SlipStatus", 1, store)
+        message.header.stamp.sec, message.header.stamp.nanosec, message.state = sec, nanosec, state
+        return message
+
+    with BagWriter(path) as bag:
+        for topic, (msgtype, qos) in RIG_TRAFFIC_TOPICS.items():
+            bag.add_topic(topic, msgtype, qos)
+        bag.add_topic("/rig/slip_status", "bearing_rig_msgs/msg/SlipStatus", "transient_local")
+        bag.write_message("/rig/slip_status", 0, status(wall, 0, 0))
+        for topic, time_ns, data in rig_traffic(2.0, spindle_speed=rpm_to_rad_s(1800.0)):
+            if time_ns >= 500_000_000:
+                bag.write(topic, time_ns, data)
+            if time_ns == 1_000_000_000 and topic == "/rig/truth":
+                bag.write_message("/rig/slip_status", time_ns + 1, status(1, 0, 1))
+                bag.write_message("/rig/slip_status", time_ns + 2, status(wall, 5, 2))
+    result = analyse_bag(path)
+    times = [t for t, _state in result.recorded_transitions]
+    assert result.recorded_transitions[0] == (0.0, 0) and [s for _t, s in result.recorded_transitions] == [0, 1, 2]
+    assert times[1] == 1.0 and 0.99 < times[2] <= 1.0  # the pulse clock when it arrived

@@ -98,6 +98,9 @@ CONTEXT_TOPICS: dict[str, str] = {
 MONITOR_PARAMETERS_KEY = f"parameters/{NODE_NAME}"
 """Run-context key holding the monitor's parameter file of the run."""
 
+PLAUSIBLE_STAMP_S = 10.0
+"""A recorded status or command stamped further than this from the pulse clock was stamped on
+another clock (s); see :meth:`OfflineAnalysis._decoded`."""
 MAX_TRANSITIONS = 20_000
 """State changes kept per source; further ones are counted, not kept (1)."""
 DEFAULT_MAX_POINTS = 2000
@@ -187,7 +190,7 @@ class OfflineResult:
     transitions: list[tuple[float, int]] = field(default_factory=list)
     """Offline state changes (rig time, state), the first row included."""
     recorded_transitions: list[tuple[float, int]] = field(default_factory=list)
-    """State changes of the recorded ``/rig/slip_status`` (stamp, state)."""
+    """State changes of the recorded ``/rig/slip_status`` (stamp on the pulse clock, state)."""
     transitions_dropped: int = 0
     segments: list[SegmentSummary] = field(default_factory=list)
     csv_files: list[Path] = field(default_factory=list)
@@ -206,7 +209,7 @@ class _Latest:
         self._value: Any = None
         self.failed = 0
 
-    def put(self, raw: bytes) -> None:
+    def put(self, _log_time_ns: int, raw: bytes) -> None:
         self._raw, self._value = raw, None
 
     def get(self) -> Any:
@@ -339,13 +342,12 @@ class OfflineAnalysis:
     # -- the pass ------------------------------------------------------------------------------
     def run(self) -> OfflineResult:
         """Read the bag once and return the result; CSV files are closed whatever happens."""
-        handlers: dict[str, Callable[[bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
+        handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
-            latest = self._latest[name]
-            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, latest.put)
+            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
         try:
-            for topic, _log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
-                handlers[topic](data)
+            for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
+                handlers[topic](log_time_ns, data)
             self._finish()
         finally:
             for sink in self._sinks:
@@ -363,7 +365,7 @@ class OfflineAnalysis:
             result.csv_files = [sink.path for sink in self._sinks] + [write_segments_csv(self._csv_dir / SEGMENTS_CSV, result.segments)]
         return result
 
-    def _on_pulse(self, topic: str, data: bytes) -> None:
+    def _on_pulse(self, topic: str, _log_time_ns: int, data: bytes) -> None:
         try:
             pulse = decode_pulse(data) if data[:2] == b"\x00\x01" else _pulse_from_message(self._decode_pulse_message(data))
         except BagError as exc:
@@ -410,17 +412,22 @@ class OfflineAnalysis:
         self.result.segments = self._segments.finish()
 
     # -- context topics ------------------------------------------------------------------------
-    def _decoded(self, topic: str, data: bytes) -> tuple[Any, float]:
-        """The message (None if it does not decode) and its ``header.stamp`` in s."""
+    def _decoded(self, topic: str, log_time_ns: int, data: bytes) -> tuple[Any, float]:
+        """The message (None if it does not decode) and its time on the pulse clock, s: its
+        ``header.stamp``, unless that lies more than :data:`PLAUSIBLE_STAMP_S` from the pulse
+        clock (or, before the first pulse, from the log time): a stamp on another clock, such as
+        the monitor's status before its first window. The pulse clock (or log time) is used then."""
         latest = self._latest[topic]
-        latest.put(data)
+        latest.put(log_time_ns, data)
         message = latest.get()
         if message is None:
             return None, _NAN
-        return message, message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        reference = self._clock if self._origin is not None else log_time_ns * 1e-9
+        return message, stamp if abs(stamp - reference) <= PLAUSIBLE_STAMP_S else reference
 
-    def _on_recorded_status(self, data: bytes) -> None:
-        message, stamp = self._decoded(STATUS, data)
+    def _on_recorded_status(self, log_time_ns: int, data: bytes) -> None:
+        message, stamp = self._decoded(STATUS, log_time_ns, data)
         if message is None:
             return
         state = int(message.state)
@@ -432,8 +439,8 @@ class OfflineAnalysis:
         self._recorded = message
         self._segments.recorded(stamp, state)
 
-    def _on_command(self, data: bytes) -> None:
-        command, start = self._decoded(COMMAND, data)
+    def _on_command(self, log_time_ns: int, data: bytes) -> None:
+        command, start = self._decoded(COMMAND, log_time_ns, data)
         if command is None:
             return
         window = self.monitor.latest_window

@@ -238,8 +238,13 @@ def _agreement(segments: Sequence[SegmentSummary]) -> str:
     compared = [s for s in segments if s.final_recorded_state >= 0]
     if not compared:
         return "no recorded verdict to compare with"
+    reached = sum(s.time_to_stable is not None for s in compared)
+    recorded = sum(s.recorded_time_to_stable is not None for s in compared)
     same = sum(s.final_state == s.final_recorded_state for s in compared)
-    return f"{same} of {len(compared)} segments end with the recorded verdict"
+    return (
+        f"a stable verdict after the ramp in {reached} of {len(compared)} offline, {recorded} recorded; "
+        f"the last state agrees in {same} (the recorded statuses follow the node's timing)"
+    )
 
 
 def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Sequence[Path]) -> str:

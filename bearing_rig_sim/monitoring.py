@@ -288,6 +288,7 @@ class SlipMonitor:
             refit_interval=settings.refit_interval,
             window=settings.stability_window_points,
             max_fit_age=settings.max_fit_age_s,
+            defer_refit=True,  # refits run in check(), off the pulse path (status latency)
         )
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
         self.reset()
@@ -501,6 +502,7 @@ class SlipMonitor:
         """
         if not math.isfinite(now):
             return
+        self.stability.refit_if_due()
         st = self.settings
         for key, (when, reason) in list(self._latched.items()):
             if when is None:

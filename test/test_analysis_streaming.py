@@ -233,3 +233,19 @@ def test_window_bounds_the_points_held() -> None:
 def test_bad_options(kwargs: dict, message: str) -> None:
     with pytest.raises(AnalysisError, match=message):
         StreamingStability(**kwargs)
+
+
+def test_deferred_refits_run_only_when_asked() -> None:
+    """With defer_refit, add() only stores (cheap on a latency-sensitive path); refit_if_due()
+    then fits exactly when the policy is due, and the verdict uses that fit."""
+    t = np.linspace(0.0, 3.0, 61)
+    y = 3.0 * np.exp(-(((t + 1.0) / 1.5) ** 2))
+    eager = StreamingStability("time", refit_interval=5)
+    lazy = StreamingStability("time", refit_interval=5, defer_refit=True)
+    for x, v in zip(t, y):
+        eager.add(float(x), float(v))
+        lazy.add(float(x), float(v))
+    assert eager.refits > 0 and lazy.refits == 0 and lazy.fit is None
+    assert lazy.refit_if_due() is True and lazy.refits == 1
+    assert lazy.refit_if_due() is False  # nothing new since the fit
+    assert lazy.verdict().state == eager.verdict().state

@@ -137,11 +137,15 @@ class StreamingStability:
         window: int | None = None,
         max_fit_age: float | None = None,
         full_refit_every: int = 20,
+        defer_refit: bool = False,
     ) -> None:
         if criterion not in CRITERIA:
             raise AnalysisError(f"criterion: must be one of {', '.join(CRITERIA)}, got {criterion!r}")
         default_k, default_terms, default_min, unit = CRITERIA[criterion]
         self.criterion = criterion
+        self.defer_refit = defer_refit
+        """True: :meth:`add` only stores; the caller runs :meth:`refit_if_due` when it has time
+        (keeps a latency-sensitive caller's per-point cost at microseconds)."""
         self.unit = unit
         self.critical_slope = default_k if critical_slope is None else finite_number("critical_slope", critical_slope)
         self.max_terms = default_terms if max_terms is None else positive_int("max_terms", max_terms)
@@ -228,8 +232,18 @@ class StreamingStability:
             self._start = self._end - self.window
             self._dropped = True
         self._since_fit += 1
-        if self.n_points >= self.min_points and self._refit_due(xv):
-            self._refit()
+        if not self.defer_refit:
+            self.refit_if_due()
+
+    def refit_if_due(self) -> bool:
+        """Refit now if the refit policy says one is due; return whether it refitted. :meth:`add`
+        calls it unless ``defer_refit``; between refits the verdict uses the last fit."""
+        if self._end == self._start or self.n_points < self.min_points:
+            return False
+        if not self._refit_due(float(self._x[self._end - 1])):
+            return False
+        self._refit()
+        return True
 
     def _make_room(self) -> None:
         live = self.n_points

@@ -74,6 +74,9 @@ class MonitorNode(Node):
         self._last_state: MonitorState | None = None
         self._last_level: bytes | None = None
         self._received = {"spindle": 0, "cage": 0}
+        # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
+        # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
+        self._sim_time = bool(self.get_parameter("use_sim_time").value)
 
         self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
@@ -107,9 +110,9 @@ class MonitorNode(Node):
             self._last_pulse_wall = time.monotonic()
             self._received[shaft] += 1
             if self.monitor.add_pulse(shaft, pulse):
-                status = self.monitor.status()
-                if status.state != self._last_state:
-                    self._publish(status)
+                # A slip window just closed: publish its status now rather than at the next
+                # timer tick, so the status follows the pulse within the processing time.
+                self._publish(self.monitor.status())
         except Exception as exc:  # noqa: BLE001 - bad data never stops the monitor
             if not self.context.ok():
                 raise
@@ -118,24 +121,28 @@ class MonitorNode(Node):
     def _clock_now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
-    def _rig_now(self, clock_now: float) -> float:
-        """The later of the node's clock and the latest pulse extrapolated by the wall clock."""
+    def _rig_now(self, clock_now: float) -> float | None:
+        """Rig time now: the latest pulse extrapolated by the steady clock; with use_sim_time,
+        the later of that and the node's clock. None before any pulse without sim time."""
         last = self.monitor.last_pulse_time()
         if last is None or self._last_pulse_wall is None:
-            return clock_now
-        return max(clock_now, last + (time.monotonic() - self._last_pulse_wall))
+            return clock_now if self._sim_time else None
+        extrapolated = last + (time.monotonic() - self._last_pulse_wall)
+        return max(clock_now, extrapolated) if self._sim_time else extrapolated
 
     # -- periodic ------------------------------------------------------------------------------
     @survives_shutdown
     def _on_status_timer(self) -> None:
         clock_now = self._clock_now()
         tolerance = self.settings.clock_jump_tolerance_s
-        if self._last_clock is not None and clock_now < self._last_clock - tolerance:
+        if self._sim_time and self._last_clock is not None and clock_now < self._last_clock - tolerance:
             self.get_logger().warning(f"rig clock jumped back from {self._last_clock:.6g} s to {clock_now:.6g} s: reset")
             self.monitor.clock_jump(self._last_clock, clock_now)
             self._last_pulse_wall = None
         self._last_clock = clock_now
-        self.monitor.check(self._rig_now(clock_now))
+        now = self._rig_now(clock_now)
+        if now is not None:
+            self.monitor.check(now)
         self._publish(self.monitor.status())
 
     @survives_shutdown

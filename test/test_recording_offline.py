@@ -147,7 +147,7 @@ def twin_bag(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, list[tuple
 
 def direct_monitor(pulses: list[tuple[str, Pulse]]) -> tuple[list[SlipWindowRow], list[tuple[float, int, str]], SlipMonitor]:
     """SlipMonitor fed the pulses directly, no bag: its windows and its state changes (time,
-    state, and "tick" or "change" for a check or a closed window), with checks every status
+    state, and "tick" or "window" for a check or a closed window), with checks every status
     period on the pulse clock from the first pulse, as the node's timer runs them."""
     settings = MonitorSettings.from_yaml()
     monitor = SlipMonitor(settings.kinematics(), settings)
@@ -171,7 +171,7 @@ def direct_monitor(pulses: list[tuple[str, Pulse]]) -> tuple[list[SlipWindowRow]
         if monitor.add_pulse(shaft, pulse):
             w = monitor.latest_window
             windows.append(SlipWindowRow(w.start_time, w.end_time, w.inner_ring_speed, w.cage_speed, w.slip_rate))
-            note(pulse.time, "change")
+            note(pulse.time, "window")
     monitor.check(pulses[-1][1].time)
     return windows, changes, monitor
 
@@ -212,6 +212,7 @@ def test_offline_verdicts_are_the_monitors(twin_bag: tuple[Path, list[tuple[str,
     # status-rate ticks, where refits run, or a closed window); the clean run has no fault
     offline_changes = [(r.time, r.state, r.reason) for a, r in zip(rows, rows[1:]) if r.state != a.state]
     assert offline_changes == changes and changes
+    assert sum(r.reason == "window" for r in rows) == len(windows)  # a status per closed window, as the node
     final = monitor.status()
     assert result.final_status is not None and result.final_status.state == final.state == MonitorState.STABLE
     assert result.final_status.slip_rate == final.slip_rate

@@ -10,13 +10,13 @@ The two fibre-optic pulse topics are read in log-time order and fed, in lockstep
 verdicts offline are the monitor's. Nothing depends on a wall clock: two runs over one bag give
 bit-identical results.
 
-**The clock.** The monitor node calls :meth:`SlipMonitor.check` and publishes a status
-``status_rate_hz`` times a second and on every state change. Offline, the rig clock is the pulse
-stamps (the only clock a bench bag is sure to have): before each pulse, ``check`` runs at every
-tick ``t0 + k / status_rate_hz`` up to the pulse's time (``t0``: the first pulse), and a status
-row is emitted per tick; a slip window that changes the state emits a row at once. A pulse
-further back than ``clock_jump_tolerance_s`` restarts the ticks (the monitor resets itself on
-it). After the last pulse one final ``check`` and row close the series.
+**The clock.** The monitor node takes the pulse stamps as its time base; it calls
+:meth:`SlipMonitor.check` (where the Gaussian refits run) and publishes a status
+``status_rate_hz`` times a second, and publishes one more as each slip window closes. Offline,
+before each pulse ``check`` runs at every tick ``t0 + k / status_rate_hz`` up to the pulse's time
+(``t0``: the first pulse), each followed by a status row, and each closed window emits a row at
+once. A pulse further back than ``clock_jump_tolerance_s`` restarts the ticks (the monitor
+resets itself on it). After the last pulse one final ``check`` and row close the series.
 
 **What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
 of the five fields the monitor needs (little-endian CDR; other encodings through the reader's
@@ -387,9 +387,7 @@ class OfflineAnalysis:
                 self._windows_csv.write(window)
             if self._on_window is not None:
                 self._on_window(window)
-            status = self.monitor.status()
-            if self._last_row is not None and status.state != self._last_row.state:
-                self._emit(self._clock, "change", status)
+            self._emit(self._clock, "window", self.monitor.status())
 
     def _advance(self, t: float) -> None:
         """Run the checks of every tick up to ``t``; restart the ticks on a clock jump back."""

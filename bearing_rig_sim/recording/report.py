@@ -273,7 +273,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         "",
         f"* pulses: {result.pulses['spindle']} spindle, {result.pulses['cage']} cage, over {span:.3f} s of rig time "
         "(time below runs from the first pulse)",
-        f"* slip windows: {result.windows}; status rows: {result.status_rows} (the monitor's rate and every change of state)",
+        f"* slip windows: {result.windows}; status rows: {result.status_rows} (one per check at the monitor's status rate and per closed window)",
     ]
     final = result.final_status
     if final is not None:

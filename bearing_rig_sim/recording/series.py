@@ -31,7 +31,7 @@ _RAD_S_TO_RPM = 1.0 / RPM_TO_RAD_S
 class StatusRow:
     """One status the monitor would publish, with what the other topics said at that moment.
 
-    ``time`` is the rig time of the emission (a tick, a state change, the end), s; the monitor's
+    ``time`` is the rig time of the emission (a tick, a closed window, the end), s; the monitor's
     fields are :class:`~bearing_rig_sim.monitoring.MonitorStatus`'s (``window_end`` its ``time``);
     the context fields are the latest message of their topic (NaN / -1 when absent).
     Speeds rad/s, slip %, slope %/s, forces N.
@@ -39,7 +39,7 @@ class StatusRow:
 
     time: float
     reason: str
-    """``"tick"``, ``"change"`` (a window changed the state) or ``"end"``."""
+    """``"tick"`` (a check at the status rate), ``"window"`` (a slip window closed) or ``"end"``."""
     state: int
     window_end: float
     inner_ring_speed: float

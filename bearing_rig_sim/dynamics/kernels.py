@@ -402,6 +402,25 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 
 
 @njit(cache=True)
+def ball_drag(p: np.ndarray, v: float) -> tuple[float, float]:
+    """Drag on a ball moving at ``v`` (m/s) through the oil-air mixture and its derivative:
+    F = c1 v + c2 v|v| (N), dF/dv (N s/m)."""
+    return p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v), p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
+
+
+@njit(cache=True)
+def finish_step(ring: np.ndarray, stats: np.ndarray, omega_i_old: float, omega_i: float, cage_mean: float, dt: float) -> None:
+    """Advance the inner ring's angle (trapezoidal in its prescribed speed) and the clock, and
+    accumulate the running integrals of cage and inner-ring speed."""
+    ring[R_ANGLE] += 0.5 * (omega_i_old + omega_i) * dt
+    ring[R_OMEGA] = omega_i
+    ring[R_TIME] += dt
+    stats[S_CAGE] += cage_mean * dt
+    stats[S_INNER] += omega_i * dt
+    stats[S_TIME] += dt
+
+
+@njit(cache=True)
 def step_reduced(
     p: np.ndarray,
     ball: np.ndarray,
@@ -451,9 +470,7 @@ def step_reduced(
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
             fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
-            v = rb * wm
-            fd = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
-            dfd = p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
+            fd, dfd = ball_drag(p, rb * wm)
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
             mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm)
@@ -506,12 +523,7 @@ def step_reduced(
             ball[j, B_THETA] += dt * ball[j, B_OMEGA]
             cage[j, C_PHI] += dt * cage[j, C_OMEGA]
             cage_sum += cage[j, C_OMEGA]
-        ring[R_ANGLE] += 0.5 * (omega_i_old + omega_i) * dt
-        ring[R_OMEGA] = omega_i
-        ring[R_TIME] += dt
-        stats[S_CAGE] += cage_sum / z * dt
-        stats[S_INNER] += omega_i * dt
-        stats[S_TIME] += dt
+        finish_step(ring, stats, omega_i_old, omega_i, cage_sum / z, dt)
     return worst_iter
 
 
@@ -563,8 +575,7 @@ def step_stiff(
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
             fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
-            v = rb * wm
-            fd = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
+            fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
             mres = spin_resistance(p, di, do, fs, wa + cb * wm)
             # momenta at the current positions (p_theta first: p_r's update needs it)
@@ -594,12 +605,7 @@ def step_stiff(
         vdelta_new = vdelta + dt * ring_force / p[P_M_INNER]
         ring[R_VDELTA] = vdelta_new
         ring[R_DELTA] = delta_a + dt * vdelta_new
-        ring[R_ANGLE] += 0.5 * (omega_i_old + omega_i) * dt
-        ring[R_OMEGA] = omega_i
-        ring[R_TIME] += dt
-        stats[S_CAGE] += cage_sum / z * dt
-        stats[S_INNER] += omega_i * dt
-        stats[S_TIME] += dt
+        finish_step(ring, stats, omega_i_old, omega_i, cage_sum / z, dt)
     return 0
 
 

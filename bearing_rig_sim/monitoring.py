@@ -243,6 +243,23 @@ class MonitorStatus:
     notes: tuple[str, ...] = ()
     windows: int = 0
 
+    def message_fields(self) -> dict[str, object]:
+        """The SlipStatus.msg fields of this status (all but the header), for any message class
+        of that type (rclpy's or a bag typestore's)."""
+        return {
+            "inner_ring_speed": self.inner_ring_speed,
+            "cage_speed": self.cage_speed,
+            "theoretical_cage_speed": self.theoretical_cage_speed,
+            "slip_rate": self.slip_rate,
+            "fitted_slope": self.fitted_slope,
+            "critical_slope": self.critical_slope,
+            "state": int(self.state),
+            "criterion": self.criterion,
+            "confidence": self.confidence,
+            "window_revolutions": self.window_revolutions,
+            "detail": self.detail,
+        }
+
 
 @dataclass
 class _Shaft:

@@ -78,18 +78,7 @@ def write_twin_bag(
         status = live.status()
         last_state[0] = status.state
         message = types["bearing_rig_msgs/msg/SlipStatus"](
-            header=header(status.time if status.time is not None else now),
-            inner_ring_speed=status.inner_ring_speed,
-            cage_speed=status.cage_speed,
-            theoretical_cage_speed=status.theoretical_cage_speed,
-            slip_rate=status.slip_rate,
-            fitted_slope=status.fitted_slope,
-            critical_slope=status.critical_slope,
-            state=int(status.state),
-            criterion=status.criterion,
-            confidence=status.confidence,
-            window_revolutions=status.window_revolutions,
-            detail=status.detail,
+            header=header(status.time if status.time is not None else now), **status.message_fields()
         )
         bag.write_message("/rig/slip_status", int(round(now * 1e9)), message)
 

@@ -159,19 +159,7 @@ class MonitorNode(Node):
             self._publish_diagnostics(status)
 
     def _status_message(self, status: MonitorStatus) -> SlipStatus:
-        msg = SlipStatus(
-            inner_ring_speed=status.inner_ring_speed,
-            cage_speed=status.cage_speed,
-            theoretical_cage_speed=status.theoretical_cage_speed,
-            slip_rate=status.slip_rate,
-            fitted_slope=status.fitted_slope,
-            critical_slope=status.critical_slope,
-            state=int(status.state),
-            criterion=status.criterion,
-            confidence=status.confidence,
-            window_revolutions=status.window_revolutions,
-            detail=status.detail,
-        )
+        msg = SlipStatus(**status.message_fields())
         stamp = status.time if status.time is not None else self._clock_now()
         msg.header.stamp = to_stamp(max(stamp, 0.0))
         msg.header.frame_id = "bearing"

@@ -11,13 +11,14 @@ them with digest Eq. 11-12 at the nominal contact angle, as on the bench.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
 import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
-from bearing_rig_sim.calibration import SteadyState, steady_states
+from bearing_rig_sim.calibration import SteadyState, process_pool, steady_states
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 
@@ -112,13 +113,9 @@ def acceleration_sweep(
     workers: int | None = None,
 ) -> list[AccelerationSeries]:
     """:func:`acceleration_run` for each acceleration, on ``workers`` processes."""
-    import multiprocessing
-    import os
-    from concurrent.futures import ProcessPoolExecutor
-
     jobs = [(params, float(a), load, duration) for a in accelerations]
     workers = workers or os.cpu_count() or 1
     if workers <= 1:
         return [_acceleration_job(j) for j in jobs]
-    with ProcessPoolExecutor(max_workers=min(workers, len(jobs)), mp_context=multiprocessing.get_context("fork")) as pool:
+    with process_pool(min(workers, len(jobs))) as pool:
         return list(pool.map(_acceleration_job, jobs))

@@ -42,8 +42,8 @@ from pathlib import Path
 from typing import Iterator
 
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.recording import BagWriter, open_bag, rig_typestore
-from bearing_rig_sim.recording.synthetic import (
+from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.synthetic.traffic import (
     CAGE_PULSES_TOPIC,
     RIG_TRAFFIC_TOPICS,
     SPEEDS_TOPIC,
@@ -187,8 +187,8 @@ def measure_analysis(path: str, out: str) -> dict:
     import matplotlib.pyplot  # noqa: F401, PLC0415 - imported before the baseline, as analyse_bag's modules
 
     from bearing_rig_sim.monitoring import SlipMonitor  # noqa: PLC0415
-    from bearing_rig_sim.recording.offline import analyse_bag  # noqa: PLC0415
-    from bearing_rig_sim.recording.report import write_report  # noqa: PLC0415
+    from bearing_rig_sim.offline.analysis import analyse_bag  # noqa: PLC0415
+    from bearing_rig_sim.offline.report import write_report  # noqa: PLC0415
 
     spent = [0.0]
 

@@ -40,8 +40,8 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Replay the bag; returns the exit status."""
     from bearing_rig_sim.commands.bag import bag_warnings_as_lines  # noqa: PLC0415 - keeps --help fast
-    from bearing_rig_sim.recording import open_bag  # noqa: PLC0415
-    from bearing_rig_sim.recording.replay import ReplayOptions, RosReplaySink, check_topics, replay_bag  # noqa: PLC0415
+    from bearing_rig_sim.bags import open_bag  # noqa: PLC0415
+    from bearing_rig_sim.replay.player import ReplayOptions, RosReplaySink, check_topics, replay_bag  # noqa: PLC0415
 
     if not args.delay >= 0.0:
         raise RigError(f"--delay must be >= 0 s, got {args.delay!r}")

@@ -25,7 +25,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run or reuse the experiments and write the outputs."""
     from bearing_rig_sim.config import config_path
-    from bearing_rig_sim.reproduce import reproduce
+    from bearing_rig_sim.studies.reproduction import reproduce
 
     params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
     out = reproduce(args.out, params, workers=args.workers, use_cache=not args.no_cache, progress=not args.quiet)

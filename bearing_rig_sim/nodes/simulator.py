@@ -13,7 +13,7 @@ Publishes (interface table, docs/interfaces.md):
 * ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, sensor data, ``truth_rate_hz`` simulated):
   the engine's ground truth with the achieved real-time factor and the overrun count;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
-  on every change of level (see :mod:`bearing_rig_sim.simulation.health`).
+  on every change of level (see :mod:`bearing_rig_sim.health`).
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
 and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable). Bad input
@@ -54,7 +54,7 @@ from bearing_rig_sim.nodes.common import (
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
-from bearing_rig_sim.simulation.health import Health, HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import Health, HealthLevel, SimulatorHealth
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
 from bearing_rig_sim.simulation.twin import RigTwin, TickOutput

@@ -2,7 +2,7 @@
 
 Every topic of the interface table (README) is recorded as the serialized CDR the publisher sent
 (:data:`RECORDED_TOPICS`), into anything with ``add_topic`` and ``write`` (the project's
-:class:`~bearing_rig_sim.recording.BagWriter`, or a fake in tests).
+:class:`~bearing_rig_sim.bags.BagWriter`, or a fake in tests).
 
 **Log time** (the bag's timeline; the MCAP ``log_time``), simulation time in ns:
 
@@ -71,7 +71,7 @@ CLOCK_TOPIC = "/clock"
 
 
 class MessageWriter(Protocol):
-    """What the recorder writes into (:class:`~bearing_rig_sim.recording.BagWriter`'s methods)."""
+    """What the recorder writes into (:class:`~bearing_rig_sim.bags.BagWriter`'s methods)."""
 
     def add_topic(self, name: str, msgtype: str, qos: str) -> None: ...
 

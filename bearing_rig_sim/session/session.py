@@ -37,7 +37,7 @@ from types import FrameType
 from typing import Sequence, TextIO
 
 from bearing_rig_sim.config import rad_s_to_rpm
-from bearing_rig_sim.recording import BagWriter
+from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import make_run_id, run_context
 from bearing_rig_sim.session.processes import (

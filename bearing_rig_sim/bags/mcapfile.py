@@ -28,7 +28,7 @@ from mcap.exceptions import McapError
 from mcap.reader import SeekingReader
 from mcap.records import Channel, Metadata, Schema
 
-from bearing_rig_sim.recording.errors import BagError
+from bearing_rig_sim.bags.errors import BagError
 
 MAGIC = b"\x89MCAP0\r\n"
 """Magic bytes at both ends of an MCAP file."""

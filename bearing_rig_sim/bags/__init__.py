@@ -10,13 +10,13 @@
 No ROS import anywhere in this package: bags are written and read with ``mcap`` and ``rosbags``.
 """
 
-from bearing_rig_sim.recording.errors import BagError, BagWarning
-from bearing_rig_sim.recording.layout import RUN_METADATA_RECORD
-from bearing_rig_sim.recording.qos import QOS_PROFILES, QosSpec
-from bearing_rig_sim.recording.reader import BagMessage, BagReader, TopicInfo, open_bag
-from bearing_rig_sim.recording.repair import FileRepair, RepairReport, repair_bag
-from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore
-from bearing_rig_sim.recording.writer import PROJECT_VERSION_KEY, BagWriter
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD
+from bearing_rig_sim.bags.qos import QOS_PROFILES, QosSpec
+from bearing_rig_sim.bags.reader import BagMessage, BagReader, TopicInfo, open_bag
+from bearing_rig_sim.bags.repair import FileRepair, RepairReport, repair_bag
+from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
+from bearing_rig_sim.bags.writer import PROJECT_VERSION_KEY, BagWriter
 
 __all__ = [
     "QOS_PROFILES",

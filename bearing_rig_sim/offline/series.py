@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.config import RPM_TO_RAD_S
-from bearing_rig_sim.recording.errors import BagError
+from bearing_rig_sim.bags.errors import BagError
 
 STATUS_CSV = "status_rows.csv"
 WINDOWS_CSV = "slip_windows.csv"

@@ -23,10 +23,10 @@ from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
 
 import bearing_rig_sim
-from bearing_rig_sim.recording import BagError, BagWriter, QosSpec, open_bag, rig_typestore
-from bearing_rig_sim.recording.qos import QOS_PROFILES
-from bearing_rig_sim.recording.synthetic import message_fields, sample_message
-from bearing_rig_sim.recording.typestore import rig_message_texts, type_hash
+from bearing_rig_sim.bags import BagError, BagWriter, QosSpec, open_bag, rig_typestore
+from bearing_rig_sim.bags.qos import QOS_PROFILES
+from bearing_rig_sim.synthetic.traffic import message_fields, sample_message
+from bearing_rig_sim.bags.typestore import rig_message_texts, type_hash
 
 STANDARD_TYPES = [
     "sensor_msgs/msg/JointState",

@@ -13,7 +13,7 @@ Foxglove's indexed loading) need the index back. :func:`repair_bag` rebuilds it:
    kept as ``metadata.yaml.orig``).
 
 Repairing a bag that needs nothing changes nothing. From a shell, until the ``bearing-rig``
-command has its ``bag repair`` sub-command: ``python -m bearing_rig_sim.recording repair BAG...``.
+command has its ``bag repair`` sub-command: ``python -m bearing_rig_sim.bags repair BAG...``.
 """
 
 from __future__ import annotations
@@ -28,8 +28,8 @@ from typing import Literal
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
 import bearing_rig_sim
-from bearing_rig_sim.recording.errors import BagError
-from bearing_rig_sim.recording.layout import (
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.layout import (
     METADATA_FILE,
     BagLayout,
     layout_from_indexes,
@@ -39,9 +39,9 @@ from bearing_rig_sim.recording.layout import (
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.recording.mcapfile import FileIndex, check_chunks, index_file, iter_file_messages
-from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore
-from bearing_rig_sim.recording.writer import DEFAULT_CHUNK_SIZE, CountingSink
+from bearing_rig_sim.bags.mcapfile import FileIndex, check_chunks, index_file, iter_file_messages
+from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
+from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink
 
 BACKUP_SUFFIX = ".orig"
 """Appended to the name of a file the repair replaced (``run_0.mcap.orig``)."""
@@ -233,7 +233,7 @@ def repair_bag(path: str | Path) -> RepairReport:
 
 def main(argv: list[str] | None = None) -> int:
     """Repair each bag named in ``argv`` and say what was done; exit status 2 if a path is not
-    a bag (``python -m bearing_rig_sim.recording repair BAG...``)."""
+    a bag (``python -m bearing_rig_sim.bags repair BAG...``)."""
     parser = argparse.ArgumentParser(description="Restore the index of bags whose recording was interrupted.")
     parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="bag directory")
     status = 0

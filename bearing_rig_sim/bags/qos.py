@@ -19,7 +19,7 @@ from typing import Literal
 
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 
-from bearing_rig_sim.recording.errors import BagError
+from bearing_rig_sim.bags.errors import BagError
 
 Reliability = Literal["reliable", "best_effort"]
 Durability = Literal["volatile", "transient_local"]

@@ -14,7 +14,7 @@ and ``bearing_rig_msgs``' own.
 
 Damage is reported, not fatal: a file whose recording was killed (no summary) is read up to its
 last complete chunk, a corrupt chunk is skipped, a topic whose type is unknown is left out; each
-problem is a :class:`~bearing_rig_sim.recording.errors.BagWarning` and a line in
+problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
 :attr:`BagReader.problems`. ``strict=True`` turns them into :class:`BagError`. Padding that
 Fast-CDR leaves after a message (bags from ``ros2 bag record``) is ignored.
 """
@@ -33,12 +33,12 @@ from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from bearing_rig_sim.recording.cdr import make_decoder
-from bearing_rig_sim.recording.errors import BagError, BagWarning
-from bearing_rig_sim.recording.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
-from bearing_rig_sim.recording.mcapfile import FileIndex, index_file, iter_file_messages
-from bearing_rig_sim.recording.qos import QosSpec
-from bearing_rig_sim.recording.typestore import SCHEMA_SEPARATOR, rig_typestore
+from bearing_rig_sim.bags.cdr import make_decoder
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
+from bearing_rig_sim.bags.mcapfile import FileIndex, index_file, iter_file_messages
+from bearing_rig_sim.bags.qos import QosSpec
+from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
 
 
 class BagMessage(NamedTuple):

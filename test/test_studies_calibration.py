@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bearing_rig_sim.calibration import (
+from bearing_rig_sim.studies.calibration import (
     BenchPoint,
     CalibrationError,
     calibrate,

@@ -23,7 +23,7 @@ import numpy as np
 from rosbags.interfaces import Nodetype
 from rosbags.typesys.store import Typestore
 
-from bearing_rig_sim.recording.typestore import rig_typestore
+from bearing_rig_sim.bags.typestore import rig_typestore
 
 _INT_RANGES = {
     "int8": (-(2**7), 2**7 - 1),

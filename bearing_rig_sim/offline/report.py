@@ -1,6 +1,6 @@
 """The offline analysis of a bag as a report: markdown, PNG plots against time, CSV series.
 
-:func:`write_report` turns an :class:`~bearing_rig_sim.recording.offline.OfflineResult` into
+:func:`write_report` turns an :class:`~bearing_rig_sim.offline.analysis.OfflineResult` into
 ``report.md`` and four plots in the output folder (the CSV series are written there by the
 analysis itself, as it streams):
 
@@ -26,9 +26,9 @@ from typing import Any, Sequence
 import bearing_rig_sim
 from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
 from bearing_rig_sim.monitoring import MonitorState
-from bearing_rig_sim.recording.offline import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
-from bearing_rig_sim.recording.segments import SEGMENTS_CSV, SegmentSummary
-from bearing_rig_sim.recording.series import STATUS_CSV, WINDOWS_CSV
+from bearing_rig_sim.offline.analysis import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
+from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
+from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
 
 REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")

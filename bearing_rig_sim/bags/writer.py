@@ -20,7 +20,7 @@ keeps the time it was given. :attr:`BagWriter.nudged_count` counts such messages
 
 Robustness: chunks go to the operating system as soon as they are complete, and
 ``metadata.yaml`` is written when the bag opens and whenever topics or files change, so a killed
-recording leaves every complete chunk readable (:func:`~bearing_rig_sim.recording.repair.repair_bag`
+recording leaves every complete chunk readable (:func:`~bearing_rig_sim.bags.repair.repair_bag`
 restores the index). Leaving the ``with`` block for any reason, Ctrl-C included, finalises the bag.
 """
 
@@ -36,9 +36,9 @@ from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from rosbags.typesys.store import Typestore
 
 import bearing_rig_sim
-from bearing_rig_sim.recording.cdr import CdrBytes, make_normaliser
-from bearing_rig_sim.recording.errors import BagError
-from bearing_rig_sim.recording.layout import (
+from bearing_rig_sim.bags.cdr import CdrBytes, make_normaliser
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.layout import (
     RUN_METADATA_RECORD,
     BagLayout,
     FileEntry,
@@ -47,8 +47,8 @@ from bearing_rig_sim.recording.layout import (
     storage_file_name,
     write_layout,
 )
-from bearing_rig_sim.recording.qos import QosSpec, qos_spec
-from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore, type_hash
+from bearing_rig_sim.bags.qos import QosSpec, qos_spec
+from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore, type_hash
 
 PROJECT_VERSION_KEY = "project_version"
 """Run-context key the writer always fills with ``bearing_rig_sim.__version__``."""
@@ -133,7 +133,7 @@ class BagWriter:
             and its summary); None for a single file.
         metadata: run context as string key/value pairs (configuration, calibration, test
             program text...); ``project_version`` is added.
-        typestore: types to accept; default :func:`~bearing_rig_sim.recording.typestore.rig_typestore`.
+        typestore: types to accept; default :func:`~bearing_rig_sim.bags.typestore.rig_typestore`.
 
     Raises:
         BagError: bad option, or the path exists and is not an empty directory.
@@ -217,7 +217,7 @@ class BagWriter:
             name: fully qualified topic name, e.g. ``/rig/speeds``.
             msgtype: ``pkg/msg/Name`` (or ``pkg/Name``), a ROS 2 Jazzy or ``bearing_rig_msgs`` type.
             qos: the offered QoS: ``"reliable"``, ``"sensor_data"``, ``"transient_local"`` or a
-                :class:`~bearing_rig_sim.recording.qos.QosSpec`.
+                :class:`~bearing_rig_sim.bags.qos.QosSpec`.
 
         Raises:
             BagError: bag closed, bad name, unknown type, or the topic exists with another type
@@ -250,7 +250,7 @@ class BagWriter:
         """Record one serialized message (CDR with its 4-byte encapsulation header, as from
         ``rclpy.serialization.serialize_message`` or a raw subscription).
 
-        Trailing Fast-CDR padding is trimmed (see :mod:`bearing_rig_sim.recording.cdr`).
+        Trailing Fast-CDR padding is trimmed (see :mod:`bearing_rig_sim.bags.cdr`).
 
         Args:
             topic: a topic declared with :meth:`add_topic`.

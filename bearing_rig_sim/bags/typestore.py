@@ -13,7 +13,7 @@ from pathlib import Path
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
-from bearing_rig_sim.recording.errors import BagError
+from bearing_rig_sim.bags.errors import BagError
 
 RIG_MSG_PACKAGE = "bearing_rig_msgs"
 """ROS package name of the project's custom messages."""

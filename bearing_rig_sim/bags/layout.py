@@ -19,9 +19,9 @@ import yaml
 from rosbags.interfaces import Qos
 from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.mcapfile import FileIndex
 from bearing_rig_sim.config import ConfigError, parse_yaml
-from bearing_rig_sim.recording.errors import BagError
-from bearing_rig_sim.recording.mcapfile import FileIndex
 
 METADATA_FILE = "metadata.yaml"
 RUN_METADATA_RECORD = "bearing_rig_sim"

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from bearing_rig_sim.simulation.health import HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import HealthLevel, SimulatorHealth
 
 
 def test_ok_when_nothing_is_wrong():

@@ -25,7 +25,7 @@ from pathlib import Path
 
 from bearing_rig_sim.config import ConfigError, parse_yaml
 from bearing_rig_sim.monitoring import MonitorState
-from bearing_rig_sim.recording.series import CsvWriter, StatusRow, csv_columns
+from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
 
 SEGMENTS_CSV = "segments.csv"
 STRETCH_TOLERANCE = 0.01

@@ -18,7 +18,7 @@ from typing import Callable, Sequence
 import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
-from bearing_rig_sim.calibration import SteadyState, process_pool, steady_states
+from bearing_rig_sim.studies.calibration import SteadyState, process_pool, steady_states
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 

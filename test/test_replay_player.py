@@ -13,9 +13,9 @@ import pytest
 
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.monitoring import MonitorState
-from bearing_rig_sim.recording import QOS_PROFILES, BagError, BagWarning, BagWriter, TopicInfo, open_bag, rig_typestore
-from bearing_rig_sim.recording.offline import analyse_bag
-from bearing_rig_sim.recording.replay import (
+from bearing_rig_sim.bags import QOS_PROFILES, BagError, BagWarning, BagWriter, TopicInfo, open_bag, rig_typestore
+from bearing_rig_sim.offline.analysis import analyse_bag
+from bearing_rig_sim.replay.player import (
     CLOCK_TOPIC,
     ReplayOptions,
     ReplaySchedule,
@@ -24,10 +24,10 @@ from bearing_rig_sim.recording.replay import (
     offered_qos,
     replay_bag,
 )
-from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, sample_message
+from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, sample_message
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_recording_offline import write_twin_bag  # noqa: E402 - the twin bag of the offline tests
+from test_offline_analysis import write_twin_bag  # noqa: E402 - the twin bag of the offline tests
 
 PULSE = "bearing_rig_msgs/msg/FibreOpticPulse"
 CAGE = "/rig/cage/pulses"
@@ -264,7 +264,7 @@ def test_replayed_pulses_keep_their_timing(ros_graph, tmp_path: Path, rate: floa
 
 @pytest.mark.ros
 def test_unknown_type_is_warned_and_skipped(ros_graph) -> None:
-    from bearing_rig_sim.recording.replay import RosReplaySink
+    from bearing_rig_sim.replay.player import RosReplaySink
 
     topics = {
         CAGE: TopicInfo(CAGE, PULSE, 1, None, "", True),

@@ -56,11 +56,11 @@ from typing import Any, Callable
 
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, shipped_parameters
-from bearing_rig_sim.recording.cdr import make_decoder
-from bearing_rig_sim.recording.errors import BagError, BagWarning
-from bearing_rig_sim.recording.reader import BagReader, open_bag
-from bearing_rig_sim.recording.segments import SEGMENTS_CSV, SegmentSummary, SegmentTracker, program_segment_names, write_segments_csv
-from bearing_rig_sim.recording.series import (
+from bearing_rig_sim.bags.cdr import make_decoder
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.reader import BagReader, open_bag
+from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary, SegmentTracker, program_segment_names, write_segments_csv
+from bearing_rig_sim.offline.series import (
     STATUS_CSV,
     WINDOWS_CSV,
     CsvWriter,

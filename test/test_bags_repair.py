@@ -14,16 +14,16 @@ import yaml
 from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
-from bearing_rig_sim.recording import BagError, BagWarning, BagWriter, open_bag, repair_bag
-from bearing_rig_sim.recording.repair import main as repair_main
-from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, rig_traffic
+from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, repair_bag
+from bearing_rig_sim.bags.repair import main as repair_main
+from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic
 
 REPO = Path(__file__).resolve().parents[1]
 DURABLE_BEFORE_KILL = 3000
 
 RECORDER = r"""
 import sys
-from bearing_rig_sim.recording import BagWriter, rig_typestore
+from bearing_rig_sim.bags import BagWriter, rig_typestore
 
 types = rig_typestore().types
 max_file_bytes = int(sys.argv[2]) or None

@@ -1,6 +1,6 @@
 """Reproduction of the paper's experiments with the calibrated twin (issue 4).
 
-:func:`reproduce` runs the three experiments of :mod:`bearing_rig_sim.experiments` (cached by
+:func:`reproduce` runs the three experiments of :mod:`bearing_rig_sim.studies.experiments` (cached by
 a hash of every input), applies the paper's method (Gaussian fits, slope criterion) and writes
 into ``out_dir``: one CSV per experiment, one PNG per paper figure (5-10 analogues) and
 ``report.md`` with the paper's numbers beside the twin's.
@@ -22,10 +22,10 @@ import numpy as np
 from bearing_rig_sim import __version__
 from bearing_rig_sim.analysis.gaussian import GaussianFit, fit_gaussians, select_gaussian_fit
 from bearing_rig_sim.analysis.stability import K1_AXIAL_LOAD, K2_TIME, stable_onset
-from bearing_rig_sim.calibration import SteadyState
+from bearing_rig_sim.studies.calibration import SteadyState
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
-from bearing_rig_sim.experiments import (
+from bearing_rig_sim.studies.experiments import (
     ACCELERATION_LOAD_N,
     ACCELERATIONS,
     SWEEP_LOADS_N,
@@ -86,7 +86,7 @@ class Outputs:
 def inputs_key(params: BearingParameters) -> str:
     """Hash of every input of the experiments: bearing parameters, grids, code version and the
     engine's kernel source."""
-    kernels = (Path(__file__).parent / "dynamics" / "kernels.py").read_bytes()
+    kernels = (Path(__file__).parent.parent / "dynamics" / "kernels.py").read_bytes()
     fields = {k: v for k, v in dataclasses.asdict(params).items() if k != "source"}
     doc = {
         "params": fields,

@@ -19,15 +19,15 @@ from mcap.writer import Writer as McapWriter
 from mcap_ros2.writer import Writer as McapRos2Writer
 from rosbags.highlevel import AnyReader
 
-from bearing_rig_sim.recording import BagError, BagWarning, BagWriter, open_bag, rig_typestore
-from bearing_rig_sim.recording.synthetic import (
+from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.synthetic.traffic import (
     RIG_TRAFFIC_TOPICS,
     SPEEDS_TOPIC,
     TRUTH_TOPIC,
     message_fields,
     rig_traffic,
 )
-from bearing_rig_sim.recording.typestore import msg_folder
+from bearing_rig_sim.bags.typestore import msg_folder
 
 HEADER_DEPENDENCIES = (
     "=" * 80 + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"

@@ -18,12 +18,12 @@ from mcap_ros2.writer import Writer as McapRos2Writer
 
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonitor
-from bearing_rig_sim.recording import BagError, BagWarning, BagWriter, open_bag, rig_typestore
-from bearing_rig_sim.recording.offline import analyse_bag, decode_pulse
-from bearing_rig_sim.recording.segments import PROFILE_CONSTANT_ACCELERATION, SEGMENTS_CSV, SegmentTracker
-from bearing_rig_sim.recording.series import STATUS_CSV, WINDOWS_CSV, RowDecimator, SlipWindowRow, StatusRow
-from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
-from bearing_rig_sim.recording.typestore import msg_folder
+from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.offline.analysis import analyse_bag, decode_pulse
+from bearing_rig_sim.offline.segments import PROFILE_CONSTANT_ACCELERATION, SEGMENTS_CSV, SegmentTracker
+from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, RowDecimator, SlipWindowRow, StatusRow
+from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
+from bearing_rig_sim.bags.typestore import msg_folder
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation import RigTwin, SpindleCommand
 

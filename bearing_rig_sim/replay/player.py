@@ -40,9 +40,9 @@ from types import TracebackType
 from typing import Any, Iterable, Iterator, Literal, Protocol
 
 from bearing_rig_sim.config import ConfigError, check_number
-from bearing_rig_sim.recording.errors import BagError, BagWarning
-from bearing_rig_sim.recording.qos import QOS_PROFILES, QosSpec
-from bearing_rig_sim.recording.reader import BagReader, TopicInfo
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.qos import QOS_PROFILES, QosSpec
+from bearing_rig_sim.bags.reader import BagReader, TopicInfo
 
 CLOCK_TOPIC = "/clock"
 CLOCK_TYPE = "rosgraph_msgs/msg/Clock"

@@ -24,7 +24,7 @@ from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
-from bearing_rig_sim.recording.errors import BagError
+from bearing_rig_sim.bags.errors import BagError
 
 CdrBytes = bytes | memoryview
 """Serialized message: 4-byte encapsulation header, then the CDR body."""

@@ -72,6 +72,7 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
 NODE_NAME = "load_controller"
@@ -129,6 +130,7 @@ class LoadControllerNode(Node):
 
         if not self.get_parameter("use_sim_time").value:
             raise RigError(f"{NODE_NAME}: steps the loading chain on the simulation clock: use_sim_time must be true")
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
         self._bearing_msg = WrenchStamped()
         self._bearing_msg.header.frame_id = "bearing"
         self._load_cell_msg = WrenchStamped()

@@ -51,6 +51,7 @@ from bearing_rig_sim.nodes.common import (
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 LEVELS = {MonitorState.STABLE: OK, MonitorState.SLIPPING: WARN, MonitorState.UNKNOWN: WARN, MonitorState.FAULT: ERROR}
@@ -77,6 +78,7 @@ class MonitorNode(Node):
         # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
         self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)

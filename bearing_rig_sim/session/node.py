@@ -29,6 +29,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
+from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -37,6 +38,9 @@ __all__ = ["DRAIN_PERIOD_S", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
 
 DRAIN_PERIOD_S = 0.02
 """Wall time between two takes of the recorder's queues, s."""
+
+MAX_CLOCK_EVENTS = 10
+"""Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
 RECORDER_DEPTH = 5000
 """Reader queue depth of each recorded topic: 5 s of a 1 kHz topic in real time, 1 s at 5x."""
@@ -132,7 +136,9 @@ class SessionNode(Node):
         self.sim_time_ns = 0
         """Stamp of the last ``/clock`` taken, ns."""
         self.clock_count = 0
-        """``/clock`` messages taken."""
+        """``/clock`` messages taken (and accepted by :attr:`clock_guard`)."""
+        self.clock_guard = ClockGuard()
+        """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
 
@@ -195,7 +201,10 @@ class SessionNode(Node):
         for _, _, name, raw, msgtype in batch:
             if name == "/clock":
                 stamp = header_stamp_ns(raw)
-                if stamp is not None:
+                verdict = self.clock_guard.check(stamp) if stamp is not None else None
+                if verdict is not None and verdict.note and self.clock_guard.refused <= MAX_CLOCK_EVENTS:
+                    self.on_event(verdict.note if self.clock_guard.refused < MAX_CLOCK_EVENTS else f"{verdict.note}; further ones only counted")
+                if stamp is not None and verdict is not None and verdict.accepted:
                     self.sim_time_ns = stamp
                     self.clock_count += 1
             else:

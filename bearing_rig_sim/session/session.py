@@ -352,5 +352,12 @@ class _Session:
             f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "
             f"{self.writer.path / 'logs'}\n"
         )
+        rule = self.recorder.rule
+        if rule.clock_guard.refused or rule.clock_guard.jumps:
+            first = f"; first: {rule.clock_notes[0]}" if rule.clock_notes else ""
+            self.out.write(
+                f"clock: {rule.clock_guard.refused} /clock stamp(s) refused (kept off the bag's timeline), "
+                f"{rule.clock_guard.jumps} confirmed jump(s){first}\n"
+            )
         self.out.flush()
         return status

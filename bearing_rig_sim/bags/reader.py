@@ -39,6 +39,7 @@ from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_
 from bearing_rig_sim.bags.mcapfile import FileIndex, index_file, iter_file_messages
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
+from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
 
 
 class BagMessage(NamedTuple):
@@ -193,6 +194,11 @@ class BagReader:
             if RUN_METADATA_RECORD in index.metadata:
                 return dict(index.metadata[RUN_METADATA_RECORD])
         return dict(self.layout.custom_data) if self.layout is not None else {}
+
+    def verify(self) -> BagCheck:
+        """Read every chunk: checksums, unreadable messages, log-time outliers (see
+        :mod:`.verify`); slower than opening, which reads the index only."""
+        return verify_indexes(self._indexes)
 
     @property
     def complete(self) -> bool:

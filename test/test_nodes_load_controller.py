@@ -232,9 +232,13 @@ def test_interlock_trip_refused_reset_then_reset(ros_graph: Any, tmp_path: Path)
         (["-p", "use_sim_time:=false"], "use_sim_time must be true"),
         (["-p", "rig_file:=/nonexistent/rig.yaml"], "/nonexistent/rig.yaml"),
         (["-p", "state_rate_hz:=0.0"], "state_rate_hz must be a finite number > 0"),
+        (["-p", "state_rate_hz:=fast"], "parameter refused: Trying to set parameter 'state_rate_hz' to 'fast'"),
+        (["--params-file", "{tmp}/broken.yaml"], "ROS arguments refused: failed to initialize rcl: Couldn't parse params file"),
     ],
 )
-def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, ros_args: list[str], expected: str) -> None:
+def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, tmp_path: Path, ros_args: list[str], expected: str) -> None:
+    (tmp_path / "broken.yaml").write_text("load_controller:\n  ros__parameters:\n    state_rate_hz: [1,\n")
+    ros_args = [arg.replace("{tmp}", str(tmp_path)) for arg in ros_args]
     process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--ros-args", *ros_args)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 2, err[-2000:]

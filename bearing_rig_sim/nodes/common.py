@@ -9,6 +9,7 @@ and starts through :func:`run_node`, which uses a ``SingleThreadedExecutor`` (th
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
@@ -16,11 +17,14 @@ from typing import Callable, Mapping, Sequence
 import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy._rclpy_pybind11 import RCLError
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.errors import RigError
 
 SENSOR_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
@@ -90,15 +94,26 @@ def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[s
     return args + ["--ros-args", "--params-file", str(path)]
 
 
+def _rcl_message(exc: Exception) -> str:
+    """rcl's error text without the C source locations it appends (", at /path/file.c:123")."""
+    return re.sub(r", at [^,]*\.c:\d+", "", " ".join(str(exc).split()))
+
+
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Initialise rclpy (with the node's shipped parameter file), spin the node made by
     ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
     Returns the process exit status."""
-    rclpy.init(args=ros_args_with_defaults(node_name, argv))
+    try:
+        rclpy.init(args=ros_args_with_defaults(node_name, argv))
+    except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
+        raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
     executor = SingleThreadedExecutor()
     try:
-        node = factory()
+        try:
+            node = factory()
+        except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+            raise RigError(f"parameter refused: {exc}") from None
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):

@@ -41,6 +41,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from typing import Iterator
 
+from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
 from bearing_rig_sim.synthetic.traffic import (
@@ -63,7 +64,7 @@ HOLD_S = 30.0
 """Time each speed is held in :func:`program_traffic` (s)."""
 STRIPS = 4
 """Reflective strips per shaft (config/rig.yaml)."""
-STATUS_TOPIC = "/rig/slip_status"
+STATUS_TOPIC = SLIP_STATUS.name
 CASES = ("record", "read", "analyse")
 
 

@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.interfaces import CLOCK
 from bearing_rig_sim.errors import RigError
 
 
@@ -58,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         sink = RosReplaySink(bag.topics)
         try:
             if args.wait_for_subscribers:
-                alone = sink.wait_for_subscribers([t for t in topics if t != "/clock"], args.delay)
+                alone = sink.wait_for_subscribers([t for t in topics if t != CLOCK.name], args.delay)
                 if alone:
                     print(f"bearing-rig: warning: no subscriber after {args.delay:g} s on {', '.join(alone)}; replaying anyway", file=sys.stderr)
             else:

@@ -21,7 +21,7 @@ first time, a jump backwards the monitor treats as a reset.
 the recorded types, imported from the installed interface packages by name
 (``bearing_rig_msgs/msg/SlipStatus`` -> ``bearing_rig_msgs.msg.SlipStatus``); a type that is not
 installed is warned about and its topic skipped. Each topic is offered with the QoS recorded in
-the bag, else the interface contract's (:data:`CONTRACT_QOS`), else reliable.
+the bag, else the interface contract's (:func:`~bearing_rig_sim.interfaces.contract_qos`), else reliable.
 
 The schedule and the player (:func:`replay_bag`) import no ROS; :class:`RosReplaySink` imports
 rclpy when it is made.
@@ -43,25 +43,10 @@ from bearing_rig_sim.config import ConfigError, check_number
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.qos import QOS_PROFILES, QosSpec
 from bearing_rig_sim.bags.reader import BagReader, TopicInfo
+from bearing_rig_sim.interfaces import CLOCK, contract_qos
 
-CLOCK_TOPIC = "/clock"
-CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
-
-CONTRACT_QOS: dict[str, str] = {
-    "/clock": "reliable",
-    "/rig/spindle/command": "transient_local",
-    "/rig/spindle/pulses": "sensor_data",
-    "/rig/cage/pulses": "sensor_data",
-    "/rig/speeds": "sensor_data",
-    "/rig/truth": "sensor_data",
-    "/rig/axial_load/setpoint": "reliable",
-    "/rig/axial_load/state": "reliable",
-    "/rig/axial_load/force": "sensor_data",
-    "/rig/bearing/axial_force": "reliable",
-    "/rig/slip_status": "transient_local",
-    "/diagnostics": "reliable",
-}
-"""QoS profile of each topic of the interface contract (README), for bags that store none."""
+CLOCK_TOPIC = CLOCK.name
+CLOCK_TYPE = CLOCK.msgtype
 
 
 def clock_message(time_ns: int) -> bytes:
@@ -304,7 +289,7 @@ def offered_qos(topic: str, info: TopicInfo | None) -> QosSpec:
     """The QoS to offer on a replayed topic: the bag's, else the contract's, else reliable."""
     if info is not None and info.qos is not None:
         return info.qos
-    return QOS_PROFILES[CONTRACT_QOS.get(topic, "reliable")]
+    return QOS_PROFILES[contract_qos(topic) or "reliable"]
 
 
 class RosReplaySink:

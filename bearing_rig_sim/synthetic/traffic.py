@@ -23,6 +23,7 @@ import numpy as np
 from rosbags.interfaces import Nodetype
 from rosbags.typesys.store import Typestore
 
+from bearing_rig_sim.interfaces import CAGE_PULSES, SPEEDS, SPINDLE_PULSES, TRUTH
 from bearing_rig_sim.bags.typestore import rig_typestore
 
 _INT_RANGES = {
@@ -54,10 +55,10 @@ _DTYPES = {
 }
 _TEXT = string.ascii_letters + string.digits + " _-/µé°"
 
-SPEEDS_TOPIC = "/rig/speeds"
-SPINDLE_PULSES_TOPIC = "/rig/spindle/pulses"
-CAGE_PULSES_TOPIC = "/rig/cage/pulses"
-TRUTH_TOPIC = "/rig/truth"
+SPEEDS_TOPIC = SPEEDS.name
+SPINDLE_PULSES_TOPIC = SPINDLE_PULSES.name
+CAGE_PULSES_TOPIC = CAGE_PULSES.name
+TRUTH_TOPIC = TRUTH.name
 RIG_TRAFFIC_TOPICS: dict[str, tuple[str, str]] = {
     SPEEDS_TOPIC: ("sensor_msgs/msg/JointState", "sensor_data"),
     SPINDLE_PULSES_TOPIC: ("bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data"),

@@ -54,7 +54,8 @@ from bearing_rig_sim.nodes.common import (
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
-from bearing_rig_sim.health import Health, HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import Health, HealthLevel
+from bearing_rig_sim.simulation.health import SimulatorHealth
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
 from bearing_rig_sim.simulation.twin import RigTwin, TickOutput

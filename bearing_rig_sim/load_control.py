@@ -140,7 +140,7 @@ class AxialLoadOperation:
         self._apply_zero_load_rule()
 
     @classmethod
-    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> "AxialLoadOperation":
+    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> AxialLoadOperation:
         """An operation of a new chain built from ``config`` (options as in the constructor)."""
         return cls(LoadingChain(config), **options)  # type: ignore[arg-type]
 

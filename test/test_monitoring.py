@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 import pytest
@@ -120,7 +120,7 @@ def test_exact_slip_for_known_constant_speeds(revolutions):
 
 def test_state_goes_from_unknown_to_stable_at_constant_speed():
     rng = np.random.default_rng(5)
-    jitter = lambda t: t + rng.normal(0.0, 1e-6, t.size)  # noqa: E731 - the sensors' 1 us jitter
+    jitter = lambda t: t + rng.normal(0.0, 1e-6, t.size)
     monitor = make()
     states: list[MonitorState] = []
     feed(

@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Sequence, overload
+from typing import Any, overload
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.optimize import least_squares

@@ -74,7 +74,7 @@ class BearingKinematics:
             raise AnalysisError(f"contact_angle: must be in [0, pi/2) rad, got {self.contact_angle!r}")
 
     @classmethod
-    def from_config(cls, source: Section | str | Path) -> "BearingKinematics":
+    def from_config(cls, source: Section | str | Path) -> BearingKinematics:
         """Read ``geometry.ball_diameter_m``, ``geometry.pitch_diameter_m`` and
         ``geometry.contact_angle_deg`` (the nominal angle, degrees) from a bearing file.
 
@@ -93,7 +93,7 @@ class BearingKinematics:
             raise geometry.error("pitch_diameter_m", f"must exceed ball_diameter_m = {ball}, got {pitch}")
         return cls(ball, pitch, math.radians(angle_deg))
 
-    def at_contact_angle(self, contact_angle: float) -> "BearingKinematics":
+    def at_contact_angle(self, contact_angle: float) -> BearingKinematics:
         """The same bearing at another contact angle (rad), e.g. the loaded one."""
         return replace(self, contact_angle=contact_angle)
 

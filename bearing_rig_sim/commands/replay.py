@@ -40,9 +40,9 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Replay the bag; returns the exit status."""
-    from bearing_rig_sim.commands.bag import bag_warnings_as_lines  # noqa: PLC0415 - keeps --help fast
-    from bearing_rig_sim.bags import open_bag  # noqa: PLC0415
-    from bearing_rig_sim.replay.player import ReplayOptions, RosReplaySink, check_topics, replay_bag  # noqa: PLC0415
+    from bearing_rig_sim.commands.bag import bag_warnings_as_lines
+    from bearing_rig_sim.bags import open_bag
+    from bearing_rig_sim.replay.player import ReplayOptions, RosReplaySink, check_topics, replay_bag
 
     if not args.delay >= 0.0:
         raise RigError(f"--delay must be >= 0 s, got {args.delay!r}")

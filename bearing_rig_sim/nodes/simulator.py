@@ -29,7 +29,8 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
@@ -211,7 +212,7 @@ class SimulatorNode(Node):
                 time=stamp if stamp > 0.0 else None,
             )
             self.twin.command_spindle(command)
-        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+        except Exception as exc:
             self._refuse("spindle command", str(exc))
             return
         when = "now" if command.time is None or command.time <= self.twin.time else f"at t = {command.time:.6g} s"
@@ -225,7 +226,7 @@ class SimulatorNode(Node):
     def _on_force(self, msg: WrenchStamped) -> None:
         try:
             self.twin.set_axial_load(msg.wrench.force.z)
-        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+        except Exception as exc:
             self._refuse("axial force", str(exc))
 
     def _refuse(self, kind: str, reason: str) -> None:

@@ -37,7 +37,8 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from types import TracebackType
-from typing import Any, Iterable, Iterator, Literal, Protocol
+from typing import Any, Literal, Protocol
+from collections.abc import Iterable, Iterator
 
 from bearing_rig_sim.config import ConfigError, check_number
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -275,7 +276,7 @@ def message_class(msgtype: str) -> type | None:
 
 def qos_profile(spec: QosSpec) -> Any:
     """An rclpy ``QoSProfile`` for a stored profile."""
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: PLC0415
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     return QoSProfile(
         history=HistoryPolicy.KEEP_LAST if spec.history == "keep_last" else HistoryPolicy.KEEP_ALL,
@@ -306,8 +307,8 @@ class RosReplaySink:
     """
 
     def __init__(self, topics: dict[str, TopicInfo], node_name: str = "bag_replay", args: list[str] | None = None) -> None:
-        import rclpy  # noqa: PLC0415 - the recording package imports ROS only here
-        from rclpy.node import Node  # noqa: PLC0415
+        import rclpy
+        from rclpy.node import Node
 
         self._rclpy = rclpy
         self.context = rclpy.Context()
@@ -351,7 +352,7 @@ class RosReplaySink:
         """Let the last messages leave (reliable ones acknowledged, at most ``linger`` s in all),
         then destroy the node and shut its context down (idempotent)."""
         if self.node is not None:
-            from rclpy.duration import Duration  # noqa: PLC0415
+            from rclpy.duration import Duration
 
             deadline = time.monotonic() + linger
             for publisher in self._publishers.values():

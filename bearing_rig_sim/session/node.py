@@ -16,7 +16,8 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
 from diagnostic_msgs.msg import DiagnosticArray

@@ -21,8 +21,8 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
 from __future__ import annotations
 
 import struct
-from dataclasses import dataclass
-from typing import Iterable, Protocol, Sequence
+from typing import Protocol
+from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
 

@@ -216,7 +216,7 @@ class RigTwin:
         *,
         model: str = "reduced",
         **options: float,
-    ) -> "RigTwin":
+    ) -> RigTwin:
         """A twin from a bearing file, an optional calibration overlay and a rig file.
 
         Args:

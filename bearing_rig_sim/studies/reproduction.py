@@ -15,7 +15,8 @@ import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
@@ -173,7 +174,7 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 def _fit_or_none(fn: Callable[[], Any]) -> Any:
     try:
         return fn()
-    except Exception:  # noqa: BLE001 - a fit that fails is reported as missing, not fatal
+    except Exception:
         return None
 
 
@@ -262,7 +263,7 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         (pts,) = ax8.plot(x_all[rolling], y_all[rolling], "o", ms=3, label=f"{rpm:.0f} rpm")
         ax8.plot(x_all[~rolling], y_all[~rolling], "x", ms=5, color=pts.get_color())
         x, y = x_all[rolling], y_all[rolling]
-        chosen_fits = _fit_or_none(lambda: select_gaussian_fit(x, y, max_terms=2)) if len(x) >= 7 else None
+        chosen_fits = _fit_or_none(lambda: select_gaussian_fit(x, y, max_terms=2)) if len(x) >= 7 else None  # noqa: B023 - called at once
         if chosen_fits is None:
             lines.append(f"| {rpm:.0f} | {_fmt(skid_to, 4)} | too few rolling points to fit | | | | | | | | | - | - |")
             load_onsets[rpm] = None
@@ -307,8 +308,8 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         t, y = series.time, series.slip_pct
         ax9.plot(t, rad_s_to_rpm(series.cage_speed), "-", label=f"{series.acceleration:.0f} rad/s^2")
         ax10.plot(t, y, ".", ms=2, label=f"{series.acceleration:.0f} rad/s^2")
-        one: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 1))
-        two: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 2))
+        one: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 1))  # noqa: B023 - called at once
+        two: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 2))  # noqa: B023 - called at once
         lam, kk, dd = PAPER_TABLE7.get(series.acceleration, (None, None, None))
         paper_onset = None
         if lam is not None:

@@ -17,7 +17,8 @@ import math
 import random
 import string
 import struct
-from typing import Any, Iterator
+from typing import Any
+from collections.abc import Iterator
 
 import numpy as np
 from rosbags.interfaces import Nodetype

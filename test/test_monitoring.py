@@ -2,7 +2,7 @@
 sequence, sensor loss, a stop, lost pulses, clock jumps, out-of-order and malformed pulses.
 
 Pulse times are computed here from the shaft's angle (crossings of equally spaced strips), and
-the expected slip from the bearing file's geometry with the paper's formula (digest Eq. 11-12),
+the expected slip from the bearing file's geometry with the paper's formula (paper Eq. 11-12),
 independently of the monitor and of the analysis module.
 """
 

@@ -1,4 +1,4 @@
-"""Sums of Gaussian terms fitted to slip data (paper section 2.2, digest section 7).
+"""Sums of Gaussian terms fitted to slip data (paper section 2.2, docs/paper.md section 7).
 
 The model, with ``params`` an (n_terms, 3) array of rows (a, b, c)::
 

@@ -1,4 +1,4 @@
-"""Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12, digest section 6).
+"""Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12; docs/paper.md section 6).
 
 The epicyclic (pure-rolling) cage speed is
 
@@ -15,7 +15,7 @@ Dw the ball diameter, dm the pitch diameter (m) and alpha the contact angle (rad
 
 Speeds are SI (rad/s) and the slip rate is the one quantity kept in percent, as in the paper.
 
-:func:`whole_revolution_slip` computes the slip as the monitor does on the bench (digest
+:func:`whole_revolution_slip` computes the slip as the monitor does on the bench (docs/paper.md
 section 8): from the time stamps of the fibre-optic sensors' light pulses, one per reflective
 strip passing, averaging over whole cage revolutions.
 """
@@ -161,7 +161,7 @@ def _speeds(name: str, value: float | FloatArray) -> tuple[FloatArray, bool]:
 def epicyclic_cage_speed(
     inner_ring_speed: float | FloatArray, ball_diameter: float, pitch_diameter: float, contact_angle: float
 ) -> float | FloatArray:
-    """Pure-rolling cage speed n_s (rad/s); digest Eq. 12.
+    """Pure-rolling cage speed n_s (rad/s); paper Eq. 12.
 
     Args:
         inner_ring_speed: n_i, rad/s (scalar or 1-D array, any finite value).
@@ -182,7 +182,7 @@ def slip_rate(
     pitch_diameter: float,
     contact_angle: float,
 ) -> float | FloatArray:
-    """Cage slip rate S_c in **percent**; digest Eq. 11. See :meth:`BearingKinematics.slip_rate`.
+    """Cage slip rate S_c in **percent**; paper Eq. 11. See :meth:`BearingKinematics.slip_rate`.
 
     Args:
         cage_speed: n_c, rad/s.

@@ -4,7 +4,7 @@
 everything the kernels need (groove geometry, Hertz constants, masses, inertias, resistance
 coefficients) into a flat float64 vector whose layout is defined in :mod:`.kernels`.
 
-Resistance models (what makes the cage slip; digest section 12), each applied in the kernels:
+Resistance models (what makes the cage slip; docs/paper.md section 12), each applied in the kernels:
 
 * Ball drag in the oil-air mixture (Harris and Kotzalas, *Advanced Concepts*, ch. 7, sphere drag
   with C_d = 24/Re + C_d,inf): F = s (3 pi eta_mix Dw v + 1/2 rho_mix C_d (pi Dw^2/4) v|v|),
@@ -214,7 +214,7 @@ class BearingParameters:
     # -- derived -------------------------------------------------------------------------------
     @property
     def epicyclic_ratio(self) -> float:
-        """n_s / n_i at the free contact angle (digest Eq. 12), 1."""
+        """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
 
 

@@ -1,4 +1,4 @@
-"""The bench's axial loading chain (digest section 8) put together, with its interlocks.
+"""The bench's axial loading chain (docs/paper.md section 8) put together, with its interlocks.
 
 A linear brake pulls a wire rope, which moves a lever down; a clutch on the lever, held by a
 permanent magnet, moves the bearing housing down and so presses the bearing axially::

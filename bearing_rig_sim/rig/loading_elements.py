@@ -1,4 +1,4 @@
-"""Elements of the bench's axial loading chain (digest section 8): linear brake, wire rope,
+"""Elements of the bench's axial loading chain (docs/paper.md section 8): linear brake, wire rope,
 lever, permanent-magnet clutch and bearing housing; how they are put together and integrated is
 in :mod:`bearing_rig_sim.rig.loading`.
 

@@ -65,12 +65,6 @@ def state_name(state: int) -> str:
     return _STATE_NAMES.get(state, "-")
 
 
-def _num(value: float | None, digits: int = 4) -> str:
-    if value is None or not math.isfinite(value):
-        return "-"
-    return f"{value:.{digits}g}"
-
-
 def _fixed(value: float | None, decimals: int) -> str:
     if value is None or not math.isfinite(value):
         return "-"

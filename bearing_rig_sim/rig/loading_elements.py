@@ -201,14 +201,6 @@ class Lever:
         """Output force / input force (1)."""
         return self.params.force_ratio
 
-    def output_force(self, input_force: float) -> float:
-        """Force at the output for a force at the input, N."""
-        return self.ratio * input_force
-
-    def input_displacement(self, output_displacement: float) -> float:
-        """Input (rope end) displacement for an output displacement, m."""
-        return self.ratio * output_displacement
-
 
 @dataclass(frozen=True)
 class MagnetClutchParams(ParameterRecord):

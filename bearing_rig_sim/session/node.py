@@ -13,8 +13,6 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
-import math
-import time
 from dataclasses import dataclass, field
 from typing import Any
 from collections.abc import Callable
@@ -262,12 +260,3 @@ class SessionNode(Node):
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun
     """Callback of the recorder's subscriptions; their queues are taken by ``drain``."""
 
-
-def wall_now() -> float:
-    """Monotonic wall time, s."""
-    return time.monotonic()
-
-
-def finite_or_none(value: float | None) -> float | None:
-    """``value`` when it is a finite number, else None."""
-    return value if value is not None and math.isfinite(value) else None

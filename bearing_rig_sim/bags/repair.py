@@ -39,7 +39,8 @@ from bearing_rig_sim.bags.layout import (
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.bags.mcapfile import FileIndex, check_chunks, index_file, iter_file_messages
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
 from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
 from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink
 
@@ -164,7 +165,7 @@ def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) 
                 schema_id = schema_by_name[topic.msgtype] = writer.register_schema(topic.msgtype, "ros2msg", text)
             metadata = {"offered_qos_profiles": qos_yaml(topic.qos), "topic_type_hash": topic.type_hash or _type_hash(topic.msgtype)}
             writer.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
-        for log_time, channel_id, publish_time, data in iter_file_messages(index, report=problems.append):
+        for log_time, channel_id, publish_time, data in storage_for_file(index.path).messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()
     except BaseException:
@@ -196,14 +197,14 @@ def repair_bag(path: str | Path) -> RepairReport:
     indexes: list[FileIndex] = []
     for file in files:
         try:
-            index = index_file(file)
+            index = storage_for_file(file).index(file)
         except BagError as exc:
             backup = _backup_path(file)
             os.replace(file, backup)
             report.files.append(FileRepair(file.name, "removed", backup=backup, problems=[str(exc)]))
             continue
         if index.indexed and not index.problems:
-            index.problems.extend(check_chunks(index))
+            index.problems.extend(storage_for_file(file).check(index))
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)
@@ -213,7 +214,7 @@ def repair_bag(path: str | Path) -> RepairReport:
         entry.backup = _backup_path(file)
         os.replace(file, entry.backup)
         os.replace(rebuilt, file)
-        index = index_file(file)
+        index = storage_for_file(file).index(file)
         entry.messages_recovered = index.message_count
         report.files.append(entry)
         indexes.append(index)

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any
+from collections.abc import Iterator, Sequence
 
 import yaml
 
@@ -51,13 +52,13 @@ def config_path(*parts: str) -> Path:
     if local.exists():
         return local
     try:
-        from ament_index_python.packages import get_package_share_directory  # noqa: PLC0415
+        from ament_index_python.packages import get_package_share_directory
 
         share = Path(get_package_share_directory("bearing_rig_sim")) / "config"
         installed = share.joinpath(*parts)
         if installed.exists():
             return installed
-    except Exception:  # noqa: BLE001 - ament index absent or package not installed
+    except Exception:
         pass
     return local
 
@@ -82,12 +83,11 @@ class _BoundedSafeLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
 
-    def compose_node(self, parent: Any, index: Any) -> Any:  # noqa: D102 - PyYAML hook
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        """PyYAML's hook for each node: refuse an alias, count the depth."""
         if self.check_event(yaml.AliasEvent):
             event = self.peek_event()
-            raise yaml.composer.ComposerError(
-                None, None, "aliases (*name) are not accepted", event.start_mark
-            )
+            raise yaml.composer.ComposerError(None, None, "aliases (*name) are not accepted", event.start_mark)
         self._depth += 1
         try:
             if self._depth > MAX_YAML_DEPTH:
@@ -148,7 +148,7 @@ def read_yaml_file(path: str | Path) -> Any:
     return parse_yaml(raw, source)
 
 
-def load_yaml(path: str | Path) -> "Section":
+def load_yaml(path: str | Path) -> Section:
     """Read a YAML file whose top level is a mapping (see :func:`parse_yaml` for the limits).
 
     Raises:
@@ -208,7 +208,7 @@ class Section:
                 raise self.error(str(key), f"unknown key; allowed keys: {', '.join(sorted(allowed))}")
 
     # -- accessors ---------------------------------------------------------------------------
-    def section(self, key: str, default: Any = _MISSING) -> "Section":
+    def section(self, key: str, default: Any = _MISSING) -> Section:
         """A nested mapping as a :class:`Section`."""
         value = self._get(key, default)
         if not isinstance(value, dict):
@@ -271,7 +271,7 @@ class Section:
         path = self.key_path(key)
         return [check_number(v, self.source, f"{path}[{i}]", gt=gt, ge=ge) for i, v in enumerate(value)]
 
-    def sections(self, key: str) -> list["Section"]:
+    def sections(self, key: str) -> list[Section]:
         """A list of mappings, each as a :class:`Section` (``key[i]`` in error paths)."""
         value = self._get(key, _MISSING)
         if not isinstance(value, list) or not value:

@@ -1,14 +1,10 @@
-"""The simulator's health for /diagnostics: OK, WARN (overruns, raised load), ERROR (refused input,
-diverged engine), with the reasons.
+"""The health vocabulary every node core reports on ``/diagnostics``: one level enum and one
+value type, shared by the simulator, the load controller and the monitor.
 
-* ERROR while the engine has diverged (for good: the twin cannot continue), and for
-  ``fault_hold`` seconds after the latest refused spindle command or axial force (so that a reader
-  at 1 Hz sees a refusal even when valid messages follow at once).
-* WARN while the loop has overrun since the previous report, or while the axial force asked for
-  is below the engine's minimum and has been raised to it.
-* OK otherwise.
-
-Times are the wall clock's (s), given by the caller.
+Each core assesses its own health (the simulator's rules: :class:`~bearing_rig_sim.simulation.health.
+SimulatorHealth`; the load controller's: ``AxialLoadOperation.health``) and returns a
+:class:`Health`; the node shells map :class:`HealthLevel` one to one onto
+``diagnostic_msgs/DiagnosticStatus`` levels.
 """
 
 from __future__ import annotations
@@ -31,61 +27,9 @@ class Health:
 
     level: HealthLevel
     reasons: tuple[str, ...]
+    """Why the level is what it is, or, at OK, what the component is doing (may be empty)."""
 
     @property
     def message(self) -> str:
         """One line for the diagnostics' message."""
         return "; ".join(self.reasons) if self.reasons else "running"
-
-
-class SimulatorHealth:
-    """Tracks refusals, divergence and overruns (see the module docstring).
-
-    Args:
-        fault_hold: how long a refusal keeps the level at ERROR, s (>= 0).
-    """
-
-    def __init__(self, fault_hold: float) -> None:
-        self.fault_hold = float(fault_hold)
-        self._refusals: dict[str, tuple[float, str]] = {}
-        self.halted = ""
-        """Why the simulation stopped for good (empty while it runs)."""
-        self.refused = 0
-        """Inputs refused since the start (1)."""
-        self._reported_overruns = 0
-
-    def refuse(self, kind: str, reason: str, now: float) -> None:
-        """Note a refused input of ``kind`` (e.g. "spindle command", "axial force") at ``now``."""
-        self._refusals[kind] = (now, f"{kind} refused: {reason}")
-        self.refused += 1
-
-    def halt(self, reason: str) -> None:
-        """Note that the simulation stopped for good (diverged engine)."""
-        self.halted = reason
-
-    def assess(self, now: float, overruns: int, load_clamped: bool, min_load: float) -> Health:
-        """The health at ``now`` given the loop's overrun count so far and the load flag.
-
-        Overruns counted since the latest :meth:`reported` make WARN.
-        """
-        errors = [f"simulation stopped: {self.halted}"] if self.halted else []
-        for kind, (when, reason) in list(self._refusals.items()):
-            if now - when > self.fault_hold:
-                del self._refusals[kind]
-            else:
-                errors.append(reason)
-        if errors:
-            return Health(HealthLevel.ERROR, tuple(errors))
-        warnings = []
-        new = overruns - self._reported_overruns
-        if new > 0:
-            warnings.append(f"{new} overrun(s): the loop fell behind the wall clock")
-        if load_clamped:
-            warnings.append(f"axial force below the engine's minimum; {min_load:g} N applied")
-        if warnings:
-            return Health(HealthLevel.WARN, tuple(warnings))
-        return Health(HealthLevel.OK, ())
-
-    def reported(self, overruns: int) -> None:
-        """The periodic report went out with this overrun count: later ones are new."""
-        self._reported_overruns = overruns

@@ -230,7 +230,7 @@ def test_truncated_file_is_read_up_to_its_last_complete_chunk(tmp_path: Path, tr
         reader = open_bag(bag)
     text = " | ".join(str(w.message) for w in caught)
     assert "chunk record at offset" in text and "cut by the end of the file" in text
-    assert "states %d messages" % count in text  # metadata.yaml no longer matches
+    assert f"states {count} messages" in text  # metadata.yaml no longer matches
     assert reader.message_count == expected and not reader.complete
     full = anyreader_messages(source)
     store = rig_typestore()

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from bearing_rig_sim.health import HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import HealthLevel
+from bearing_rig_sim.simulation.health import SimulatorHealth
 
 
 def test_ok_when_nothing_is_wrong():

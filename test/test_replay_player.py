@@ -27,7 +27,7 @@ from bearing_rig_sim.replay.player import (
 from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, sample_message
 
 sys.path.insert(0, str(Path(__file__).parent))
-from test_offline_analysis import write_twin_bag  # noqa: E402 - the twin bag of the offline tests
+from test_offline_analysis import write_twin_bag
 
 PULSE = "bearing_rig_msgs/msg/FibreOpticPulse"
 CAGE = "/rig/cage/pulses"
@@ -244,7 +244,7 @@ def test_replayed_pulses_keep_their_timing(ros_graph, tmp_path: Path, rate: floa
         process = ros_graph.spawn_python(
             "-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--rate", str(rate), "--wait-for-subscribers", "--delay", "20"
         )
-        ros_graph.spin_until(lambda: len(arrivals) == len(TIMES_NS) or process.poll() is not None, timeout=30.0, executor=executor)
+        ros_graph.spin_until(lambda: len(arrivals) == len(TIMES_NS) or process.poll() is not None, timeout=30.0, executor=executor)  # noqa: B023 - waited on at once
         ros_graph.spin_until(lambda: len(arrivals) == len(TIMES_NS), timeout=1.0, executor=executor)
         out, err = process.communicate(timeout=10.0)
         assert process.returncode == 0, err

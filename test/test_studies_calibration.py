@@ -41,7 +41,7 @@ def test_known_scales_are_recovered_from_synthetic_bench_data(tmp_path: Path) ->
 
 
 def test_shipped_calibration_reproduces_the_bench_rows() -> None:
-    """The four Table 3 rows (digest section 9) against the shipped calibrated engine: the
+    """The four Table 3 rows (docs/paper.md section 9) against the shipped calibrated engine: the
     paper's own model reached 0.11 % RMS; the twin must do at least as well (< 0.15 %)."""
     points = read_bench_csv(config_path("calibration", "h7006c_table3.csv"))
     assert [round(p.inner_ring_speed * 60 / (2 * math.pi)) for p in points] == [900, 1500, 2100, 2700]

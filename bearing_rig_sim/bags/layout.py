@@ -20,6 +20,7 @@ from rosbags.interfaces import Qos
 from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
 from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.storage import STORAGE_FORMATS
 from bearing_rig_sim.bags.mcapfile import FileIndex
 from bearing_rig_sim.config import ConfigError, parse_yaml
 
@@ -219,8 +220,8 @@ def read_layout(bag_dir: Path) -> BagLayout:
     where = "rosbag2_bagfile_information."
     version = _get(info, "version", source, int, where)
     storage = _get(info, "storage_identifier", source, str, where)
-    if storage != "mcap":
-        raise BagError(f"{source}: storage {storage!r} is not supported (only MCAP bags are read)")
+    if storage not in STORAGE_FORMATS:
+        raise BagError(f"{source}: storage {storage!r} is not supported (this project reads: {', '.join(STORAGE_FORMATS)})")
     mode = str(info.get("compression_mode") or "").lower()
     if mode not in ("", "none"):
         raise BagError(

@@ -19,7 +19,7 @@ import struct
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO, Callable, Iterable, Iterator
+from typing import Any, BinaryIO, Callable, Iterable, Iterator
 
 import lz4.frame
 import zstandard
@@ -110,6 +110,8 @@ class FileIndex:
     file_size: int = 0
     compression: str = ""
     problems: list[str] = field(default_factory=list)
+    damaged_bytes: int = 0
+    """Bytes of the chunks :func:`check_chunks` found damaged."""
 
     @property
     def bytes_lost(self) -> int:
@@ -117,7 +119,7 @@ class FileIndex:
         return max(0, self.file_size - self.readable_bytes)
 
 
-def _parse(record_type: type, body: bytes):  # noqa: ANN202 - mcap record classes are untyped
+def _parse(record_type: Any, body: bytes) -> Any:  # mcap's record classes carry no type information
     return record_type.read(ReadDataStream(io.BytesIO(body)))
 
 
@@ -425,19 +427,20 @@ def index_file(path: Path) -> FileIndex:
     return index
 
 
-def damaged_chunks(index: FileIndex) -> tuple[list[str], int]:
-    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk, and
-    the bytes those chunks occupy in the file (to its end for one whose length cannot be read)."""
+def check_chunks(index: FileIndex) -> list[str]:
+    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk. The
+    bytes those chunks occupy (to the end of the file for one whose length cannot be read) are
+    left in ``index.damaged_bytes``."""
     problems = []
-    lost = 0
+    index.damaged_bytes = 0
     with open(index.path, "rb") as stream:
         for ref in index.chunks:
             try:
                 read_chunk_messages(stream, ref)
             except DamagedRecord as exc:
                 problems.append(f"{index.path.name}: chunk at offset {ref.offset}: {exc}")
-                lost += _record_size(stream, ref, index.file_size)
-    return problems, lost
+                index.damaged_bytes += _record_size(stream, ref, index.file_size)
+    return problems
 
 
 def _record_size(stream: BinaryIO, ref: ChunkRef, file_size: int) -> int:

@@ -27,7 +27,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import Callable, Iterable, Iterator, Literal, NamedTuple
+from typing import Any, Callable, Iterable, Iterator, Literal, NamedTuple, cast
 
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -36,7 +36,8 @@ from rosbags.typesys.store import Typestore
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
-from bearing_rig_sim.bags.mcapfile import FileIndex, index_file, iter_file_messages
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
 from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
@@ -82,7 +83,8 @@ def _dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
         if name in found or name not in store.fielddefs:
             continue
         found.add(name)
-        for _field, (kind, arg) in store.fielddefs[name][1]:
+        for _field, desc in store.fielddefs[name][1]:
+            kind, arg = cast("tuple[Nodetype, Any]", desc)
             if kind == Nodetype.NAME:
                 todo.append(arg)
             elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:
@@ -141,7 +143,7 @@ class BagReader:
             files = [f for f in files if f not in missing]
         else:
             files = [self.path]
-        self._indexes: list[FileIndex] = [index_file(f) for f in files]
+        self._indexes: list[FileIndex] = [storage_for_file(f).index(f) for f in files]
         if self._indexes and not any(i.has_header for i in self._indexes):
             raise BagError(f"{self.path}: nothing readable: " + "; ".join(p for i in self._indexes for p in i.problems))
         for index in self._indexes:
@@ -363,7 +365,7 @@ class BagReader:
                     for cid in wanted
                 }
             )
-            messages = iter_file_messages(index, wanted, start_ns, stop_ns, self._report)
+            messages = storage_for_file(index.path).messages(index, wanted, start_ns, stop_ns, self._report)
             streams.append((index.start_ns, index.end_ns, ((t, tagged, cid, data) for t, cid, _pub, data in messages)))
         streams.sort(key=lambda s: s[0])
         in_order = all(b[0] > a[1] for a, b in zip(streams, streams[1:]))

@@ -23,7 +23,7 @@ import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import IO, Any, Literal, cast
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
@@ -39,7 +39,8 @@ from bearing_rig_sim.bags.layout import (
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.bags.mcapfile import FileIndex, damaged_chunks, index_file, iter_file_messages
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
 from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
 from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink
 
@@ -153,7 +154,7 @@ def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) 
     if target.exists():
         target.unlink()
     sink = CountingSink(target)
-    writer = Writer(sink, chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
+    writer = Writer(cast(IO[Any], sink), chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
     try:
         writer.start(profile=index.profile or "ros2", library=index.library or f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
         for name, values in index.metadata.items():
@@ -179,7 +180,7 @@ def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) 
                 schema_id = schema_by_name[topic.msgtype] = writer.register_schema(topic.msgtype, "ros2msg", text)
             metadata = {"offered_qos_profiles": qos_yaml(topic.qos), "topic_type_hash": topic.type_hash or _type_hash(topic.msgtype)}
             writer.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
-        for log_time, channel_id, publish_time, data in iter_file_messages(index, report=problems.append):
+        for log_time, channel_id, publish_time, data in storage_for_file(index.path).messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()
     except BaseException:
@@ -211,7 +212,7 @@ def repair_bag(path: str | Path) -> RepairReport:
     indexes: list[FileIndex] = []
     for file in files:
         try:
-            index = index_file(file)
+            index = storage_for_file(file).index(file)
         except BagError as exc:
             backup = _backup_path(file)
             os.replace(file, backup)
@@ -219,8 +220,8 @@ def repair_bag(path: str | Path) -> RepairReport:
             continue
         chunk_bytes_lost = 0
         if index.indexed and not index.problems:
-            damaged, chunk_bytes_lost = damaged_chunks(index)
-            index.problems.extend(damaged)
+            index.problems.extend(storage_for_file(file).check(index))
+            chunk_bytes_lost = index.damaged_bytes
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)
@@ -231,7 +232,7 @@ def repair_bag(path: str | Path) -> RepairReport:
         entry.backup = _backup_path(file)
         os.replace(file, entry.backup)
         os.replace(rebuilt, file)
-        index = index_file(file)
+        index = storage_for_file(file).index(file)
         entry.messages_recovered = index.message_count
         entry.messages_lost = max(0, counted - index.message_count)
         report.files.append(entry)

@@ -4,21 +4,23 @@ Opening a bag reads its index only (fast, and enough to list topics and counts);
 bytes were damaged after the recording (a bad disk, a truncated copy) still looks fine there.
 :func:`verify_bag` reads every chunk once:
 
-* **Chunks**: each is decompressed and its CRC-32 compared; a chunk that fails is named, and the
-  messages the index promised but no chunk delivered are counted as unreadable.
+* **Chunks**: each is read through the file's storage format (:mod:`.storage`; for MCAP
+  decompressed and its CRC-32 compared); a chunk that fails is named, and the messages the index
+  promised but no chunk delivered are counted as unreadable.
 * **Timeline**: the log times of all readable messages are grouped into stretches with no gap
   longer than :data:`TIMELINE_GAP_NS`; a healthy recording is one stretch. Every stretch but the
   largest is reported as log-time outliers (a stamp from another clock, a ``/clock`` far in the
   future that became the recording's time).
 
-Memory stays bounded: a chunk's times are reduced to its stretches before the next is read.
+Memory stays bounded: messages come in log-time order and only the stretches are kept.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from bearing_rig_sim.bags.mcapfile import DamagedRecord, FileIndex, read_chunk_messages
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
 
 __all__ = ["TIMELINE_GAP_NS", "BagCheck", "Stretch", "verify_indexes"]
 
@@ -41,8 +43,6 @@ class Stretch:
 class BagCheck:
     """What :func:`verify_indexes` found."""
 
-    chunks: int = 0
-    """Chunks (and runs of loose messages) read."""
     damaged: list[str] = field(default_factory=list)
     """One line per chunk that failed to decompress or whose checksum did not match."""
     messages_read: int = 0
@@ -87,18 +87,6 @@ class BagCheck:
         return lines
 
 
-def _stretches_of(times: list[int]) -> list[Stretch]:
-    """Stretches of a sorted list of times."""
-    out: list[Stretch] = []
-    for t in times:
-        if out and t - out[-1].end_ns <= TIMELINE_GAP_NS:
-            out[-1].end_ns = t
-            out[-1].count += 1
-        else:
-            out.append(Stretch(t, t, 1))
-    return out
-
-
 def _merge(stretches: list[Stretch]) -> list[Stretch]:
     """Stretches that overlap or lie within the gap of each other, joined; in time order."""
     merged: list[Stretch] = []
@@ -113,22 +101,20 @@ def _merge(stretches: list[Stretch]) -> list[Stretch]:
 
 
 def verify_indexes(indexes: list[FileIndex]) -> BagCheck:
-    """Read every chunk of the indexed files (see the module documentation)."""
+    """Read every message of the indexed files through their storage format (see the module
+    documentation)."""
     check = BagCheck()
     pieces: list[Stretch] = []
     for index in indexes:
         check.messages_indexed += index.message_count
-        with open(index.path, "rb") as stream:
-            for ref in index.chunks:
-                check.chunks += 1
-                try:
-                    messages = read_chunk_messages(stream, ref)
-                except DamagedRecord as exc:
-                    check.damaged.append(f"{index.path.name}: chunk at offset {ref.offset}: {exc}")
-                    continue
-                check.messages_read += len(messages)
-                pieces.extend(_stretches_of([m[0] for m in messages]))
-                if len(pieces) > 1000:  # keep memory bounded on a long bag
-                    pieces = _merge(pieces)
+        current: Stretch | None = None
+        for log_time, _channel, _publish, _data in storage_for_file(index.path).messages(index, report=check.damaged.append):
+            check.messages_read += 1
+            if current is not None and log_time - current.end_ns <= TIMELINE_GAP_NS:
+                current.end_ns = max(current.end_ns, log_time)
+                current.count += 1
+            else:
+                current = Stretch(log_time, log_time, 1)
+                pieces.append(current)
     check.stretches = _merge(pieces)
     return check

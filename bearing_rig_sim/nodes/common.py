@@ -12,7 +12,7 @@ import math
 import re
 import sys
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import rclpy
 from builtin_interfaces.msg import Time
@@ -25,6 +25,7 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import Topic
 
 SENSOR_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
@@ -130,3 +131,16 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {
+    "reliable": RELIABLE_QOS,
+    "sensor_data": SENSOR_QOS,
+    "transient_local": STATUS_QOS,
+}
+"""The rclpy profile of each QoS name of the interface contract (:mod:`bearing_rig_sim.interfaces`)."""
+
+
+def qos_profile(topic: Topic) -> QoSProfile:
+    """The rclpy QoS profile the contract gives ``topic``."""
+    return CONTRACT_QOS_PROFILES[topic.qos]

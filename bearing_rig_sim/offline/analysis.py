@@ -51,7 +51,8 @@ import struct
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters

@@ -20,7 +20,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 
 import bearing_rig_sim
@@ -61,12 +62,6 @@ class ReportFiles:
 def state_name(state: int) -> str:
     """``stable``, ``slipping``, ``unknown``, ``fault``; ``-`` for none (-1)."""
     return _STATE_NAMES.get(state, "-")
-
-
-def _num(value: float | None, digits: int = 4) -> str:
-    if value is None or not math.isfinite(value):
-        return "-"
-    return f"{value:.{digits}g}"
 
 
 def _fixed(value: float | None, decimals: int) -> str:
@@ -130,10 +125,10 @@ def _step(transitions: list[tuple[float, int]], t0: float, t_end: float) -> tupl
 
 def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
     """The four PNG plots of the module documentation; returns their paths."""
-    import matplotlib  # noqa: PLC0415 - heavy; only the report needs it
+    import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    import matplotlib.pyplot as plt
 
     paths = []
     thin = {"linewidth": 0.8}

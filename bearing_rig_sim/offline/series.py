@@ -120,7 +120,7 @@ class CsvWriter:
     def __init__(self, path: Path, columns: list[tuple[str, str, float]]) -> None:
         self.path = path
         self.columns = columns
-        self._file = open(path, "w", encoding="utf-8", newline="")  # noqa: SIM115 - closed by close()
+        self._file = open(path, "w", encoding="utf-8", newline="")
         self._writer = csv.writer(self._file)
         self._writer.writerow([name for name, _attr, _scale in columns])
 

@@ -21,7 +21,7 @@ first time, a jump backwards the monitor treats as a reset.
 the recorded types, imported from the installed interface packages by name
 (``bearing_rig_msgs/msg/SlipStatus`` -> ``bearing_rig_msgs.msg.SlipStatus``); a type that is not
 installed is warned about and its topic skipped. Each topic is offered with the QoS recorded in
-the bag, else the interface contract's (:data:`CONTRACT_QOS`), else reliable.
+the bag, else the interface contract's (:func:`~bearing_rig_sim.interfaces.contract_qos`), else reliable.
 
 The schedule and the player (:func:`replay_bag`) import no ROS; :class:`RosReplaySink` imports
 rclpy when it is made.
@@ -40,31 +40,17 @@ import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Iterable, Iterator, Literal, Protocol
+from typing import Any, Literal, Protocol, cast
+from collections.abc import Iterable, Iterator
 
 from bearing_rig_sim.config import ConfigError, check_number
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.qos import QOS_PROFILES, QosSpec
 from bearing_rig_sim.bags.reader import BagReader, TopicInfo
+from bearing_rig_sim.interfaces import CLOCK, contract_qos
 
-CLOCK_TOPIC = "/clock"
-CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
-
-CONTRACT_QOS: dict[str, str] = {
-    "/clock": "reliable",
-    "/rig/spindle/command": "transient_local",
-    "/rig/spindle/pulses": "sensor_data",
-    "/rig/cage/pulses": "sensor_data",
-    "/rig/speeds": "sensor_data",
-    "/rig/truth": "sensor_data",
-    "/rig/axial_load/setpoint": "reliable",
-    "/rig/axial_load/state": "reliable",
-    "/rig/axial_load/force": "sensor_data",
-    "/rig/bearing/axial_force": "reliable",
-    "/rig/slip_status": "transient_local",
-    "/diagnostics": "reliable",
-}
-"""QoS profile of each topic of the interface contract (README), for bags that store none."""
+CLOCK_TOPIC = CLOCK.name
+CLOCK_TYPE = CLOCK.msgtype
 
 
 def clock_message(time_ns: int) -> bytes:
@@ -250,7 +236,7 @@ def replay_bag(
         if options.max_loops is not None and loop >= options.max_loops:
             break
         messages: Iterator[tuple[int, int, str, bytes]] = (
-            (m.log_time_ns, 1, m.topic, m.message) for m in bag.messages(selected, start_ns=first, stop_ns=stop, raw=True)
+            (m.log_time_ns, 1, m.topic, cast(bytes, m.message)) for m in bag.messages(selected, start_ns=first, stop_ns=stop, raw=True)
         )
         if publish_clock and not bag_clock:
             messages = heapq.merge(_clock_ticks(first + period_ns, last, period_ns), messages)
@@ -322,7 +308,7 @@ def message_class(msgtype: str) -> type | None:
 
 def qos_profile(spec: QosSpec) -> Any:
     """An rclpy ``QoSProfile`` for a stored profile."""
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: PLC0415
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     return QoSProfile(
         history=HistoryPolicy.KEEP_LAST if spec.history == "keep_last" else HistoryPolicy.KEEP_ALL,
@@ -336,7 +322,7 @@ def offered_qos(topic: str, info: TopicInfo | None) -> QosSpec:
     """The QoS to offer on a replayed topic: the bag's, else the contract's, else reliable."""
     if info is not None and info.qos is not None:
         return info.qos
-    return QOS_PROFILES[CONTRACT_QOS.get(topic, "reliable")]
+    return QOS_PROFILES[contract_qos(topic) or "reliable"]
 
 
 class RosReplaySink:
@@ -353,8 +339,8 @@ class RosReplaySink:
     """
 
     def __init__(self, topics: dict[str, TopicInfo], node_name: str = "bag_replay", args: list[str] | None = None) -> None:
-        import rclpy  # noqa: PLC0415 - the recording package imports ROS only here
-        from rclpy.node import Node  # noqa: PLC0415
+        import rclpy
+        from rclpy.node import Node
 
         self._rclpy = rclpy
         self.context = rclpy.Context()
@@ -398,7 +384,7 @@ class RosReplaySink:
         """Let the last messages leave (reliable ones acknowledged, at most ``linger`` s in all),
         then destroy the node and shut its context down (idempotent)."""
         if self.node is not None:
-            from rclpy.duration import Duration  # noqa: PLC0415
+            from rclpy.duration import Duration
 
             deadline = time.monotonic() + linger
             for publisher in self._publishers.values():

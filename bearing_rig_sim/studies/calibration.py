@@ -1,10 +1,10 @@
 """Steady operating points of the engine, calibration to bench data, and prediction.
 
 The engine's uncertain parameters are the lubricant resistances (the paper's dry model has
-none; digest section 12). :func:`calibrate` fits the chosen ones (by default the cage-land
+none; docs/paper.md section 12). :func:`calibrate` fits the chosen ones (by default the cage-land
 viscous scale and the ball-drag scale) to measured (inner-ring speed, axial load, slip) rows by
 nonlinear least squares on the logarithm of the scale factors, running the engine to a steady
-state at every row. The slip of the bench rows and of the engine is the paper's S_c (digest
+state at every row. The slip of the bench rows and of the engine is the paper's S_c (paper
 Eq. 11-12) at the nominal contact angle, computed from cage and inner-ring speeds.
 """
 
@@ -17,7 +17,7 @@ import os
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 import yaml
@@ -31,7 +31,7 @@ from bearing_rig_sim.errors import RigError
 
 DEFAULT_FITTED: tuple[str, ...] = ("cage_land_viscous_scale", "ball_drag_scale")
 """Parameters fitted by default: a viscous (speed-proportional) and a quadratic resistance, the
-two shapes the bench's slip-speed curve needs (slip = a + b n, digest section 9)."""
+two shapes the bench's slip-speed curve needs (slip = a + b n, docs/paper.md section 9)."""
 
 DEFAULT_FIXED: dict[str, float] = {"stiction_velocity": 0.3}
 """Held fixed during the fit (m/s): see ``config/calibration/h7006c_table3.yaml`` for why."""

@@ -1,4 +1,4 @@
-"""The paper's three experiments run on the engine (digest sections 9-11), without analysis.
+"""The paper's three experiments run on the engine (docs/paper.md sections 9-11), without analysis.
 
 * :func:`validation_table`: steady slip at 100 N over 900-2700 rpm (Table 3 analogue);
 * :func:`load_sweep`: steady slip over speed x axial load (Figures 7-8);
@@ -6,14 +6,14 @@
   rate from rest under 200 N (Figures 9-10).
 
 Every result is simulated: cage speeds come from the engine; the slip rate is computed from
-them with digest Eq. 11-12 at the nominal contact angle, as on the bench.
+them with paper Eq. 11-12 at the nominal contact angle, as on the bench.
 """
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Callable, Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 

@@ -15,7 +15,8 @@ import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
 
@@ -38,7 +39,7 @@ from bearing_rig_sim.studies.experiments import (
     validation_table,
 )
 
-# -- the paper's numbers (digest sections 9-11) ----------------------------------------------------
+# -- the paper's numbers (docs/paper.md sections 9-11) ----------------------------------------------------
 PAPER_TABLE3: dict[int, tuple[float, float]] = {900: (3.22, 3.17), 1500: (4.07, 3.95), 2100: (4.64, 4.76), 2700: (5.28, 5.17)}
 """rpm -> (bench slip %, the paper's simulated slip %), 100 N."""
 PAPER_TABLE4: dict[int, tuple[float, float, float]] = {1: (0.012, 0.9996, 0.045), 2: (0.007, 0.9993, 0.040)}
@@ -55,7 +56,7 @@ SKID_SLIP_PCT = 20.0
 Gaussian-slope method presumes a smooth slip curve, so such points are shown but not fitted."""
 K1_FRACTION_READING = K1_AXIAL_LOAD * 100.0
 """k1 read as slip fraction per newton (-5e-4 %/N): the paper does not state k1's unit; this
-second reading is reported beside the first (digest section 7)."""
+second reading is reported beside the first (docs/paper.md section 7)."""
 
 ACCELERATION_DURATION_S = 3.0
 """Simulated duration of each acceleration run, s (the paper's fits reach the stable state
@@ -173,7 +174,7 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 def _fit_or_none(fn: Callable[[], Any]) -> Any:
     try:
         return fn()
-    except Exception:  # noqa: BLE001 - a fit that fails is reported as missing, not fatal
+    except Exception:
         return None
 
 
@@ -210,7 +211,7 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         "# Reproduction of Yang et al. (2023) with the bearing-rig-sim twin",
         "",
         f"Project version {__version__}; bearing `{params.name}` from `{params.source}`.",
-        "Slip S_c = (1 - n_c/n_s) x 100 % with n_s at the nominal contact angle (digest Eq. 11-12).",
+        "Slip S_c = (1 - n_c/n_s) x 100 % with n_s at the nominal contact angle (paper Eq. 11-12).",
         "Every twin number is simulated by the engine; nothing is taken from the paper except where a column says so.",
         "",
     ]
@@ -262,7 +263,7 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         (pts,) = ax8.plot(x_all[rolling], y_all[rolling], "o", ms=3, label=f"{rpm:.0f} rpm")
         ax8.plot(x_all[~rolling], y_all[~rolling], "x", ms=5, color=pts.get_color())
         x, y = x_all[rolling], y_all[rolling]
-        chosen_fits = _fit_or_none(lambda: select_gaussian_fit(x, y, max_terms=2)) if len(x) >= 7 else None
+        chosen_fits = _fit_or_none(lambda: select_gaussian_fit(x, y, max_terms=2)) if len(x) >= 7 else None  # noqa: B023 - called at once
         if chosen_fits is None:
             lines.append(f"| {rpm:.0f} | {_fmt(skid_to, 4)} | too few rolling points to fit | | | | | | | | | - | - |")
             load_onsets[rpm] = None
@@ -307,8 +308,8 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         t, y = series.time, series.slip_pct
         ax9.plot(t, rad_s_to_rpm(series.cage_speed), "-", label=f"{series.acceleration:.0f} rad/s^2")
         ax10.plot(t, y, ".", ms=2, label=f"{series.acceleration:.0f} rad/s^2")
-        one: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 1))
-        two: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 2))
+        one: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 1))  # noqa: B023 - called at once
+        two: GaussianFit | None = _fit_or_none(lambda: fit_gaussians(t, y, 2))  # noqa: B023 - called at once
         lam, kk, dd = PAPER_TABLE7.get(series.acceleration, (None, None, None))
         paper_onset = None
         if lam is not None:

@@ -17,12 +17,14 @@ import math
 import random
 import string
 import struct
-from typing import Any, Iterator
+from typing import Any
+from collections.abc import Iterator
 
 import numpy as np
 from rosbags.interfaces import Nodetype
 from rosbags.typesys.store import Typestore
 
+from bearing_rig_sim.interfaces import CAGE_PULSES, SPEEDS, SPINDLE_PULSES, TRUTH
 from bearing_rig_sim.bags.typestore import rig_typestore
 
 _INT_RANGES = {
@@ -54,10 +56,10 @@ _DTYPES = {
 }
 _TEXT = string.ascii_letters + string.digits + " _-/µé°"
 
-SPEEDS_TOPIC = "/rig/speeds"
-SPINDLE_PULSES_TOPIC = "/rig/spindle/pulses"
-CAGE_PULSES_TOPIC = "/rig/cage/pulses"
-TRUTH_TOPIC = "/rig/truth"
+SPEEDS_TOPIC = SPEEDS.name
+SPINDLE_PULSES_TOPIC = SPINDLE_PULSES.name
+CAGE_PULSES_TOPIC = CAGE_PULSES.name
+TRUTH_TOPIC = TRUTH.name
 RIG_TRAFFIC_TOPICS: dict[str, tuple[str, str]] = {
     SPEEDS_TOPIC: ("sensor_msgs/msg/JointState", "sensor_data"),
     SPINDLE_PULSES_TOPIC: ("bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data"),
@@ -172,7 +174,7 @@ def rig_traffic(
     steps = int(round(duration_s * 1000))
     pack_into = struct.pack_into
 
-    def header(time_ns: int, frame: str) -> object:
+    def header(time_ns: int, frame: str) -> Any:
         stamp = types["builtin_interfaces/msg/Time"](sec=time_ns // 10**9, nanosec=time_ns % 10**9)
         return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
 

@@ -1,0 +1,71 @@
+"""The simulator's health for /diagnostics: OK, WARN (overruns, raised load), ERROR (refused input,
+diverged engine), with the reasons.
+
+* ERROR while the engine has diverged (for good: the twin cannot continue), and for
+  ``fault_hold`` seconds after the latest refused spindle command or axial force (so that a reader
+  at 1 Hz sees a refusal even when valid messages follow at once).
+* WARN while the loop has overrun since the previous report, or while the axial force asked for
+  is below the engine's minimum and has been raised to it.
+* OK otherwise.
+
+Times are the wall clock's (s), given by the caller.
+"""
+
+from __future__ import annotations
+
+from bearing_rig_sim.health import Health, HealthLevel
+
+__all__ = ["Health", "HealthLevel", "SimulatorHealth"]
+
+
+class SimulatorHealth:
+    """Tracks refusals, divergence and overruns (see the module docstring).
+
+    Args:
+        fault_hold: how long a refusal keeps the level at ERROR, s (>= 0).
+    """
+
+    def __init__(self, fault_hold: float) -> None:
+        self.fault_hold = float(fault_hold)
+        self._refusals: dict[str, tuple[float, str]] = {}
+        self.halted = ""
+        """Why the simulation stopped for good (empty while it runs)."""
+        self.refused = 0
+        """Inputs refused since the start (1)."""
+        self._reported_overruns = 0
+
+    def refuse(self, kind: str, reason: str, now: float) -> None:
+        """Note a refused input of ``kind`` (e.g. "spindle command", "axial force") at ``now``."""
+        self._refusals[kind] = (now, f"{kind} refused: {reason}")
+        self.refused += 1
+
+    def halt(self, reason: str) -> None:
+        """Note that the simulation stopped for good (diverged engine)."""
+        self.halted = reason
+
+    def assess(self, now: float, overruns: int, load_clamped: bool, min_load: float) -> Health:
+        """The health at ``now`` given the loop's overrun count so far and the load flag.
+
+        Overruns counted since the latest :meth:`reported` make WARN.
+        """
+        errors = [f"simulation stopped: {self.halted}"] if self.halted else []
+        for kind, (when, reason) in list(self._refusals.items()):
+            if now - when > self.fault_hold:
+                del self._refusals[kind]
+            else:
+                errors.append(reason)
+        if errors:
+            return Health(HealthLevel.ERROR, tuple(errors))
+        warnings = []
+        new = overruns - self._reported_overruns
+        if new > 0:
+            warnings.append(f"{new} overrun(s): the loop fell behind the wall clock")
+        if load_clamped:
+            warnings.append(f"axial force below the engine's minimum; {min_load:g} N applied")
+        if warnings:
+            return Health(HealthLevel.WARN, tuple(warnings))
+        return Health(HealthLevel.OK, ())
+
+    def reported(self, overruns: int) -> None:
+        """The periodic report went out with this overrun count: later ones are new."""
+        self._reported_overruns = overruns

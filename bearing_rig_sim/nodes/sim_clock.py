@@ -8,7 +8,8 @@ first; a refused stamp is logged (at most once a second, with the running count)
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 from rclpy.node import Node
 
@@ -27,7 +28,7 @@ def guard_sim_clock(node: Node, guard: ClockGuard | None = None) -> ClockGuard:
     set later). Returns the guard, whose ``refused`` and ``jumps`` count what it did.
     """
     guard = guard if guard is not None else ClockGuard(name=f"{node.get_name()}: /clock")
-    source: Any = node._time_source  # noqa: SLF001 - rclpy offers no hook on its /clock input
+    source: Any = node._time_source
     logger = node.get_logger()
     forward: Callable[[Any], None] = source.clock_callback
 
@@ -39,6 +40,6 @@ def guard_sim_clock(node: Node, guard: ClockGuard | None = None) -> ClockGuard:
             forward(msg)
 
     source.clock_callback = guarded  # for a subscription made later
-    if source._clock_sub is not None:  # noqa: SLF001 - and the one made already
-        source._clock_sub.callback = guarded  # noqa: SLF001
+    if source._clock_sub is not None:
+        source._clock_sub.callback = guarded
     return guard

@@ -247,7 +247,7 @@ class RigLimits:
     """The rig file the limits come from (for messages)."""
 
     @classmethod
-    def from_rig_file(cls, path: str | Path | None = None) -> "RigLimits":
+    def from_rig_file(cls, path: str | Path | None = None) -> RigLimits:
         """The limits of a rig file (default: the shipped ``config/rig.yaml``).
 
         Raises:

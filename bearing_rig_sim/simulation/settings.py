@@ -108,12 +108,14 @@ class SimulatorSettings:
             if path is not None and not path.is_file():
                 raise s.error(key, f"file not found: {raw!r} (looked for {path})")
             files[key] = path
-        spindle = SpindleConfig.from_yaml(files["rig_file"])
+        bearing_file, rig_file = files["bearing_file"], files["rig_file"]
+        assert bearing_file is not None and rig_file is not None  # only calibration_file may be ""
+        spindle = SpindleConfig.from_yaml(rig_file)
         max_speed = spindle.max_speed_rad_s
         return cls(
-            bearing_file=files["bearing_file"],
+            bearing_file=bearing_file,
             calibration_file=files["calibration_file"],
-            rig_file=files["rig_file"],
+            rig_file=rig_file,
             model=s.choice("model", MODELS),
             chunk_s=s.number("chunk_s", gt=0.0, le=0.1),
             realtime=s.boolean("realtime"),

@@ -240,3 +240,17 @@ def test_calibrate_writes_under_out_by_default_and_never_replaces_a_file_unasked
     assert "exists; give --force" in err
     assert default.read_text() == "earlier result\n"
     assert hashlib.sha256(shipped.read_bytes()).hexdigest() == before
+
+
+def test_run_refuses_a_program_beyond_the_shipped_rig_naming_the_segment(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Checked at start, before any node runs: config/rig.yaml's spindle goes to 10 000 rpm."""
+    program = tmp_path / "fast.yaml"
+    program.write_text(
+        "name: fast\nbearing: bearings/h7006c.yaml\nstability_criterion: time\nsegments:\n"
+        "  - {name: n5000, speed_rpm: 5000, ramp_s: 1.0, axial_load_n: 100, dwell_s: 1.0}\n"
+        "  - {name: n12000, speed_rpm: 12000, ramp_s: 2.0, axial_load_n: 100, dwell_s: 1.0}\n",
+        encoding="utf-8",
+    )
+    err = one_line_error(["run", str(program), "--bag-dir", str(tmp_path / "bags")], capsys)
+    assert "segments[1].speed_rpm: segment 'n12000': 12000 rpm is above the rig's limit of 10000 rpm" in err
+    assert not (tmp_path / "bags").exists()  # nothing started, nothing recorded

@@ -180,3 +180,62 @@ def test_interrupt_ends_the_running_segment(program: TestProgram) -> None:
     assert runner.finished and runner.current is None and runner.update(9.0) == []
     with pytest.raises(RuntimeError):
         runner.start(10.0)
+
+
+# -- conditions: measured beside commanded, disturbances from outside ------------------------------
+def test_a_speed_the_spindle_did_not_reach_is_marked(program: TestProgram) -> None:
+    """The audit's load sweep: the drive refused 7000 rpm and stayed at 5000; the row said
+    "stable". Here n0900 is measured at 600 rpm (62.8 rad/s against 94.2)."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
+    slow = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(600.0), cage_speed=40.0, window_revolutions=1)
+    runner.observe_status(slow)
+    runner.observe_status(SlipObservation(**{**slow.__dict__, "time": 3.5, "state": StatusState.STABLE}))
+    runner.update(3.6)
+    outcome = runner.outcomes[-1]
+    assert outcome.verdict is Verdict.STABLE
+    assert outcome.measured_speed == pytest.approx(rpm_to_rad_s(600.0))
+    assert outcome.conditions == ("speed 600 rpm measured, 900 rpm commanded",)
+    assert not outcome.conditions_met
+
+
+def test_speed_within_one_percent_meets_the_conditions(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    near = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(900.0) * 0.995, cage_speed=40.0, window_revolutions=1)
+    runner.observe_status(near)
+    runner.observe_status(SlipObservation(**{**near.__dict__, "time": 3.5, "state": StatusState.STABLE}))
+    runner.update(3.6)
+    assert runner.outcomes[-1].conditions_met
+
+
+def test_a_load_off_its_set_point_is_marked_once_settled(program: TestProgram) -> None:
+    """The audit's case: 30 N on the bearing against a 100 N set-point, summary "stable"."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_load(0.1, 0.0)  # the load still rising: not judged (LOAD_SETTLE_S = 0.5 s)
+    for k in range(5):
+        runner.observe_load(0.6 + 0.1 * k, 30.0)
+    runner.update(1.0)
+    outcome = runner.outcomes[-1]
+    assert outcome.bearing_force == pytest.approx(30.0)
+    assert outcome.conditions == ("load 30.0 N on the bearing, 100 N commanded",)
+
+
+def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_axial_setpoint(0.2, 0.0)  # before the program's set-point can have arrived: not judged
+    runner.observe_axial_setpoint(0.7, 100.0)  # the program's own
+    runner.update(1.0)
+    assert runner.outcomes[-1].conditions_met
+    runner.observe_axial_setpoint(1.6, 30.0)  # n0900 (starts at 1.0): someone called the service
+    runner.observe_disturbance(1.7, "a message on /rig/spindle/command not sent by this session")
+    runner.observe_disturbance(1.8, "a message on /rig/spindle/command not sent by this session")  # once
+    runner.interrupt(2.0)
+    assert runner.outcomes[-1].conditions == (
+        "disturbed: the load controller's set-point was 30 N, not the program's 100 N",
+        "disturbed: a message on /rig/spindle/command not sent by this session",
+    )

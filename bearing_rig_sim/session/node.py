@@ -13,9 +13,10 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
+from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
-from collections.abc import Callable
 
 from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
 from diagnostic_msgs.msg import DiagnosticArray
@@ -23,7 +24,7 @@ from geometry_msgs.msg import WrenchStamped
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.serialization import deserialize_message
+from rclpy.serialization import deserialize_message, serialize_message
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -141,6 +142,9 @@ class SessionNode(Node):
         """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
+        self._own: dict[str, Counter[bytes]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter()}
+        """Serialized commands and set-points this session published, not yet seen by its recorder:
+        any other on those topics came from outside and marks the running segment."""
 
     def close(self) -> None:
         """Destroy the recorder's node (the session node is destroyed by its owner)."""
@@ -156,8 +160,11 @@ class SessionNode(Node):
         command.profile = plan.segment.profile.message_code
         command.ramp_time = plan.segment.ramp_time
         command.acceleration = plan.segment.acceleration
+        setpoint = Float64(data=plan.segment.axial_load)
+        self._own[SPINDLE_COMMAND.name][serialize_message(command)] += 1
+        self._own[AXIAL_LOAD_SETPOINT.name][serialize_message(setpoint)] += 1
         self._spindle.publish(command)
-        self._setpoint.publish(Float64(data=plan.segment.axial_load))
+        self._setpoint.publish(setpoint)
 
     # -- readiness --------------------------------------------------------------------------------
     def subscribers_besides_recorder(self, topic: str) -> int:
@@ -231,6 +238,12 @@ class SessionNode(Node):
         return self.sim_time_ns * 1e-9
 
     def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
+        own = self._own.get(name)
+        if own is not None:
+            if own[raw] > 0:
+                own[raw] -= 1
+            else:
+                self.runner.observe_disturbance(self.sim_time, f"a message on {name} not sent by this session")
         if name == SPEEDS.name:
             self.live.speeds_raw = raw
         elif name == SLIP_STATUS.name:
@@ -252,6 +265,7 @@ class SessionNode(Node):
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1
             self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
+            self.runner.observe_axial_setpoint(from_stamp(msg.header.stamp), msg.setpoint)
         elif name == DIAGNOSTICS.name:
             self._diagnostics_events(deserialize_message(raw, msgtype))
 

@@ -54,9 +54,12 @@ from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, 
 from bearing_rig_sim.session.recorder import SessionRecorder
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentOutcome, SegmentPlan
 
-__all__ = ["EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
+__all__ = ["EXIT_CONDITIONS", "EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
 
-EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
+EXIT_OK, EXIT_FAILED, EXIT_CONDITIONS, EXIT_INTERRUPTED = 0, 1, 3, 130
+"""Exit statuses: all segments ran under their conditions; a node or the session failed; the
+program ran to its end but some segment's speed or load was not as commanded, or was changed from
+outside (the summary marks which); stopped by a signal."""
 
 CHUNK_SIZE = 256 * 1024
 """Uncompressed bytes per bag chunk: about 0.5 s of the rig's traffic, the most a killed session
@@ -259,7 +262,11 @@ class _Session:
         for plan in started:
             self._start_segment(plan)
         if self.runner.finished:
-            self._end(EXIT_OK)
+            off = [o.name for o in self.runner.outcomes if o.conditions]
+            if off:
+                self._end(EXIT_CONDITIONS, f"conditions not met in {len(off)} segment(s): {', '.join(off)}")
+            else:
+                self._end(EXIT_OK)
 
     def _start_segment(self, plan: SegmentPlan) -> None:
         assert self.node is not None
@@ -341,9 +348,16 @@ class _Session:
         status = EXIT_FAILED if self.status is None else self.status
         if status == EXIT_FAILED:
             self.err.write(f"bearing-rig run: {self.failure}\n")
+        elif status == EXIT_CONDITIONS:
+            self.err.write(f"bearing-rig run: {self.failure} (see the summary)\n")
         elif status == EXIT_INTERRUPTED:
             self.err.write(f"bearing-rig run: {self.failure}; the summary so far and the bag are complete to this point\n")
-        heading = {EXIT_OK: "summary", EXIT_INTERRUPTED: "summary (interrupted)", EXIT_FAILED: "summary (failed)"}[status]
+        heading = {
+            EXIT_OK: "summary",
+            EXIT_CONDITIONS: "summary (conditions not met)",
+            EXIT_INTERRUPTED: "summary (interrupted)",
+            EXIT_FAILED: "summary (failed)",
+        }[status]
         self.out.write(f"\n{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n")
         self.out.write(format_summary(self.runner.outcomes) + "\n")
         counts = self.recorder.counts

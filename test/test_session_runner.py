@@ -239,3 +239,15 @@ def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
         "disturbed: the load controller's set-point was 30 N, not the program's 100 N",
         "disturbed: a message on /rig/spindle/command not sent by this session",
     )
+
+
+def test_a_segment_too_short_for_the_load_to_settle_is_not_judged_on_it(tmp_path: Path) -> None:
+    path = tmp_path / "short.yaml"
+    path.write_text(PROGRAM.replace("dwell_s: 1.0}", "dwell_s: 0.3}", 1), encoding="utf-8")
+    runner = ProgramRunner(load_program(path))
+    runner.start(0.0)
+    for k in range(3):
+        runner.observe_load(0.1 * k, 30.0 * k)  # still rising when the segment ends
+    runner.update(0.3)
+    outcome = runner.outcomes[-1]
+    assert outcome.bearing_force == pytest.approx(30.0) and outcome.conditions_met

@@ -161,8 +161,8 @@ class SessionNode(Node):
         command.ramp_time = plan.segment.ramp_time
         command.acceleration = plan.segment.acceleration
         setpoint = Float64(data=plan.segment.axial_load)
-        self._own[SPINDLE_COMMAND.name][serialize_message(command)] += 1
-        self._own[AXIAL_LOAD_SETPOINT.name][serialize_message(setpoint)] += 1
+        self._own[SPINDLE_COMMAND.name][_content(serialize_message(command))] += 1
+        self._own[AXIAL_LOAD_SETPOINT.name][_content(serialize_message(setpoint))] += 1
         self._spindle.publish(command)
         self._setpoint.publish(setpoint)
 
@@ -240,8 +240,9 @@ class SessionNode(Node):
     def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
         own = self._own.get(name)
         if own is not None:
-            if own[raw] > 0:
-                own[raw] -= 1
+            key = _content(raw)
+            if own[key] > 0:
+                own[key] -= 1
             else:
                 self.runner.observe_disturbance(self.sim_time, f"a message on {name} not sent by this session")
         if name == SPEEDS.name:
@@ -278,6 +279,12 @@ class SessionNode(Node):
             if level != previous and (level > 0 or previous > 0):
                 message = status.message if len(status.message) <= EVENT_WIDTH else status.message[: EVENT_WIDTH - 3] + "..."
                 self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {message}")
+
+
+def _content(cdr: bytes) -> bytes:
+    """A serialized message without what differs between serializers for the same content: the
+    encapsulation options (XCDR2 puts the padding count there) and the trailing padding."""
+    return bytes(cdr[:2]) + bytes(cdr[4:]).rstrip(b"\x00")
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun

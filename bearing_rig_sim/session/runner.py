@@ -313,6 +313,7 @@ class ProgramRunner:
             time_to_stable: float | None = data.stable.time - plan.ramp_end
         else:
             time_to_stable = None
+        settled = data.force_count > 0
         if data.force_count:
             force: float | None = data.force_sum / data.force_count
         elif data.force_count_all:
@@ -334,7 +335,7 @@ class ProgramRunner:
             truth_slip=self.truth_slip_over(decisive) if decisive is not None else None,
             bearing_force=force,
             measured_speed=measured_speed,
-            conditions=_conditions(plan.segment, measured_speed, force, data.disturbances, verdict),
+            conditions=_conditions(plan.segment, measured_speed, force if settled else None, data.disturbances, verdict),
         )
         self.outcomes.append(outcome)
         self._data = None
@@ -410,8 +411,9 @@ class ProgramRunner:
 def _conditions(
     segment: Segment, measured_speed: float | None, bearing_force: float | None, disturbances: list[str], verdict: Verdict
 ) -> tuple[str, ...]:
-    """What was off in a segment (see the module documentation); an interrupted segment is
-    judged on what it reached, a missing measurement is not judged."""
+    """What was off in a segment (see the module documentation). An interrupted segment's speed
+    and load are not judged, nor a measurement that is missing (a segment shorter than
+    :data:`LOAD_SETTLE_S` has no settled load)."""
     off: list[str] = []
     if verdict is not Verdict.INTERRUPTED:
         target = segment.target_speed

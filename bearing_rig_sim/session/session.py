@@ -37,10 +37,10 @@ from types import FrameType
 from typing import TextIO
 from collections.abc import Sequence
 
-from bearing_rig_sim.config import rad_s_to_rpm
+from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
-from bearing_rig_sim.session.context import make_run_id, run_context
+from bearing_rig_sim.session.context import make_run_id, node_parameters, run_context
 from bearing_rig_sim.session.processes import (
     NODES,
     NodeProcess,
@@ -101,8 +101,12 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     err = err if err is not None else sys.stderr
     program = load_program(options.program)  # checked against the shipped rig, as the nodes use it
     commands = {name: node_command(spec) for name, spec in NODES.items()}
+    simulator_defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
+    overrides = node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime:
-        commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
+        overrides.setdefault("simulator", {})["realtime"] = "false"
+    for name, values in overrides.items():
+        commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
     start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)
@@ -112,7 +116,11 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         run_id=run_id,
         start=start,
         command_line=options.command_line or sys.argv,
-        extra={"ros_domain_id": env["ROS_DOMAIN_ID"], "realtime": str(options.realtime).lower()},
+        extra={
+            "ros_domain_id": env["ROS_DOMAIN_ID"],
+            "realtime": str(options.realtime).lower(),
+            **({"calibration": "none"} if overrides.get("simulator", {}).get("calibration_file") == "" else {}),
+        },
     )
     try:
         writer = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE)

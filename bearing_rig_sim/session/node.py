@@ -24,7 +24,7 @@ from geometry_msgs.msg import WrenchStamped
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
-from rclpy.serialization import deserialize_message, serialize_message
+from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
@@ -142,7 +142,7 @@ class SessionNode(Node):
         """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
-        self._own: dict[str, Counter[bytes]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter()}
+        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter()}
         """Serialized commands and set-points this session published, not yet seen by its recorder:
         any other on those topics came from outside and marks the running segment."""
 
@@ -161,8 +161,8 @@ class SessionNode(Node):
         command.ramp_time = plan.segment.ramp_time
         command.acceleration = plan.segment.acceleration
         setpoint = Float64(data=plan.segment.axial_load)
-        self._own[SPINDLE_COMMAND.name][_content(serialize_message(command))] += 1
-        self._own[AXIAL_LOAD_SETPOINT.name][_content(serialize_message(setpoint))] += 1
+        self._own[SPINDLE_COMMAND.name][repr(command)] += 1
+        self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._spindle.publish(command)
         self._setpoint.publish(setpoint)
 
@@ -240,7 +240,7 @@ class SessionNode(Node):
     def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
         own = self._own.get(name)
         if own is not None:
-            key = _content(raw)
+            key = repr(deserialize_message(raw, msgtype))  # the fields, whatever the serializer's padding
             if own[key] > 0:
                 own[key] -= 1
             else:
@@ -279,12 +279,6 @@ class SessionNode(Node):
             if level != previous and (level > 0 or previous > 0):
                 message = status.message if len(status.message) <= EVENT_WIDTH else status.message[: EVENT_WIDTH - 3] + "..."
                 self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {message}")
-
-
-def _content(cdr: bytes) -> bytes:
-    """A serialized message without what differs between serializers for the same content: the
-    encapsulation options (XCDR2 puts the padding count there) and the trailing padding."""
-    return bytes(cdr[:2]) + bytes(cdr[4:]).rstrip(b"\x00")
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun

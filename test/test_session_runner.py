@@ -163,6 +163,7 @@ def test_mean_bearing_force_counts_after_the_ramp(program: TestProgram) -> None:
     runner = ProgramRunner(program)
     runner.start(0.0)
     runner.update(1.0)  # n0900 ramp 1.0 .. 2.5
+    runner.observe_axial_setpoint(1.0, 100.0)  # the load controller has the segment's set-point
     runner.observe_load(0.5, 1000.0)  # previous segment: not counted
     runner.observe_load(2.0, 50.0)  # during the ramp: not counted
     for t in (2.5, 2.6, 2.7):
@@ -215,6 +216,7 @@ def test_a_load_off_its_set_point_is_marked_once_settled(program: TestProgram) -
     """The audit's case: 30 N on the bearing against a 100 N set-point, summary "stable"."""
     runner = ProgramRunner(program)
     runner.start(0.0)
+    runner.observe_axial_setpoint(0.05, 100.0)
     runner.observe_load(0.1, 0.0)  # the load still rising: not judged (LOAD_SETTLE_S = 0.5 s)
     for k in range(5):
         runner.observe_load(0.6 + 0.1 * k, 30.0)
@@ -239,6 +241,30 @@ def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
         "disturbed: the load controller's set-point was 30 N, not the program's 100 N",
         "disturbed: a message on /rig/spindle/command not sent by this session",
     )
+
+
+def test_a_set_point_that_reaches_the_load_controller_late_is_not_a_disturbance(program: TestProgram) -> None:
+    """Without real time the simulator runs ahead of the session: the load controller's state can
+    show the previous segment's set-point well into the next segment's sim time."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_axial_setpoint(0.1, 100.0)
+    runner.update(1.0)  # n0900, 100 N
+    runner.observe_axial_setpoint(1.1, 100.0)
+    run_until(runner, 1.0, 2.6)
+    runner.observe_status(status(5.0, StatusState.SLIPPING))
+    runner.observe_status(status(6.0, StatusState.STABLE))
+    runner.update(6.0)  # n1200, 150 N, starts at 6.0
+    runner.observe_axial_setpoint(6.9, 100.0)  # still the previous segment's, 0.9 s in
+    for k in range(10):
+        runner.observe_load(7.0 + 0.1 * k, 100.0)  # not judged: the set-point has not arrived
+    runner.observe_axial_setpoint(8.0, 150.0)
+    for k in range(10):
+        runner.observe_load(8.5 + 0.1 * k, 150.0)
+    runner.interrupt(9.5)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "n1200" and outcome.conditions_met
+    assert outcome.bearing_force == pytest.approx(150.0)
 
 
 def test_a_segment_too_short_for_the_load_to_settle_is_not_judged_on_it(tmp_path: Path) -> None:

@@ -37,6 +37,22 @@ RELIABLE_QOS = QoSProfile(
 )
 """Commands, set-points, /clock, /diagnostics, the force to the simulator: reliable, depth 10."""
 
+RELIABLE_STREAM_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=5000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
+)
+"""The publishers of the 1 kHz reliable streams (``/clock``, the force on the bearing): reliable
+like :data:`RELIABLE_QOS` (and compatible with its readers), but a reliable writer drops a sample
+its readers have not acknowledged once ``depth`` newer ones are written. At depth 10 a recorder
+held up for 10 ms (a busy host) lost stretches of ``/clock``; 5000 covers 5 s of it."""
+
+PULSE_READER_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
+)
+"""The monitor's pulse subscriptions: sensor data, but deep. A reader's history drops the oldest
+sample once ``depth`` are waiting; at 100 a monitor held up for a fraction of a second (niced
+below the simulator on a busy host, or a fit at a window's end) lost bursts of pulses and reported
+a FAULT for pulses the bag held. 10000 is some 20 s of pulses at 9000 rpm."""
+
 STATUS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
 )

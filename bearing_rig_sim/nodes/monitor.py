@@ -41,8 +41,8 @@ from bearing_rig_sim.monitoring import (
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
+    PULSE_READER_QOS,
     RELIABLE_QOS,
-    SENSOR_QOS,
     STATUS_QOS,
     WARN,
     diagnostic_array,
@@ -83,8 +83,8 @@ class MonitorNode(Node):
 
         self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), PULSE_READER_QOS)
+        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), PULSE_READER_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)

@@ -96,10 +96,6 @@ class LoadingChainConfig(ParameterRecord):
 
     SECTION: ClassVar[str] = "loading_chain"
 
-    max_setpoint_n: float = bounded(gt=0.0)
-    """Largest axial-load set-point accepted, N."""
-    max_substep_s: float = bounded(gt=0.0, le=0.01)
-    """Longest internal integration step, s; longer calls to ``step`` are subdivided."""
     brake: LinearBrakeParams
     rope: WireRopeParams
     lever: LeverParams
@@ -108,6 +104,12 @@ class LoadingChainConfig(ParameterRecord):
     load_cell: LoadCellParams
     controller: ForceControllerParams
     interlocks: InterlockParams
+    # the bounded numbers after the nested records: a dataclass field with a (typing) default
+    # may not precede one without
+    max_setpoint_n: float = bounded(gt=0.0)
+    """Largest axial-load set-point accepted, N."""
+    max_substep_s: float = bounded(gt=0.0, le=0.01)
+    """Longest internal integration step, s; longer calls to ``step`` are subdivided."""
 
     def check_consistency(self, error: Callable[[str, str], ConfigError]) -> None:
         """The load-limit trip must sit above the largest set-point."""

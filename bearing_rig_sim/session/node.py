@@ -265,8 +265,8 @@ class SessionNode(Node):
         elif name == AXIAL_LOAD_STATE.name:
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1
-            self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
             self.runner.observe_axial_setpoint(from_stamp(msg.header.stamp), msg.setpoint)
+            self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
         elif name == DIAGNOSTICS.name:
             self._diagnostics_events(deserialize_message(raw, msgtype))
 

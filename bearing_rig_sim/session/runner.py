@@ -28,8 +28,9 @@ Rules (simulation time throughout, s):
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
   two are compared over the same stretch of time. Bearing force: mean of the load controller's
   bearing force once the load has settled (after the ramp end and at least
-  :data:`LOAD_SETTLE_S` after the segment's start). Measured speed: mean of the monitor's
-  inner-ring speed over the statuses stamped after the ramp end.
+  :data:`LOAD_SETTLE_S` after the load controller's state first shows the segment's set-point).
+  Measured speed: the monitor's inner-ring speed in the deciding status (else the segment's last),
+  when it is stamped after the ramp end.
 * Conditions: a segment whose measured speed or bearing force is off the commanded one by more
   than the tolerance (:func:`speed_tolerance`, :func:`~bearing_rig_sim.load_control.settle_band`),
   or during which a command, a set-point or the load controller's set-point came from outside
@@ -210,9 +211,9 @@ class _SegmentData:
     statuses: int = field(default=0)
     unsettled_after_ramp: bool = False
     """A status other than stable, stamped after the ramp end, has come."""
-    speed_sum: float = 0.0
-    speed_count: int = 0
     disturbances: list[str] = field(default_factory=list)
+    setpoint_seen: float | None = None
+    """When the load controller's state first showed the segment's set-point, s of sim time."""
 
 
 class ProgramRunner:
@@ -320,7 +321,11 @@ class ProgramRunner:
             force = data.force_sum_all / data.force_count_all
         else:
             force = None
-        measured_speed = data.speed_sum / data.speed_count if data.speed_count else None
+        measured_speed = (
+            decisive.inner_ring_speed
+            if decisive is not None and decisive.time >= plan.ramp_end and math.isfinite(decisive.inner_ring_speed)
+            else None
+        )
         outcome = SegmentOutcome(
             index=plan.index,
             name=plan.segment.name,
@@ -351,9 +356,6 @@ class ProgramRunner:
         data.last_status = status
         data.statuses += 1
         plan = data.plan
-        if status.time >= plan.ramp_end and math.isfinite(status.inner_ring_speed):
-            data.speed_sum += status.inner_ring_speed
-            data.speed_count += 1
         if status.time < plan.ramp_end or data.stable is not None:
             return
         if status.state is not StatusState.STABLE:
@@ -376,19 +378,29 @@ class ProgramRunner:
             return
         data.force_sum_all += bearing_force
         data.force_count_all += 1
-        if time >= max(data.plan.ramp_end, data.plan.start_time + LOAD_SETTLE_S):
+        seen = data.setpoint_seen
+        if seen is not None and time >= max(data.plan.ramp_end, seen + LOAD_SETTLE_S):
             data.force_sum += bearing_force
             data.force_count += 1
 
     def observe_axial_setpoint(self, time: float, setpoint: float) -> None:
-        """The load controller's set-point in force (N) at ``time`` (s of sim time): one other
-        than the segment's, once :data:`LOAD_SETTLE_S` has passed, was set from outside."""
+        """The load controller's set-point in force (N) at ``time`` (s of sim time), from its
+        state. The segment's own set-point starts the load's settling time (the simulator may run
+        ahead of the session, so the set-point can arrive well after the segment's start in sim
+        time); any other, once the segment's was seen, or one that is neither the segment's nor
+        the previous segment's, was set from outside."""
         data = self._data
-        if data is None or time < data.plan.start_time + LOAD_SETTLE_S or setpoint == data.plan.segment.axial_load:
+        if data is None or time < data.plan.start_time:
             return
-        self.observe_disturbance(
-            time, f"the load controller's set-point was {setpoint:g} N, not the program's {data.plan.segment.axial_load:g} N"
-        )
+        own = data.plan.segment.axial_load
+        if setpoint == own:
+            if data.setpoint_seen is None:
+                data.setpoint_seen = time
+            return
+        index = data.plan.index
+        previous = self.program.segments[index - 1].axial_load if index > 0 else None
+        if data.setpoint_seen is not None or (previous is not None and setpoint != previous):
+            self.observe_disturbance(time, f"the load controller's set-point was {setpoint:g} N, not the program's {own:g} N")
 
     def observe_disturbance(self, time: float, what: str) -> None:
         """Something from outside the session changed the rig's conditions at ``time`` (s of sim

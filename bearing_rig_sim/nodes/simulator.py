@@ -45,7 +45,6 @@ from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
     RELIABLE_QOS,
     RELIABLE_STREAM_QOS,
-    SENSOR_QOS,
     STATUS_QOS,
     diagnostic_array,
     diagnostic_status,
@@ -112,11 +111,11 @@ class SimulatorNode(Node):
 
         self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_STREAM_QOS)
         self._pulse_pubs = {
-            "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
-            "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
+            "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", RELIABLE_STREAM_QOS),
+            "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", RELIABLE_STREAM_QOS),
         }
-        self._speeds_pub = self.create_publisher(JointState, "/rig/speeds", SENSOR_QOS)
-        self._truth_pub = self.create_publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
+        self._speeds_pub = self.create_publisher(JointState, "/rig/speeds", RELIABLE_STREAM_QOS)
+        self._truth_pub = self.create_publisher(SimulatorTruth, "/rig/truth", RELIABLE_STREAM_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
         self.create_subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
         self.create_subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)

@@ -43,8 +43,11 @@ DRAIN_PERIOD_S = 0.02
 MAX_CLOCK_EVENTS = 10
 """Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
-RECORDER_DEPTH = 5000
-"""Reader queue depth of each recorded topic: 5 s of a 1 kHz topic in real time, 1 s at 5x."""
+RECORDER_DEPTH = 50000
+"""Reader queue depth of each recorded topic: 50 s of a 1 kHz topic in real time, some 15 s at
+the 3x of a session without real time. The reader's history drops its oldest sample once this many
+wait (reliable or not): at 5000 a session held up for two seconds on a busy host lost stretches of
+/clock."""
 
 MESSAGE_TYPES: dict[str, type] = {
     "rosgraph_msgs/msg/Clock": Clock,

@@ -385,7 +385,7 @@ def test_monitor_parameters_come_from_the_run_context(tmp_path: Path) -> None:
 
 
 def status_row(time: float, windows: int, inner: float, state: int = 1, slip: float = 1.0) -> StatusRow:
-    return StatusRow(time, "tick", state, time, inner, 0.4 * inner, 0.43 * inner, slip, 0.0, 0.5, windows, "")
+    return StatusRow(time, "tick", state, time, inner, 0.4 * inner, 0.43 * inner, slip, 0.0, 0.5, windows, "", window_start=time - 0.1)
 
 
 def test_segments_of_a_program_and_stretches_of_a_bench_run() -> None:

@@ -49,18 +49,25 @@ import functools
 import math
 import struct
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable
 
 import yaml
 
 from bearing_rig_sim.config import ConfigError, Section, ros_parameters
-from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, shipped_parameters
+from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters
 from bearing_rig_sim.recording.cdr import make_decoder
 from bearing_rig_sim.recording.errors import BagError, BagWarning
 from bearing_rig_sim.recording.reader import BagReader, open_bag
-from bearing_rig_sim.recording.segments import SEGMENTS_CSV, SegmentSummary, SegmentTracker, program_segment_names, write_segments_csv
+from bearing_rig_sim.recording.segments import (
+    SEGMENTS_CSV,
+    SegmentSummary,
+    SegmentTracker,
+    program_criterion,
+    program_segment_names,
+    write_segments_csv,
+)
 from bearing_rig_sim.recording.series import (
     STATUS_CSV,
     WINDOWS_CSV,
@@ -265,9 +272,13 @@ class OfflineAnalysis:
         source = "given"
         if settings is None:
             settings, source = self._run_settings()
+        criterion = program_criterion(bag.run_metadata)
+        if source != "given" and criterion and criterion != settings.criterion:
+            settings = replace(settings, criterion=criterion)
+            source += f", criterion {criterion!r} from the run's test program"
         self.settings = settings
         self.monitor = SlipMonitor(settings.kinematics(), settings)
-        self.period = 1.0 / settings.status_rate_hz
+        self.schedule = StatusSchedule(self.monitor)
         topics = bag.topics
         self.result = OfflineResult(
             path=bag.path,
@@ -286,9 +297,6 @@ class OfflineAnalysis:
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0
         self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
-        self._origin: float | None = None
-        self._tick = 0
-        self._clock = -math.inf
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
         self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata))
@@ -345,6 +353,8 @@ class OfflineAnalysis:
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
             handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
+            if name == LOAD_CELL and self.settings.criterion == "axial_load":
+                handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
                 handlers[topic](log_time_ns, data)
@@ -375,38 +385,34 @@ class OfflineAnalysis:
             return
         shaft = self._shaft_of[topic]
         self.result.pulses[shaft] += 1
-        t = pulse.time
-        if math.isfinite(t):
-            self._advance(t)
-        if self.monitor.add_pulse(shaft, pulse):
-            latest = self.monitor.latest_window
-            assert latest is not None
-            window = SlipWindowRow(latest.start_time, latest.end_time, latest.inner_ring_speed, latest.cage_speed, latest.slip_rate)
-            self.result.windows += 1
-            if self._sinks:
-                self._windows_csv.write(window)
-            if self._on_window is not None:
-                self._on_window(window)
-            self._emit(self._clock, "window", self.monitor.status())
+        for scheduled in self.schedule.on_pulse(shaft, pulse):
+            if scheduled.reason == "window":
+                latest = self.monitor.latest_window
+                assert latest is not None
+                window = SlipWindowRow(latest.start_time, latest.end_time, latest.inner_ring_speed, latest.cage_speed, latest.slip_rate)
+                self.result.windows += 1
+                if self._sinks:
+                    self._windows_csv.write(window)
+                if self._on_window is not None:
+                    self._on_window(window)
+            self._emit(scheduled.time, scheduled.reason, scheduled.status)
+        clock = self.schedule.clock
+        if math.isfinite(clock):
+            if not math.isfinite(self.result.first_time):
+                self.result.first_time = clock
+            self.result.last_time = clock
 
-    def _advance(self, t: float) -> None:
-        """Run the checks of every tick up to ``t``; restart the ticks on a clock jump back."""
-        if self._origin is None or t < self._clock - self.settings.clock_jump_tolerance_s:
-            self._origin, self._tick, self._clock = t, 0, t
-        while (tick := self._origin + self._tick * self.period) <= t:
-            self.monitor.check(tick)
-            self._emit(tick, "tick", self.monitor.status())
-            self._tick += 1
-        self._clock = max(self._clock, t)
-        if not math.isfinite(self.result.first_time):
-            self.result.first_time = t
-        self.result.last_time = self._clock
+    def _on_load_cell(self, log_time_ns: int, data: bytes) -> None:
+        """The load cell's force, for the axial-load criterion (and the rows)."""
+        message, stamp = self._decoded(LOAD_CELL, log_time_ns, data)
+        if message is not None:
+            self.monitor.add_load(stamp, float(message.wrench.force.z))
 
     def _finish(self) -> None:
-        if self._origin is not None:
-            self.monitor.check(self._clock)
-            self._emit(self._clock, "end", self.monitor.status())
-            self.result.final_status = self.monitor.status()
+        final = self.schedule.finish()
+        if final is not None:
+            self._emit(final.time, final.reason, final.status)
+            self.result.final_status = final.status
         self.result.segments = self._segments.finish()
 
     # -- context topics ------------------------------------------------------------------------
@@ -421,7 +427,8 @@ class OfflineAnalysis:
         if message is None:
             return None, _NAN
         stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-        reference = self._clock if self._origin is not None else log_time_ns * 1e-9
+        clock = self.schedule.clock
+        reference = clock if math.isfinite(clock) else log_time_ns * 1e-9
         return message, stamp if abs(stamp - reference) <= PLAUSIBLE_STAMP_S else reference
 
     def _on_recorded_status(self, log_time_ns: int, data: bytes) -> None:
@@ -435,7 +442,9 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
-        self._segments.recorded(stamp, state)
+        cage, revolutions = float(message.cage_speed), int(message.window_revolutions)
+        duration = 2.0 * math.pi * revolutions / cage if cage > 0.0 and math.isfinite(cage) else 0.0
+        self._segments.recorded(stamp, stamp - duration, state)
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
         command, start = self._decoded(COMMAND, log_time_ns, data)
@@ -498,6 +507,7 @@ class OfflineAnalysis:
             reason=reason,
             state=int(status.state),
             window_end=_NAN if status.time is None else status.time,
+            window_start=_NAN if status.window_start is None else status.window_start,
             inner_ring_speed=status.inner_ring_speed,
             cage_speed=status.cage_speed,
             theoretical_cage_speed=status.theoretical_cage_speed,

@@ -26,7 +26,7 @@ import yaml
 
 import bearing_rig_sim
 from bearing_rig_sim.config import RPM_TO_RAD_S
-from bearing_rig_sim.monitoring import MonitorState
+from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.recording.offline import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
 from bearing_rig_sim.recording.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.recording.series import STATUS_CSV, WINDOWS_CSV
@@ -35,7 +35,7 @@ REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")
 
 _RPM = 1.0 / RPM_TO_RAD_S
-_STATE_NAMES = {int(s): s.name.lower() for s in MonitorState}
+_STATE_NAMES = {int(s): s.name.lower() for s in SlipState}
 _RUN_KEYS = ("run_id", "started_utc", "program_file", "command_line", "project_version", "realtime", "ros_domain_id")
 _TOPIC_USE = {
     **{topic: "slip windows and verdicts (offline monitor)" for topic in PULSE_TOPICS.values()},
@@ -296,7 +296,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     lines.append(f"* state changes: {max(len(result.transitions) - 1, 0)} offline, {max(len(result.recorded_transitions) - 1, 0)} recorded")
     if result.transitions_dropped:
         lines.append(f"* {result.transitions_dropped} further state changes were counted but not kept for the status plot")
-    stable = sum(s.final_state == MonitorState.STABLE for s in result.segments)
+    stable = sum(s.final_state == SlipState.STABLE for s in result.segments)
     source = "program segments (from /rig/spindle/command)" if result.segment_source == "program" else "constant-speed stretches (no spindle command in the bag)"
     lines += [f"* {len(result.segments)} {source}: {stable} end stable; {_agreement(result.segments)}", ""]
     lines += ["## Segments", ""]

@@ -11,8 +11,9 @@
   least :data:`STRETCH_MIN_DURATION_S`; the ramp end is the stretch's start.
 
 A segment's means are taken over the rows from its ramp end on; its verdicts are the last state
-in it; its time to stable runs from the ramp end to the end of the first stable window (the
-window must end after the ramp: a stable verdict from before belongs to the previous speed).
+in it; its time to stable follows the one rule the live session summary also uses
+(:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`), for the offline statuses and the
+recorded ones alike.
 
 Units: s, rad/s, N; slip in percent.
 """
@@ -25,7 +26,8 @@ from pathlib import Path
 
 import yaml
 
-from bearing_rig_sim.monitoring import MonitorState
+from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.monitoring.schedule import TimeToStable
 from bearing_rig_sim.recording.series import CsvWriter, StatusRow, csv_columns
 
 SEGMENTS_CSV = "segments.csv"
@@ -52,8 +54,7 @@ class SegmentSummary:
         slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
             status / simulator truth, %.
         final_state / final_recorded_state: state at the segment's end (recorded: -1 if none).
-        time_to_stable / recorded_time_to_stable: first stable verdict whose window ends at or
-            after the ramp end, minus the ramp end, s (None without one).
+        time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one).
         rows: status rows after the ramp end (1).
     """
 
@@ -77,15 +78,15 @@ class SegmentSummary:
 class _Segment:
     """Accumulates one segment's figures from the status rows after its ramp end."""
 
-    def __init__(self, name: str, start: float, ramp_end: float, target: float) -> None:
+    def __init__(self, name: str, start: float, ramp_end: float, target: float, changes_speed: bool) -> None:
         self.name, self.start, self.ramp_end, self.target = name, start, ramp_end, target
         self.end = start
         self.sums: dict[str, list[float]] = {}
         self.rows = 0
-        self.final_state = int(MonitorState.UNKNOWN)
+        self.final_state = int(SlipState.UNKNOWN)
         self.final_recorded = -1
-        self.stable_at: float | None = None
-        self.recorded_stable_at: float | None = None
+        self.stable = TimeToStable(ramp_end, changes_speed)
+        self.recorded_stable = TimeToStable(ramp_end, changes_speed)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):
@@ -101,17 +102,16 @@ class _Segment:
         self.end = row.time
         self.final_state = row.state
         self.final_recorded = row.recorded_state
-        if row.state == MonitorState.STABLE and self.stable_at is None and row.window_end >= self.ramp_end:
-            self.stable_at = row.window_end
+        if math.isfinite(row.window_end):
+            self.stable.observe(row.window_end, row.window_start, row.state)
         if row.time < self.ramp_end:
             return
         self.rows += 1
         for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
             self._add(key, getattr(row, key))
 
-    def add_recorded(self, stamp: float, state: int) -> None:
-        if state == MonitorState.STABLE and self.recorded_stable_at is None and stamp >= self.ramp_end:
-            self.recorded_stable_at = stamp
+    def add_recorded(self, stamp: float, window_start: float, state: int) -> None:
+        self.recorded_stable.observe(stamp, window_start, state)
 
     def summary(self) -> SegmentSummary:
         return SegmentSummary(
@@ -127,8 +127,8 @@ class _Segment:
             truth_slip_rate=self.mean("truth_slip_rate"),
             final_state=self.final_state,
             final_recorded_state=self.final_recorded,
-            time_to_stable=None if self.stable_at is None else self.stable_at - self.ramp_end,
-            recorded_time_to_stable=None if self.recorded_stable_at is None else self.recorded_stable_at - self.ramp_end,
+            time_to_stable=self.stable.time_to_stable,
+            recorded_time_to_stable=self.recorded_stable.time_to_stable,
             rows=self.rows,
         )
 
@@ -143,6 +143,15 @@ def program_segment_names(run_metadata: dict[str, str]) -> list[str]:
         return []
 
 
+def program_criterion(run_metadata: dict[str, str]) -> str:
+    """The run's test program's ``stability_criterion`` ("" when absent or unreadable)."""
+    try:
+        doc = yaml.safe_load(run_metadata.get("program", "") or "")
+        return str(doc.get("stability_criterion", "") or "")
+    except (yaml.YAMLError, AttributeError):
+        return ""
+
+
 def write_segments_csv(path: Path, segments: list[SegmentSummary]) -> Path:
     """The segment table as CSV (speeds in rpm); returns ``path``."""
     sink = CsvWriter(path, csv_columns(SegmentSummary))
@@ -152,8 +161,6 @@ def write_segments_csv(path: Path, segments: list[SegmentSummary]) -> Path:
     finally:
         sink.close()
     return path
-
-
 
 
 class SegmentTracker:
@@ -186,7 +193,7 @@ class SegmentTracker:
         self._previous_target = target
         index = len(self.segments) + (self._open is not None)
         self._close()
-        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target)
+        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, target != previous)
 
     def row(self, row: StatusRow) -> None:
         """One status row, in time order."""
@@ -199,17 +206,17 @@ class SegmentTracker:
                 mean = self._stretch_sum / self._stretch_windows if self._stretch_windows else _NAN
                 if self._open is None or abs(inner - mean) > STRETCH_TOLERANCE * mean:
                     self._close()
-                    self._open = _Segment("", row.time, row.time, _NAN)
+                    self._open = _Segment("", row.time, row.time, _NAN, True)
                     self._stretch_sum, self._stretch_windows = 0.0, 0
                 self._stretch_sum += inner
                 self._stretch_windows += 1
         if self._open is not None:
             self._open.add_row(row)
 
-    def recorded(self, stamp: float, state: int) -> None:
-        """A recorded slip status (its stamp, s, and state)."""
+    def recorded(self, stamp: float, window_start: float, state: int) -> None:
+        """A recorded slip status: its stamp (window end), its window's start (s), its state."""
         if self._open is not None:
-            self._open.add_recorded(stamp, state)
+            self._open.add_recorded(stamp, window_start, state)
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

@@ -14,15 +14,11 @@ Rules (simulation time throughout, s):
 * ``dwell_s``: the segment ends at ``ramp end + dwell``. Its verdict is the monitor's last state
   within the segment (stable, slipping, fault; unknown when no status came).
 * ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
-  new operating point: its slip window (``window_revolutions`` cage revolutions ending at its
-  stamp) lies entirely after the ramp end, and, when the segment changes the speed, the monitor
-  has reported some other state (unknown, slipping) in a status stamped after the ramp end
-  before it. The monitor restarts its slip series for a new speed and needs a dozen windows
-  before a verdict, so this second rule keeps a verdict fitted on the ramp's own points (slip
-  rising during a run-up has a slope above the critical one: "stable") or carried over from the
-  previous speed from ending the segment; a speed change too small for the monitor to restart
-  then ends in "timeout" rather than in a false "stable". Verdict "stable", time to stable =
-  that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".
+  new operating point, by the rule offline analysis also uses
+  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): its slip window lies entirely
+  after the ramp end and, when the segment changes the speed, some other state came after the
+  ramp end first. Verdict "stable", time to stable = that status's stamp - ramp end. Without one
+  by ``ramp end + timeout_s``: verdict "timeout".
 * Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
@@ -35,8 +31,10 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from enum import Enum, IntEnum
+from enum import Enum
 
+from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.monitoring.schedule import TimeToStable
 from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
 
 __all__ = [
@@ -52,13 +50,8 @@ TRUTH_HISTORY = 6000
 """True-slip samples kept (60 s at the simulator's 100 Hz): enough for any status window."""
 
 
-class StatusState(IntEnum):
-    """The ``STATE_*`` constants of SlipStatus.msg."""
-
-    UNKNOWN = 0
-    SLIPPING = 1
-    STABLE = 2
-    FAULT = 3
+StatusState = SlipState
+"""The ``STATE_*`` constants of SlipStatus.msg: the project's one state enum."""
 
 
 class Verdict(str, Enum):
@@ -172,8 +165,8 @@ class _SegmentData:
     force_sum_all: float = 0.0
     force_count_all: int = 0
     statuses: int = field(default=0)
-    unsettled_after_ramp: bool = False
-    """A status other than stable, stamped after the ramp end, has come."""
+    rule: TimeToStable | None = None
+    """The "stable after the ramp" rule, shared with offline analysis."""
 
 
 class ProgramRunner:
@@ -232,7 +225,8 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        self._data = _SegmentData(plan)
+        changes_speed = plan.profile.target_speed != plan.profile.start_speed
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, changes_speed))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -307,15 +301,8 @@ class ProgramRunner:
             return
         data.last_status = status
         data.statuses += 1
-        plan = data.plan
-        if status.time < plan.ramp_end or data.stable is not None:
-            return
-        if status.state is not StatusState.STABLE:
-            data.unsettled_after_ramp = True
-            return
-        window_after_ramp = status.time - status.window_duration >= plan.ramp_end
-        changes_speed = plan.profile.target_speed != plan.profile.start_speed
-        if window_after_ramp and (data.unsettled_after_ramp or not changes_speed):
+        assert data.rule is not None
+        if data.rule.observe(status.time, status.time - status.window_duration, int(status.state)):
             data.stable = status
 
     def observe_truth(self, time: float, slip_rate: float) -> None:

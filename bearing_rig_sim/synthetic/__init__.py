@@ -1,0 +1,1 @@
+"""Generated test traffic: bench-like pulse recordings from a known slip history (:mod:`.bench`)."""

@@ -7,7 +7,7 @@ kinematics, so it runs unchanged on the real bench's topics.
 * **Windows** come from :class:`~bearing_rig_sim.monitoring.windows.SlipWindows`: whole cage
   revolutions counted by pulse index, the spindle's angle interpolated at both ends, lost pulses
   accounted for (an isolated loss is a warning, a sustained one a fault).
-* **Slip** of each window: Eq. 11 of the paper (docs/model.md), percent.
+* **Slip** of each window: Eq. 11 of the paper (docs/paper.md), percent.
 * **Verdict**: the paper's slope criterion on the slip series, against time (k2) or against the
   measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
   slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,

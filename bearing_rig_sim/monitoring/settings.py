@@ -77,7 +77,7 @@ class MonitorSettings:
     diagnostics_rate_hz: float
 
     @classmethod
-    def from_section(cls, s: Section) -> "MonitorSettings":
+    def from_section(cls, s: Section) -> MonitorSettings:
         """Validate the parameters in ``s`` (every key required, none unknown besides
         ``use_sim_time``).
 
@@ -119,12 +119,12 @@ class MonitorSettings:
         )
 
     @classmethod
-    def from_values(cls, values: dict[str, object], source: str = "monitor parameters") -> "MonitorSettings":
+    def from_values(cls, values: dict[str, object], source: str = "monitor parameters") -> MonitorSettings:
         """Validate a flat mapping of parameter values (the node's ROS parameters)."""
         return cls.from_section(Section(dict(values), source))
 
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "MonitorSettings":
+    def from_yaml(cls, path: str | Path | None = None) -> MonitorSettings:
         """Read ``monitor: ros__parameters:`` of a parameter file (default: the shipped one)."""
         return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
 

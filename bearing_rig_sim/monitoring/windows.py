@@ -250,12 +250,13 @@ class SlipWindows:
             return []
         s = self._shafts[shaft]
         t, index = float(pulse.time), int(pulse.pulse_index)
-        if s.last_time is not None and s.last_index is not None:
-            if t < s.last_time - self.clock_jump_tolerance_s:
+        last_time, last_index = s.last_time, s.last_index
+        if last_time is not None and last_index is not None:
+            if t < last_time - self.clock_jump_tolerance_s:
                 self.reset()
-                self.events.append(("reset", t, f"reset: {shaft} pulse at {t:.6f} s after one at {s.last_time:.6f} s (clock jumped back)"))
+                self.events.append(("reset", t, f"reset: {shaft} pulse at {t:.6f} s after one at {last_time:.6f} s (clock jumped back)"))
                 s = self._shafts[shaft]
-            elif t <= s.last_time or index <= s.last_index:
+            elif t <= last_time or index <= last_index:
                 self.events.append(
                     (
                         "note",

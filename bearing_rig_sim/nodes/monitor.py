@@ -19,10 +19,12 @@ The rig time is the pulses' stamps, extrapolated by the steady clock while none 
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
@@ -31,6 +33,7 @@ from rclpy.node import Node
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, DIAGNOSTICS, PULSE_TOPICS, SLIP_STATUS
 from bearing_rig_sim.monitoring import (
     NODE_NAME,
     MonitorSettings,
@@ -43,13 +46,11 @@ from bearing_rig_sim.monitoring import (
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
-    RELIABLE_QOS,
-    SENSOR_QOS,
-    STATUS_QOS,
     WARN,
     diagnostic_array,
     diagnostic_status,
     from_stamp,
+    qos_profile,
     run_node,
     to_stamp,
 )
@@ -82,12 +83,12 @@ class MonitorNode(Node):
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
 
-        self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self._status_pub = self.create_publisher(SlipStatus, SLIP_STATUS.name, qos_profile(SLIP_STATUS))
+        self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
+        for shaft, topic in PULSE_TOPICS.items():
+            self.create_subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), qos_profile(topic))
         if self.settings.criterion == "axial_load":
-            self.create_subscription(WrenchStamped, "/rig/axial_load/force", self._on_load, SENSOR_QOS)
+            self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
@@ -117,7 +118,7 @@ class MonitorNode(Node):
             self._received[shaft] += 1
             for scheduled in self.schedule.on_pulse(shaft, pulse):
                 self._publish(scheduled.status)
-        except Exception as exc:  # noqa: BLE001 - bad data never stops the monitor
+        except Exception as exc:
             if not self.context.ok():
                 raise
             self.get_logger().error(f"{shaft} pulse not processed: {exc}", throttle_duration_sec=1.0)

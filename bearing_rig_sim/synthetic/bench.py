@@ -7,7 +7,7 @@ load cell's force, stamped on the bench computer's system clock (an epoch offset
 
 * the spindle speed ``omega_i(t)`` (rad/s) and the slip ``S(t)`` (percent) are given as
   functions; the cage turns at ``omega_c = r omega_i (1 - S / 100)``, ``r`` the bearing's
-  epicyclic ratio (Eq. 11-12 of the paper, docs/model.md), so the slip of the pulses is ``S``;
+  epicyclic ratio (Eq. 11-12 of the paper, docs/paper.md), so the slip of the pulses is ``S``;
 * both angles are integrated on a fine grid (trapezoidal rule, 50 us steps); a strip passes the
   sensor when the shaft's angle reaches the strip's position, ``k + j / n + e_j`` revolutions for
   strip ``j`` of ``n`` in revolution ``k``, ``e_j`` the strip's spacing error;
@@ -26,11 +26,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS, SPINDLE_PULSES
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 BENCH_EPOCH_S = 1_732_300_000.0
@@ -171,31 +173,29 @@ def true_verdict(scenario: BenchScenario, times: np.ndarray, critical_slope: flo
 def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
     """Write the scenario's pulses (and load cell, if any) as a bag like the bench's: the pulse
     topics and ``/rig/axial_load/force`` only, log times on the bench clock. Returns the path."""
-    from bearing_rig_sim.recording import BagWriter, rig_typestore  # noqa: PLC0415 - bag I/O only here
+    from bearing_rig_sim.bags import BagWriter, rig_typestore  # bag I/O only for this function
 
     store = rig_typestore()
     types = store.types
-    pulse_type = "bearing_rig_msgs/msg/FibreOpticPulse"
-    wrench_type = "geometry_msgs/msg/WrenchStamped"
+    pulse_type = SPINDLE_PULSES.msgtype
+    wrench_type = AXIAL_LOAD_FORCE.msgtype
 
-    def header(time_s: float) -> object:
+    def header(time_s: float) -> Any:
         ns = int(round(time_s * 1e9))
         return types["std_msgs/msg/Header"](stamp=types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9), frame_id="bench")
 
-    messages: list[tuple[float, str, object]] = []
+    messages: list[tuple[float, str, Any]] = []
     for shaft, p in bench_pulses(scenario):
         message = types[pulse_type](header=header(p.time), sensor_id=shaft, strip_id=p.strip_id, strip_count=p.strip_count, revolution=p.revolution, pulse_index=p.pulse_index)
-        messages.append((p.time, f"/rig/{shaft}/pulses", message))
+        messages.append((p.time, PULSE_TOPICS[shaft].name, message))
     vector = types["geometry_msgs/msg/Vector3"]
     for when, force in load_samples(scenario):
         wrench = types["geometry_msgs/msg/Wrench"](force=vector(x=0.0, y=0.0, z=force), torque=vector(x=0.0, y=0.0, z=0.0))
-        messages.append((when, "/rig/axial_load/force", types[wrench_type](header=header(when), wrench=wrench)))
+        messages.append((when, AXIAL_LOAD_FORCE.name, types[wrench_type](header=header(when), wrench=wrench)))
     messages.sort(key=lambda m: m[0])
     with BagWriter(path, typestore=store) as bag:
-        bag.add_topic("/rig/spindle/pulses", pulse_type, "sensor_data")
-        bag.add_topic("/rig/cage/pulses", pulse_type, "sensor_data")
-        if scenario.load_n is not None:
-            bag.add_topic("/rig/axial_load/force", wrench_type, "sensor_data")
+        for topic in (*PULSE_TOPICS.values(), *((AXIAL_LOAD_FORCE,) if scenario.load_n is not None else ())):
+            bag.add_topic(topic.name, topic.msgtype, topic.qos)
         for when, topic, message in messages:
             bag.write_message(topic, int(round(when * 1e9)), message)
     return Path(path)

@@ -157,6 +157,7 @@ class SlipMonitor:
         self._steady: bool | None = None
         self._previous_inner: float | None = None
         self._last_x: float | None = None
+        self._bin: tuple[float, float, int] = (0.0, 0.0, 0)  # load sum, slip sum, windows
         self._now: float | None = None
         self.windows = 0
         """Windows completed since the last reset (1)."""
@@ -205,6 +206,7 @@ class SlipMonitor:
             if kind == "reset":
                 self.slope.reset()
                 self._latest, self._steady, self._previous_inner, self._last_x = None, None, None, None
+                self._bin = (0.0, 0.0, 0)
                 self.windows = 0
                 self._notes.append((when, text))
             elif kind == "invalid":
@@ -220,6 +222,7 @@ class SlipMonitor:
             self._notes.append((time, f"slip series restarted at {time:.6f} s: {why}"))
         self.slope.reset()
         self._last_x = None
+        self._bin = (0.0, 0.0, 0)
 
     def _mean_load(self, t0: float, t1: float) -> float:
         loads = self._loads
@@ -251,18 +254,30 @@ class SlipMonitor:
         self._previous_inner = inner
         slip = float(self.kinematics.slip_rate(window.cage_speed, inner))
         self._latest = MonitorWindow(window, slip, load)
-        x = t1 if self.criterion == "time" else load
-        if not math.isfinite(x):
-            return
-        if self.criterion == "axial_load" and self._last_x is not None and x < self._last_x + st.load_step_n:
-            return  # the load has not risen by a load step since the last point
+        if self.criterion == "time":
+            self._add_point(t1, t1, slip)
+        elif math.isfinite(load):
+            self._add_to_load_bin(t1, load, slip)
+
+    def _add_to_load_bin(self, t1: float, load: float, slip: float) -> None:
+        """Against load, the slip points are bins of load: the windows whose mean load stays
+        within ``load_step_n / 2`` of their bin's mean are averaged, and a bin becomes a point
+        (mean load, mean slip) when the load leaves it, if its load is above the last point's."""
+        total_load, total_slip, count = self._bin
+        if count and abs(load - total_load / count) > 0.5 * self.settings.load_step_n:
+            x, y = total_load / count, total_slip / count
+            if self._last_x is None or x > self._last_x:
+                self._add_point(t1, x, y)
+            total_load, total_slip, count = 0.0, 0.0, 0
+        self._bin = (total_load + load, total_slip + slip, count + 1)
+
+    def _add_point(self, t1: float, x: float, slip: float) -> None:
         try:
             if self.slope.add(x, slip):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))
             self._last_x = x
-        except AnalysisError:
-            if self.criterion == "time":  # cannot happen with ordered windows; never crash
-                self._restart_series(t1, "time not increasing")
+        except AnalysisError as exc:  # cannot happen with ordered points; never crash
+            self._restart_series(t1, str(exc))
 
     # -- time-based checks ---------------------------------------------------------------------
     def check(self, now: float) -> None:

@@ -34,8 +34,8 @@ class MonitorSettings:
         critical_slope_pct_per_n: k1, %/N.
         slope_span_s: trailing window of the slope against time, s.
         slope_span_n: trailing window of the slope against load, N.
-        load_step_n: with the load criterion, a slip point is taken each time the measured load
-            has risen this much since the last one, N.
+        load_step_n: with the load criterion, the windows are averaged in bins of this width of
+            measured load, one slip point per bin, N.
         min_slope_points: points needed for a slope (>= 3).
         slip_resolution_pct: least scatter of the slip believed, percentage points.
         change_threshold: prediction standard errors for a change in the slip (1).

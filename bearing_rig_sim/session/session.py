@@ -102,6 +102,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     commands = {name: node_command(spec) for name, spec in NODES.items()}
     if not options.realtime:
         commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
+    # the monitor judges slip against what the program's stability_criterion names
+    commands["monitor"] = commands["monitor"] + ["--ros-args", "-p", f"criterion:={program.stability_criterion}"]
     start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)

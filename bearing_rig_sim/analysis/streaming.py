@@ -49,6 +49,7 @@ extrapolation beyond the fitted points is trusted as far as the covariance says.
 from __future__ import annotations
 
 import math
+import statistics
 from collections import deque
 from dataclasses import dataclass
 
@@ -200,6 +201,13 @@ class StreamingStability:
     def full_refits(self) -> int:
         """Refits since the last reset that ran the full multi-start search."""
         return self._full_refits
+
+    def forget_scatter(self) -> None:
+        """Start the scatter estimate afresh (a new operating point: the points' scatter about
+        the curve may differ, and the second differences of a steep, curved stretch such as a
+        run-up measure its curvature, not the scatter); points and decision are kept."""
+        self._d2.clear()
+        self._last2 = []
 
     def points(self) -> tuple[FloatArray, FloatArray]:
         """Copies of the points held: x (s or N) and slip (percent)."""
@@ -442,6 +450,13 @@ class TrailingSlope:
         """Points in the trailing window."""
         return len(self._x)
 
+    def forget_scatter(self) -> None:
+        """Start the scatter estimate afresh (a new operating point: the points' scatter about
+        the curve may differ, and the second differences of a steep, curved stretch such as a
+        run-up measure its curvature, not the scatter); points and decision are kept."""
+        self._d2.clear()
+        self._last2 = []
+
     def points(self) -> tuple[FloatArray, FloatArray]:
         """Copies of the points in the trailing window: x (unit of x) and slip (percent)."""
         origin = self._origin or 0.0
@@ -522,7 +537,7 @@ class TrailingSlope:
     def _scatter(self, residual_scatter: float) -> tuple[float, int]:
         """sigma (percent) and its degrees of freedom."""
         if len(self._d2) >= MIN_SCATTER_POINTS:
-            pooled = float(np.median(np.fromiter(self._d2, dtype=np.float64))) / (0.6745 * math.sqrt(6.0))
+            pooled = statistics.median(self._d2) / (0.6745 * math.sqrt(6.0))
             return max(pooled, self.resolution), len(self._d2)
         return max(residual_scatter, self.resolution), max(len(self._x) - 2, 1)
 
@@ -531,17 +546,17 @@ class TrailingSlope:
         if n < self.min_points:
             self._line = None
             return
-        xs = np.asarray(self._x)
-        ys = np.asarray(self._y)
-        xbar, ybar = float(xs.mean()), float(ys.mean())
-        dx = xs - xbar
-        sxx = float(dx @ dx)
+        # plain sums: a few dozen points, where numpy's call overhead would dominate
+        xs, ys = self._x, self._y
+        xbar, ybar = sum(xs) / n, sum(ys) / n
+        dx = [x - xbar for x in xs]
+        sxx = sum(d * d for d in dx)
         if not sxx > 0.0:
             self._line = None
             return
-        slope = float(dx @ (ys - ybar)) / sxx
-        resid = ys - ybar - slope * dx
-        scatter = math.sqrt(float(resid @ resid) / (n - 2)) if n > 2 else 0.0
+        slope = sum(d * (y - ybar) for d, y in zip(dx, ys)) / sxx
+        sse = sum((y - ybar - slope * d) ** 2 for d, y in zip(dx, ys))
+        scatter = math.sqrt(sse / (n - 2)) if n > 2 else 0.0
         self._sigma, self._dof = self._scatter(scatter)
         self._line = (slope, self._sigma / math.sqrt(sxx), xbar, ybar, sxx, n)
 

@@ -12,11 +12,11 @@ kinematics, so it runs unchanged on the real bench's topics.
   measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
   slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,
   and a change in the slip itself (whatever caused it) restarts the slope's window.
-* **The series restarts with each new operating phase**: at the start and the end of a speed
-  change (a window's mean spindle speed more than ``restart_speed_change_fraction`` from the
-  previous window's, or back within it) and after the spindle was below
-  ``min_inner_ring_speed_rad_s``. A restart makes the state unknown until the new phase's points
-  decide.
+* **Speed changes**: at the start and the end of one (a window's mean spindle speed more than
+  ``restart_speed_change_fraction`` from the previous window's, or back within it) the slip's
+  scatter is estimated afresh; the verdict is kept, its trailing window forgets the ramp within
+  ``slope_span_s``. Below ``min_inner_ring_speed_rad_s`` (and at a stop) the series restarts:
+  state unknown until new points decide.
 
 **Bad data is reported, never raised**: a malformed pulse is a fault held ``fault_hold_s``; an
 out-of-order pulse restarts its shaft's counting (a note); a clock jump back resets everything.
@@ -133,6 +133,7 @@ class SlipMonitor:
         self.kinematics = kinematics
         self.settings = settings
         self.criterion = settings.criterion
+        self._ratio = kinematics.epicyclic_ratio()
         span = settings.slope_span_s if self.criterion == "time" else settings.slope_span_n
         self.slope = TrailingSlope(
             critical_slope=settings.critical_slope,
@@ -249,10 +250,11 @@ class SlipMonitor:
         steady = None if previous is None else abs(inner - previous) <= st.restart_speed_change_fraction * previous
         if steady is not None and self._steady is not None and steady != self._steady and st.restart_speed_change_fraction > 0.0:
             change = f"steady at {inner:.6g} rad/s" if steady else f"changing, {previous:.6g} -> {inner:.6g} rad/s"
-            self._restart_series(t1, f"spindle speed {change}")
+            self.slope.forget_scatter()
+            self._notes.append((t1, f"spindle speed {change}: slip scatter estimated afresh"))
         self._steady = steady
         self._previous_inner = inner
-        slip = float(self.kinematics.slip_rate(window.cage_speed, inner))
+        slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
         self._latest = MonitorWindow(window, slip, load)
         if self.criterion == "time":
             self._add_point(t1, t1, slip)
@@ -330,7 +332,7 @@ class SlipMonitor:
             time=latest.end_time if latest is not None else None,
             inner_ring_speed=inner,
             cage_speed=latest.cage_speed if latest is not None else math.nan,
-            theoretical_cage_speed=self.kinematics.epicyclic_ratio() * inner,
+            theoretical_cage_speed=self._ratio * inner,
             slip_rate=latest.slip_rate if latest is not None else math.nan,
             fitted_slope=verdict.slope if verdict.slope is not None else math.nan,
             critical_slope=verdict.critical_slope,

@@ -10,11 +10,13 @@ stop, the node calls :meth:`StatusSchedule.idle` with its own estimate of the ri
 silent sensor is still reported; offline the ticks catch up at the next pulse, and
 :meth:`StatusSchedule.finish` closes the series.
 
-**Time to stable** (:class:`TimeToStable`): a segment is stable at the first STABLE status whose
-slip window starts at or after the ramp's end and, when the segment changes the speed, that
-follows a status other than STABLE stamped after the ramp's end (the monitor restarts its series
-for a new phase, so a stable verdict carried over from the previous speed does not count). The
-time to stable is that status's stamp (its window's end) minus the ramp's end.
+**Time to stable** (:class:`TimeToStable`): a segment is stable at the first status that is
+STABLE *on evidence from after the ramp's end*: its confidence P(slope >= k) is at least
+:data:`STABLE_CONFIDENCE` (so the present points, not a state held by hysteresis, say stable)
+and every slip window its slope rests on started at or after the ramp's end
+(:func:`evidence_start`). The time to stable is that status's stamp (its window's end) minus the
+ramp's end. The live session summary and ``analyze`` both use it, on the fields a SlipStatus
+carries, so they agree.
 """
 
 from __future__ import annotations
@@ -81,30 +83,42 @@ class StatusSchedule:
         return ScheduledStatus(self.clock, "end", self.monitor.status())
 
 
+STABLE_CONFIDENCE = 0.95
+"""A stable status counts for the time to stable when P(slope >= k) is at least this (1): the
+one-sided 95 % bound the verdict itself uses."""
+
+
+def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int) -> float:
+    """The earliest time the verdict of a status stamped ``stamp`` (s) can rest on, s.
+
+    Its slope is fitted to the slip windows that ended in the last ``slope_span_s`` (at least the
+    last ``min_slope_points`` of them), each ``window_revolutions`` cage revolutions long at
+    ``cage_speed`` (rad/s). -inf when the cage speed is unknown.
+    """
+    if not (math.isfinite(cage_speed) and cage_speed > 0.0 and window_revolutions > 0):
+        return -math.inf
+    window = window_revolutions * 2.0 * math.pi / cage_speed
+    return stamp - max(slope_span_s + window, min_slope_points * window)
+
+
 class TimeToStable:
     """The one "stable after the ramp" rule (module docstring).
 
     Args:
         ramp_end: end of the segment's ramp, rig s.
-        changes_speed: whether the segment changes the spindle speed.
     """
 
-    def __init__(self, ramp_end: float, changes_speed: bool) -> None:
+    def __init__(self, ramp_end: float) -> None:
         self.ramp_end = ramp_end
-        self.changes_speed = changes_speed
-        self.unsettled = False
         self.stable_at: float | None = None
         """Stamp of the status that made the segment stable, s (None before)."""
 
-    def observe(self, stamp: float, window_start: float, state: int) -> bool:
-        """A status stamped ``stamp`` whose slip window started at ``window_start`` (s); returns
-        whether this status made the segment stable."""
-        if self.stable_at is not None or not stamp >= self.ramp_end:
+    def observe(self, stamp: float, evidence_from: float, state: int, confidence: float) -> bool:
+        """A status stamped ``stamp`` whose verdict rests on data from ``evidence_from`` on (s,
+        :func:`evidence_start`); returns whether this status made the segment stable."""
+        if self.stable_at is not None or state != SlipState.STABLE or not confidence >= STABLE_CONFIDENCE:
             return False
-        if state != SlipState.STABLE:
-            self.unsettled = True
-            return False
-        if window_start >= self.ramp_end and (self.unsettled or not self.changes_speed):
+        if evidence_from >= self.ramp_end:
             self.stable_at = stamp
             return True
         return False

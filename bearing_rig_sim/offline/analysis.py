@@ -300,7 +300,9 @@ class OfflineAnalysis:
         self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
-        self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata))
+        self._segments = SegmentTracker(
+            self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings
+        )
         self._sinks: list[CsvWriter] = []
         self._csv_dir = csv_dir
         if csv_dir is not None:
@@ -443,9 +445,7 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
-        cage, revolutions = float(message.cage_speed), int(message.window_revolutions)
-        duration = 2.0 * math.pi * revolutions / cage if cage > 0.0 and math.isfinite(cage) else 0.0
-        self._segments.recorded(stamp, stamp - duration, state)
+        self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
         command, start = self._decoded(COMMAND, log_time_ns, data)

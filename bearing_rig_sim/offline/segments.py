@@ -27,7 +27,8 @@ from pathlib import Path
 import yaml
 
 from bearing_rig_sim.analysis.stability import SlipState
-from bearing_rig_sim.monitoring.schedule import TimeToStable
+from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
+from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
 
 SEGMENTS_CSV = "segments.csv"
@@ -78,15 +79,16 @@ class SegmentSummary:
 class _Segment:
     """Accumulates one segment's figures from the status rows after its ramp end."""
 
-    def __init__(self, name: str, start: float, ramp_end: float, target: float, changes_speed: bool) -> None:
+    def __init__(self, name: str, start: float, ramp_end: float, target: float, settings: MonitorSettings) -> None:
         self.name, self.start, self.ramp_end, self.target = name, start, ramp_end, target
         self.end = start
         self.sums: dict[str, list[float]] = {}
         self.rows = 0
         self.final_state = int(SlipState.UNKNOWN)
         self.final_recorded = -1
-        self.stable = TimeToStable(ramp_end, changes_speed)
-        self.recorded_stable = TimeToStable(ramp_end, changes_speed)
+        self.settings = settings
+        self.stable = TimeToStable(ramp_end)
+        self.recorded_stable = TimeToStable(ramp_end)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):
@@ -103,15 +105,19 @@ class _Segment:
         self.final_state = row.state
         self.final_recorded = row.recorded_state
         if math.isfinite(row.window_end):
-            self.stable.observe(row.window_end, row.window_start, row.state)
+            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence)
         if row.time < self.ramp_end:
             return
         self.rows += 1
         for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
             self._add(key, getattr(row, key))
 
-    def add_recorded(self, stamp: float, window_start: float, state: int) -> None:
-        self.recorded_stable.observe(stamp, window_start, state)
+    def evidence(self, stamp: float, cage_speed: float) -> float:
+        st = self.settings
+        return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points)
+
+    def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
+        self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence)
 
     def summary(self) -> SegmentSummary:
         return SegmentSummary(
@@ -171,9 +177,10 @@ class SegmentTracker:
         names: the test program's segment names (used when their count matches).
     """
 
-    def __init__(self, by_program: bool, names: list[str]) -> None:
+    def __init__(self, by_program: bool, names: list[str], settings: MonitorSettings | None = None) -> None:
         self.by_program = by_program
         self.names = names
+        self.settings = settings if settings is not None else MonitorSettings.from_yaml()
         self.segments: list[SegmentSummary] = []
         self._open: _Segment | None = None
         self._previous_target = _NAN
@@ -193,7 +200,7 @@ class SegmentTracker:
         self._previous_target = target
         index = len(self.segments) + (self._open is not None)
         self._close()
-        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, target != previous)
+        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings)
 
     def row(self, row: StatusRow) -> None:
         """One status row, in time order."""
@@ -206,17 +213,18 @@ class SegmentTracker:
                 mean = self._stretch_sum / self._stretch_windows if self._stretch_windows else _NAN
                 if self._open is None or abs(inner - mean) > STRETCH_TOLERANCE * mean:
                     self._close()
-                    self._open = _Segment("", row.time, row.time, _NAN, True)
+                    self._open = _Segment("", row.time, row.time, _NAN, self.settings)
                     self._stretch_sum, self._stretch_windows = 0.0, 0
                 self._stretch_sum += inner
                 self._stretch_windows += 1
         if self._open is not None:
             self._open.add_row(row)
 
-    def recorded(self, stamp: float, window_start: float, state: int) -> None:
-        """A recorded slip status: its stamp (window end), its window's start (s), its state."""
+    def recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
+        """A recorded slip status: its stamp (window end, s), cage speed (rad/s), state and
+        confidence."""
         if self._open is not None:
-            self._open.add_recorded(stamp, window_start, state)
+            self._open.add_recorded(stamp, cage_speed, state, confidence)
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

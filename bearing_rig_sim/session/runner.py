@@ -15,10 +15,10 @@ Rules (simulation time throughout, s):
   within the segment (stable, slipping, fault; unknown when no status came).
 * ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
   new operating point, by the rule offline analysis also uses
-  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): its slip window lies entirely
-  after the ramp end and, when the segment changes the speed, some other state came after the
-  ramp end first. Verdict "stable", time to stable = that status's stamp - ramp end. Without one
-  by ``ramp end + timeout_s``: verdict "timeout".
+  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): P(slope >= k) at least 0.95 on
+  slip windows that all started after the ramp end (the monitor's ``slope_span_s`` and
+  ``min_slope_points`` say how far back its verdict reaches). Verdict "stable", time to stable =
+  that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".
 * Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 from enum import Enum
 
 from bearing_rig_sim.analysis.stability import SlipState
-from bearing_rig_sim.monitoring.schedule import TimeToStable
+from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
+from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
 
 __all__ = [
@@ -94,6 +95,8 @@ class SlipObservation:
     """rad/s."""
     window_revolutions: int
     """Whole cage revolutions in the slip window."""
+    confidence: float = 0.0
+    """P(slope >= k) of the monitor's verdict (1)."""
 
     @property
     def window_duration(self) -> float:
@@ -182,8 +185,10 @@ class ProgramRunner:
         if runner.finished: ...                 # runner.outcomes holds one row per segment
     """
 
-    def __init__(self, program: TestProgram) -> None:
+    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None) -> None:
         self.program = program
+        self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
+        """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
         self.outcomes: list[SegmentOutcome] = []
         self._data: _SegmentData | None = None
         self._truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_HISTORY)
@@ -225,8 +230,7 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        changes_speed = plan.profile.target_speed != plan.profile.start_speed
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, changes_speed))
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -302,7 +306,9 @@ class ProgramRunner:
         data.last_status = status
         data.statuses += 1
         assert data.rule is not None
-        if data.rule.observe(status.time, status.time - status.window_duration, int(status.state)):
+        st = self.monitor_settings
+        evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points)
+        if data.rule.observe(status.time, evidence, int(status.state), status.confidence):
             data.stable = status
 
     def observe_truth(self, time: float, slip_rate: float) -> None:

@@ -298,7 +298,8 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     if result.segments:
         lines += [
             "Means are taken from the ramp's end to the segment's end; verdicts are the last state in the segment; "
-            "time to stable counts from the ramp's end to the end of the first stable window.",
+            "time to stable counts from the ramp's end to the first stable status (P(slope >= k) >= 0.95) whose "
+            "slip windows all follow the ramp's end, the rule the live session summary uses.",
             "",
             *_segment_table(result),
             "",

@@ -1,8 +1,16 @@
-"""The slope criterion on points arriving one by one: the monitor's online verdict.
+"""The slope criterion on points arriving one by one.
 
-:class:`StreamingStability` collects (x, slip %) points, x being the time (s) or the axial load
-(N), refits the Gaussian sum on a fixed policy and answers at any moment whether the bearing is
-slipping or stable, with the onset of the stable state and a confidence.
+Two forms, x being the time (s) or the axial load (N):
+
+* :class:`TrailingSlope`, **the monitor's verdict**: the slope of a least-squares line through the
+  slip of a trailing window, decided only when its one-sided 95 % bound is on one side of k (with
+  hysteresis), with change detection on the slip itself; microseconds per point (see its
+  docstring). A global Gaussian does not describe a slip that steps and decays, or a plateau
+  (a 1-term fit to a flat series runs to its width bound and reports R^2 below zero), and its
+  refits cost milliseconds on the pulse path.
+* :class:`StreamingStability`: the paper's own form, the Gaussian sum refitted on a fixed policy
+  over the whole series, with the onset of the stable state; kept for studies and the
+  ``bearing-rig bench analysis`` streaming case. The rest of this docstring describes it.
 
 **Refit policy** (cheap enough for ``add`` at 10-100 Hz):
 

@@ -82,7 +82,8 @@ SPACING_AVERAGE_REVOLUTIONS = 32
 
 @dataclass(frozen=True)
 class LossRules:
-    """When lost pulses make a fault (see the module docstring); every count in revolutions.
+    """When lost pulses make a fault (see the module docstring); every count in revolutions. The
+    values come from ``config/monitor.yaml`` (:meth:`MonitorSettings.loss_rules`).
 
     Attributes:
         loss_horizon_revolutions: revolutions over which the lost fraction is taken (> 0).
@@ -94,11 +95,11 @@ class LossRules:
             turned this many revolutions.
     """
 
-    loss_horizon_revolutions: float = 50.0
-    max_lost_fraction: float = 0.2
-    loss_silence_revolutions: float = 8.0
-    loss_min_timeout_s: float = 0.5
-    silent_shaft_revolutions: float = 5.0
+    loss_horizon_revolutions: float
+    max_lost_fraction: float
+    loss_silence_revolutions: float
+    loss_min_timeout_s: float
+    silent_shaft_revolutions: float
 
 
 @dataclass(frozen=True)

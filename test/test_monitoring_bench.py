@@ -247,3 +247,28 @@ def test_axial_load_criterion_judges_slip_against_the_measured_load() -> None:
     assert slipping and slipping[0] < 6 * 3.0  # decided within the first load steps
     steep = [s for t, s in states if load(np.array([t]))[0] < 450.0]
     assert SlipState.STABLE not in steep
+
+
+def test_sustained_loss_is_a_fault_by_the_stated_rule() -> None:
+    """30 % of the cage pulses lost at random: more than max_lost_fraction (20 %) of those
+    expected over the last 50 revolutions, a FAULT naming the cage; 0.5 % stays a warning."""
+    scenario = BenchScenario(20.0, constant(W900), constant(2.0), epicyclic_ratio=RATIO, lost_fraction=0.3, seed=11)
+    out = run(scenario)
+    faults = [s for s in out.statuses if s.state == SlipState.FAULT]
+    assert faults and all("sustained loss" in s.detail for s in faults)
+    assert any("cage" in s.detail for s in faults) and any("spindle" in s.detail for s in faults)
+
+
+def test_strip_spacing_is_measured_from_the_pulses() -> None:
+    """The spindle's strip spacing errors of the generator (mean removed: only differences are
+    observable) are found from the pulses to within a few 1e-5 revolution."""
+    scenario = BenchScenario(20.0, constant(W900), constant(2.0), epicyclic_ratio=RATIO)
+    monitor = SlipMonitor(SETTINGS.kinematics(), SETTINGS)
+    for shaft, pulse in bench_pulses(scenario):
+        monitor.add_pulse(shaft, pulse)
+    errors = np.array(scenario.spacing_error_rev["spindle"])  # by strip id
+    measured = monitor.counter.spacing()
+    expected = {strip: float(e) for strip, e in enumerate(errors - errors.mean())}
+    assert set(measured) == set(expected)
+    for strip, value in expected.items():
+        assert measured[strip] == pytest.approx(value, abs=3e-5)

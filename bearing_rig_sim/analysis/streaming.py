@@ -210,13 +210,6 @@ class StreamingStability:
         """Refits since the last reset that ran the full multi-start search."""
         return self._full_refits
 
-    def forget_scatter(self) -> None:
-        """Start the scatter estimate afresh (a new operating point: the points' scatter about
-        the curve may differ, and the second differences of a steep, curved stretch such as a
-        run-up measure its curvature, not the scatter); points and decision are kept."""
-        self._d2.clear()
-        self._last2 = []
-
     def points(self) -> tuple[FloatArray, FloatArray]:
         """Copies of the points held: x (s or N) and slip (percent)."""
         return self._x[self._start : self._end].copy(), self._y[self._start : self._end].copy()

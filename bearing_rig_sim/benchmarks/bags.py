@@ -144,7 +144,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     status: Any = store.types["bearing_rig_msgs/msg/SlipStatus"](
         header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
         theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
-        confidence=0.9, window_revolutions=1, detail="1-term Gaussian fit of 300 points; slope -0.001 %/s >= k = -0.03 %/s",
+        confidence=0.9, window_revolutions=1, detail="slope -0.001 +- 0.002 over 7 points (0.953) clearly >= k = -0.03; P(slope >= k) 1.000",
     )
     dt = 1e-3
     for step in range(int(round(duration_s / dt))):

@@ -5,18 +5,14 @@
     result = analyse_bag("bags/20250612T093015Z-validation", csv_dir="reports/run")
     print(result.final_status.state, [s.final_state for s in result.segments])
 
-The two fibre-optic pulse topics are read in log-time order and fed, in lockstep, into the same
-:class:`~bearing_rig_sim.monitoring.SlipMonitor` the monitor node wraps, so the slip windows and
-verdicts offline are the monitor's. Nothing depends on a wall clock: two runs over one bag give
+The two fibre-optic pulse topics are read in log-time order and fed through the same
+:class:`~bearing_rig_sim.monitoring.StatusSchedule` and
+:class:`~bearing_rig_sim.monitoring.SlipMonitor` the monitor node runs, so the slip windows,
+verdicts and the moments of the statuses offline are the node's (one status row per status the
+node would publish, plus a last one after the last pulse). With the ``axial_load`` criterion the
+load cell's force is fed too. The criterion is the run's test program's ``stability_criterion``
+when the bag records the program. Nothing depends on a wall clock: two runs over one bag give
 bit-identical results.
-
-**The clock.** The monitor node takes the pulse stamps as its time base; it calls
-:meth:`SlipMonitor.check` (where the Gaussian refits run) and publishes a status
-``status_rate_hz`` times a second, and publishes one more as each slip window closes. Offline,
-before each pulse ``check`` runs at every tick ``t0 + k / status_rate_hz`` up to the pulse's time
-(``t0``: the first pulse), each followed by a status row, and each closed window emits a row at
-once. A pulse further back than ``clock_jump_tolerance_s`` restarts the ticks (the monitor
-resets itself on it). After the last pulse one final ``check`` and row close the series.
 
 **What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
 of the five fields the monitor needs (little-endian CDR; other encodings through the reader's

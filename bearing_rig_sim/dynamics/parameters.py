@@ -105,6 +105,7 @@ class BearingParameters:
     lubricant: Lubricant | None = None
     lubricant_temperature: float = 40.0
     ehl_rolling_scale: float = 1.0
+    composite_roughness: float = 0.0
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -192,6 +193,7 @@ class BearingParameters:
             lubricant=lubricant,
             lubricant_temperature=temperature,
             ehl_rolling_scale=res.number("ehl_rolling_scale", ge=0.0, default=1.0),
+            composite_roughness=g.number("composite_roughness_rq_m", ge=0.0, lt=1e-5, default=0.0),
             source=doc.source,
         )
         if friction_model == "rheology" and lubricant is None:
@@ -217,6 +219,7 @@ class BearingParameters:
     def conservative(self) -> BearingParameters:
         """Friction, damping and resistances off: a conservative system (energy test)."""
         return self.without_resistances().replace(
+            friction_model="paper",
             static_friction=0.0,
             dynamic_friction=0.0,
             ehl_max_coefficient=0.0,
@@ -404,8 +407,8 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
         # Sphere in a Herschel-Bulkley grease: plastic drag 3.5 pi Dw^2 tau_y (Beris et al. 1985,
         # J. Fluid Mech. 158:219) plus Stokes drag with the apparent viscosity at v/Dw.
         fill = lub.fill_fraction
-        drag_yield = fill * 3.5 * math.pi * dw * dw * lub.yield_stress
-        drag_pow = fill * 3.0 * math.pi * lub.consistency * dw ** (2.0 - lub.flow_index)
+        drag_yield = p.ball_drag_scale * fill * 3.5 * math.pi * dw * dw * lub.yield_stress
+        drag_pow = p.ball_drag_scale * fill * 3.0 * math.pi * lub.consistency * dw ** (2.0 - lub.flow_index)
         drag_n = lub.flow_index
         drag_lin = 0.0
         drag_quad = p.ball_drag_scale * fill * 0.5 * lub.density(p.lubricant_temperature) * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw

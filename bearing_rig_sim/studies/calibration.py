@@ -87,6 +87,10 @@ class SteadyState:
     axial_load: float
     cage_speed: float
     slip_pct: float
+    friction_torque: float = math.nan
+    power_loss: float = math.nan
+    film_min_inner: float = math.nan
+    film_min_outer: float = math.nan
 
     def as_row(self) -> dict[str, float]:
         """The point at the edge: rpm, N, %."""
@@ -96,6 +100,18 @@ class SteadyState:
             "cage_rpm": round(rad_s_to_rpm(self.cage_speed), 4),
             "slip_pct": round(self.slip_pct, 4),
         }
+
+    def losses_row(self, composite_roughness: float = 0.0) -> dict[str, object]:
+        """Torque (N m), power (W), minimum films (um) and, with a composite roughness (m), the
+        film parameter lambda = h_min / sigma of the thinner contact."""
+        row: dict[str, object] = {
+            "friction_torque_nm": round(self.friction_torque, 6),
+            "power_loss_w": round(self.power_loss, 4),
+            "film_min_um": {"inner": round(self.film_min_inner * 1e6, 4), "outer": round(self.film_min_outer * 1e6, 4)},
+        }
+        if composite_roughness > 0.0:
+            row["lambda_ratio"] = round(min(self.film_min_inner, self.film_min_outer) / composite_roughness, 3)
+        return row
 
 
 @dataclass(frozen=True)
@@ -148,7 +164,8 @@ def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load:
     avg = engine.advance(AVERAGE_S)
     kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
     slip = float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
-    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip)
+    h_in, h_out = engine.minimum_films()
+    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip, engine.friction_torque(), engine.power_loss(), h_in, h_out)
 
 
 def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyState:

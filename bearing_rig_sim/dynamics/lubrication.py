@@ -75,7 +75,7 @@ class Lubricant:
     source: str = "<memory>"
 
     @classmethod
-    def from_yaml(cls, path: str | Path) -> "Lubricant":
+    def from_yaml(cls, path: str | Path) -> Lubricant:
         """Load and validate a lubricant file; a bare name is looked up in config/lubricants/."""
         p = Path(path)
         if not p.suffix:
@@ -85,7 +85,7 @@ class Lubricant:
         return cls.from_section(load_yaml(p))
 
     @classmethod
-    def from_section(cls, doc: Section) -> "Lubricant":
+    def from_section(cls, doc: Section) -> Lubricant:
         """Validate a parsed lubricant document; errors name file, key and range."""
         lub, oil, film, sup = doc.section("lubricant"), doc.section("base_oil"), doc.section("film"), doc.section("supply")
         kind = lub.choice("kind", KINDS)
@@ -146,7 +146,7 @@ class Lubricant:
         alpha = Z (ln eta0 + 9.67) / p0 (Roelands 1966; Hamrock, Schmid and Jacobson, ch. 4)."""
         return self.pressure_viscosity * ROELANDS_P0 / (math.log(self.dynamic_viscosity(temperature_c)) - ROELANDS_LN_ETA_INF)
 
-    def replace_rheology(self, **changes: float) -> "Lubricant":
+    def replace_rheology(self, **changes: float) -> Lubricant:
         """A copy with some numeric fields changed (calibrated values)."""
         import dataclasses
 

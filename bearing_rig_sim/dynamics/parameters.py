@@ -228,7 +228,7 @@ class BearingParameters:
         )
 
     # -- derived -------------------------------------------------------------------------------
-    def with_lubricant(self, **changes: float) -> "BearingParameters":
+    def with_lubricant(self, **changes: float) -> BearingParameters:
         """A copy whose lubricant has some rheology fields changed (calibrated values)."""
         if self.lubricant is None:
             raise ValueError("this bearing has no lubricant file")
@@ -309,7 +309,7 @@ def overlay_calibration(bearing: Section, calibration: Section) -> Section:
 
 
 @functools.lru_cache(maxsize=8)
-def _traction_table(p: "BearingParameters") -> np.ndarray:
+def _traction_table(p: BearingParameters) -> np.ndarray:
     lub = p.lubricant
     assert lub is not None
     dw, dm, a0 = p.ball_diameter, p.pitch_diameter, p.contact_angle
@@ -334,7 +334,7 @@ def _traction_table(p: "BearingParameters") -> np.ndarray:
     )
 
 
-def traction_table(p: "BearingParameters") -> np.ndarray:
+def traction_table(p: BearingParameters) -> np.ndarray:
     """The rheology traction table of a bearing (:func:`.traction.build_table`), built once per
     distinct geometry and film rheology (the grease's bulk rheology and the resistances do not
     enter it; a copy is returned)."""

@@ -118,7 +118,7 @@ class BearingKinematics:
         return float(out[0]) if scalar else out
 
     @overload
-    def slip_rate(self, cage_speed: float, inner_ring_speed: float) -> float: ...
+    def slip_rate(self, cage_speed: float, inner_ring_speed: float) -> float: ...  # type: ignore[overload-overlap]  # a float pair is never an array
     @overload
     def slip_rate(self, cage_speed: FloatArray | float, inner_ring_speed: FloatArray | float) -> FloatArray: ...
     def slip_rate(self, cage_speed: float | FloatArray, inner_ring_speed: float | FloatArray) -> float | FloatArray:

@@ -18,7 +18,7 @@ project's reader therefore decodes leniently, ignoring bytes after the message.
 from __future__ import annotations
 
 import struct
-from typing import Callable
+from typing import Any, Callable, cast
 
 from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
@@ -42,7 +42,7 @@ def has_sequences(typestore: Typestore, msgtype: str, _seen: frozenset[str] = fr
         return False
     seen = _seen | {msgtype}
     for _name, desc in typestore.fielddefs[msgtype][1]:
-        kind, arg = desc
+        kind, arg = cast("tuple[Nodetype, Any]", desc)
         if kind == Nodetype.SEQUENCE:
             return True
         if kind == Nodetype.NAME and has_sequences(typestore, arg, seen):

@@ -19,7 +19,7 @@ import struct
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO, Callable, Iterable, Iterator
+from typing import Any, BinaryIO, Callable, Iterable, Iterator
 
 import lz4.frame
 import zstandard
@@ -117,7 +117,7 @@ class FileIndex:
         return max(0, self.file_size - self.readable_bytes)
 
 
-def _parse(record_type: type, body: bytes):  # noqa: ANN202 - mcap record classes are untyped
+def _parse(record_type: Any, body: bytes) -> Any:  # mcap's record classes carry no type information
     return record_type.read(ReadDataStream(io.BytesIO(body)))
 
 

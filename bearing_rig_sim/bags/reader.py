@@ -27,7 +27,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import Callable, Iterable, Iterator, Literal, NamedTuple
+from typing import Any, Callable, Iterable, Iterator, Literal, NamedTuple, cast
 
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -82,7 +82,8 @@ def _dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
         if name in found or name not in store.fielddefs:
             continue
         found.add(name)
-        for _field, (kind, arg) in store.fielddefs[name][1]:
+        for _field, desc in store.fielddefs[name][1]:
+            kind, arg = cast("tuple[Nodetype, Any]", desc)
             if kind == Nodetype.NAME:
                 todo.append(arg)
             elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:

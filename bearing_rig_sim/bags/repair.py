@@ -23,7 +23,7 @@ import os
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import IO, Any, Literal, cast
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 
@@ -139,7 +139,7 @@ def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) 
     if target.exists():
         target.unlink()
     sink = CountingSink(target)
-    writer = Writer(sink, chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
+    writer = Writer(cast(IO[Any], sink), chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
     try:
         writer.start(profile=index.profile or "ros2", library=index.library or f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
         for name, values in index.metadata.items():

@@ -30,7 +30,7 @@ import operator
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import Callable, Literal
+from typing import IO, Any, Callable, Literal, cast
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from rosbags.typesys.store import Typestore
@@ -357,7 +357,7 @@ class BagWriter:
             log_time = self._last_time + 1
             self._nudged += 1
         assert mcap is not None
-        mcap.add_message(entry.channel_id, log_time, data, log_time_ns)
+        mcap.add_message(entry.channel_id, log_time, cast(bytes, data), log_time_ns)  # mcap takes any buffer
         self._last_time = log_time
         entry.count += 1
         current = self._files[-1]
@@ -372,7 +372,7 @@ class BagWriter:
     def _start_file(self) -> None:
         name = storage_file_name(self._path, len(self._files))
         self._sink = CountingSink(self._path / name)
-        self._mcap = Writer(self._sink, chunk_size=self._chunk_size, compression=self._compression)
+        self._mcap = Writer(cast(IO[Any], self._sink), chunk_size=self._chunk_size, compression=self._compression)
         self._mcap.start(profile="ros2", library=f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
         self._mcap.add_metadata(RUN_METADATA_RECORD, dict(self._run_context))
         self._schema_ids = {}

@@ -43,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _series(criterion: str, n: int, rate: float) -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng(0)
     if criterion == "time":
-        x = np.arange(1, n + 1) / rate
+        x: np.ndarray = np.arange(1, n + 1) / rate
         params = TABLE7_20
     else:
         x = 50.0 + 5.0 * np.arange(n)

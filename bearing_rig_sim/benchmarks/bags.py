@@ -40,6 +40,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 from collections.abc import Iterator
+from typing import Any
 
 from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
@@ -126,7 +127,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
         slip = 1.0 + 0.5 * after / speeds[-1] + transient_pct * math.exp(-max(t - t0 - 1.0, 0.0) / 2.0)
         return inner, inner * 0.4283 * (1.0 - slip / 100.0)
 
-    def stamp(time_ns: int) -> object:
+    def stamp(time_ns: int) -> Any:
         return types["builtin_interfaces/msg/Time"](sec=time_ns // 10**9, nanosec=time_ns % 10**9)
 
     def pulse(time_ns: int, shaft: str, index: int) -> bytes:
@@ -140,7 +141,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     angles = {SPINDLE_PULSES_TOPIC: 0.0, CAGE_PULSES_TOPIC: 0.0}
     counts = {SPINDLE_PULSES_TOPIC: 0, CAGE_PULSES_TOPIC: 0}
     shafts = {SPINDLE_PULSES_TOPIC: "spindle", CAGE_PULSES_TOPIC: "cage"}
-    status = store.types["bearing_rig_msgs/msg/SlipStatus"](
+    status: Any = store.types["bearing_rig_msgs/msg/SlipStatus"](
         header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
         theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
         confidence=0.9, window_revolutions=1, detail="1-term Gaussian fit of 300 points; slope -0.001 %/s >= k = -0.03 %/s",

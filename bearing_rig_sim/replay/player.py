@@ -37,7 +37,7 @@ import time
 import warnings
 from dataclasses import dataclass, field
 from types import TracebackType
-from typing import Any, Literal, Protocol
+from typing import Any, Literal, Protocol, cast
 from collections.abc import Iterable, Iterator
 
 from bearing_rig_sim.config import ConfigError, check_number
@@ -233,7 +233,7 @@ def replay_bag(
         if options.max_loops is not None and loop >= options.max_loops:
             break
         messages: Iterator[tuple[int, int, str, bytes]] = (
-            (m.log_time_ns, 1, m.topic, m.message) for m in bag.messages(selected, start_ns=first, stop_ns=stop, raw=True)
+            (m.log_time_ns, 1, m.topic, cast(bytes, m.message)) for m in bag.messages(selected, start_ns=first, stop_ns=stop, raw=True)
         )
         if publish_clock and not bag_clock:
             messages = heapq.merge(_clock_ticks(first + period_ns, last, period_ns), messages)

@@ -174,7 +174,7 @@ def rig_traffic(
     steps = int(round(duration_s * 1000))
     pack_into = struct.pack_into
 
-    def header(time_ns: int, frame: str) -> object:
+    def header(time_ns: int, frame: str) -> Any:
         stamp = types["builtin_interfaces/msg/Time"](sec=time_ns // 10**9, nanosec=time_ns % 10**9)
         return types["std_msgs/msg/Header"](stamp=stamp, frame_id=frame)
 

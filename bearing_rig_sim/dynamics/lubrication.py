@@ -17,9 +17,11 @@ slide-to-roll ratio) is integrated over the Hertz ellipse in :mod:`.traction`.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, cast
 
 from bearing_rig_sim.config import Section, config_path, load_yaml
 
@@ -148,9 +150,7 @@ class Lubricant:
 
     def replace_rheology(self, **changes: float) -> Lubricant:
         """A copy with some numeric fields changed (calibrated values)."""
-        import dataclasses
-
-        return dataclasses.replace(self, **changes)
+        return dataclasses.replace(self, **cast(dict[str, Any], changes))
 
 
 def roelands_viscosity(eta0: float, z: float, pressure: float) -> float:

@@ -23,6 +23,7 @@ import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 
@@ -202,7 +203,7 @@ class BearingParameters:
 
     def replace(self, **changes: object) -> BearingParameters:
         """A copy with some fields changed (e.g. calibrated scale factors)."""
-        return dataclasses.replace(self, **changes)
+        return dataclasses.replace(self, **cast(dict[str, Any], changes))
 
     def without_resistances(self) -> BearingParameters:
         """All slip-causing resistances off: no drag, no cage land or pocket friction, no

@@ -143,17 +143,18 @@ def traction_coefficient(p: np.ndarray, s: float, entrainment: float) -> tuple[f
 
 
 @njit(cache=True)
-def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float]:
-    """Traction coefficient, d mu/ds (s/m) and dissipated power (W) of raceway contact
-    ``contact`` (0 inner, 1 outer) at sliding velocity ``s`` (m/s), entrainment speed (m/s) and
-    load (N). Model 2 interpolates the rheology table (spin and Heathcote losses included in
-    the power); models 0 and 1 dissipate |F s|."""
+def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
+    """Traction coefficient, d mu/ds (s/m), dissipated power (W) and Houpert rolling force (N)
+    of raceway contact ``contact`` (0 inner, 1 outer) at sliding velocity ``s`` (m/s),
+    entrainment speed (m/s) and load (N). Model 2 interpolates the rheology table (spin and
+    Heathcote losses included in the power); models 0 and 1 dissipate |F s| and leave the
+    rolling force to :func:`spin_resistance` (0 here)."""
     if p[P_FRIC_MODEL] == 2.0:
         ue = max(entrainment, 1e-3)
-        mu, slope, pw = table_lookup(p, int(p[P_TABLE]), contact, s / ue, ue, load)
-        return mu, slope / ue, pw * load * ue
+        mu, slope, pw, rolling = table_lookup(p, int(p[P_TABLE]), contact, s / ue, ue, load)
+        return mu, slope / ue, pw * load * ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
-    return mu, dmu, abs(mu * load * s)
+    return mu, dmu, abs(mu * load * s), 0.0
 
 
 @njit(cache=True)
@@ -337,12 +338,13 @@ def spin_resistance(p: np.ndarray, di: float, do: float, fpocket: float, omega_r
     """Moment (N m) resisting the ball's rolling: elastic hysteresis (3/16) alpha_h Q b at both
     raceways (written with the penetrations: Q b = b(1 N) K^(4/3) delta^2), Houpert's EHL
     rolling force F_R = c u^0.66 Q^0.47 at both raceways with the lever R (u = R |omega_roll|,
-    Q = K delta^1.5), plus pocket friction mu_p |F_p| R, with a smoothed sign of the rolling
+    Q = K delta^1.5; with the rheology model the steppers add it from the contacts' entrainment
+    speeds instead), plus pocket friction mu_p |F_p| R, with a smoothed sign of the rolling
     speed."""
     dip, dop = max(di, 0.0), max(do, 0.0)
     hyst = p[P_HYST_IN] * dip**2 + p[P_HYST_OUT] * dop**2
     r = p[P_RBALL]
-    if p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0:
+    if p[P_FRIC_MODEL] != 2.0 and (p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0):  # model 2: from the table lookup
         u066 = (r * abs(omega_roll)) ** 0.66
         qi = p[P_K_IN] * dip * math.sqrt(dip)
         qo = p[P_K_OUT] * dop * math.sqrt(dop)
@@ -390,8 +392,9 @@ def cage_land_torque(p: np.ndarray, omega: float, z: int) -> tuple[float, float]
     dt = (p[P_LAND_COULOMB] * q * q * q / SPIN_SIGN_SPEED + p[P_LAND_VISC]) / z
     if p[P_LAND_POW] > 0.0:
         a = max(abs(omega), SPIN_SIGN_SPEED)
-        t += p[P_LAND_POW] * a ** p[P_LAND_N] * y * q / z
-        dt += p[P_LAND_POW] * p[P_LAND_N] * a ** (p[P_LAND_N] - 1.0) / z
+        an = math.sqrt(a) if p[P_LAND_N] == 0.5 else a ** p[P_LAND_N]
+        t += p[P_LAND_POW] * an * y * q / z
+        dt += p[P_LAND_POW] * p[P_LAND_N] * an / a / z
     return t, dt
 
 
@@ -406,18 +409,19 @@ def link_strain(cage: np.ndarray, k: int, z: int) -> float:
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
-    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta): traction
-    forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for the
-    implicit step), sliding velocities (m/s) and the lever arms of :func:`ball_kinematics`.
+    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll):
+    traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for
+    the implicit step), sliding velocities (m/s), the lever arms of :func:`ball_kinematics` and
+    the sum of the two contacts' Houpert rolling forces (N; model 2 only, else 0).
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
     wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
-    mui, dmui, _ = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    muo, dmuo, _ = contact_traction(p, 1, so, abs(wm * r_co), qo)
-    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb
+    mui, dmui, _, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    muo, dmuo, _, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
+    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
 
 
 @njit(cache=True)
@@ -444,8 +448,8 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 def ball_power(p: np.ndarray, wm: float, rb: float, omega_i: float, qi: float, qo: float, si: float, so: float, r_ci: float, r_co: float, mres: float, omega_roll: float, fd: float) -> float:
     """Power (W) dissipated at ball j: both raceway contacts (sliding, spin and Heathcote
     losses), the rolling-resistance and pocket moments on its rolling, and its drag."""
-    _, _, pi = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    _, _, po = contact_traction(p, 1, so, abs(wm * r_co), qo)
+    _, _, pi, _ = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    _, _, po, _ = contact_traction(p, 1, so, abs(wm * r_co), qo)
     return pi + po + abs(mres * omega_roll) + abs(fd * rb * wm)
 
 
@@ -460,9 +464,10 @@ def ball_drag(p: np.ndarray, v: float) -> tuple[float, float]:
         y = v / DRAG_SIGN_SPEED
         q = 1.0 / math.sqrt(1.0 + y * y)
         a = max(abs(v), DRAG_SIGN_SPEED)
-        plastic = p[P_DRAG_YIELD] + p[P_DRAG_POW] * a ** p[P_DRAG_N]
+        an = math.sqrt(a) if p[P_DRAG_N] == 0.5 else a ** p[P_DRAG_N]
+        plastic = p[P_DRAG_YIELD] + p[P_DRAG_POW] * an
         f += plastic * y * q
-        df += plastic * q * q * q / DRAG_SIGN_SPEED + p[P_DRAG_POW] * p[P_DRAG_N] * a ** (p[P_DRAG_N] - 1.0)
+        df += plastic * q * q * q / DRAG_SIGN_SPEED + p[P_DRAG_POW] * p[P_DRAG_N] * an / a
     return f, df
 
 
@@ -526,12 +531,12 @@ def step_reduced(
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm)
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
             gm = rb * (fi + fo - fd) - rm * fs
             ga = r * (ci * fi - co * fo) - mres
             jmm = rb * (-kti * aim - kto * aom - dfd * rb)
@@ -632,11 +637,11 @@ def step_stiff(
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
-            mres = spin_resistance(p, di, do, fs, wa + cb * wm)
+            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
             # momenta at the current positions (p_theta first: p_r's update needs it)
             ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
             wnew = ptheta / (m * rb * rb)

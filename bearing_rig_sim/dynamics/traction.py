@@ -177,10 +177,11 @@ def build_table(
 
 
 @njit(cache=True)
-def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float]:
+def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float, float]:
     """Interpolate a traction table stored in ``t`` from index ``base``: returns
-    (mu, d mu / d SRR, P / (Q u_e)) for ``contact`` (0 inner, 1 outer). Trilinear in
-    (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges."""
+    (mu, d mu / d SRR, P / (Q u_e), u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer).
+    Trilinear in (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last
+    value is the speed-load factor of Houpert's rolling force, from the same logarithms."""
     ns = int(t[base])
     nu = int(t[base + 1])
     nq = int(t[base + 2])
@@ -188,8 +189,10 @@ def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: floa
     dxi = 2.0 * xi_max / (ns - 1)
     xi = math.asinh(srr / SRR_REF)
     fs = min(max((xi + xi_max) / dxi, 0.0), ns - 1.000001)
-    fu = min(max((math.log(max(speed, 1e-9)) - t[base + 4]) / t[base + 5], 0.0), nu - 1.000001)
-    fq = min(max((math.log(max(load, 1e-9)) - t[base + 6]) / t[base + 7], 0.0), nq - 1.000001)
+    lu = math.log(max(speed, 1e-9))
+    lq = math.log(max(load, 1e-9))
+    fu = min(max((lu - t[base + 4]) / t[base + 5], 0.0), nu - 1.000001)
+    fq = min(max((lq - t[base + 6]) / t[base + 7], 0.0), nq - 1.000001)
     i_s, i_u, i_q = int(fs), int(fu), int(fq)
     ws, wu, wq = fs - i_s, fu - i_u, fq - i_q
     size = ns * nu * nq
@@ -206,4 +209,5 @@ def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: floa
             pw += cq * cu * ((1.0 - ws) * t[k + 2 * size] + ws * t[k + 2 * size + 1])
     mu = mu0 + ws * (mu1 - mu0)
     slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
-    return mu, slope, pw
+    rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
+    return mu, slope, pw, rolling

@@ -160,3 +160,16 @@ def test_calibrated_value_outside_its_physical_range_is_refused() -> None:
     check_in_range({"yield_stress": 600.0, "consistency": 50.0})
     with pytest.raises(CalibrationError, match="consistency"):
         check_in_range({"yield_stress": 600.0, "consistency": 207.0})
+
+
+def test_cage_weight_loads_the_land_only_with_a_horizontal_spindle(bearing: BearingParameters) -> None:
+    """Vertical axis (the bench, docs/paper.md section 8): the land carries no cage weight;
+    horizontal: boundary torque mu m_c g r_land more."""
+    from bearing_rig_sim.dynamics import derive
+    from bearing_rig_sim.dynamics import kernels as kn
+
+    assert bearing.spindle_axis == "vertical"
+    v_vert, geo = derive(bearing)
+    v_hor, _ = derive(bearing.replace(spindle_axis="horizontal"))
+    extra = bearing.cage_land_friction * geo.cage_mass * 9.80665 * 0.5 * bearing.cage_outer_diameter
+    assert v_hor[kn.P_LAND_COULOMB] - v_vert[kn.P_LAND_COULOMB] == pytest.approx(extra, rel=1e-9)

@@ -107,6 +107,7 @@ class BearingParameters:
     lubricant_temperature: float = 40.0
     ehl_rolling_scale: float = 1.0
     composite_roughness: float = 0.0
+    spindle_axis: str = "horizontal"
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -195,6 +196,7 @@ class BearingParameters:
             lubricant_temperature=temperature,
             ehl_rolling_scale=res.number("ehl_rolling_scale", ge=0.0, default=1.0),
             composite_roughness=g.number("composite_roughness_rq_m", ge=0.0, lt=1e-5, default=0.0),
+            spindle_axis=doc.section("installation", default={}).choice("spindle_axis", SPINDLE_AXES, default="horizontal"),
             source=doc.source,
         )
         if friction_model == "rheology" and lubricant is None:
@@ -240,6 +242,12 @@ class BearingParameters:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
 
+
+SPINDLE_AXES = ("horizontal", "vertical")
+"""Orientation of the bearing axis: with a horizontal axis the cage's weight presses it on its
+land (boundary friction mu m_c g r); with a vertical axis the weight acts along the axis and the
+land carries none of it (the balls' and cage's weights, about 0.2 N, are negligible against the
+axial load and are not added to it)."""
 
 FRICTION_MODELS = {"paper": 0.0, "coulomb_step": 0.0, "ehl_traction": 1.0, "rheology": 2.0}
 """Traction laws (``friction.model``) and their kernel codes: ``paper`` (alias ``coulomb_step``)
@@ -430,7 +438,8 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
         drag_quad = p.ball_drag_scale * 0.5 * rho_mix * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
         land_visc = p.cage_land_viscous_scale * fill * 2.0 * math.pi * p.oil_viscosity * r_land**3 * p.land_width / p.land_clearance
         land_yield = 0.0
-    land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_mass * GRAVITY * r_land
+    cage_weight_on_land = cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
+    land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_weight_on_land * r_land
     b_in = inner.semi_axes(1.0)[1]
     b_out = outer.semi_axes(1.0)[1]
 

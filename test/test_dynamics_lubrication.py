@@ -114,7 +114,7 @@ def test_gyroscopic_moment_of_the_rolling_ball(bearing: BearingParameters, rpm: 
 
 def test_traction_is_odd_bounded_and_tabulated_faithfully(bearing: BearingParameters) -> None:
     """Without spin and Heathcote slip the traction is odd in SRR, rises with |SRR| and stays
-    below the limiting shear coefficient; the table interpolates the direct integral to 2 %."""
+    below the limiting shear coefficient; with them a small offset remains at zero centre slip."""
     lub = bearing.lubricant
     assert lub is not None
     inner, _ = raceway_contacts(DW, DM, A0, FI, FO, 208e9, 0.3, 208e9, 0.3)
@@ -131,6 +131,45 @@ def test_traction_is_odd_bounded_and_tabulated_faithfully(bearing: BearingParame
     table = traction_table(bearing)
     grid_mu = table_lookup(table, 0, 0, 0.0, 1.0, 22.0)[0]
     assert abs(grid_mu) < 0.01  # Heathcote and spin give a small offset at zero centre slip
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_traction_table_returns_the_direct_integral_at_its_nodes(bearing: BearingParameters, contact: int) -> None:
+    """At a node of the table (load, speed, SRR) the lookup equals the ellipse integral with the
+    contact's film, spin and Heathcote coefficients (checks the layout and the interpolation);
+    half-way between two SRR nodes it lies between them."""
+    from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
+    from bearing_rig_sim.dynamics.traction import ContactKinematics, spin_and_heathcote, table_power
+
+    lub = bearing.lubricant
+    assert lub is not None
+    t = traction_table(bearing)
+    ns, nu_, nq = int(t[0]), int(t[1]), int(t[2])
+    iq, iu, i_s = 5, 6, 70
+    q = math.exp(t[6] + iq * t[7])
+    u = math.exp(t[4] + iu * t[5])
+    xi_max = t[3]
+    srr = 1e-5 * math.sinh(-xi_max + i_s * 2 * xi_max / (ns - 1))
+    inner, outer = raceway_contacts(DW, DM, A0, FI, FO, 208e9, 0.3, 208e9, 0.3)
+    hz = inner if contact == 0 else outer
+    gamma = DW * math.cos(A0) / DM
+    rx = DW / 2 * (1 - gamma) if contact == 0 else DW / 2 * (1 + gamma)
+    k_n = 1.0 / (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** 1.5
+    a = harris_thrust_angle(q * Z * math.sin(A0), Z, A0, FI + FO - 1, DW, k_n)
+    a = harris_thrust_angle(q * Z * math.sin(a), Z, A0, FI + FO - 1, DW, k_n)
+    spin, kh = spin_and_heathcote(ContactKinematics(hz, rx, (FI if contact == 0 else FO) * DW, contact == 0), a, DW, DM)
+    semi_a, semi_b = hz.semi_axes(q)
+    film = film_thickness(lub, bearing.lubricant_temperature, hz.reduced_modulus, rx, hz.ellipticity, semi_b, hz.max_pressure(q), u, q)
+    args = (hz.max_pressure(q), semi_a, semi_b, film.central, lub.dynamic_viscosity(bearing.lubricant_temperature), lub.roelands_index(bearing.lubricant_temperature),
+            lub.eyring_stress, lub.limiting_shear_coefficient, lub.shear_modulus, u)
+    mu, pw = ellipse_traction(*args, srr, spin, kh)
+    assert table_lookup(t, 0, contact, srr, u, q)[0] == pytest.approx(mu, rel=1e-6, abs=1e-12)
+    assert table_power(t, 0, contact, srr, u, q) == pytest.approx(pw, rel=1e-6, abs=1e-15)
+    srr_next = 1e-5 * math.sinh(-xi_max + (i_s + 1) * 2 * xi_max / (ns - 1))
+    mid = 1e-5 * math.sinh(-xi_max + (i_s + 0.5) * 2 * xi_max / (ns - 1))
+    mu_next, _ = ellipse_traction(*args, srr_next, spin, kh)
+    assert min(mu, mu_next) <= table_lookup(t, 0, contact, mid, u, q)[0] <= max(mu, mu_next)
+    assert nu_ > iu and nq > iq
 
 
 def test_twin_torque_within_factor_two_of_the_skf_model_oil_air(bearing: BearingParameters) -> None:

@@ -34,7 +34,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.traction import table_lookup
+from bearing_rig_sim.dynamics.traction import table_lookup, table_power
 
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
@@ -143,18 +143,28 @@ def traction_coefficient(p: np.ndarray, s: float, entrainment: float) -> tuple[f
 
 
 @njit(cache=True)
-def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
-    """Traction coefficient, d mu/ds (s/m), dissipated power (W) and Houpert rolling force (N)
-    of raceway contact ``contact`` (0 inner, 1 outer) at sliding velocity ``s`` (m/s),
-    entrainment speed (m/s) and load (N). Model 2 interpolates the rheology table (spin and
-    Heathcote losses included in the power); models 0 and 1 dissipate |F s| and leave the
-    rolling force to :func:`spin_resistance` (0 here)."""
+def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float]:
+    """Traction coefficient, d mu/ds (s/m) and Houpert rolling force (N) of raceway contact
+    ``contact`` (0 inner, 1 outer) at sliding velocity ``s`` (m/s), entrainment speed (m/s) and
+    load (N). Model 2 interpolates the rheology table; models 0 and 1 use
+    :func:`traction_coefficient` and leave the rolling force to :func:`spin_resistance` (0)."""
     if p[P_FRIC_MODEL] == 2.0:
         ue = max(entrainment, 1e-3)
-        mu, slope, pw, rolling = table_lookup(p, int(p[P_TABLE]), contact, s / ue, ue, load)
-        return mu, slope / ue, pw * load * ue, p[P_FR_IN + contact] * rolling
+        mu, slope, rolling = table_lookup(p, int(p[P_TABLE]), contact, s / ue, ue, load)
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
-    return mu, dmu, abs(mu * load * s), 0.0
+    return mu, dmu, 0.0
+
+
+@njit(cache=True)
+def contact_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> float:
+    """Power (W) dissipated at a raceway contact: the rheology table's sliding, spin and
+    Heathcote losses (model 2), else |mu Q s|."""
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        return table_power(p, int(p[P_TABLE]), contact, s / ue, ue, load) * load * ue
+    mu, _ = traction_coefficient(p, s, entrainment)
+    return abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -419,8 +429,8 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
-    mui, dmui, _, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    muo, dmuo, _, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
+    mui, dmui, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    muo, dmuo, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
     return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
 
 
@@ -448,8 +458,8 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 def ball_power(p: np.ndarray, wm: float, rb: float, omega_i: float, qi: float, qo: float, si: float, so: float, r_ci: float, r_co: float, mres: float, omega_roll: float, fd: float) -> float:
     """Power (W) dissipated at ball j: both raceway contacts (sliding, spin and Heathcote
     losses), the rolling-resistance and pocket moments on its rolling, and its drag."""
-    _, _, pi, _ = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    _, _, po, _ = contact_traction(p, 1, so, abs(wm * r_co), qo)
+    pi = contact_power(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    po = contact_power(p, 1, so, abs(wm * r_co), qo)
     return pi + po + abs(mres * omega_roll) + abs(fd * rb * wm)
 
 

@@ -177,11 +177,9 @@ def build_table(
 
 
 @njit(cache=True)
-def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float, float]:
-    """Interpolate a traction table stored in ``t`` from index ``base``: returns
-    (mu, d mu / d SRR, P / (Q u_e), u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer).
-    Trilinear in (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last
-    value is the speed-load factor of Houpert's rolling force, from the same logarithms."""
+def _table_position(t: np.ndarray, base: int, srr: float, speed: float, load: float) -> tuple[int, int, int, float, float, float, float, float]:
+    """Cell indices and weights of (asinh(SRR/SRR_REF), ln u_e, ln Q) in a table, clamped at
+    its edges, and ln u_e, ln Q."""
     ns = int(t[base])
     nu = int(t[base + 1])
     nq = int(t[base + 2])
@@ -194,11 +192,21 @@ def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: floa
     fu = min(max((lu - t[base + 4]) / t[base + 5], 0.0), nu - 1.000001)
     fq = min(max((lq - t[base + 6]) / t[base + 7], 0.0), nq - 1.000001)
     i_s, i_u, i_q = int(fs), int(fu), int(fq)
-    ws, wu, wq = fs - i_s, fu - i_u, fq - i_q
-    size = ns * nu * nq
+    return i_s, i_u, i_q, fs - i_s, fu - i_u, fq - i_q, lu, lq
+
+
+@njit(cache=True)
+def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float]:
+    """Interpolate a traction table stored in ``t`` from index ``base``: returns
+    (mu, d mu / d SRR, u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer). Trilinear in
+    (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last value is the
+    speed-load factor of Houpert's rolling force, from the same logarithms."""
+    ns = int(t[base])
+    nu = int(t[base + 1])
+    size = ns * nu * int(t[base + 2])
+    i_s, i_u, i_q, ws, wu, wq, lu, lq = _table_position(t, base, srr, speed, load)
     mu0 = 0.0
     mu1 = 0.0
-    pw = 0.0
     for dq in range(2):
         cq = wq if dq == 1 else 1.0 - wq
         for du in range(2):
@@ -206,8 +214,25 @@ def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: floa
             k = base + HEADER + contact * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s
             mu0 += cq * cu * t[k]
             mu1 += cq * cu * t[k + 1]
-            pw += cq * cu * ((1.0 - ws) * t[k + 2 * size] + ws * t[k + 2 * size + 1])
     mu = mu0 + ws * (mu1 - mu0)
+    dxi = 2.0 * t[base + 3] / (ns - 1)
     slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
     rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
-    return mu, slope, pw, rolling
+    return mu, slope, rolling
+
+
+@njit(cache=True)
+def table_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
+    """Interpolated dissipation P / (Q u_e) of ``contact`` (same grid as :func:`table_lookup`)."""
+    ns = int(t[base])
+    nu = int(t[base + 1])
+    size = ns * nu * int(t[base + 2])
+    i_s, i_u, i_q, ws, wu, wq, _, _ = _table_position(t, base, srr, speed, load)
+    pw = 0.0
+    for dq in range(2):
+        cq = wq if dq == 1 else 1.0 - wq
+        for du in range(2):
+            cu = wu if du == 1 else 1.0 - wu
+            k = base + HEADER + (2 + contact) * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s
+            pw += cq * cu * ((1.0 - ws) * t[k] + ws * t[k + 1])
+    return pw

@@ -46,6 +46,7 @@ from bearing_rig_sim.monitoring import (
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
+    PULSE_READER_QOS,
     WARN,
     diagnostic_array,
     diagnostic_status,
@@ -55,6 +56,7 @@ from bearing_rig_sim.nodes.common import (
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WARN, SlipState.FAULT: ERROR}
@@ -82,11 +84,12 @@ class MonitorNode(Node):
         # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
         self._status_pub = self.create_publisher(SlipStatus, SLIP_STATUS.name, qos_profile(SLIP_STATUS))
         self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         for shaft, topic in PULSE_TOPICS.items():
-            self.create_subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), qos_profile(topic))
+            self.create_subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
         if self.settings.criterion == "axial_load":
             self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)

@@ -24,9 +24,8 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import yaml
-
 from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.config import ConfigError, parse_yaml
 from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
@@ -143,18 +142,18 @@ def program_segment_names(run_metadata: dict[str, str]) -> list[str]:
     """Segment names of the run's test program (run context key ``program``); [] when absent or
     unreadable."""
     try:
-        doc = yaml.safe_load(run_metadata.get("program", "") or "")
+        doc = parse_yaml(run_metadata.get("program", "") or "", "run context: program")
         return [str(s.get("name", "")) for s in doc["segments"]]
-    except (yaml.YAMLError, TypeError, KeyError, AttributeError):
+    except (ConfigError, TypeError, KeyError, AttributeError):
         return []
 
 
 def program_criterion(run_metadata: dict[str, str]) -> str:
     """The run's test program's ``stability_criterion`` ("" when absent or unreadable)."""
     try:
-        doc = yaml.safe_load(run_metadata.get("program", "") or "")
+        doc = parse_yaml(run_metadata.get("program", "") or "", "run context: program")
         return str(doc.get("stability_criterion", "") or "")
-    except (yaml.YAMLError, AttributeError):
+    except (ConfigError, AttributeError):
         return ""
 
 

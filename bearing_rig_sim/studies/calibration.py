@@ -138,6 +138,8 @@ def read_bench_csv(path: str | Path) -> list[BenchPoint]:
         lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     except OSError as exc:
         raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     reader = csv.DictReader(lines)
     need = ("inner_ring_rpm", "axial_load_n", "slip_pct")
     if reader.fieldnames is None or any(k not in reader.fieldnames for k in need):

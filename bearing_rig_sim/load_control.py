@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.loading import ClutchState, LoadChainState, LoadingChain, LoadingChainConfig, SetpointError
 
 __all__ = [
@@ -63,22 +64,6 @@ class SetpointSource(str, Enum):
     TOPIC = "topic"
     SERVICE = "service"
     PARAMETER = "parameter"
-
-
-class HealthLevel(str, Enum):
-    """Level of the load controller's diagnostic status; compares equal to its string value."""
-
-    OK = "ok"
-    WARN = "warn"
-    ERROR = "error"
-
-
-@dataclass(frozen=True)
-class Health:
-    """What ``/diagnostics`` says about the load controller."""
-
-    level: HealthLevel
-    message: str
 
 
 @dataclass(frozen=True)
@@ -155,7 +140,7 @@ class AxialLoadOperation:
         self._apply_zero_load_rule()
 
     @classmethod
-    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> "AxialLoadOperation":
+    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> AxialLoadOperation:
         """An operation of a new chain built from ``config`` (options as in the constructor)."""
         return cls(LoadingChain(config), **options)  # type: ignore[arg-type]
 
@@ -282,14 +267,14 @@ class AxialLoadOperation:
         health changed" means something happened; the live values go beside it."""
         chain = self.chain
         if chain.fault:
-            return Health(HealthLevel.ERROR, f"interlock: {chain.fault_reason}")
+            return Health(HealthLevel.ERROR, (f"interlock: {chain.fault_reason}",))
         if self._refusal:
-            return Health(HealthLevel.WARN, self._refusal)
+            return Health(HealthLevel.WARN, (self._refusal,))
         if chain.clutch.state is ClutchState.RELEASED:
-            return Health(HealthLevel.OK, f"clutch released; set-point {chain.setpoint:g} N")
+            return Health(HealthLevel.OK, (f"clutch released; set-point {chain.setpoint:g} N",))
         if chain.setpoint == 0.0:
-            return Health(HealthLevel.OK, "set-point 0 N: brake de-energised")
-        return Health(HealthLevel.OK, f"controlling the axial load; set-point {chain.setpoint:g} N")
+            return Health(HealthLevel.OK, ("set-point 0 N: brake de-energised",))
+        return Health(HealthLevel.OK, (f"controlling the axial load; set-point {chain.setpoint:g} N",))
 
     def mark_reported(self, health: Health) -> None:
         """Note that ``health`` was published (diagnostics are due again when it changes)."""

@@ -19,7 +19,7 @@ settle there) or not.
 Time integration stays the reference. The solver falls back to it (:data:`METHOD_INTEGRATION`
 or :data:`METHOD_INTEGRATION_NEWTON`) when Newton does not converge from the starting guess
 or converges to an unstable equilibrium: it then integrates from the same start, as
-:func:`bearing_rig_sim.calibration.steady_state` does, and polishes the settled state by
+:func:`bearing_rig_sim.studies.calibration.steady_state` does, and polishes the settled state by
 Newton where that converges.
 
 The model can hold two stable steady states at one operating point (rolling with creep, and
@@ -335,7 +335,7 @@ class SteadySolver:
 
     def integrate(self, inner_ring_speed: float, axial_load: float) -> SteadyPoint:
         """The reference: integrate from the rolling start for :data:`SETTLE_S`, then average
-        the cage speed over :data:`AVERAGE_S` (as :func:`bearing_rig_sim.calibration.steady_state`)."""
+        the cage speed over :data:`AVERAGE_S` (as :func:`bearing_rig_sim.studies.calibration.steady_state`)."""
         omega, axial_load = self._inputs(inner_ring_speed, axial_load)
         self.engine.initialise(omega, axial_load)
         self.engine.advance(SETTLE_S)

@@ -43,7 +43,7 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
-from typing import Sequence
+from collections.abc import Sequence
 
 from bearing_rig_msgs.msg import AxialLoadState
 from bearing_rig_msgs.srv import SetAxialLoad

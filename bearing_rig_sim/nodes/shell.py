@@ -17,7 +17,8 @@
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, Mapping, TypeVar
+from typing import Any, TypeVar
+from collections.abc import Callable, Mapping
 
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node

@@ -30,14 +30,15 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from enum import Enum
 from pathlib import Path
 from types import FrameType
-from typing import Sequence, TextIO
+from typing import TextIO
+from collections.abc import Sequence
 
 from bearing_rig_sim.config import rad_s_to_rpm
-from bearing_rig_sim.recording import BagWriter
+from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.loading import LoadingChainConfig
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import make_run_id, run_context
@@ -101,7 +102,7 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     commands = {name: node_command(spec) for name, spec in NODES.items()}
     if not options.realtime:
         commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
-    start = datetime.now(timezone.utc)
+    start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)
     env, lease = session_environment(os.environ)
@@ -164,11 +165,11 @@ class _Session:
 
     # -- main -------------------------------------------------------------------------------------
     def run(self) -> int:
-        import rclpy  # noqa: PLC0415 - ROS is needed only once the session really starts
-        from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
-        from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.signals import SignalHandlerOptions
 
-        from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode  # noqa: PLC0415
+        from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode
 
         segments = len(self.program.segments)
         self._event(

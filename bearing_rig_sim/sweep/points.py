@@ -192,7 +192,7 @@ def _continuation_rows(task: SweepTask) -> list[dict[str, Any]]:
 def _transient_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str, Any]:
     from bearing_rig_sim.analysis.gaussian import fit_gaussians  # noqa: PLC0415
     from bearing_rig_sim.analysis.stability import K2_TIME, stable_onset  # noqa: PLC0415
-    from bearing_rig_sim.experiments import acceleration_run  # noqa: PLC0415
+    from bearing_rig_sim.studies.experiments import acceleration_run  # noqa: PLC0415
 
     row = _base_row(point, key, KIND_TRANSIENT)
     try:

@@ -31,13 +31,13 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the sweep, write the table and the map, print a summary."""
-    import pyarrow.parquet as pq  # noqa: PLC0415
+    import pyarrow.parquet as pq
 
-    from bearing_rig_sim.errors import RigError  # noqa: PLC0415
-    from bearing_rig_sim.sweep.operating_map import boundaries, plot_operating_map  # noqa: PLC0415
-    from bearing_rig_sim.sweep.points import INTEGRATE, SOLVE  # noqa: PLC0415
-    from bearing_rig_sim.sweep.runner import run_sweep  # noqa: PLC0415
-    from bearing_rig_sim.sweep.spec import load_spec  # noqa: PLC0415
+    from bearing_rig_sim.errors import RigError
+    from bearing_rig_sim.sweep.operating_map import boundaries, plot_operating_map
+    from bearing_rig_sim.sweep.points import INTEGRATE, SOLVE
+    from bearing_rig_sim.sweep.runner import run_sweep
+    from bearing_rig_sim.sweep.spec import load_spec
 
     if args.workers is not None and args.workers < 1:
         raise RigError(f"--workers must be >= 1, got {args.workers}")

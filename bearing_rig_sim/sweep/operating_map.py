@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -60,10 +61,10 @@ def boundaries(table: Any, threshold_pct: float) -> dict[str, dict[float, float 
 
 def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, factor_kn: float, title: str = "") -> Path:
     """Write the operating map of a steady sweep table as a PNG; return its path."""
-    import matplotlib  # noqa: PLC0415
+    import matplotlib
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
+    import matplotlib.pyplot as plt
 
     branch = np.asarray(table["branch"].to_pylist())
     rpm = np.asarray(table["rpm"].to_pylist(), dtype=float)

@@ -105,7 +105,11 @@ def point_key(point: dict[str, float], branch: str) -> str:
 
 def parameters_for(base: BearingParameters, point: dict[str, float]) -> BearingParameters:
     """``base`` with the point's parameter axes applied."""
-    changes = {AXES[k].parameter: v for k, v in point.items() if AXES[k].parameter is not None}
+    changes: dict[str, object] = {}
+    for name, value in point.items():
+        field = AXES[name].parameter
+        if field is not None:
+            changes[field] = value
     return base.replace(**changes) if changes else base
 
 
@@ -190,9 +194,9 @@ def _continuation_rows(task: SweepTask) -> list[dict[str, Any]]:
 
 
 def _transient_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str, Any]:
-    from bearing_rig_sim.analysis.gaussian import fit_gaussians  # noqa: PLC0415
-    from bearing_rig_sim.analysis.stability import K2_TIME, stable_onset  # noqa: PLC0415
-    from bearing_rig_sim.studies.experiments import acceleration_run  # noqa: PLC0415
+    from bearing_rig_sim.analysis.gaussian import fit_gaussians
+    from bearing_rig_sim.analysis.stability import K2_TIME, stable_onset
+    from bearing_rig_sim.studies.experiments import acceleration_run
 
     row = _base_row(point, key, KIND_TRANSIENT)
     try:

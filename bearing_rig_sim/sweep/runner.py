@@ -19,7 +19,8 @@ import time
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any
+from collections.abc import Callable, Iterator
 
 from bearing_rig_sim import __version__
 from bearing_rig_sim.config import config_path
@@ -142,7 +143,7 @@ def _warm_worker(params: BearingParameters) -> bool:
 
 
 def _progress_bar(total: int, enabled: bool) -> Any:
-    from tqdm import tqdm  # noqa: PLC0415
+    from tqdm import tqdm
 
     return tqdm(total=total, unit="pt", desc="sweep", disable=not enabled, file=sys.stderr, smoothing=0.1)
 
@@ -151,7 +152,7 @@ def open_client(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
     """A Dask client on ``scheduler`` (address) or on a new ``LocalCluster`` of ``workers``
     single-threaded worker processes (default: one per core). Returns (client, cluster or
     None); close both when done."""
-    from distributed import Client, LocalCluster  # noqa: PLC0415
+    from distributed import Client, LocalCluster
 
     if scheduler:
         try:
@@ -206,7 +207,7 @@ def run_sweep(
         if own:
             client, cluster = open_client(scheduler, workers)
         try:
-            from distributed import as_completed  # noqa: PLC0415
+            from distributed import as_completed
 
             n_workers = len(client.scheduler_info().get("workers", {}))
             client.run(_warm_worker, params)
@@ -225,7 +226,7 @@ def run_sweep(
                 if cluster is not None:
                     cluster.close()
     path = table.finish(sort_by=["branch", *spec.axis_names])
-    from pyarrow.parquet import read_metadata  # noqa: PLC0415
+    from pyarrow.parquet import read_metadata
 
     return SweepOutcome(path, read_metadata(path).num_rows, computed, errors, time.perf_counter() - start, n_workers)
 

@@ -192,7 +192,7 @@ def _check_in_range(definition: AxisDefinition, value: float, source: str, key: 
 
 
 def _samples(section: Section) -> tuple[dict[str, float], ...]:
-    from scipy.stats import qmc  # noqa: PLC0415 - only sweeps with samples need it
+    from scipy.stats import qmc
 
     section.reject_unknown(["method", "count", "seed", "ranges"])
     method = section.choice("method", SAMPLE_METHODS)

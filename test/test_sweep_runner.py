@@ -165,3 +165,20 @@ def test_the_same_sweep_on_a_dask_scheduler_and_worker_started_on_localhost(tmp_
                     proc.wait(timeout=20)
                 except subprocess.TimeoutExpired:
                     proc.kill()
+
+
+def test_calibration_points_run_on_the_cluster_named_by_dask_scheduler_address(client: Any) -> None:
+    import dask
+
+    from bearing_rig_sim.config import rpm_to_rad_s
+    from bearing_rig_sim.dynamics import BearingParameters
+    from bearing_rig_sim.studies.calibration import steady_states
+
+    params = BearingParameters.calibrated()
+    points = [(rpm_to_rad_s(n), 100.0) for n in (900.0, 1800.0, 2700.0)]
+    here = steady_states(params, points, workers=1)
+    with dask.config.set({"scheduler-address": client.scheduler.address}):
+        there = steady_states(params, points, workers=2)
+    assert [s.slip_pct for s in there] == [s.slip_pct for s in here]
+    prefixes = client.run_on_scheduler(lambda dask_scheduler: sorted(dask_scheduler.task_prefixes))
+    assert "steady_state_job" in prefixes  # Dask drops the leading underscore of the key prefix

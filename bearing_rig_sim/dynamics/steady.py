@@ -18,9 +18,9 @@ settle there) or not.
 
 Time integration stays the reference. The solver falls back to it (:data:`METHOD_INTEGRATION`
 or :data:`METHOD_INTEGRATION_NEWTON`) when Newton does not converge from the starting guess
-or converges to an unstable equilibrium: it then integrates from the same start, as
-:func:`bearing_rig_sim.studies.calibration.steady_state` does, and polishes the settled state by
-Newton where that converges.
+or converges to an unstable equilibrium: it then integrates from the same start, trying Newton
+on the settling state every few milliseconds, and averages the integration where Newton never
+converges. :meth:`SteadySolver.integrate` is the reference itself.
 
 The model can hold two stable steady states at one operating point (rolling with creep, and
 gross skid); which one is found depends on where the solution starts: from the engine's
@@ -66,11 +66,12 @@ BASIN_S = 0.002
 rolling or in gross skid is decided within about a millisecond (the skid's slip passes 10 %
 in 0.5 ms at the paper's grid points that skid); Newton then skips the slow tail."""
 SETTLE_S = 0.15
-"""Integration fallback: settling time before Newton or averaging, s (as calibration)."""
+"""Integration: settling time before averaging, s. The traction and pocket dynamics settle in a
+few milliseconds; the margin covers light-load points where the cage takes longer."""
 FALLBACK_CHUNK_S = 0.005
 """Integration fallback: Newton is tried again after each chunk of this length, s."""
 AVERAGE_S = 0.05
-"""Integration fallback: averaging window when Newton cannot polish, s."""
+"""Integration: averaging window of the steady cage speed, s."""
 
 _CONVERGED, _UNSTABLE, _NOT_CONVERGED = 0, 1, 2
 _STEP_TOL = 1e-11
@@ -99,23 +100,14 @@ def _load_state(x: np.ndarray, omega_i: float, rm: float, base_ball: np.ndarray,
 
 
 @njit(cache=True)
-def _residual(
-    p: np.ndarray,
-    x: np.ndarray,
-    omega_i: float,
-    load: float,
-    h: float,
-    base_ball: np.ndarray,
-    base_ring: np.ndarray,
-    ball: np.ndarray,
-    cage: np.ndarray,
-    ring: np.ndarray,
-    out: np.ndarray,
-    stats: np.ndarray,
-    work: np.ndarray,
-    g: np.ndarray,
-) -> None:
-    """g = (step_h(x) - x) / h, averaged over balls and pockets (they are identical)."""
+def _residual(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float, arrays: tuple, g: np.ndarray) -> None:
+    """g = (step_h(x) - x) / h, averaged over balls and pockets (they are identical).
+
+    ``arrays`` = (base_ball, base_ring, ball, cage, ring, out, stats, work): the ball positions
+    and ring state to start each step from (the warm start of the normal-contact solution),
+    then the engine-shaped arrays the step works in (see :mod:`.kernels`).
+    """
+    base_ball, base_ring, ball, cage, ring, out, stats, work = arrays
     rm = p[kn.P_RM]
     _load_state(x, omega_i, rm, base_ball, base_ring, ball, cage, ring)
     kn.step_reduced(p, ball, cage, ring, out, stats, work, 1, h, load, 0.0, 0)
@@ -137,23 +129,18 @@ def _residual(
 
 
 @njit(cache=True)
-def _newton(
-    p: np.ndarray,
-    x: np.ndarray,
-    omega_i: float,
-    load: float,
-    h: float,
-    base_ball: np.ndarray,
-    base_ring: np.ndarray,
-    ball: np.ndarray,
-    cage: np.ndarray,
-    ring: np.ndarray,
-    out: np.ndarray,
-    stats: np.ndarray,
-    work: np.ndarray,
-    max_iter: int,
-) -> tuple[int, int, float]:
-    """Damped Newton on the step residual from ``x`` (updated in place).
+def _keep_warm_start(arrays: tuple) -> None:
+    """The normal-contact solution of the last residual step becomes the next warm start."""
+    base_ball, base_ring, ball, ring = arrays[0], arrays[1], arrays[2], arrays[4]
+    base_ball[:, kn.B_R] = ball[:, kn.B_R]
+    base_ball[:, kn.B_Z] = ball[:, kn.B_Z]
+    base_ring[kn.R_DELTA] = ring[kn.R_DELTA]
+
+
+@njit(cache=True)
+def _newton(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float, arrays: tuple, max_iter: int) -> tuple[int, int, float]:
+    """Damped Newton on the step residual from ``x`` (updated in place); ``arrays`` as for
+    :func:`_residual`, its base ball positions and ring state updated to each accepted iterate.
 
     Returns (status, iterations, largest real part of the Jacobian's eigenvalues, 1/s).
     """
@@ -167,11 +154,8 @@ def _newton(
     gt = np.zeros(4)
     jac = np.zeros((4, 4))
     xt = np.zeros(4)
-    _residual(p, x, omega_i, load, h, base_ball, base_ring, ball, cage, ring, out, stats, work, g)
-    # keep the quasi-static normal solution of the current iterate as the next warm start
-    base_ball[:, kn.B_R] = ball[:, kn.B_R]
-    base_ball[:, kn.B_Z] = ball[:, kn.B_Z]
-    base_ring[kn.R_DELTA] = ring[kn.R_DELTA]
+    _residual(p, x, omega_i, load, h, arrays, g)
+    _keep_warm_start(arrays)
     norm = np.max(np.abs(g * rscale))
     converged = False
     it = 0
@@ -181,7 +165,7 @@ def _newton(
             e = 1e-7 * scale[k]
             xt[:] = x
             xt[k] += e
-            _residual(p, xt, omega_i, load, h, base_ball, base_ring, ball, cage, ring, out, stats, work, gt)
+            _residual(p, xt, omega_i, load, h, arrays, gt)
             jac[:, k] = (gt - g) / e
         if not np.all(np.isfinite(jac)):
             return _NOT_CONVERGED, it, 0.0
@@ -198,7 +182,7 @@ def _newton(
         new_norm = norm
         for _ in range(12):
             xt[:] = x + lam * dx
-            _residual(p, xt, omega_i, load, h, base_ball, base_ring, ball, cage, ring, out, stats, work, gt)
+            _residual(p, xt, omega_i, load, h, arrays, gt)
             new_norm = np.max(np.abs(gt * rscale))
             if new_norm <= (1.0 - 1e-4 * lam) * norm:
                 accepted = True
@@ -211,9 +195,7 @@ def _newton(
             x[:] = xt
             g[:] = gt
             norm = new_norm
-            base_ball[:, kn.B_R] = ball[:, kn.B_R]
-            base_ball[:, kn.B_Z] = ball[:, kn.B_Z]
-            base_ring[kn.R_DELTA] = ring[kn.R_DELTA]
+            _keep_warm_start(arrays)
     if not converged:
         return _NOT_CONVERGED, it, 0.0
     eig = np.linalg.eigvals(jac.astype(np.complex128))
@@ -243,7 +225,8 @@ class SteadyPoint:
         method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON` or
             :data:`METHOD_INTEGRATION`.
         iterations: Newton iterations of the last Newton run (0 if none converged).
-        stable: whether the state is a stable equilibrium (Newton) or a settled integration.
+        stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
+            False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
     """
 
     inner_ring_speed: float
@@ -335,7 +318,7 @@ class SteadySolver:
 
     def integrate(self, inner_ring_speed: float, axial_load: float) -> SteadyPoint:
         """The reference: integrate from the rolling start for :data:`SETTLE_S`, then average
-        the cage speed over :data:`AVERAGE_S` (as :func:`bearing_rig_sim.studies.calibration.steady_state`)."""
+        the cage speed over :data:`AVERAGE_S`."""
         omega, axial_load = self._inputs(inner_ring_speed, axial_load)
         self.engine.initialise(omega, axial_load)
         self.engine.advance(SETTLE_S)
@@ -378,10 +361,8 @@ class SteadySolver:
         base_ball = e.ball.copy()
         base_ring = e.ring.copy()
         try:
-            status, iterations, _ = _newton(
-                e.vector, x, omega, load, self.step, base_ball, base_ring,
-                self._ball, self._cage, self._ring, self._out, self._stats, self._work, _MAX_ITER,
-            )  # fmt: skip
+            arrays = (base_ball, base_ring, self._ball, self._cage, self._ring, self._out, self._stats, self._work)
+            status, iterations, _ = _newton(e.vector, x, omega, load, self.step, arrays, _MAX_ITER)
         except np.linalg.LinAlgError:  # a singular Jacobian: no Newton step from here
             return _NOT_CONVERGED, 0
         return int(status), int(iterations)
@@ -390,7 +371,8 @@ class SteadySolver:
         e = self.engine
         # the diagnostics (tractions, angles) at the solution: one residual step from it
         g = np.zeros(4)
-        _residual(e.vector, x, omega, load, self.step, e.ball.copy(), e.ring.copy(), self._ball, self._cage, self._ring, self._out, self._stats, self._work, g)
+        arrays = (e.ball.copy(), e.ring.copy(), self._ball, self._cage, self._ring, self._out, self._stats, self._work)
+        _residual(e.vector, x, omega, load, self.step, arrays, g)
         r = self.params.ball_diameter / 2.0
         r_ci = self._ball[:, kn.B_R] - r * np.cos(self._out[:, kn.O_AI])
         torque = float(np.sum(self._out[:, kn.O_FI] * r_ci))

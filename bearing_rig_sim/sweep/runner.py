@@ -17,6 +17,8 @@ import os
 import sys
 import time
 from collections import defaultdict
+from concurrent.futures import Executor
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -162,6 +164,23 @@ def open_client(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
     n = workers or os.cpu_count() or 1
     cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR)
     return Client(cluster), cluster
+
+
+@contextmanager
+def cluster_executor(workers: int | None = None) -> Iterator[Executor]:
+    """A ``concurrent.futures`` executor on Dask workers, for code written against a process
+    pool (calibration, the paper's experiments): the cluster whose address is in Dask's
+    configuration (``DASK_SCHEDULER_ADDRESS``) if there is one, else a ``LocalCluster`` of
+    ``workers`` processes. Results of ``map`` come in order."""
+    import dask
+
+    client, cluster = open_client(dask.config.get("scheduler-address", None), workers)
+    try:
+        yield client.get_executor(pure=False)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
 
 
 def run_sweep(

@@ -92,3 +92,13 @@ def test_sobol_samples_stay_in_their_range_and_are_reproducible(tmp_path: Path) 
     assert all(100.0 <= v <= 5000.0 for v in values) and len(set(values)) == 16
     assert a.samples == b.samples and a.spec_hash == b.spec_hash
     assert not any(math.isnan(v) for v in values)
+
+
+def test_the_command_refuses_a_bad_spec_in_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from bearing_rig_sim.cli import main
+
+    path = write(tmp_path, HEAD + "grid: {inner_ring_speed_rpm: [1000], axial_load_n: [-5]}\n")
+    assert main(["sweep", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("bearing-rig: error:") and "grid.axial_load_n[0]" in err and "\n" not in err
+    assert not (tmp_path / "out").exists()

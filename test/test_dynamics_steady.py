@@ -15,6 +15,7 @@ from bearing_rig_sim.dynamics.steady import (
     ORIGIN_ROLLING_START,
     STATE_ROLLING,
     STATE_SKID,
+    SteadyPoint,
     SteadySolver,
 )
 
@@ -43,6 +44,19 @@ def integrated_slip(params: BearingParameters, rpm: float, load: float, settle: 
     return float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
 
 
+def engine_in_state(params: BearingParameters, point: SteadyPoint) -> BearingDynamics:
+    """A fresh engine at the point's speed and load, every ball and pocket in the solved state."""
+    engine = BearingDynamics(params)
+    engine.initialise(point.inner_ring_speed, point.axial_load)
+    theta = 2.0 * np.pi * np.arange(params.ball_count) / params.ball_count
+    engine.ball[:, kn.B_THETA] = theta
+    engine.ball[:, kn.B_OMEGA] = point.ball_orbit_speed
+    engine.ball[:, kn.B_SPIN] = point.ball_spin_speed
+    engine.cage[:, kn.C_PHI] = theta - point.pocket_offset / engine.vector[kn.P_RM]
+    engine.cage[:, kn.C_OMEGA] = point.cage_speed
+    return engine
+
+
 def test_solver_agrees_with_integration_across_the_paper_grid(params: BearingParameters, solver: SteadySolver) -> None:
     """The paper's load-sweep grid at 10 N steps (1000-9000 rpm x 50-700 N, 330 points), each
     from the rolling start: the solver's slip within 0.005 pp of the integration's, including
@@ -68,16 +82,7 @@ def test_the_solution_is_an_equilibrium_of_the_integrator(params: BearingParamet
     omega, load = rpm_to_rad_s(3000), 200.0
     point = solver.solve(omega, load)
     assert point.stable
-    engine = BearingDynamics(params)
-    engine.initialise(omega, load)
-    z = params.ball_count
-    rm = engine.vector[kn.P_RM]
-    theta = 2.0 * np.pi * np.arange(z) / z
-    engine.ball[:, kn.B_THETA] = theta
-    engine.ball[:, kn.B_OMEGA] = point.ball_orbit_speed
-    engine.ball[:, kn.B_SPIN] = point.ball_spin_speed
-    engine.cage[:, kn.C_PHI] = theta - point.pocket_offset / rm
-    engine.cage[:, kn.C_OMEGA] = point.cage_speed
+    engine = engine_in_state(params, point)
     avg = engine.advance(0.02)
     assert avg.cage_speed == pytest.approx(point.cage_speed, rel=1e-7)
     assert np.max(np.abs(engine.ball[:, kn.B_OMEGA] - point.ball_orbit_speed)) < 1e-6 * point.ball_orbit_speed
@@ -94,15 +99,7 @@ def test_two_branches_at_one_point_are_both_steady_under_integration(params: Bea
     assert rolling.origin == ORIGIN_ROLLING_START and rolling.state == STATE_ROLLING
     kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
     for branch in (continued, rolling):
-        engine = BearingDynamics(params)
-        engine.initialise(omega, 300.0)
-        z = params.ball_count
-        theta = 2.0 * np.pi * np.arange(z) / z
-        engine.ball[:, kn.B_THETA] = theta
-        engine.ball[:, kn.B_OMEGA] = branch.ball_orbit_speed
-        engine.ball[:, kn.B_SPIN] = branch.ball_spin_speed
-        engine.cage[:, kn.C_PHI] = theta - branch.pocket_offset / engine.vector[kn.P_RM]
-        engine.cage[:, kn.C_OMEGA] = branch.cage_speed
+        engine = engine_in_state(params, branch)
         engine.advance(0.05)
         avg = engine.advance(0.02)
         assert abs(float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed)) - branch.slip_pct) < AGREEMENT_PP

@@ -249,8 +249,3 @@ def run_sweep(
 
     return SweepOutcome(path, read_metadata(path).num_rows, computed, errors, time.perf_counter() - start, n_workers)
 
-
-def run_points_locally(tasks: list[SweepTask]) -> Iterator[dict[str, Any]]:
-    """Evaluate tasks in this process (no cluster), row by row."""
-    for task in tasks:
-        yield from evaluate(task)

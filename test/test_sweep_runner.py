@@ -182,3 +182,22 @@ def test_calibration_points_run_on_the_cluster_named_by_dask_scheduler_address(c
     assert [s.slip_pct for s in there] == [s.slip_pct for s in here]
     prefixes = client.run_on_scheduler(lambda dask_scheduler: sorted(dask_scheduler.task_prefixes))
     assert "steady_state_job" in prefixes  # Dask drops the leading underscore of the key prefix
+
+
+def test_an_interrupted_sweep_resumes_from_the_batches_it_wrote(tmp_path: Path, client: Any) -> None:
+    spec = load_spec(write_spec(tmp_path))
+    out = tmp_path / "out"
+
+    def interrupt(c: Any, done: int) -> None:
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(spec, out, client=client, progress=False, batch=2, on_batch=interrupt)
+    assert not (out / "results.parquet").exists()
+    parts = list((out / "parts").glob("part-*.parquet"))
+    assert len(parts) == 1
+    written = pq.read_table(parts[0]).num_rows
+    assert 0 < written < 12
+    resumed = run_sweep(spec, out, client=client, progress=False, batch=2)
+    assert resumed.computed == 12 - written and resumed.points == 12
+    assert not list((out / "parts").glob("part-*.parquet"))

@@ -16,6 +16,11 @@ formed by finite differences (four more steps). At the solution the eigenvalues 
 Jacobian tell whether the equilibrium is stable (all real parts negative: integration would
 settle there) or not.
 
+The four unknowns are the reduced model's dynamic states (ball centres and the inner ring's
+axial position are quasi-static: the step solves them itself). A dynamic state added to the
+reduced model later must be added to x here; ``test/test_dynamics_steady.py`` compares the
+solver with the integration over the paper's grid and would show the omission.
+
 Time integration stays the reference. The solver falls back to it (:data:`METHOD_INTEGRATION`
 or :data:`METHOD_INTEGRATION_NEWTON`) when Newton does not converge from the starting guess
 or converges to an unstable equilibrium: it then integrates from the same start, trying Newton

@@ -12,9 +12,10 @@ where ``step_h`` is one linearly implicit step (:func:`.kernels.step_reduced`) o
 the symmetric state x. That step is x + (I - h J~)^-1 h f(x) with f the model's right-hand
 side, so g(x) = 0 exactly where f(x) = 0: the solution is the engine's equilibrium under the
 engine's own force laws, whatever they are, and no law is restated here. The Jacobian of g is
-formed by finite differences (four more steps). At the solution the eigenvalues of that
-Jacobian tell whether the equilibrium is stable (all real parts negative: integration would
-settle there) or not.
+formed by finite differences (four more steps). At the solution that Jacobian is
+(I - h J~)^-1 J, and its eigenvalues tell whether integration with step h would settle there
+(all real parts negative) or leave: stability as the reference integrator sees it (an unstable
+mode growing faster than 1/h looks stable to both).
 
 The four unknowns are the reduced model's dynamic states (ball centres and the inner ring's
 axial position are quasi-static: the step solves them itself). A dynamic state added to the

@@ -122,3 +122,21 @@ def test_power_is_torque_times_speed_and_the_bearing_resists(solver: SteadySolve
 def test_a_speed_that_is_not_positive_is_refused(solver: SteadySolver, speed: float) -> None:
     with pytest.raises(DynamicsInputError, match="inner_ring_speed"):
         solver.solve(speed, 100.0)
+
+
+@pytest.mark.parametrize(
+    "variant",
+    [
+        pytest.param(lambda: BearingParameters.calibrated().replace(friction_model="ehl_traction"), id="ehl-traction-law"),
+        pytest.param(BearingParameters.from_yaml, id="uncalibrated-resistances"),
+    ],
+)
+def test_the_solver_follows_whatever_laws_the_engine_has(variant: object) -> None:
+    """No force law is restated in the solver: with the engine's other traction law, or the
+    clean (uncalibrated) resistances, it still lands where the integration does."""
+    params = variant()  # type: ignore[operator]
+    solver = SteadySolver(params)
+    for rpm in (1000, 5000, 9000):
+        for load in (50.0, 300.0, 700.0):
+            point = solver.solve(rpm_to_rad_s(rpm), load)
+            assert abs(point.slip_pct - integrated_slip(params, rpm, load)) < AGREEMENT_PP, (rpm, load)

@@ -137,6 +137,13 @@ def plan_tasks(spec: SweepSpec, params: BearingParameters, done: set[str], metho
     return tasks
 
 
+def task_key(spec: SweepSpec, task: SweepTask, context: dict[str, Any]) -> str:
+    """The Dask key of a task, from what it computes: a key the scheduler may still hold from
+    an earlier (interrupted) run then names the same result, never another batch's."""
+    content = json.dumps([context["context_key"], task.kind, task.method, task.keys, sorted(task.wanted)])
+    return f"{spec.name}-{task.kind}-{hashlib.sha256(content.encode()).hexdigest()[:16]}"
+
+
 def _warm_worker(params: BearingParameters) -> bool:
     """Build the worker's solver and compile (or load) the engine's kernels once."""
     solver = solver_for(params)
@@ -230,7 +237,7 @@ def run_sweep(
 
             n_workers = len(client.scheduler_info().get("workers", {}))
             client.run(_warm_worker, params)
-            futures = [client.submit(evaluate, t, key=f"{spec.name}-{t.task_id}-{context['context_key']}", pure=False) for t in tasks]
+            futures = [client.submit(evaluate, t, key=task_key(spec, t, context), pure=False) for t in tasks]
             with _progress_bar(wanted, progress) as bar:
                 for future in as_completed(futures):
                     rows = future.result()

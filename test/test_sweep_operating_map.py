@@ -25,6 +25,8 @@ def test_skid_boundary_is_the_smallest_load_from_which_slip_stays_low() -> None:
     assert skid_boundary(loads, [5, 4, 3, 2, 1], 20.0) == 50
     assert skid_boundary(loads, [80, 70, 60, 50, 40], 20.0) is None
     assert skid_boundary(loads, [80, 5, float("nan"), 3, 2], 20.0) == 200
+    # several rows per load (sampled parameters): a load rolls when every row at it rolls
+    assert skid_boundary([200, 200, 300, 300, 300, 400, 400], [70, 3, 2, 64, 2, 2, 1], 20.0) == 400
 
 
 def test_the_map_is_drawn_from_a_table(tmp_path: Path) -> None:

@@ -102,3 +102,13 @@ def test_the_command_refuses_a_bad_spec_in_one_line(tmp_path: Path, capsys: pyte
     err = capsys.readouterr().err.strip()
     assert err.startswith("bearing-rig: error:") and "grid.axial_load_n[0]" in err and "\n" not in err
     assert not (tmp_path / "out").exists()
+
+
+def test_every_shipped_sweep_spec_is_valid() -> None:
+    specs = sorted(config_path("sweeps", "paper_load_grid.yaml").parent.glob("*.yaml"))
+    assert len(specs) >= 2
+    for path in specs:
+        spec = load_spec(path)
+        assert spec.points(), path
+    scatter = load_spec(config_path("sweeps", "tolerance_scatter.yaml"))
+    assert len(scatter.points()) == 3 * 64

@@ -31,16 +31,17 @@ def skf_minimum_axial_load(rpm: float | np.ndarray, factor_kn: float) -> float |
 
 def skid_boundary(loads: Sequence[float], slips: Sequence[float], threshold_pct: float) -> float | None:
     """The smallest load (N) from which every larger load of the row has slip below
-    ``threshold_pct``; ``None`` if the largest load still skids. NaN slips count as skidding."""
-    order = np.argsort(np.asarray(loads, dtype=float))
-    x = np.asarray(loads, dtype=float)[order]
-    y = np.asarray(slips, dtype=float)[order]
-    bad = ~(y < threshold_pct)
+    ``threshold_pct``; ``None`` if the largest load still skids. NaN slips count as skidding.
+    With several rows per load (sampled parameters) a load counts as rolling when all roll."""
+    x = np.asarray(loads, dtype=float)
+    y = np.asarray(slips, dtype=float)
+    levels = np.unique(x)
+    bad = np.array([not np.all(y[x == level] < threshold_pct) for level in levels])
     if bad[-1]:
         return None
     if not bad.any():
-        return float(x[0])
-    return float(x[int(np.flatnonzero(bad)[-1]) + 1])
+        return float(levels[0])
+    return float(levels[int(np.flatnonzero(bad)[-1]) + 1])
 
 
 def boundaries(table: Any, threshold_pct: float) -> dict[str, dict[float, float | None]]:
@@ -79,7 +80,10 @@ def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, facto
             sel = (branch == b) & (rpm == n)
             if sel.any():
                 order = np.argsort(load[sel])
-                left.plot(load[sel][order], slip[sel][order], style, color=c, lw=1.2, label=f"{n:.0f} rpm, {label}")
+                # several rows per load (sampled parameters): points, not a line through them
+                scatter = len(np.unique(load[sel])) < int(sel.sum())
+                fmt = ("." if b == KIND_ROLLING_START else "x") if scatter else style
+                left.plot(load[sel][order], slip[sel][order], fmt, color=c, lw=1.2, ms=4, label=f"{n:.0f} rpm, {label}")
     left.axhline(threshold_pct, color="grey", lw=0.8, ls=":")
     left.set_xlabel("axial load F_a (N)")
     left.set_ylabel("cage slip S_c (%)")

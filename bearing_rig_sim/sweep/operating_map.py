@@ -60,6 +60,23 @@ def boundaries(table: Any, threshold_pct: float) -> dict[str, dict[float, float 
     return out
 
 
+def _slip_field(fig: Any, ax: Any, branch: np.ndarray, rpm: np.ndarray, load: np.ndarray, slip: np.ndarray) -> None:
+    """Colour the (load, speed) plane by the rolling-start slip where the rows form a full grid
+    (one row per speed and load)."""
+    from matplotlib.colors import LogNorm
+
+    sel = (branch == KIND_ROLLING_START) & np.isfinite(rpm) & np.isfinite(slip)
+    speeds, loads = np.unique(rpm[sel]), np.unique(load[sel])
+    if len(speeds) < 2 or len(loads) < 2 or int(sel.sum()) != len(speeds) * len(loads):
+        return
+    grid = np.full((len(speeds), len(loads)), np.nan)
+    grid[np.searchsorted(speeds, rpm[sel]), np.searchsorted(loads, load[sel])] = slip[sel]
+    if np.isnan(grid).any() or not np.all(grid > 0.0):
+        return
+    mesh = ax.pcolormesh(loads, speeds, grid, shading="nearest", cmap="viridis", norm=LogNorm(), alpha=0.6)
+    fig.colorbar(mesh, ax=ax, label="slip from the rolling start S_c (%)")
+
+
 def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, factor_kn: float, title: str = "") -> Path:
     """Write the operating map of a steady sweep table as a PNG; return its path."""
     import matplotlib
@@ -71,7 +88,7 @@ def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, facto
     rpm = np.asarray(table["rpm"].to_pylist(), dtype=float)
     load = np.asarray(table["axial_load_n"].to_pylist(), dtype=float)
     slip = np.asarray(table["slip_pct"].to_pylist(), dtype=float)
-    fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 4.8))
     speeds = sorted(set(rpm[np.isfinite(rpm)].tolist()))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for i, n in enumerate(speeds):
@@ -92,6 +109,7 @@ def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, facto
     left.grid(alpha=0.3)
     left.legend(fontsize=6)
     left.set_title("slip against load")
+    _slip_field(fig, right, branch, rpm, load, slip)
     found = boundaries(table, threshold_pct)
     for b, marker, label in ((KIND_ROLLING_START, "o-", "skid boundary, rolling start"), (KIND_CONTINUATION, "s--", "skid boundary, continued from lower loads")):
         if b in found:

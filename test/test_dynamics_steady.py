@@ -88,21 +88,27 @@ def test_the_solution_is_an_equilibrium_of_the_integrator(params: BearingParamet
     assert np.max(np.abs(engine.ball[:, kn.B_OMEGA] - point.ball_orbit_speed)) < 1e-6 * point.ball_orbit_speed
 
 
-def test_two_branches_at_one_point_are_both_steady_under_integration(params: BearingParameters, solver: SteadySolver) -> None:
-    """5000 rpm, 300 N: a load sweep coming from 50 N stays in gross skid, the rolling start
-    rolls (issue 15: 55 % against 2.7 %). Each branch, integrated from its own state, stays."""
+def test_continued_states_are_steady_under_integration_and_branches_are_labelled(params: BearingParameters, solver: SteadySolver) -> None:
+    """A load sweep at 5000 rpm continued from 50 N. Where it ends in another state than the
+    rolling start (two steady states at one point: the first engine gave 55 % against 2.7 % at
+    300 N), both must be real: each, integrated from its own state, stays. Where they are the
+    same state, they agree."""
     omega = rpm_to_rad_s(5000)
     loads = [50.0, 100.0, 150.0, 200.0, 250.0, 300.0]
-    continued = solver.sweep_load(omega, loads)[-1]
-    rolling = solver.solve(omega, 300.0)
-    assert continued.origin == ORIGIN_CONTINUATION and continued.state == STATE_SKID
-    assert rolling.origin == ORIGIN_ROLLING_START and rolling.state == STATE_ROLLING
+    continued = solver.sweep_load(omega, loads)
     kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
-    for branch in (continued, rolling):
-        engine = engine_in_state(params, branch)
-        engine.advance(0.05)
-        avg = engine.advance(0.02)
-        assert abs(float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed)) - branch.slip_pct) < AGREEMENT_PP
+    assert continued[0].origin == ORIGIN_ROLLING_START
+    for branch in continued[1:]:
+        assert branch.origin == ORIGIN_CONTINUATION
+        rolling = solver.solve(omega, branch.axial_load)
+        assert rolling.origin == ORIGIN_ROLLING_START
+        if branch.state == rolling.state:
+            assert abs(branch.slip_pct - rolling.slip_pct) < AGREEMENT_PP
+        for state in (branch, rolling):
+            engine = engine_in_state(params, state)
+            engine.advance(0.05)
+            avg = engine.advance(0.02)
+            assert abs(float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed)) - state.slip_pct) < AGREEMENT_PP
 
 
 def test_integrate_is_the_reference_and_says_so(params: BearingParameters, solver: SteadySolver) -> None:
@@ -111,11 +117,15 @@ def test_integrate_is_the_reference_and_says_so(params: BearingParameters, solve
     assert abs(point.slip_pct - integrated_slip(params, 1000, 100.0)) < 1e-9
 
 
-def test_power_is_torque_times_speed_and_the_bearing_resists(solver: SteadySolver) -> None:
+def test_torque_power_and_films_are_the_engines_at_the_solution(params: BearingParameters, solver: SteadySolver) -> None:
+    """The solver reports the engine's own power loss and films, taken at the solved state; the
+    integration reference, settled at the same point, reports the same."""
     omega = rpm_to_rad_s(3000)
     point = solver.solve(omega, 300.0)
-    assert point.torque > 0.0
-    assert point.power == pytest.approx(point.torque * omega, rel=1e-12)
+    reference = solver.integrate(omega, 300.0)
+    assert point.power > 0.0 and point.torque == pytest.approx(point.power / omega, rel=1e-12)
+    assert point.power == pytest.approx(reference.power, rel=1e-4)
+    assert point.film_min_inner == pytest.approx(reference.film_min_inner, rel=1e-4)
 
 
 @pytest.mark.parametrize("speed", [0.0, -5.0, float("nan")])

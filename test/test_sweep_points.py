@@ -40,6 +40,8 @@ def test_parameter_axes_set_their_bearing_field(params: BearingParameters) -> No
     changed = parameters_for(params, {"inner_ring_speed_rpm": 1000.0, "axial_load_n": 100.0, "ball_drag_scale": 7.0, "oil_viscosity_pa_s": 0.05})
     assert changed.ball_drag_scale == 7.0 and changed.oil_viscosity == 0.05
     assert changed.cage_land_viscous_scale == params.cage_land_viscous_scale
+    grease = parameters_for(params, {"inner_ring_speed_rpm": 1000.0, "axial_load_n": 100.0, "yield_stress_pa": 321.0})
+    assert grease.lubricant is not None and grease.lubricant.yield_stress == 321.0
 
 
 def test_more_ball_drag_means_more_slip_at_the_same_point(params: BearingParameters) -> None:

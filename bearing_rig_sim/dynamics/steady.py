@@ -223,9 +223,10 @@ class SteadyPoint:
         ball_spin_speed: rad/s (about the rolling axis, absolute).
         pocket_offset: m, ball centre ahead of its pocket centre at the pitch radius.
         slip_pct: cage slip S_c, % (digest Eq. 11-12, nominal contact angle).
-        torque: friction torque of the bearing on the inner ring, N m (sum of the inner-race
-            tractions times their radii).
-        power: friction power, W (torque x inner-ring speed).
+        torque: friction torque on the inner ring, N m (power loss over inner-ring speed).
+        power: power loss of the bearing, W (:meth:`BearingDynamics.power_loss`).
+        film_min_inner / film_min_outer: minimum film thickness of the inner and outer contacts,
+            m (:meth:`BearingDynamics.minimum_films`; NaN without a lubricant file).
         state: :data:`STATE_ROLLING` or :data:`STATE_SKID`.
         origin: :data:`ORIGIN_ROLLING_START` or :data:`ORIGIN_CONTINUATION`.
         method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON` or
@@ -244,6 +245,8 @@ class SteadyPoint:
     slip_pct: float
     torque: float
     power: float
+    film_min_inner: float
+    film_min_outer: float
     state: str
     origin: str
     method: str
@@ -375,13 +378,11 @@ class SteadySolver:
 
     def _point(self, x: np.ndarray, omega: float, load: float, origin: str, method: str, iterations: int, stable: bool = True) -> SteadyPoint:
         e = self.engine
-        # the diagnostics (tractions, angles) at the solution: one residual step from it
-        g = np.zeros(4)
-        arrays = (e.ball.copy(), e.ring.copy(), self._ball, self._cage, self._ring, self._out, self._stats, self._work)
-        _residual(e.vector, x, omega, load, self.step, arrays, g)
-        r = self.params.ball_diameter / 2.0
-        r_ci = self._ball[:, kn.B_R] - r * np.cos(self._out[:, kn.O_AI])
-        torque = float(np.sum(self._out[:, kn.O_FI] * r_ci))
+        # the engine's own diagnostics (power loss, films) at the solution: one step from it
+        self._load_engine(x, omega)
+        e.advance(e.time_step, axial_load=load)
+        power = e.power_loss()
+        film_inner, film_outer = e.minimum_films()
         slip = float(self.kinematics.slip_rate(float(x[2]), omega))
         return SteadyPoint(
             inner_ring_speed=omega,
@@ -391,8 +392,10 @@ class SteadySolver:
             ball_spin_speed=float(x[1]),
             pocket_offset=float(x[3]),
             slip_pct=slip,
-            torque=torque,
-            power=torque * omega,
+            torque=power / omega,
+            power=power,
+            film_min_inner=film_inner,
+            film_min_outer=film_outer,
             state=STATE_SKID if slip > SKID_SLIP_PCT else STATE_ROLLING,
             origin=origin,
             method=method,

@@ -44,6 +44,9 @@ KIND_ROLLING_START = ORIGIN_ROLLING_START
 KIND_CONTINUATION = ORIGIN_CONTINUATION
 KIND_TRANSIENT = "transient"
 
+LUBRICANT_PREFIX = "lubricant."
+"""Axes whose parameter starts so set a rheology field of the bearing's lubricant file."""
+
 SOLVE = "solve"
 """Steady points by the direct solver (default)."""
 INTEGRATE = "integrate"
@@ -58,6 +61,8 @@ COLUMNS: dict[str, str] = {
     "slip_pct": "float64",
     "torque_n_m": "float64",
     "power_w": "float64",
+    "film_min_inner_m": "float64",
+    "film_min_outer_m": "float64",
     "state": "string",
     "method": "string",
     "newton_iterations": "int64",
@@ -106,11 +111,15 @@ def point_key(point: dict[str, float], branch: str) -> str:
 def parameters_for(base: BearingParameters, point: dict[str, float]) -> BearingParameters:
     """``base`` with the point's parameter axes applied."""
     changes: dict[str, object] = {}
+    rheology: dict[str, float] = {}
     for name, value in point.items():
         field = AXES[name].parameter
-        if field is not None:
+        if field is not None and field.startswith(LUBRICANT_PREFIX):
+            rheology[field[len(LUBRICANT_PREFIX) :]] = value
+        elif field is not None:
             changes[field] = value
-    return base.replace(**changes) if changes else base
+    params = base.replace(**changes) if changes else base
+    return params.with_lubricant(**rheology) if rheology else params
 
 
 @functools.lru_cache(maxsize=16)
@@ -138,6 +147,8 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
         "slip_pct": math.nan,
         "torque_n_m": math.nan,
         "power_w": math.nan,
+        "film_min_inner_m": math.nan,
+        "film_min_outer_m": math.nan,
         "state": "",
         "method": "",
         "newton_iterations": 0,
@@ -156,6 +167,8 @@ def _fill(row: dict[str, Any], result: SteadyPoint) -> dict[str, Any]:
         slip_pct=result.slip_pct,
         torque_n_m=result.torque,
         power_w=result.power,
+        film_min_inner_m=result.film_min_inner,
+        film_min_outer_m=result.film_min_outer,
         state=result.state,
         method=result.method,
         newton_iterations=result.iterations,

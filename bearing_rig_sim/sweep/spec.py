@@ -44,7 +44,8 @@ class AxisDefinition:
 
     Attributes:
         name: the key in a spec, its unit in the name.
-        parameter: the :class:`~bearing_rig_sim.dynamics.BearingParameters` field it sets
+        parameter: the :class:`~bearing_rig_sim.dynamics.BearingParameters` field it sets,
+            ``lubricant.<field>`` for a rheology field of the bearing's lubricant file
             (``None`` for the operating conditions: speed, acceleration, load).
         low / high: the allowed range (inclusive), in the axis's unit.
         description: what it is, with its unit.
@@ -70,6 +71,10 @@ AXES: dict[str, AxisDefinition] = {
         # lubricant
         AxisDefinition("oil_viscosity_pa_s", "oil_viscosity", 1e-4, 10.0, "dynamic viscosity of the oil, Pa s"),
         AxisDefinition("oil_volume_fraction", "oil_volume_fraction", 0.0, 1.0, "oil share of the oil-air mixture, 1"),
+        AxisDefinition("yield_stress_pa", "lubricant.yield_stress", 0.0, 1e5, "Herschel-Bulkley yield stress of the grease, Pa"),
+        AxisDefinition("consistency_pa_sn", "lubricant.consistency", 0.0, 1e4, "Herschel-Bulkley consistency of the grease, Pa s^n"),
+        AxisDefinition("fill_fraction", "lubricant.fill_fraction", 0.0, 1.0, "share of the swept volume holding grease, 1"),
+        AxisDefinition("eyring_stress_pa", "lubricant.eyring_stress", 1e5, 1e9, "Eyring stress of the base oil, Pa"),
         # geometry tolerances
         AxisDefinition("ball_diameter_m", "ball_diameter", 1e-4, 0.1, "ball diameter Dw, m"),
         AxisDefinition("inner_groove_curvature_ratio", "inner_curvature_ratio", 0.5001, 0.5999, "inner groove radius / Dw, 1"),

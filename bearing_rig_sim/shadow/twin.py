@@ -57,6 +57,7 @@ class ResidualWindow:
         inner_ring_speed: measured mean spindle speed, rad/s.
         axial_load: mean axial force the engine applied over the window (load cell), N; NaN if
             not predicted.
+        measured_cage_speed: measured mean cage speed, rad/s.
         measured_slip: percent.
         predicted_slip: percent (NaN if not predicted).
         predicted_cage_speed: rad/s (NaN if not predicted).
@@ -72,6 +73,7 @@ class ResidualWindow:
     time: float
     inner_ring_speed: float
     axial_load: float
+    measured_cage_speed: float
     measured_slip: float
     predicted_slip: float
     predicted_cage_speed: float
@@ -239,6 +241,7 @@ class ShadowTwin:
             time=w.end_time,
             inner_ring_speed=w.inner_ring_speed,
             axial_load=load,
+            measured_cage_speed=w.cage_speed,
             measured_slip=measured,
             predicted_slip=predicted,
             predicted_cage_speed=cage,

@@ -136,3 +136,27 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
                 )
                 writer.write_message((SPINDLE_PULSES if kind == "spindle" else CAGE_PULSES).name, int(round(t * 1e9)), msg)
     return Path(path)
+
+
+def scaled_calibration(source: str | Path, key: str, factor: float, dest: str | Path) -> Path:
+    """A copy of the calibration file ``source`` with parameter ``key`` (as written under its
+    ``parameters:``, e.g. ``resistances.ball_drag_scale``) multiplied by ``factor``: a bench whose
+    drag or traction has changed. A ``{value: ...}`` entry has its value scaled.
+
+    Raises:
+        KeyError: no such parameter in the file.
+    """
+    import yaml
+
+    doc = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    params = doc["parameters"]
+    if key not in params:
+        raise KeyError(f"{source}: no parameter {key!r} (it has {', '.join(params)})")
+    entry = params[key]
+    if isinstance(entry, dict):
+        entry["value"] = float(entry["value"]) * factor
+    else:
+        params[key] = float(entry) * factor
+    out = Path(dest)
+    out.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    return out

@@ -14,12 +14,14 @@ No ROS import: :mod:`bearing_rig_sim.nodes.common` turns a :class:`Topic`'s prof
 rclpy ``QoSProfile``; :mod:`bearing_rig_sim.bags.qos` into the profile stored in a bag.
 
 Adding a topic: one :class:`Topic` constant below, added to :data:`TOPICS`; then regenerate the two
-tables (``python -m bearing_rig_sim.interfaces``) and wire the publisher in its node.
+tables (``python -m bearing_rig_sim.interfaces`` rewrites them in place) and wire the publisher in its node.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal
 
 QosName = Literal["reliable", "sensor_data", "transient_local"]
@@ -252,5 +254,26 @@ def markdown_table() -> str:
     return "\n".join(rows) + "\n"
 
 
-if __name__ == "__main__":  # pragma: no cover - prints the table for the docs
-    print(markdown_table(), end="")
+TABLE_DOCUMENTS = ("docs/interfaces.md", "README.md")
+"""The documents, relative to the repository, that carry :func:`markdown_table`."""
+
+_TABLE_PATTERN = r"\| topic \| type \| QoS \| rate \| unit \| publisher \|\n(?:\|.*\|\n)+"
+
+
+def write_tables(root: Path) -> list[Path]:
+    """Replace the interface table in each of :data:`TABLE_DOCUMENTS` under ``root`` by
+    :func:`markdown_table`; returns the files that changed."""
+    changed = []
+    for name in TABLE_DOCUMENTS:
+        path = root / name
+        text = path.read_text(encoding="utf-8")
+        new = re.sub(_TABLE_PATTERN, lambda _m: markdown_table(), text, count=1)
+        if new != text:
+            path.write_text(new, encoding="utf-8")
+            changed.append(path)
+    return changed
+
+
+if __name__ == "__main__":  # pragma: no cover - the docs' regeneration command
+    for changed_file in write_tables(Path(__file__).resolve().parent.parent):
+        print(f"updated {changed_file}")

@@ -48,3 +48,15 @@ def test_unknown_topic_is_named_in_the_error() -> None:
         interfaces.topic("/rig/nothing")
     assert interfaces.contract_qos("/rig/nothing") is None
     assert interfaces.contract_qos("/rig/cage/pulses") == "sensor_data"
+
+
+def test_write_tables_replaces_a_stale_table(tmp_path: Path) -> None:
+    stale = "# t\n\n| topic | type | QoS | rate | unit | publisher |\n|---|---|---|---|---|---|\n| `/old` | x | y | z | - | - |\n\nafter\n"
+    for name in interfaces.TABLE_DOCUMENTS:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(stale, encoding="utf-8")
+    changed = interfaces.write_tables(tmp_path)
+    assert len(changed) == len(interfaces.TABLE_DOCUMENTS)
+    text = (tmp_path / "README.md").read_text(encoding="utf-8")
+    assert "/old" not in text and interfaces.markdown_table() in text and text.endswith("\nafter\n")
+    assert interfaces.write_tables(tmp_path) == []

@@ -93,3 +93,18 @@ def test_shadow_missing_calibration_file_is_a_one_line_error(bench_bag: Path, tm
     assert main(["shadow", "--bag", str(bench_bag), "--calibration", str(tmp_path / "none.yaml")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "none.yaml" in err[0] and "not found" in err[0]
+
+
+def test_bench_shadow_reports_its_figures(capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    assert main(["bench", "shadow", "--json", "--rpm", "1800", "--bench-seconds", "1", "--repeats", "1", "--recalibrate", "off"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert len(rows) == 1
+    row = rows[0]
+    keys = {"rtf", "rtf_min", "message_p99_ms", "residual_wait_p50_ms", "residual_wait_p99_ms", "residual_latency_p99_ms", "windows"}
+    assert keys <= row.keys()
+    # 1.5 s of bench at up to 1800 rpm: a cage revolution every 0.078 s at speed
+    assert 8 <= row["windows"] <= 1.5 / 0.078 + 1
+    # the residual waits for the engine, which runs half a spindle revolution (16.7 ms) behind
+    assert row["residual_wait_p50_ms"] >= 16.0

@@ -30,11 +30,12 @@ DETECTION_S = 2.0
 DRAG_KEY = "resistances.ball_drag_scale"
 
 
-def replay(run: BenchRun, twin: ShadowTwin, check_period: float = 0.1) -> list[ResidualWindow]:
-    """Feed a bench run into the twin in time order, with the node's periodic checks."""
+def replay(run: BenchRun | list[tuple[float, str, object]], twin: ShadowTwin, check_period: float = 0.1) -> list[ResidualWindow]:
+    """Feed a bench run (or its events, in the order given) into the twin, with the node's
+    periodic checks on the bench clock."""
     rows: list[ResidualWindow] = []
     tick: float | None = None
-    for t, kind, payload in run.events():
+    for t, kind, payload in run.events() if isinstance(run, BenchRun) else run:
         tick = t if tick is None else tick
         while t >= tick:
             rows += twin.check(tick)
@@ -203,17 +204,10 @@ def test_clock_jump_back_restarts_without_a_false_anomaly(same_bench: BenchRun) 
         return Pulse(p.time - back, p.strip_id, p.strip_count, p.revolution, p.pulse_index) if p.time >= t_cut else p
 
     twin = ShadowTwin(ShadowSettings.from_yaml())
-    rows: list[ResidualWindow] = []
-    # deliver in the order the bench sent them: everything before the cut, then the rest
+    # delivered in the order the bench sent them: everything before the cut, then the rest
     before = [e for e in same_bench.events() if e[0] < t_cut]
     after = [(t - back, k, moved(p) if isinstance(p, Pulse) else p) for t, k, p in same_bench.events() if t >= t_cut]
-    for t, kind, payload in before + after:
-        if kind == "force":
-            assert isinstance(payload, float)
-            twin.add_force(t, payload)
-        else:
-            assert isinstance(payload, Pulse)
-            rows += twin.add_pulse(kind, payload)
+    rows = replay(before + after, twin)
     assert twin.drive.restarts >= 2
     assert not any(r.anomaly for r in rows)
     assert sum(r.compared for r in rows if r.time < t_cut - back + 10.0 and r.time > t_cut - back + 1.0) > 10
@@ -227,3 +221,30 @@ def test_stopped_spindle_is_not_an_anomaly() -> None:
     assert twin.drive.restarts >= 2  # restarted after the stop
     late = [r for r in rows if r.time > BENCH_CLOCK + 4.5]
     assert late and all(r.compared for r in late[-5:])
+
+
+@pytest.mark.parametrize(
+    ("changes", "problem"),
+    [
+        ({"error_after_s": 0.5}, "error_after_s"),
+        ({"band_coverage": -1.0}, "band_coverage"),
+        ({"calibration_file": "calibration/none.yaml"}, "file not found"),
+        ({"calibration_file": "", "calibration_rms_slip_pct": -1.0}, "no calibration file is given"),
+        ({"forgetting_factor": 1.5}, "forgetting_factor"),
+        ({"surprise": 1}, "surprise"),
+    ],
+)
+def test_bad_settings_are_named(changes: dict[str, object], problem: str) -> None:
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.shadow import shipped_parameters
+
+    values = {**shipped_parameters(), **changes}
+    with pytest.raises(ConfigError, match=problem):
+        ShadowSettings.from_values(values)
+
+
+def test_recalibrating_an_unknown_parameter_is_refused() -> None:
+    from bearing_rig_sim.shadow.recalibration import RecalibrationError
+
+    with pytest.raises(RecalibrationError, match="no_such_parameter"):
+        ShadowTwin(ShadowSettings.from_yaml().replace(recalibrate=True, recalibrate_parameter="no_such_parameter"))

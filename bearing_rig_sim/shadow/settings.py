@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.simulation.settings import resolve_config_file
 
 NODE_NAME = "shadow"
 """The shadow node's name: the key of its block in a ROS 2 parameter file."""
@@ -17,11 +18,12 @@ SHIPPED_FILE = "shadow.yaml"
 
 
 def _resolve(s: Section, key: str, *, empty_ok: bool = False) -> Path | None:
-    raw = s.string(key)
-    if raw == "" and empty_ok:
-        return None
-    path = Path(raw) if Path(raw).is_absolute() else config_path(*Path(raw).parts)
-    if not path.is_file():
+    """A file parameter (absolute or under ``config/``); ``""`` is None where ``empty_ok``."""
+    raw = s.data.get(key)
+    if not isinstance(raw, str) or (not raw and not empty_ok):
+        raise s.error(key, f"must be a file name (absolute or relative to config/), got {raw!r}")
+    path = resolve_config_file(raw)
+    if path is not None and not path.is_file():
         raise s.error(key, f"file not found: {raw!r} (looked for {path})")
     return path
 

@@ -2,7 +2,8 @@
 
 * ``bearing-rig shadow`` runs the shadow node on the live topics (the bench's pulse counter and
   load cell, or the twin's): predictions and residuals on ``/twin/...``, anomalies on
-  ``/diagnostics``; ROS arguments after ``--ros-args`` as for any node.
+  ``/diagnostics``; ROS arguments after ``--``: ``bearing-rig shadow -- --ros-args -p
+  warn_after_s:=2.0``.
 * ``bearing-rig shadow --bag BAG --out DIR`` runs the same core over a bag, without ROS and
   deterministically: ``DIR/residuals.csv`` (one row per slip window), ``DIR/report.md`` and
   ``DIR/shadow.png``. The bag needs ``/rig/spindle/pulses``, ``/rig/cage/pulses`` and
@@ -26,7 +27,7 @@ def register(subparsers: Any) -> None:
     p.add_argument("--params", type=Path, default=None, metavar="FILE", help="shadow parameter file (default: config/shadow.yaml)")
     p.add_argument("--calibration", type=Path, default=None, metavar="FILE", help="calibration file of the twin (default: the parameter file's)")
     p.add_argument("--recalibrate", action="store_true", help="track the parameter file's recalibrate_parameter online (never written to the calibration file)")
-    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="live: arguments for the node (--ros-args ...)")
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="live: after --, arguments for the node (-- --ros-args -p name:=value)")
     p.set_defaults(func=run)
 
 

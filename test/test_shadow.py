@@ -28,6 +28,8 @@ DETECTION_S = 2.0
 """Stated detection time: an anomaly is flagged within 2 s after each steady speed is reached
 (warn_after_s 1 s + the engine's half-revolution lag + one window + the first window's start)."""
 DRAG_KEY = "resistances.ball_drag_scale"
+TRACTION_KEY = "friction.stiction_velocity_m_s"
+"""The creep velocity of the traction law: 30 % more of it is 30 % less traction at a given sliding."""
 
 
 def replay(run: BenchRun | list[tuple[float, str, object]], twin: ShadowTwin, check_period: float = 0.1) -> list[ResidualWindow]:
@@ -54,10 +56,15 @@ def same_bench() -> BenchRun:
     return twin_bench_run(HOLDS, clock_offset_s=BENCH_CLOCK)
 
 
+def changed_bench(key: str, directory: Path) -> BenchRun:
+    """The twin as a bench whose calibration parameter ``key`` is 30 % higher."""
+    cal = scaled_calibration(config_path("calibration", "h7006c_table3.yaml"), key, 1.3, directory / "changed.yaml")
+    return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK)
+
+
 @pytest.fixture(scope="module")
 def dragged_bench(tmp_path_factory: pytest.TempPathFactory) -> BenchRun:
-    cal = scaled_calibration(config_path("calibration", "h7006c_table3.yaml"), DRAG_KEY, 1.3, tmp_path_factory.mktemp("cal") / "drag13.yaml")
-    return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK)
+    return changed_bench(DRAG_KEY, tmp_path_factory.mktemp("cal"))
 
 
 # -- inputs -------------------------------------------------------------------------------------
@@ -146,9 +153,13 @@ def test_round_trip_same_calibration_stays_inside_the_band(same_bench: BenchRun)
     assert any(r.residual != 0.0 for r in compared)
 
 
-def test_bench_with_30_percent_more_drag_is_flagged_after_each_steady_speed(dragged_bench: BenchRun) -> None:
+@pytest.mark.parametrize("key", [DRAG_KEY, TRACTION_KEY])
+def test_bench_with_more_drag_or_less_traction_is_flagged_after_each_steady_speed(
+    key: str, dragged_bench: BenchRun, tmp_path: Path
+) -> None:
+    bench = dragged_bench if key == DRAG_KEY else changed_bench(key, tmp_path)
     twin = ShadowTwin(ShadowSettings.from_yaml())
-    rows = replay(dragged_bench, twin)
+    rows = replay(bench, twin)
     begin = BENCH_CLOCK
     for hold in HOLDS[:2]:
         steady = begin + hold.ramp_s
@@ -159,7 +170,7 @@ def test_bench_with_30_percent_more_drag_is_flagged_after_each_steady_speed(drag
         start = flagged[0].time
         assert start - steady <= DETECTION_S
         assert all(r.anomaly for r in in_hold if r.time > steady + DETECTION_S)
-        assert all(r.residual > 0.0 for r in flagged)  # more drag: slip higher than predicted
+        assert all(r.residual > 0.0 for r in flagged)  # more drag, less traction: slip higher than predicted
         assert "more drag or less traction" in flagged[-1].note
         begin = end
     assert twin.health().level == HealthLevel.ERROR

@@ -75,6 +75,7 @@ class ShadowNode(Node):
         self._last_wall: float | None = None
         self._last_level: HealthLevel | None = None
         self._received = {"spindle": 0, "cage": 0, "force": 0}
+        self._estimate_updates = 0
         self._residual_pub = self.create_publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
         self._estimate_pub = self.create_publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
         self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
@@ -141,8 +142,9 @@ class ShadowNode(Node):
             msg.header.stamp = to_stamp(max(row.time, 0.0))
             msg.header.frame_id = "bearing"
             self._residual_pub.publish(msg)
-        if rows and self.twin.calibration is not None:
+        if rows and self.twin.calibration is not None and self.twin.calibration.updates != self._estimate_updates:
             e = self.twin.calibration.estimate()
+            self._estimate_updates = e.updates
             est = ShadowEstimate(parameter=e.name, calibrated=e.calibrated, value=e.value, std=e.std, updates=e.updates)
             est.header.stamp = to_stamp(max(rows[-1].time, 0.0))
             self._estimate_pub.publish(est)

@@ -79,3 +79,12 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
             assert m.measured_slip == pytest.approx(same[0].measured_slip, abs=1e-9)
     assert matched >= len(by_rosbags) - 2
     assert math.isfinite(by_rosbags[-1].predicted_slip)
+
+
+def test_the_session_records_the_shadow_topics_too() -> None:
+    """A session records every topic of the contract; its recorder needs each one's rclpy class."""
+    from bearing_rig_sim.interfaces import TOPICS, TWIN_ESTIMATE
+    from bearing_rig_sim.session.node import MESSAGE_TYPES
+
+    assert {TWIN_RESIDUAL, TWIN_ESTIMATE} <= set(TOPICS)
+    assert {t.msgtype for t in TOPICS} <= MESSAGE_TYPES.keys()

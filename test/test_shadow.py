@@ -200,8 +200,9 @@ def test_lost_pulses_and_a_load_cell_dropout_give_no_false_anomaly(same_bench: B
     twin = ShadowTwin(ShadowSettings.from_yaml())
     rows = replay(run, twin)
     assert not any(r.anomaly for r in rows)
+    # a lost pulse never corrupts a compared window: each one is exact or not compared
+    assert all(abs(r.residual) <= r.band for r in rows if r.compared)
     notes = [r.note for r in rows if not r.compared]
-    assert any("input fault" in n for n in notes)
     assert any("load-cell dropout" in n for n in notes)
     assert len(rows) >= len(same_bench.cage) // 4 - 5  # every window still gives a row
 

@@ -235,7 +235,7 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
     skipped: dict[str, int] = {}
     for r in result.rows:
         if not r.compared:
-            key = r.note.split(" (")[0].split(":")[0]
+            key = r.note.split(" from ")[0].split(" (")[0].split(":")[0]
             skipped[key] = skipped.get(key, 0) + 1
     if skipped:
         lines += ["", "## Windows not compared", ""] + [f"* {why}: {n}" for why, n in sorted(skipped.items())]

@@ -65,6 +65,7 @@ from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
     RELIABLE_QOS,
+    RELIABLE_STREAM_QOS,
     SENSOR_QOS,
     WARN,
     diagnostic_array,
@@ -72,6 +73,7 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
 NODE_NAME = "load_controller"
@@ -113,7 +115,7 @@ class LoadControllerNode(Node):
         # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
         # walks on every wake-up (about 1000 a second here); an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
-        self._force_pub = self.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS, event_callbacks=quiet)
+        self._force_pub = self.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_STREAM_QOS, event_callbacks=quiet)
         self._load_cell_pub = self.create_publisher(WrenchStamped, "/rig/axial_load/force", SENSOR_QOS, event_callbacks=quiet)
         self._state_pub = self.create_publisher(AxialLoadState, "/rig/axial_load/state", RELIABLE_QOS, event_callbacks=quiet)
         self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS, event_callbacks=quiet)
@@ -129,6 +131,7 @@ class LoadControllerNode(Node):
 
         if not self.get_parameter("use_sim_time").value:
             raise RigError(f"{NODE_NAME}: steps the loading chain on the simulation clock: use_sim_time must be true")
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
         self._bearing_msg = WrenchStamped()
         self._bearing_msg.header.frame_id = "bearing"
         self._load_cell_msg = WrenchStamped()

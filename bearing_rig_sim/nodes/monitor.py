@@ -41,8 +41,8 @@ from bearing_rig_sim.monitoring import (
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
+    PULSE_READER_QOS,
     RELIABLE_QOS,
-    SENSOR_QOS,
     STATUS_QOS,
     WARN,
     diagnostic_array,
@@ -52,6 +52,7 @@ from bearing_rig_sim.nodes.common import (
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 LEVELS = {MonitorState.STABLE: OK, MonitorState.SLIPPING: WARN, MonitorState.UNKNOWN: WARN, MonitorState.FAULT: ERROR}
@@ -78,11 +79,12 @@ class MonitorNode(Node):
         # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
         self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
         self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), PULSE_READER_QOS)
+        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), PULSE_READER_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)

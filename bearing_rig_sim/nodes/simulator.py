@@ -44,6 +44,7 @@ from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
     RELIABLE_QOS,
+    RELIABLE_STREAM_QOS,
     SENSOR_QOS,
     STATUS_QOS,
     diagnostic_array,
@@ -109,7 +110,7 @@ class SimulatorNode(Node):
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
 
-        self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_QOS)
+        self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_STREAM_QOS)
         self._pulse_pubs = {
             "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
             "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
@@ -194,6 +195,8 @@ class SimulatorNode(Node):
             real_time_factor=float(self.pacer.real_time_factor),
             step_count=t.step_count,
             overruns=min(self.pacer.overruns, MAX_UINT32),
+            friction_torque=t.friction_torque,
+            power_loss=t.power_loss,
         )
         msg.header.stamp = to_stamp(t.time)
         msg.header.frame_id = "bearing"

@@ -14,6 +14,7 @@ from pathlib import Path
 import pytest
 
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.shadow import AnomalyRule, ResidualWindow, ShadowSettings, ShadowTwin, band_pct, likely_cause
@@ -27,9 +28,10 @@ HOLDS = [Hold(900.0, 4.0, 100.0, RAMP_S), Hold(2700.0, 4.0, 100.0, RAMP_S), Hold
 DETECTION_S = 2.0
 """Stated detection time: an anomaly is flagged within 2 s after each steady speed is reached
 (warn_after_s 1 s + the engine's half-revolution lag + one window + the first window's start)."""
-DRAG_KEY = "resistances.ball_drag_scale"
-TRACTION_KEY = "friction.stiction_velocity_m_s"
-"""The creep velocity of the traction law: 30 % more of it is 30 % less traction at a given sliding."""
+DRAG_KEY = "lubricant.consistency_pa_sn"
+"""The grease's Herschel-Bulkley consistency: the viscous part of ball and cage-land drag."""
+TRACTION_KEY = "lubricant.eyring_stress_pa"
+"""The lubricant's Eyring stress: 30 % less of it is less traction at a given sliding."""
 
 
 def replay(run: BenchRun | list[tuple[float, str, object]], twin: ShadowTwin, check_period: float = 0.1) -> list[ResidualWindow]:
@@ -57,8 +59,15 @@ def same_bench() -> BenchRun:
 
 
 def changed_bench(key: str, directory: Path) -> BenchRun:
-    """The twin as a bench whose calibration parameter ``key`` is 30 % higher."""
-    cal = scaled_calibration(config_path("calibration", "h7006c_table3.yaml"), key, 1.3, directory / "changed.yaml")
+    """The twin as a bench with 30 % more drag (the grease's consistency x 1.3) or 30 % less
+    traction (the Eyring stress x 0.7, which the calibration leaves at the lubricant file's)."""
+    source = config_path("calibration", "h7006c_table3.yaml")
+    if key == DRAG_KEY:
+        cal = scaled_calibration(source, key, 1.3, directory / "changed.yaml")
+    else:
+        lubricant = BearingParameters.calibrated().lubricant
+        assert lubricant is not None
+        cal = scaled_calibration(source, key, 0.7, directory / "changed.yaml", base=lubricant.eyring_stress)
     return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK)
 
 
@@ -114,8 +123,12 @@ def test_band_by_hand() -> None:
 
 
 def test_shipped_settings_read_the_calibration_rms() -> None:
+    import yaml
+
     st = ShadowSettings.from_yaml()
-    assert st.calibration_rms_slip_pct == pytest.approx(0.0992)  # config/calibration/h7006c_table3.yaml
+    assert st.calibration_file is not None
+    shipped = yaml.safe_load(st.calibration_file.read_text(encoding="utf-8"))["calibration"]["rms_slip_pct"]
+    assert 0.0 < shipped < 1.0 and st.calibration_rms_slip_pct == shipped
 
 
 def test_rule_warns_then_errors_and_names_the_class() -> None:
@@ -177,17 +190,20 @@ def test_bench_with_more_drag_or_less_traction_is_flagged_after_each_steady_spee
 
 
 def test_online_recalibration_converges_to_the_changed_drag(dragged_bench: BenchRun) -> None:
-    settings = ShadowSettings.from_yaml().replace(recalibrate=True, recalibrate_parameter="ball_drag_scale")
+    import yaml
+
+    settings = ShadowSettings.from_yaml().replace(recalibrate=True, recalibrate_parameter=DRAG_KEY)
     twin = ShadowTwin(settings)
     replay(dragged_bench, twin)
     estimate = twin.estimate()
-    assert estimate is not None and estimate.updates > 50
+    assert estimate is not None and estimate.updates > 50 and estimate.name == DRAG_KEY
     # stated tolerance: within 2 % of the bench's value (1.3 x calibrated)
     assert estimate.ratio == pytest.approx(1.3, rel=0.02)
     assert estimate.std < 0.05 * estimate.value
+    assert estimate.in_range  # 66 Pa s^n lies in the calibration's stated 1-100
     # never written: the calibration file still holds the calibrated value
-    text = Path(config_path("calibration", "h7006c_table3.yaml")).read_text(encoding="utf-8")
-    assert f"ball_drag_scale: {estimate.calibrated:g}" in text
+    shipped = yaml.safe_load(Path(config_path("calibration", "h7006c_table3.yaml")).read_text(encoding="utf-8"))
+    assert shipped["parameters"][DRAG_KEY]["value"] == estimate.calibrated
 
 
 # -- faults in the inputs ---------------------------------------------------------------------------
@@ -246,6 +262,7 @@ def test_stopped_spindle_is_not_an_anomaly() -> None:
         ({"calibration_file": "calibration/none.yaml"}, "file not found"),
         ({"calibration_file": "", "calibration_rms_slip_pct": -1.0}, "no calibration file is given"),
         ({"forgetting_factor": 1.5}, "forgetting_factor"),
+        ({"recalibrate_parameter": 3}, "recalibrate_parameter"),
         ({"surprise": 1}, "surprise"),
     ],
 )

@@ -19,8 +19,12 @@ The estimate's standard uncertainty is ``sqrt(P s_e^2)``, ``s_e^2`` the forgetti
 mean square of the innovations ``y - g d``. Nothing is ever written to the calibration file here;
 :meth:`OnlineCalibration.estimate` only reports.
 
-Units: the parameter's own (a :class:`~bearing_rig_sim.dynamics.BearingParameters` field); slip in
-percentage points.
+The tracked parameter is one entry of the calibration file's ``parameters:`` (e.g.
+``lubricant.yield_stress_pa``), laid over the bearing file as the calibration itself is
+(:class:`CalibrationParameter`), so whatever the physics behind it, the probe is the same twin with
+that one value changed. The estimate is checked against the entry's stated plausible range.
+
+Units: the parameter's own; slip in percentage points.
 """
 
 from __future__ import annotations
@@ -28,8 +32,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
+from bearing_rig_sim.config import ConfigError, Section, load_yaml
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.shadow.inputs import SpeedPoint
 from bearing_rig_sim.shadow.predictor import MeasuredDrive
@@ -44,7 +51,51 @@ information on the parameter and are skipped."""
 
 
 class RecalibrationError(RigError):
-    """The tracked parameter is not a numeric bearing parameter, or is zero."""
+    """The tracked parameter is not in the calibration file, or is zero."""
+
+
+class CalibrationParameter:
+    """One parameter of a calibration file, and the bearing with it set to any value.
+
+    Args:
+        bearing_file: the bearing data.
+        calibration_file: the calibration laid over it.
+        name: a key of the calibration's ``parameters:``; "" for the first one.
+
+    Raises:
+        RecalibrationError: no such parameter, or its value is not a non-zero number.
+        ConfigError: a file is malformed.
+    """
+
+    def __init__(self, bearing_file: Path, calibration_file: Path, name: str) -> None:
+        self._bearing = load_yaml(bearing_file)
+        calibration = load_yaml(calibration_file)
+        entries = calibration.section("parameters").data
+        key = name or next(iter(entries), "")
+        if key not in entries:
+            raise RecalibrationError(
+                f"recalibrate_parameter: {name!r} is not a parameter of {calibration_file} (it has {', '.join(entries) or 'none'})"
+            )
+        entry = entries[key]
+        value = entry.get("value") if isinstance(entry, dict) else entry
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value == 0.0:
+            raise RecalibrationError(f"recalibrate_parameter: {key} of {calibration_file} is not a non-zero number ({value!r})")
+        self.name = key
+        self.calibrated = float(value)
+        self.unit = str(entry.get("unit", "")) if isinstance(entry, dict) else ""
+        bounds = entry.get("range") if isinstance(entry, dict) else None
+        self.range: tuple[float, float] | None = (float(bounds[0]), float(bounds[1])) if isinstance(bounds, list) and len(bounds) == 2 else None
+        self._calibration = calibration
+
+    def params(self, value: float) -> BearingParameters:
+        """The bearing with this parameter at ``value`` (its other calibrated values kept).
+
+        Raises:
+            ConfigError: the bearing file refuses the value (outside its hard limits).
+        """
+        data = {k: v for k, v in self._calibration.data.items()}
+        data["parameters"] = {**self._calibration.section("parameters").data, self.name: float(value)}
+        return BearingParameters.from_section(overlay_calibration(self._bearing, Section(data, f"{self._calibration.source} ({self.name}={value:.6g})")))
 
 
 @dataclass(frozen=True)
@@ -52,11 +103,12 @@ class ParameterEstimate:
     """The tracked parameter's estimate.
 
     Attributes:
-        name: the bearing parameter's field name.
+        name: the calibration parameter (``section.key``).
         calibrated: its value in the calibration, parameter units.
         value: the estimate.
         std: the estimate's standard uncertainty (NaN before the first update).
         updates: steady windows used (1).
+        range: the calibration's stated plausible range, or None.
     """
 
     name: str
@@ -64,6 +116,12 @@ class ParameterEstimate:
     value: float
     std: float
     updates: int
+    range: tuple[float, float] | None = None
+
+    @property
+    def in_range(self) -> bool:
+        """Whether the estimate lies in the stated plausible range (True when none is stated)."""
+        return self.range is None or self.range[0] <= self.value <= self.range[1]
 
     @property
     def ratio(self) -> float:
@@ -75,34 +133,26 @@ class OnlineCalibration:
     """Recursive least squares on one calibration parameter (see the module docstring).
 
     Args:
-        params: the calibrated bearing the shadow's engine runs.
-        name: the field of :class:`BearingParameters` to track.
+        parameter: the calibration parameter tracked.
         forgetting_factor: lambda, per update (0.5-1].
         probe_step_fraction: the probe starts at ``theta_0 (1 + this)``.
         make_drive: builds a :class:`MeasuredDrive` for given parameters (the shadow's settings).
-
-    Raises:
-        RecalibrationError: ``name`` is not a non-zero numeric field.
     """
 
     def __init__(
         self,
-        params: BearingParameters,
-        name: str,
+        parameter: CalibrationParameter,
         *,
         forgetting_factor: float,
         probe_step_fraction: float,
         make_drive: Callable[[BearingParameters], MeasuredDrive],
     ) -> None:
-        value = getattr(params, name, None)
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value == 0.0:
-            raise RecalibrationError(f"recalibrate_parameter: {name!r} is not a non-zero numeric bearing parameter (value {value!r})")
-        self.params = params
-        self.name = name
-        self.calibrated = float(value)
+        self.parameter = parameter
+        self.name = parameter.name
+        self.calibrated = parameter.calibrated
         self.forgetting_factor = forgetting_factor
         self.probe_value = self.calibrated * (1.0 + probe_step_fraction)
-        self.probe = make_drive(params.replace(**{name: self.probe_value}))
+        self.probe = make_drive(parameter.params(self.probe_value))
         self._d = 0.0
         self._p = 1e6 * self.calibrated**2
         self._e2 = math.nan
@@ -136,9 +186,12 @@ class OnlineCalibration:
         self.updates += 1
         estimate = self.calibrated + self._d
         if abs(estimate - self.probe_value) > PROBE_MOVE_FRACTION * abs(self.calibrated) and abs(self._d) > PROBE_MOVE_FRACTION * abs(self.calibrated):
-            if estimate > 0.0:
-                self.probe_value = estimate
-                self.probe.swap_parameters(self.params.replace(**{self.name: estimate}))
+            try:
+                params = self.parameter.params(estimate)
+            except ConfigError:
+                return True  # beyond what the bearing file accepts: the probe stays where it is
+            self.probe_value = estimate
+            self.probe.swap_parameters(params)
         return True
 
     def forget_before(self, time: float) -> None:
@@ -148,4 +201,4 @@ class OnlineCalibration:
     def estimate(self) -> ParameterEstimate:
         """The present estimate with its standard uncertainty."""
         std = math.sqrt(self._p * self._e2) if self.updates and math.isfinite(self._e2) else math.nan
-        return ParameterEstimate(self.name, self.calibrated, self.calibrated + self._d, std, self.updates)
+        return ParameterEstimate(self.name, self.calibrated, self.calibrated + self._d, std, self.updates, self.parameter.range)

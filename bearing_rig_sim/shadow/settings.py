@@ -28,6 +28,15 @@ def _resolve(s: Section, key: str, *, empty_ok: bool = False) -> Path | None:
     return path
 
 
+def _string_or_empty(s: Section, key: str) -> str:
+    if key not in s:
+        raise s.error(key, "missing")
+    raw = s.data[key]
+    if not isinstance(raw, str):
+        raise s.error(key, f"must be a string (empty for the default), got {raw!r}")
+    return raw
+
+
 @dataclass(frozen=True)
 class ShadowSettings:
     """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason).
@@ -50,7 +59,8 @@ class ShadowSettings:
         load_average_s: averaging time of the load-cell force, s.
         load_timeout_s: no load-cell sample for this long is a dropout, s.
         recalibrate: track a calibration parameter online.
-        recalibrate_parameter: the :class:`~bearing_rig_sim.dynamics.BearingParameters` field tracked.
+        recalibrate_parameter: the calibration file's parameter tracked (``section.key``); "" for its
+            first one.
         forgetting_factor: of the recursive least squares, per compared steady window (1).
         probe_step_fraction: initial offset of the probe engine from the calibrated value (1).
         steady_speed_fraction: windows whose spindle speed is within this fraction of the previous
@@ -110,7 +120,7 @@ class ShadowSettings:
             load_average_s=s.number("load_average_s", gt=0.0, le=10.0),
             load_timeout_s=s.number("load_timeout_s", gt=0.0),
             recalibrate=s.boolean("recalibrate"),
-            recalibrate_parameter=s.string("recalibrate_parameter"),
+            recalibrate_parameter=_string_or_empty(s, "recalibrate_parameter"),
             forgetting_factor=s.number("forgetting_factor", gt=0.5, le=1.0),
             probe_step_fraction=s.number("probe_step_fraction", gt=0.0, lt=1.0),
             steady_speed_fraction=s.number("steady_speed_fraction", ge=0.0, lt=1.0),

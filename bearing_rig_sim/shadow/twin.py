@@ -36,7 +36,7 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.shadow.measured import MeasuredWindow, MeasuredWindows
 from bearing_rig_sim.shadow.predictor import MeasuredDrive, Prediction
-from bearing_rig_sim.shadow.recalibration import OnlineCalibration, ParameterEstimate
+from bearing_rig_sim.shadow.recalibration import CalibrationParameter, OnlineCalibration, ParameterEstimate, RecalibrationError
 from bearing_rig_sim.shadow.residual import AnomalyRule, band_pct
 from bearing_rig_sim.shadow.settings import ShadowSettings
 
@@ -111,9 +111,10 @@ class ShadowTwin:
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
         self.calibration: OnlineCalibration | None = None
         if settings.recalibrate:
+            if settings.calibration_file is None:
+                raise RecalibrationError("recalibrate: needs a calibration file (calibration_file is empty)")
             self.calibration = OnlineCalibration(
-                self.params,
-                settings.recalibrate_parameter,
+                CalibrationParameter(settings.bearing_file, settings.calibration_file, settings.recalibrate_parameter),
                 forgetting_factor=settings.forgetting_factor,
                 probe_step_fraction=settings.probe_step_fraction,
                 make_drive=self._make_drive,

@@ -138,25 +138,28 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
     return Path(path)
 
 
-def scaled_calibration(source: str | Path, key: str, factor: float, dest: str | Path) -> Path:
+def scaled_calibration(source: str | Path, key: str, factor: float, dest: str | Path, *, base: float | None = None) -> Path:
     """A copy of the calibration file ``source`` with parameter ``key`` (as written under its
-    ``parameters:``, e.g. ``resistances.ball_drag_scale``) multiplied by ``factor``: a bench whose
-    drag or traction has changed. A ``{value: ...}`` entry has its value scaled.
+    ``parameters:``, e.g. ``lubricant.yield_stress_pa``) multiplied by ``factor``: a bench whose
+    drag or traction has changed. A ``{value: ...}`` entry has its value scaled (its range kept:
+    a value outside it is refused on loading). A key the file does not set (a parameter the
+    calibration left at the bearing file's value) is added as ``base * factor``.
 
     Raises:
-        KeyError: no such parameter in the file.
+        KeyError: no such parameter in the file and no ``base``.
     """
     import yaml
 
     doc = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
     params = doc["parameters"]
     if key not in params:
-        raise KeyError(f"{source}: no parameter {key!r} (it has {', '.join(params)})")
-    entry = params[key]
-    if isinstance(entry, dict):
-        entry["value"] = float(entry["value"]) * factor
+        if base is None:
+            raise KeyError(f"{source}: no parameter {key!r} (it has {', '.join(params)})")
+        params[key] = float(base) * factor
+    elif isinstance(params[key], dict):
+        params[key]["value"] = float(params[key]["value"]) * factor
     else:
-        params[key] = float(entry) * factor
+        params[key] = float(params[key]) * factor
     out = Path(dest)
     out.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
     return out

@@ -63,20 +63,25 @@ def test_shadow_bag_is_deterministic(bench_bag: Path, tmp_path: Path) -> None:
 
 
 def test_shadow_flags_a_bench_with_other_drag_and_recalibrates(bench_bag: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    # the twin assumes 30 % less ball drag than the bench has: slip higher than predicted
-    cal = scaled_calibration(config_path("calibration", "h7006c_table3.yaml"), "resistances.ball_drag_scale", 1.0 / 1.3, tmp_path / "low.yaml")
+    import yaml
+
+    # the twin assumes a grease 30 % less consistent than the bench's: less drag, slip higher than predicted
+    key = "lubricant.consistency_pa_sn"
+    shipped = config_path("calibration", "h7006c_table3.yaml")
+    bench_value = yaml.safe_load(shipped.read_text())["parameters"][key]["value"]
+    cal = scaled_calibration(shipped, key, 1.0 / 1.3, tmp_path / "low.yaml")
     out = tmp_path / "out"
-    assert main(["shadow", "--bag", str(bench_bag), "--out", str(out), "--calibration", str(cal), "--recalibrate"]) == 1
+    assert main(["shadow", "--bag", str(bench_bag), "--out", str(out), "--calibration", str(cal), "--recalibrate", key]) == 1
     printed = capsys.readouterr().out
-    assert "slip higher than predicted" in printed and "re-calibrated ball_drag_scale" in printed
+    assert "slip higher than predicted" in printed and f"re-calibrated {key}" in printed
     rows = read_rows(out / RESIDUALS_CSV)
     assert any(r["anomaly"] == "1" and r["level"] == "2" for r in rows)
     report = (out / REPORT_MD).read_text()
     assert "| ERROR |" in report and "Not written to the calibration file." in report
-    line = next(x for x in report.splitlines() if x.startswith("`ball_drag_scale`"))
+    line = next(x for x in report.splitlines() if x.startswith(f"`{key}`"))
     value = float(line.split(": ", 1)[1].split(" ")[0])
-    assert value == pytest.approx(3641.74, rel=0.03)  # the bench's calibrated drag scale
-    assert "ball_drag_scale: 3641.74" in (config_path("calibration", "h7006c_table3.yaml")).read_text()
+    assert value == pytest.approx(bench_value, rel=0.03)  # the bench's calibrated consistency
+    assert yaml.safe_load(shipped.read_text())["parameters"][key]["value"] == bench_value
 
 
 def test_shadow_bag_without_the_load_cell_is_a_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

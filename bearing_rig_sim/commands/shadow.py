@@ -26,7 +26,14 @@ def register(subparsers: Any) -> None:
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder with --bag (default: out/shadow/<bag name>)")
     p.add_argument("--params", type=Path, default=None, metavar="FILE", help="shadow parameter file (default: config/shadow.yaml)")
     p.add_argument("--calibration", type=Path, default=None, metavar="FILE", help="calibration file of the twin (default: the parameter file's)")
-    p.add_argument("--recalibrate", action="store_true", help="track the parameter file's recalibrate_parameter online (never written to the calibration file)")
+    p.add_argument(
+        "--recalibrate",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="PARAMETER",
+        help="track a calibration parameter online (default: the parameter file's recalibrate_parameter); never written to the calibration file",
+    )
     p.add_argument("ros_args", nargs=argparse.REMAINDER, help="live: after --, arguments for the node (-- --ros-args -p name:=value)")
     p.set_defaults(func=run)
 
@@ -43,8 +50,8 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError(str(args.calibration), "calibration", "file not found")
         rms = calibration_rms(args.calibration)
         settings = settings.replace(calibration_file=args.calibration.resolve(), calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct)
-    if args.recalibrate:
-        settings = settings.replace(recalibrate=True)
+    if args.recalibrate is not None:
+        settings = settings.replace(recalibrate=True, recalibrate_parameter=args.recalibrate or settings.recalibrate_parameter)
     if args.bag is None:
         return _live(args, settings)
     from bearing_rig_sim.commands.bag import bag_warnings_as_lines
@@ -60,7 +67,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {s.start_s:.3f}-{s.end_s:.3f} s {s.worst.name}: {s.detail}")
     if result.estimate is not None:
         e = result.estimate
-        print(f"re-calibrated {e.name}: {e.value:.6g} +- {e.std:.3g} (calibrated {e.calibrated:.6g}); not written")
+        outside = "" if e.in_range or e.range is None else f"; OUTSIDE its plausible range {e.range[0]:g}-{e.range[1]:g}"
+        print(f"re-calibrated {e.name}: {e.value:.6g} +- {e.std:.3g} (calibrated {e.calibrated:.6g}{outside}); not written")
     print(f"report: {out / 'report.md'}; rows: {out / 'residuals.csv'}")
     return 1 if c["anomalous"] else 0
 
@@ -74,8 +82,8 @@ def _live(args: argparse.Namespace, settings: Any) -> int:
         extra += ["--params-file", str(args.params)]
     if args.calibration is not None:
         extra += ["-p", f"calibration_file:={settings.calibration_file}", "-p", f"calibration_rms_slip_pct:={settings.calibration_rms_slip_pct}"]
-    if args.recalibrate:
-        extra += ["-p", "recalibrate:=true"]
+    if args.recalibrate is not None:
+        extra += ["-p", "recalibrate:=true", "-p", f"recalibrate_parameter:={settings.recalibrate_parameter}"]
     if extra:
         argv += (["--ros-args"] if "--ros-args" not in argv else []) + extra
     return main(argv)

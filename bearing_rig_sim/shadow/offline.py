@@ -248,6 +248,8 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
             f"`{e.name}`: {e.value:.6g} +- {e.std:.3g} (calibrated {e.calibrated:.6g}; ratio {e.ratio:.4f}) from {e.updates} steady windows. "
             "Not written to the calibration file.",
         ]
+        if not e.in_range and e.range is not None:
+            lines += ["", f"**Outside the parameter's stated plausible range {e.range[0]:g}-{e.range[1]:g}**: the bench has changed beyond what this parameter can explain."]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 

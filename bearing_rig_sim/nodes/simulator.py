@@ -194,6 +194,8 @@ class SimulatorNode(Node):
             real_time_factor=float(self.pacer.real_time_factor),
             step_count=t.step_count,
             overruns=min(self.pacer.overruns, MAX_UINT32),
+            friction_torque=t.friction_torque,
+            power_loss=t.power_loss,
         )
         msg.header.stamp = to_stamp(t.time)
         msg.header.frame_id = "bearing"

@@ -144,7 +144,7 @@ def test_bag_info_checks_every_chunk(steady_bag: Path, tmp_path: Path, capsys: p
         reader = make_reader(stream)
         total = reader.get_summary().statistics.message_count
         chunk = sorted(reader.get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)[1]
-        in_chunk = sum(1 for _ in reader.iter_messages(start_time=chunk.message_start_time, ending_at=chunk.message_end_time))
+        in_chunk = sum(1 for _ in reader.iter_messages(starting_at=chunk.message_start_time, ending_at=chunk.message_end_time))
     with open(mcap, "r+b") as stream:
         stream.seek(chunk.chunk_start_offset + chunk.chunk_length - 32)
         stream.write(bytes(32))

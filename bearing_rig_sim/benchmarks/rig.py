@@ -207,7 +207,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
     logs = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-rig-"))
     env, lease = session_environment(os.environ)
     apply_transport_profile(env, logs)
-    children = [NodeProcess(name, node_command(spec), logs / f"{name}.log") for name, spec in NODES.items()]
+    children = [NodeProcess(name, node_command(spec) + ["--autostart"], logs / f"{name}.log") for name, spec in NODES.items()]
     context = rclpy.Context()
     probe = None
     series = _Series()

@@ -90,15 +90,41 @@ def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[s
     return args + ["--ros-args", "--params-file", str(path)]
 
 
+AUTOSTART_FLAG = "--autostart"
+"""Command-line flag of every node's console script: configure and activate at once (what a
+lifecycle manager would do), exit status 2 with the reason if configure fails."""
+
+
+def split_autostart(argv: Sequence[str]) -> tuple[list[str], bool]:
+    """``argv`` without :data:`AUTOSTART_FLAG`, and whether it was there."""
+    args = list(argv)
+    return [a for a in args if a != AUTOSTART_FLAG], AUTOSTART_FLAG in args
+
+
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Initialise rclpy (with the node's shipped parameter file), spin the node made by
     ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
-    Returns the process exit status."""
-    rclpy.init(args=ros_args_with_defaults(node_name, argv))
+
+    A lifecycle node starts unconfigured, driven by the standard ``lifecycle_msgs`` services;
+    with ``--autostart`` it configures and activates itself first.
+
+    Returns:
+        The process exit status: 0, or 2 when ``--autostart`` could not configure or activate.
+
+    Raises:
+        RigError: the node could not be made (a parameter given at start out of its range).
+    """
+    args, autostart = split_autostart(sys.argv if argv is None else argv)
+    rclpy.init(args=ros_args_with_defaults(node_name, args))
     node = None
     executor = SingleThreadedExecutor()
     try:
         node = factory()
+        if autostart and hasattr(node, "trigger_configure"):
+            failed = _autostart(node)
+            if failed:
+                print(f"{node_name}: error: {failed}", file=sys.stderr)
+                return 2
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -115,3 +141,14 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+def _autostart(node: Node) -> str:
+    """Configure then activate a lifecycle node; why it failed, or "" when it is active."""
+    from rclpy.lifecycle import TransitionCallbackReturn  # noqa: PLC0415
+
+    if node.trigger_configure() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+        return getattr(node, "configure_error", "") or "configure failed"
+    if node.trigger_activate() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+        return "activate failed"
+    return ""

@@ -25,7 +25,6 @@ from typing import Any, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.clock import Clock, ClockType
-from rclpy.node import Node
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
 from bearing_rig_sim.errors import RigError
@@ -50,14 +49,14 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 LEVELS = {MonitorState.STABLE: OK, MonitorState.SLIPPING: WARN, MonitorState.UNKNOWN: WARN, MonitorState.FAULT: ERROR}
 """Diagnostics level of each monitor state."""
 
 
-class MonitorNode(Node):
+class MonitorNode(ManagedNode):
     """The monitor node (see the module docstring).
 
     Raises:
@@ -66,8 +65,12 @@ class MonitorNode(Node):
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        values = declare_and_read(self, shipped_parameters())
-        self.settings = MonitorSettings.from_values(values, f"{NODE_NAME} parameters")
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
+
+    def configure(self) -> None:
+        """Validate the parameters; build the slip monitor, publishers, subscriptions, timers."""
+        self.settings = MonitorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.monitor = SlipMonitor(self.settings.kinematics(), self.settings)
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
@@ -78,22 +81,23 @@ class MonitorNode(Node):
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
 
-        self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self._status_pub = self.publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
+        self.subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
+        self.subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
-        self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
+        self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
+        self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
         kin = self.monitor.kinematics
         self.get_logger().info(
             f"monitoring cage slip over {self.settings.window_revolutions} cage revolution(s) per window "
             f"(epicyclic ratio {kin.epicyclic_ratio():.6g} at {math.degrees(kin.contact_angle):g} deg)"
         )
 
-    def close(self) -> None:
-        """Before ``destroy_node``: let the executor release the node's handles."""
-        release_executor(self)
+    def activate(self) -> None:
+        """Report the state at once on activation (the first status, then the timers)."""
+        self._last_state = None
+        self._last_level = None
 
     # -- inputs --------------------------------------------------------------------------------
     @survives_shutdown

@@ -34,7 +34,6 @@ from typing import Any, Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
 
@@ -51,7 +50,7 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
 from bearing_rig_sim.simulation.health import Health, HealthLevel, SimulatorHealth
@@ -65,7 +64,7 @@ NO_REALTIME_FLAG = "--no-realtime"
 MAX_UINT32 = 2**32 - 1
 
 
-class SimulatorNode(Node):
+class SimulatorNode(ManagedNode):
     """The simulator node (see the module docstring).
 
     Raises:
@@ -74,8 +73,12 @@ class SimulatorNode(Node):
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        values = declare_and_read(self, shipped_parameters())
-        s = SimulatorSettings.from_values(values, f"{NODE_NAME} parameters")
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
+
+    def configure(self) -> None:
+        """Validate the parameters; build the twin, the pacer, publishers, subscriptions, timers."""
+        s = SimulatorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.settings = s
         self.twin = RigTwin.from_files(
             s.bearing_file,
@@ -106,22 +109,23 @@ class SimulatorNode(Node):
         self._chunks = 0
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
+        self._anchor = True
 
-        self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_QOS)
+        self._clock_pub = self.publisher(ClockMsg, "/clock", RELIABLE_QOS)
         self._pulse_pubs = {
-            "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
-            "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
+            "spindle": self.publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
+            "cage": self.publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
         }
-        self._speeds_pub = self.create_publisher(JointState, "/rig/speeds", SENSOR_QOS)
-        self._truth_pub = self.create_publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
-        self.create_subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)
+        self._speeds_pub = self.publisher(JointState, "/rig/speeds", SENSOR_QOS)
+        self._truth_pub = self.publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
+        self.subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
+        self.subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
-        self._loop_timer = self.create_timer(period, self._on_loop, clock=steady)
-        self._diag_timer = self.create_timer(1.0 / s.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
+        self.timer(period, self._on_loop, clock=steady)
+        self.timer(1.0 / s.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
         self._speeds_msg = JointState(name=["inner_ring", "cage"])
         self._clock_msg = ClockMsg()
         mode = f"real time x{s.rate:g}" if s.realtime else "as fast as possible"
@@ -130,17 +134,19 @@ class SimulatorNode(Node):
             f"spindle {s.initial_speed_rad_s:g} rad/s, axial load {self.twin.axial_load:g} N"
         )
 
-    def close(self) -> None:
-        """Before ``destroy_node``: let the executor release the node's handles."""
-        release_executor(self)
+    def activate(self) -> None:
+        """The simulated time goes on from where it stands, anchored to the wall clock anew."""
+        self._anchor = True
+        self._last_level = None
 
     # -- the loop ------------------------------------------------------------------------------
     @survives_shutdown
     def _on_loop(self) -> None:
         if self.health.halted:
             return
-        if not self.pacer.started:
+        if self._anchor:
             self.pacer.start(self.twin.time)
+            self._anchor = False
         for _ in range(self.pacer.due_chunks(self.twin.time)):
             try:
                 out = self.twin.tick(with_truth=(self._chunks + 1) % self._truth_every == 0)

@@ -98,7 +98,7 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     err = err if err is not None else sys.stderr
     chain = LoadingChainConfig.from_yaml()
     program = load_program(options.program, max_axial_load_n=chain.max_setpoint_n)
-    commands = {name: node_command(spec) for name, spec in NODES.items()}
+    commands = {name: node_command(spec) + ["--autostart"] for name, spec in NODES.items()}
     if not options.realtime:
         commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
     start = datetime.now(timezone.utc)

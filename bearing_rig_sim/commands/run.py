@@ -1,4 +1,4 @@
-"""``bearing-rig run [PROGRAM] [--no-realtime] [--bag-dir DIR] [--quiet]``: a rig session.
+"""``bearing-rig run [PROGRAM] [--no-realtime] [--bag-dir DIR] [--quiet] [--params-file FILE] [--foxglove [PORT]]``.
 
 Starts the simulator, load controller and monitor as separate processes on a private ROS domain,
 runs the test program on the simulation clock, records every rig topic to
@@ -15,6 +15,23 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.config import config_path
+
+FOXGLOVE_PORT = 8765
+"""Default port of ``--foxglove``: the Foxglove app's default."""
+
+
+def add_foxglove_argument(parser: argparse.ArgumentParser) -> None:
+    """``--foxglove [PORT]``: serve the topics live to the Foxglove app (run and replay)."""
+    parser.add_argument(
+        "--foxglove",
+        type=int,
+        nargs="?",
+        const=FOXGLOVE_PORT,
+        default=None,
+        metavar="PORT",
+        help=f"serve the rig's topics live to the Foxglove app on ws://localhost:PORT (default {FOXGLOVE_PORT}); "
+        "layout: config/foxglove/rig.json",
+    )
 
 DEFAULT_PROGRAM = ("programs", "validation.yaml")
 """The default program, under ``config/``: the validation program (paper Table 3 conditions)."""
@@ -45,6 +62,14 @@ def register(subparsers: Any) -> None:
         metavar="SECONDS",
         help="longest wait for the nodes to come up (default: 60 s; the simulator's first start compiles its kernels)",
     )
+    parser.add_argument(
+        "--params-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="ROS 2 parameter file given to every node (a block per node name), over config/<node>.yaml",
+    )
+    add_foxglove_argument(parser)
     parser.set_defaults(func=run)
 
 
@@ -59,6 +84,8 @@ def run(args: argparse.Namespace) -> int:
         bag_dir=args.bag_dir,
         quiet=args.quiet,
         startup_timeout_s=args.startup_timeout,
+        params_file=args.params_file,
+        foxglove_port=args.foxglove,
         command_line=["bearing-rig", *sys.argv[1:]],
     )
     return run_session(options)

@@ -76,11 +76,10 @@ def default_params_file(node_name: str) -> Path:
 
 
 def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[str]:
-    """Command-line arguments for ``rclpy.init``: the given ones, plus the shipped parameter
-    file when the user gave none (``--params-file`` or ``-p`` after ``--ros-args``)."""
+    """Command-line arguments for ``rclpy.init``: the given ones, with the shipped parameter file
+    put first after ``--ros-args``, so parameter files and ``-p`` given by the user override it
+    (a partial user file changes only what it names)."""
     args = list(sys.argv if argv is None else argv)
-    if "--params-file" in args:
-        return args
     path = default_params_file(node_name)
     if not path.exists():
         return args

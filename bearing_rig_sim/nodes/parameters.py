@@ -87,7 +87,7 @@ SIMULATOR = [
         ("rig_file", "rig data file: sensors (strip counts, jitter, drop probability) and loading chain"),
         ("model", "engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)"),
     ),
-    ParameterSpec("chunk_s", "simulated time per engine call and per /clock message", "s", 1e-5, 0.1, low_exclusive=False),
+    ParameterSpec("chunk_s", "simulated time per engine call and per /clock message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
     ParameterSpec("realtime", "lock the simulated time to the wall clock (false: as fast as possible)"),
     ParameterSpec("rate", "simulated seconds per wall second when in real time", "1", 0.0, 100.0, low_exclusive=True),
     ParameterSpec("loop_period_s", "period of the loop timer in real time (wall clock)", "s", 1e-4, 0.1),

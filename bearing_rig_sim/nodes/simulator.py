@@ -16,13 +16,21 @@ Publishes (interface table, docs/interfaces.md):
   on every change of level (see :mod:`bearing_rig_sim.simulation.health`).
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
-and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable). Bad input
-is refused with a logged reason and an ERROR on /diagnostics; the node goes on.
+and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable; 1 kHz, so
+its queue is taken by the loop, not dispatched message by message). Bad input is refused with a
+logged reason and an ERROR on /diagnostics; the node goes on.
 
 One timer on the steady clock drives the loop (no threads): in real time it runs the chunks the
 wall clock asks for (:class:`~bearing_rig_sim.simulation.pacing.RealTimePacer`), otherwise a
 batch of ``max_batch_chunks`` per call, as fast as possible. ``simulator --no-realtime`` sets
 the parameter ``realtime`` to false.
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
+drive, sensors), publishers, subscriptions and timers are made at configure; the simulated time
+runs only while active (it stands still while inactive and goes on from there at the next
+activation, anchored to the wall clock anew). A halted engine, refused inputs and overruns are
+reported on /diagnostics (ERROR, WARN) with the node staying active; ``simulator --autostart``
+configures and activates at once.
 """
 
 from __future__ import annotations
@@ -34,6 +42,9 @@ from typing import Any, Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
+from rclpy.event_handler import SubscriptionEventCallbacks
+from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
 
@@ -62,6 +73,9 @@ NO_REALTIME_FLAG = "--no-realtime"
 """Command-line flag: run as fast as possible (parameter ``realtime`` false)."""
 
 MAX_UINT32 = 2**32 - 1
+
+FORCE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+"""The force reader: reliable like the load controller's publisher, deep enough for 1 s at 1 kHz."""
 
 
 class SimulatorNode(ManagedNode):
@@ -120,7 +134,13 @@ class SimulatorNode(ManagedNode):
         self._truth_pub = self.publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
         self._diag_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
         self.subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
-        self.subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)
+        # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
+        # instead of one per message), from a reader on a node no executor spins.
+        self._force_tap = Node(f"{NODE_NAME}_force", context=self.context)
+        self._force_sub = self._force_tap.create_subscription(
+            WrenchStamped, "/rig/bearing/axial_force", _unused, FORCE_QOS,
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+        )
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
@@ -139,6 +159,18 @@ class SimulatorNode(ManagedNode):
         self._anchor = True
         self._last_level = None
 
+    def deactivate(self) -> None:
+        """Apply the forces that came while active; later ones are applied at the next activation
+        (the latest is the load in force)."""
+        self._take_forces()
+
+    def cleanup(self) -> None:
+        """Destroy the force reader's node."""
+        tap = getattr(self, "_force_tap", None)
+        if tap is not None:
+            tap.destroy_node()
+            self._force_tap = None
+
     # -- the loop ------------------------------------------------------------------------------
     @survives_shutdown
     def _on_loop(self) -> None:
@@ -147,6 +179,7 @@ class SimulatorNode(ManagedNode):
         if self._anchor:
             self.pacer.start(self.twin.time)
             self._anchor = False
+        self._take_forces()
         for _ in range(self.pacer.due_chunks(self.twin.time)):
             try:
                 out = self.twin.tick(with_truth=(self._chunks + 1) % self._truth_every == 0)
@@ -226,12 +259,15 @@ class SimulatorNode(ManagedNode):
             f"(rig clock {self.twin.time:.6g} s)"
         )
 
-    @survives_shutdown
-    def _on_force(self, msg: WrenchStamped) -> None:
-        try:
-            self.twin.set_axial_load(msg.wrench.force.z)
-        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
-            self._refuse("axial force", str(exc))
+    def _take_forces(self) -> None:
+        """Apply the axial forces queued since the last call, in order of arrival."""
+        handle = self._force_sub.handle
+        with handle:
+            while (taken := handle.take_message(WrenchStamped, False)) is not None:
+                try:
+                    self.twin.set_axial_load(taken[0].wrench.force.z)
+                except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+                    self._refuse("axial force", str(exc))
 
     def _refuse(self, kind: str, reason: str) -> None:
         self.get_logger().error(f"{kind} refused: {reason}", throttle_duration_sec=1.0)
@@ -275,6 +311,10 @@ class SimulatorNode(ManagedNode):
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)
         self._diag_pub.publish(diagnostic_array(to_stamp(max(twin.time, 0.0)), [status]))
+
+
+def _unused(_msg: object) -> None:  # pragma: no cover - the force reader's node is never spun
+    """Callback of the force reader; its queue is taken by the loop."""
 
 
 def pulse_message(pulse: Pulse) -> FibreOpticPulse:

@@ -41,6 +41,7 @@ setup(
     name=PACKAGE_NAME,
     version=read_version(),
     packages=find_packages(exclude=["test", "test.*"]),
+    package_data={PACKAGE_NAME: ["py.typed"]},
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE_NAME}"]),
         (f"share/{PACKAGE_NAME}", ["package.xml"]),
@@ -55,9 +56,8 @@ setup(
     entry_points={
         "console_scripts": [
             "bearing-rig = bearing_rig_sim.cli:main",
-            # ROS 2 node executables (`ros2 run bearing_rig_sim <name>`) are added here with the
-            # nodes themselves, e.g. "simulator = bearing_rig_sim.nodes.simulator:main",
-            # "load_controller = ...", "monitor = ...".
+            # ROS 2 node executables (`ros2 run bearing_rig_sim <name>`), each also under a
+            # bearing-rig-* name for shells without ROS.
             "load_controller = bearing_rig_sim.nodes.load_controller:main",
             "bearing-rig-load-controller = bearing_rig_sim.nodes.load_controller:main",
             "simulator = bearing_rig_sim.nodes.simulator:main",

@@ -6,7 +6,7 @@ Layers, with one direction of dependency (see README):
 * :mod:`bearing_rig_sim.dynamics`: the bearing's equations of motion (numpy + numba, no ROS).
 * :mod:`bearing_rig_sim.rig`: sensor and loading-chain models of the bench (no ROS).
 * :mod:`bearing_rig_sim.analysis`: slip rate, Gaussian fits, stability criterion (no ROS).
-* :mod:`bearing_rig_sim.recording`: rosbag2/MCAP recording, replay and offline analysis.
+* :mod:`bearing_rig_sim.bags`: rosbag2/MCAP recording, replay and offline analysis.
 * :mod:`bearing_rig_sim.nodes`: thin ROS 2 node shells.
 """
 

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, Iterator, Sequence
+from typing import Any
+from collections.abc import Iterator, Sequence
 
 import yaml
 
@@ -51,18 +52,18 @@ def config_path(*parts: str) -> Path:
     if local.exists():
         return local
     try:
-        from ament_index_python.packages import get_package_share_directory  # noqa: PLC0415
+        from ament_index_python.packages import get_package_share_directory
 
         share = Path(get_package_share_directory("bearing_rig_sim")) / "config"
         installed = share.joinpath(*parts)
         if installed.exists():
             return installed
-    except Exception:  # noqa: BLE001 - ament index absent or package not installed
+    except Exception:
         pass
     return local
 
 
-def load_yaml(path: str | Path) -> "Section":
+def load_yaml(path: str | Path) -> Section:
     """Read a YAML file whose top level is a mapping.
 
     Raises:
@@ -131,7 +132,7 @@ class Section:
                 raise self.error(str(key), f"unknown key; allowed keys: {', '.join(sorted(allowed))}")
 
     # -- accessors ---------------------------------------------------------------------------
-    def section(self, key: str, default: Any = _MISSING) -> "Section":
+    def section(self, key: str, default: Any = _MISSING) -> Section:
         """A nested mapping as a :class:`Section`."""
         value = self._get(key, default)
         if not isinstance(value, dict):
@@ -194,7 +195,7 @@ class Section:
         path = self.key_path(key)
         return [check_number(v, self.source, f"{path}[{i}]", gt=gt, ge=ge) for i, v in enumerate(value)]
 
-    def sections(self, key: str) -> list["Section"]:
+    def sections(self, key: str) -> list[Section]:
         """A list of mappings, each as a :class:`Section` (``key[i]`` in error paths)."""
         value = self._get(key, _MISSING)
         if not isinstance(value, list) or not value:

@@ -1,10 +1,10 @@
 """The slip monitor without ROS: cage slip and its stability from the fibre-optic pulses alone.
 
 :class:`SlipMonitor` reads only what the bench's sensors give (per pulse: time, strip id, strip
-count, pulse index; digest section 8) and the bearing's kinematics, so it runs unchanged on the
+count, pulse index; docs/paper.md section 8) and the bearing's kinematics, so it runs unchanged on the
 real bench's pulses.
 
-**Slip over whole cage revolutions** (digest Eq. 11-12), incrementally, as
+**Slip over whole cage revolutions** (paper Eq. 11-12), incrementally, as
 :func:`~bearing_rig_sim.analysis.slip.whole_revolution_slip` does in one batch: the cage pulses
 are cut into consecutive windows of ``window_revolutions`` whole cage revolutions, each starting
 and ending on a passage of the same strip, so the mean cage speed ``2 pi R / (t1 - t0)`` is exact
@@ -44,7 +44,7 @@ present phase and not for the whole run. The spindle is *steady* in a window who
 is within ``restart_speed_change_fraction`` of the previous window's, *changing* otherwise; the
 series restarts when it turns from one to the other (the start and the end of a ramp), and after
 the spindle has been below ``min_inner_ring_speed_rad_s`` (a stop). A run-up from rest is thus
-one series, as in the paper's slip-against-time fits under acceleration (digest section 7), and
+one series, as in the paper's slip-against-time fits under acceleration (docs/paper.md section 7), and
 a hold at constant speed after a ramp is another, judged on its own. A 1-term Gaussian cannot
 describe a ramp and the plateau after it (a rise then a flat) without a spurious fall.
 
@@ -74,7 +74,7 @@ SHIPPED_FILE = "monitor.yaml"
 """The shipped parameter file, under ``config/``."""
 
 CRITERION = "time"
-"""Abscissa of the monitor's slope criterion: slip against time (k2, digest section 7)."""
+"""Abscissa of the monitor's slope criterion: slip against time (k2, docs/paper.md section 7)."""
 
 MAX_PENDING_WINDOWS = 1000
 """Most cage windows kept waiting for spindle pulses; older ones are dropped (1)."""
@@ -144,7 +144,7 @@ class MonitorSettings:
     diagnostics_rate_hz: float
 
     @classmethod
-    def from_section(cls, s: Section) -> "MonitorSettings":
+    def from_section(cls, s: Section) -> MonitorSettings:
         """Validate the parameters in ``s`` (every key required, none unknown besides
         ``use_sim_time``).
 
@@ -176,12 +176,12 @@ class MonitorSettings:
         )
 
     @classmethod
-    def from_values(cls, values: dict[str, object], source: str = "monitor parameters") -> "MonitorSettings":
+    def from_values(cls, values: dict[str, object], source: str = "monitor parameters") -> MonitorSettings:
         """Validate a flat mapping of parameter values (the node's ROS parameters)."""
         return cls.from_section(Section(dict(values), source))
 
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "MonitorSettings":
+    def from_yaml(cls, path: str | Path | None = None) -> MonitorSettings:
         """Read ``monitor: ros__parameters:`` of a parameter file (default: the shipped one)."""
         return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
 

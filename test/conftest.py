@@ -34,7 +34,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import IO, Any, Callable, Iterator, Sequence
+from typing import IO, Any
+from collections.abc import Callable, Iterator, Sequence
 
 import pytest
 
@@ -82,7 +83,7 @@ def lease_domain(timeout: float = 60.0) -> DomainLease:
         ordered = ids[start:] + ids[:start]
         fresh = [i for i in ordered if i not in _used_this_session]
         for domain_id in fresh + [i for i in ordered if i in _used_this_session]:
-            handle = open(LOCK_DIR / f"{domain_id}.lock", "a+", encoding="utf-8")  # noqa: SIM115
+            handle = open(LOCK_DIR / f"{domain_id}.lock", "a+", encoding="utf-8")
             try:
                 fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except BlockingIOError:
@@ -125,7 +126,7 @@ class RosGraph:
     # -- rclpy in the test process -----------------------------------------------------------
     def context(self) -> Any:
         """A new ``rclpy.Context`` initialised on this graph's domain (shut down at teardown)."""
-        import rclpy  # noqa: PLC0415 - only ROS tests need rclpy
+        import rclpy
 
         context = rclpy.Context()
         rclpy.init(args=[], context=context, domain_id=self.domain_id)
@@ -134,7 +135,7 @@ class RosGraph:
 
     def node(self, name: str, context: Any = None, **kwargs: Any) -> Any:
         """A new ``rclpy.node.Node`` in ``context`` (a fresh one by default), destroyed at teardown."""
-        from rclpy.node import Node  # noqa: PLC0415
+        from rclpy.node import Node
 
         node = Node(name, context=context if context is not None else self.context(), **kwargs)
         self._nodes.append(node)
@@ -145,7 +146,7 @@ class RosGraph:
 
         Jazzy's ``MultiThreadedExecutor`` starves timers and subscriptions; do not use it.
         """
-        from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
+        from rclpy.executors import SingleThreadedExecutor
 
         if not nodes:
             raise ValueError("executor() needs at least one node")

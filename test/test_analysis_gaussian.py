@@ -25,7 +25,7 @@ from bearing_rig_sim.analysis.gaussian import (
 
 # paper Table 7, 20 rad/s^2: slip (%) against time (s), one term
 TABLE7_20 = np.array([[3.5, -1.52, 1.29]])
-# paper Table 5, 1000 rpm (the one readable row, digest section 10): slip (%) against load (N)
+# paper Table 5, 1000 rpm (the one readable row, docs/paper.md section 10): slip (%) against load (N)
 TABLE5_1000 = np.array([[5.18, -4.14, 214.0], [2.05, 530.0, 469.0]])
 # two separated peaks
 TWO_PEAKS = np.array([[2.0, 3.0, 1.0], [1.2, 7.0, 1.5]])

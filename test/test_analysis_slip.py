@@ -1,4 +1,4 @@
-"""Slip rate (digest Eq. 11-12) and slip from fibre-optic pulse trains.
+"""Slip rate (paper Eq. 11-12) and slip from fibre-optic pulse trains.
 
 Expected values are written out here from the definitions, not taken from the module:
 n_s / n_i = (1 - Dw cos(alpha) / dm) / 2 and S = (1 - n_c / n_s) * 100.
@@ -30,7 +30,7 @@ def ratio(dw: float, dm: float, alpha: float) -> float:
 
 # -- Eq. 12 ----------------------------------------------------------------------------------------
 def test_h7006c_epicyclic_ratio_is_the_digest_value() -> None:
-    # digest section 6: n_s = 0.4283 n_i at the nominal angle (4 significant digits)
+    # docs/paper.md section 6: n_s = 0.4283 n_i at the nominal angle (4 significant digits)
     assert H7006C.epicyclic_ratio() == pytest.approx(0.4283, abs=5e-5)
 
 

@@ -3,7 +3,7 @@
 For a single Gaussian y = lam exp(-((x - b)/c)^2) the slope is -2 lam (x - b)/c^2 exp(-((x - b)/c)^2);
 the crossings of the critical slope are found here by a bisection of that formula, independently
 of the module. The paper's own check: with Table 7's parameters and k2 = -3e-2 %/s the stable
-state starts near 1.67, 1.41, 1.23 and 0.97 s (digest section 11).
+state starts near 1.67, 1.41, 1.23 and 0.97 s (docs/paper.md section 11).
 """
 
 from __future__ import annotations
@@ -115,7 +115,7 @@ def test_table7_onset_from_a_fit_of_noisy_data() -> None:
 
 
 def test_higher_acceleration_stabilises_sooner_by_table7() -> None:
-    # digest section 11: Table 7 with k2 gives shorter times for higher accelerations
+    # docs/paper.md section 11: Table 7 with k2 gives shorter times for higher accelerations
     onsets = [stable_onset(OneGaussian(lam, k, d), 0.0, 3.0, K2_TIME).onset for _, lam, k, d, _ in TABLE7]
     assert all(a is not None for a in onsets)
     assert np.all(np.diff(np.array(onsets, dtype=float)) < 0.0)

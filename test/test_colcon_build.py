@@ -142,6 +142,6 @@ def test_workspace_packages_load_from_the_workspace(workspace: Path) -> None:
 def test_console_script_runs_from_the_workspace(workspace: Path) -> None:
     result = _in_workspace(workspace, "install/bearing_rig_sim/lib/bearing_rig_sim/bearing-rig", "--version")
     assert result.returncode == 0, result.stderr
-    from bearing_rig_sim import __version__  # noqa: PLC0415
+    from bearing_rig_sim import __version__
 
     assert result.stdout.strip() == f"bearing-rig {__version__}"

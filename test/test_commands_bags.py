@@ -14,11 +14,11 @@ import pytest
 
 from bearing_rig_sim.cli import main
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.recording import BagWriter
-from bearing_rig_sim.recording.segments import SEGMENTS_CSV
-from bearing_rig_sim.recording.series import STATUS_CSV, WINDOWS_CSV
-from bearing_rig_sim.recording.report import PLOT_FILES, REPORT_FILE
-from bearing_rig_sim.recording.synthetic import RIG_TRAFFIC_TOPICS, rig_traffic
+from bearing_rig_sim.bags import BagWriter
+from bearing_rig_sim.offline.segments import SEGMENTS_CSV
+from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
+from bearing_rig_sim.offline.report import PLOT_FILES, REPORT_FILE
+from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 

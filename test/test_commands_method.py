@@ -11,7 +11,7 @@ import pytest
 from bearing_rig_sim.cli import main
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingParameters
-from bearing_rig_sim.reproduce import PAPER_TABLE3
+from bearing_rig_sim.studies.reproduction import PAPER_TABLE3
 
 
 def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[str]) -> None:

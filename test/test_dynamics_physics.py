@@ -113,13 +113,13 @@ def test_reduced_model_matches_the_stiff_reference_within_two_percent(calibrated
 
 
 def test_slip_rises_with_speed_at_100_n(calibrated: BearingParameters) -> None:
-    """Physics test 5a (digest section 9: 3.22 -> 5.28 % from 900 to 2700 rpm)."""
+    """Physics test 5a (docs/paper.md section 9: 3.22 -> 5.28 % from 900 to 2700 rpm)."""
     slips = [nominal_slip_pct(calibrated, run(calibrated, n, 100.0).last.cage_speed, n * RPM) for n in (900, 1500, 2100, 2700)]
     assert all(b > a for a, b in zip(slips, slips[1:])), slips
 
 
 def test_slip_falls_with_axial_load_at_3000_rpm(calibrated: BearingParameters) -> None:
-    """Physics test 5b (digest section 10): slip falls as the axial load grows, 50 to 700 N."""
+    """Physics test 5b (docs/paper.md section 10): slip falls as the axial load grows, 50 to 700 N."""
     slips = [nominal_slip_pct(calibrated, run(calibrated, 3000, f).last.cage_speed, 3000 * RPM) for f in (50, 100, 200, 400, 700)]
     assert all(b < a for a, b in zip(slips, slips[1:])), slips
 

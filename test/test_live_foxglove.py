@@ -29,7 +29,7 @@ from mcap.records import Schema  # noqa: E402
 from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 
 from bearing_rig_sim.live.foxglove import FoxgloveLiveView  # noqa: E402
-from bearing_rig_sim.recording.typestore import msg_definition_text, rig_typestore  # noqa: E402
+from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore  # noqa: E402
 
 SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 MESSAGE_DATA = 0x01

@@ -108,7 +108,7 @@ def message_class(name: str) -> type:
 
 def qos() -> Any:
     """Reliable, transient-local, keep last 1: a late subscriber still receives the sample."""
-    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy  # noqa: PLC0415
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
     return QoSProfile(
         depth=1,
@@ -143,8 +143,8 @@ def to_plain(message: Any) -> dict[str, Any]:
 
 # -- the peer process ------------------------------------------------------------------------
 def _peer(mode: str, name: str | None) -> int:
-    import rclpy  # noqa: PLC0415
-    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor  # noqa: PLC0415
+    import rclpy
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 
     rclpy.init()
     node = rclpy.create_node(f"peer_{mode}")
@@ -161,7 +161,7 @@ def _peer(mode: str, name: str | None) -> int:
             assert name is not None
             node.create_subscription(message_class(name), TOPIC_PREFIX + name, received.append, qos())
         elif mode == "serve":
-            from bearing_rig_msgs.srv import SetAxialLoad  # noqa: PLC0415
+            from bearing_rig_msgs.srv import SetAxialLoad
 
             def handle(request: Any, response: Any) -> Any:
                 load = request.axial_load
@@ -235,7 +235,7 @@ def test_installed_message_matches_its_definition(name: str) -> None:
 
 
 def test_installed_service_matches_its_definition() -> None:
-    from bearing_rig_msgs.srv import SetAxialLoad  # noqa: PLC0415
+    from bearing_rig_msgs.srv import SetAxialLoad
 
     request_text, response_text = (MSG_DIR / "srv" / "SetAxialLoad.srv").read_text(encoding="utf-8").split("---")
     _check_class_matches(SetAxialLoad.Request, request_text)
@@ -257,7 +257,7 @@ def test_sample_sets_every_field_to_a_non_default(name: str) -> None:
 def _peer_output(process: Any, timeout: float) -> tuple[int, str, str]:
     try:
         out, err = process.communicate(timeout=timeout)
-    except Exception:  # noqa: BLE001 - report what the peer said, then fail
+    except Exception:
         process.kill()
         out, err = process.communicate()
         pytest.fail(f"peer did not finish in {timeout} s; stderr:\n{err}")
@@ -294,7 +294,7 @@ def test_message_to_another_process_arrives_intact(ros_graph: Any, name: str) ->
 
 @pytest.mark.ros
 def test_set_axial_load_service_across_processes(ros_graph: Any) -> None:
-    from bearing_rig_msgs.srv import SetAxialLoad  # noqa: PLC0415
+    from bearing_rig_msgs.srv import SetAxialLoad
 
     peer = ros_graph.spawn_python(__file__, "serve")
     node = ros_graph.node("operator")

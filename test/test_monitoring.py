@@ -2,7 +2,7 @@
 sequence, sensor loss, a stop, lost pulses, clock jumps, out-of-order and malformed pulses.
 
 Pulse times are computed here from the shaft's angle (crossings of equally spaced strips), and
-the expected slip from the bearing file's geometry with the paper's formula (digest Eq. 11-12),
+the expected slip from the bearing file's geometry with the paper's formula (paper Eq. 11-12),
 independently of the monitor and of the analysis module.
 """
 
@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable, Iterable
+from collections.abc import Callable, Iterable
 
 import numpy as np
 import pytest
@@ -120,7 +120,7 @@ def test_exact_slip_for_known_constant_speeds(revolutions):
 
 def test_state_goes_from_unknown_to_stable_at_constant_speed():
     rng = np.random.default_rng(5)
-    jitter = lambda t: t + rng.normal(0.0, 1e-6, t.size)  # noqa: E731 - the sensors' 1 us jitter
+    jitter = lambda t: t + rng.normal(0.0, 1e-6, t.size)
     monitor = make()
     states: list[MonitorState] = []
     feed(

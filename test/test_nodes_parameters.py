@@ -9,7 +9,8 @@ does) and asked through rclpy's own parameter API, which the ``describe_paramete
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import pytest
 

@@ -99,7 +99,7 @@ def test_constant_acceleration_crossing_error_is_the_chord_error() -> None:
     # the chord lies a u (h - u) / 2 above the curve, so the pulse is early by exactly
     # a u (h - u) / (2 w_mean), at most a h^2 / (8 w_mean).
     omega0, alpha, strips, h = 5.0, 80.0, 4, 2e-3
-    theta = lambda t: omega0 * t + 0.5 * alpha * t * t  # noqa: E731
+    theta = lambda t: omega0 * t + 0.5 * alpha * t * t
     sensor = FibreOpticSensor("spindle", strips)
     pulses = run_shaft(sensor, theta, 2.0, h)
     spacing = TWO_PI / strips

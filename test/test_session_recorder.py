@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from bearing_rig_sim.recording import BagWriter, open_bag
+from bearing_rig_sim.bags import BagWriter, open_bag
 from bearing_rig_sim.session.recorder import RECORDED_TOPICS, SessionRecorder, header_stamp_ns
 
 S = 1_000_000_000  # ns per s

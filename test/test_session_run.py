@@ -19,11 +19,11 @@ import pytest
 
 pytest.importorskip("rclpy")
 
-from mcap.reader import make_reader  # noqa: E402
-from mcap_ros2.decoder import DecoderFactory  # noqa: E402
-from rosbags.highlevel import AnyReader  # noqa: E402
+from mcap.reader import make_reader
+from mcap_ros2.decoder import DecoderFactory
+from rosbags.highlevel import AnyReader
 
-from bearing_rig_sim.recording import open_bag, rig_typestore  # noqa: E402
+from bearing_rig_sim.bags import open_bag, rig_typestore
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 

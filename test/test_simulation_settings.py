@@ -74,7 +74,7 @@ def test_file_parameters_are_relative_to_config_unless_absolute(tmp_path):
 
 def test_no_realtime_flag_becomes_a_parameter_override():
     pytest.importorskip("rclpy")
-    from bearing_rig_sim.nodes.simulator import node_arguments  # noqa: PLC0415
+    from bearing_rig_sim.nodes.simulator import node_arguments
 
     assert node_arguments(["simulator"]) == ["simulator"]
     assert node_arguments(["simulator", "--no-realtime", "--ros-args", "-p", "rate:=2.0"]) == [

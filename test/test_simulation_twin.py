@@ -29,7 +29,7 @@ BEARING = config_path("bearings", "h7006c.yaml")
 
 
 def epicyclic_ratio() -> float:
-    """n_s / n_i = (1 - Dw cos(alpha) / dm) / 2, from the bearing file's numbers (digest Eq. 12)."""
+    """n_s / n_i = (1 - Dw cos(alpha) / dm) / 2, from the bearing file's numbers (paper Eq. 12)."""
     g = yaml.safe_load(BEARING.read_text())["geometry"]
     return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
 

@@ -1,4 +1,4 @@
-"""The paper's slip-analysis method, without ROS (digest sections 6 and 7).
+"""The paper's slip-analysis method, without ROS (docs/paper.md sections 6 and 7).
 
 * :mod:`.slip`: slip rate from cage and inner-ring speeds (percent), also from sensor pulses;
 * :mod:`.gaussian`: sums of Gaussians fitted to slip data, with the paper's quality figures;

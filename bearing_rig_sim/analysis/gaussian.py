@@ -1,4 +1,4 @@
-"""Sums of Gaussian terms fitted to slip data (paper section 2.2, digest section 7).
+"""Sums of Gaussian terms fitted to slip data (paper section 2.2, docs/paper.md section 7).
 
 The model, with ``params`` an (n_terms, 3) array of rows (a, b, c)::
 
@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any, Sequence, overload
+from typing import Any, overload
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.optimize import least_squares

@@ -1,4 +1,4 @@
-"""Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12, digest section 6).
+"""Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12; docs/paper.md section 6).
 
 The epicyclic (pure-rolling) cage speed is
 
@@ -15,7 +15,7 @@ Dw the ball diameter, dm the pitch diameter (m) and alpha the contact angle (rad
 
 Speeds are SI (rad/s) and the slip rate is the one quantity kept in percent, as in the paper.
 
-:func:`whole_revolution_slip` computes the slip as the monitor does on the bench (digest
+:func:`whole_revolution_slip` computes the slip as the monitor does on the bench (docs/paper.md
 section 8): from the time stamps of the fibre-optic sensors' light pulses, one per reflective
 strip passing, averaging over whole cage revolutions.
 """
@@ -74,7 +74,7 @@ class BearingKinematics:
             raise AnalysisError(f"contact_angle: must be in [0, pi/2) rad, got {self.contact_angle!r}")
 
     @classmethod
-    def from_config(cls, source: Section | str | Path) -> "BearingKinematics":
+    def from_config(cls, source: Section | str | Path) -> BearingKinematics:
         """Read ``geometry.ball_diameter_m``, ``geometry.pitch_diameter_m`` and
         ``geometry.contact_angle_deg`` (the nominal angle, degrees) from a bearing file.
 
@@ -93,7 +93,7 @@ class BearingKinematics:
             raise geometry.error("pitch_diameter_m", f"must exceed ball_diameter_m = {ball}, got {pitch}")
         return cls(ball, pitch, math.radians(angle_deg))
 
-    def at_contact_angle(self, contact_angle: float) -> "BearingKinematics":
+    def at_contact_angle(self, contact_angle: float) -> BearingKinematics:
         """The same bearing at another contact angle (rad), e.g. the loaded one."""
         return replace(self, contact_angle=contact_angle)
 
@@ -118,7 +118,7 @@ class BearingKinematics:
         return float(out[0]) if scalar else out
 
     @overload
-    def slip_rate(self, cage_speed: float, inner_ring_speed: float) -> float: ...
+    def slip_rate(self, cage_speed: float, inner_ring_speed: float) -> float: ...  # type: ignore[overload-overlap]  # a float pair is never an array
     @overload
     def slip_rate(self, cage_speed: FloatArray | float, inner_ring_speed: FloatArray | float) -> FloatArray: ...
     def slip_rate(self, cage_speed: float | FloatArray, inner_ring_speed: float | FloatArray) -> float | FloatArray:
@@ -161,7 +161,7 @@ def _speeds(name: str, value: float | FloatArray) -> tuple[FloatArray, bool]:
 def epicyclic_cage_speed(
     inner_ring_speed: float | FloatArray, ball_diameter: float, pitch_diameter: float, contact_angle: float
 ) -> float | FloatArray:
-    """Pure-rolling cage speed n_s (rad/s); digest Eq. 12.
+    """Pure-rolling cage speed n_s (rad/s); paper Eq. 12.
 
     Args:
         inner_ring_speed: n_i, rad/s (scalar or 1-D array, any finite value).
@@ -182,7 +182,7 @@ def slip_rate(
     pitch_diameter: float,
     contact_angle: float,
 ) -> float | FloatArray:
-    """Cage slip rate S_c in **percent**; digest Eq. 11. See :meth:`BearingKinematics.slip_rate`.
+    """Cage slip rate S_c in **percent**; paper Eq. 11. See :meth:`BearingKinematics.slip_rate`.
 
     Args:
         cage_speed: n_c, rad/s.

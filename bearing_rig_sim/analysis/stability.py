@@ -1,4 +1,4 @@
-"""The slope criterion: when has the slip reached its stable state? (paper Eq. 14, digest 7).
+"""The slope criterion: when has the slip reached its stable state? (paper Eq. 14; docs/paper.md section 7).
 
 The paper fits a curve to the slip (percent) against axial load (N) or time (s) and computes the
 slope between successive points of the fitted curve, k_n = (s_n - s_(n-1)) / (x_n - x_(n-1)).
@@ -21,7 +21,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from enum import StrEnum
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -39,7 +40,7 @@ from bearing_rig_sim.analysis.inputs import (
 K1_AXIAL_LOAD: float = -5e-6
 """Critical slope of slip against axial load, read as **percent per newton** (%/N).
 
-The paper gives k1 = -5e-6 without a unit (digest section 7). Its slip is in percent and its loads
+The paper gives k1 = -5e-6 without a unit (docs/paper.md section 7). Its slip is in percent and its loads
 in newtons (50-700 N), so the slope of its fitted curves is in %/N; a fall of 5e-6 %/N is 0.0035 %
 over the whole 700 N sweep, i.e. "the curve has flattened out". Read as a fraction per newton it
 would be 100 times steeper, which is not consistent with the time constant below.
@@ -48,10 +49,10 @@ would be 100 times steeper, which is not consistent with the time constant below
 K2_TIME: float = -3e-2
 """Critical slope of slip against time under acceleration, read as **percent per second** (%/s).
 
-The paper gives k2 = -3e-2 without a unit (digest section 7). Read as %/s, with slip in percent
+The paper gives k2 = -3e-2 without a unit (docs/paper.md section 7). Read as %/s, with slip in percent
 and time in seconds as in its Table 7 fits y = lambda exp(-((t - k)/d)^2), it reproduces the
 stable-onset times the paper's data imply: 1.67, 1.41, 1.23 and 0.97 s for 20, 40, 60 and
-80 rad/s^2 (digest section 11). Read as a fraction per second (3 %/s) it would put every onset
+80 rad/s^2 (docs/paper.md section 11). Read as a fraction per second (3 %/s) it would put every onset
 before 0.6 s.
 """
 

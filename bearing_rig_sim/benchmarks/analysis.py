@@ -20,7 +20,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from typing import Iterator
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -30,7 +30,7 @@ from bearing_rig_sim.analysis.streaming import StreamingStability
 TABLE7_20 = np.array([[3.5, -1.52, 1.29]])
 """Slip (%) against time (s) at 20 rad/s^2, paper Table 7."""
 TABLE5_1000 = np.array([[5.18, -4.14, 214.0], [2.05, 530.0, 469.0]])
-"""Slip (%) against axial load (N) at 1000 rpm, paper Table 5 (digest section 10)."""
+"""Slip (%) against axial load (N) at 1000 rpm, paper Table 5 (docs/paper.md section 10)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -43,7 +43,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _series(criterion: str, n: int, rate: float) -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng(0)
     if criterion == "time":
-        x = np.arange(1, n + 1) / rate
+        x: np.ndarray = np.arange(1, n + 1) / rate
         params = TABLE7_20
     else:
         x = 50.0 + 5.0 * np.arange(n)

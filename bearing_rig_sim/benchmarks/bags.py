@@ -39,11 +39,13 @@ import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
-from typing import Iterator
+from collections.abc import Iterator
+from typing import Any
 
+from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.recording import BagWriter, open_bag, rig_typestore
-from bearing_rig_sim.recording.synthetic import (
+from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.synthetic.traffic import (
     CAGE_PULSES_TOPIC,
     RIG_TRAFFIC_TOPICS,
     SPEEDS_TOPIC,
@@ -63,7 +65,7 @@ HOLD_S = 30.0
 """Time each speed is held in :func:`program_traffic` (s)."""
 STRIPS = 4
 """Reflective strips per shaft (config/rig.yaml)."""
-STATUS_TOPIC = "/rig/slip_status"
+STATUS_TOPIC = SLIP_STATUS.name
 CASES = ("record", "read", "analyse")
 
 
@@ -109,7 +111,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     CDR bytes); see the module documentation. The cage turns at the epicyclic speed of H7006C
     (0.4283 n_i) less a slip of 1-1.5 % plus 2 % decaying with a 2 s time constant after each
     speed change."""
-    from bearing_rig_sim.rig.program import step_ramp  # noqa: PLC0415
+    from bearing_rig_sim.rig.program import step_ramp
 
     store = rig_typestore()
     types = store.types
@@ -125,7 +127,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
         slip = 1.0 + 0.5 * after / speeds[-1] + transient_pct * math.exp(-max(t - t0 - 1.0, 0.0) / 2.0)
         return inner, inner * 0.4283 * (1.0 - slip / 100.0)
 
-    def stamp(time_ns: int) -> object:
+    def stamp(time_ns: int) -> Any:
         return types["builtin_interfaces/msg/Time"](sec=time_ns // 10**9, nanosec=time_ns % 10**9)
 
     def pulse(time_ns: int, shaft: str, index: int) -> bytes:
@@ -139,7 +141,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     angles = {SPINDLE_PULSES_TOPIC: 0.0, CAGE_PULSES_TOPIC: 0.0}
     counts = {SPINDLE_PULSES_TOPIC: 0, CAGE_PULSES_TOPIC: 0}
     shafts = {SPINDLE_PULSES_TOPIC: "spindle", CAGE_PULSES_TOPIC: "cage"}
-    status = store.types["bearing_rig_msgs/msg/SlipStatus"](
+    status: Any = store.types["bearing_rig_msgs/msg/SlipStatus"](
         header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
         theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
         confidence=0.9, window_revolutions=1, detail="1-term Gaussian fit of 300 points; slope -0.001 %/s >= k = -0.03 %/s",
@@ -184,16 +186,16 @@ def _record_rig_bag(folder: Path, minutes: float) -> tuple[float, int, int]:
 def measure_analysis(path: str, out: str) -> dict:
     """``bearing-rig analyze`` of a bag (CSV, plots and report into ``out``); runs in a fresh
     process. Returns seconds of each part, counts, peak and baseline resident memory (MB)."""
-    import matplotlib.pyplot  # noqa: F401, PLC0415 - imported before the baseline, as analyse_bag's modules
+    import matplotlib.pyplot  # noqa: F401 - imported before the baseline, as analyse_bag's modules
 
-    from bearing_rig_sim.monitoring import SlipMonitor  # noqa: PLC0415
-    from bearing_rig_sim.recording.offline import analyse_bag  # noqa: PLC0415
-    from bearing_rig_sim.recording.report import write_report  # noqa: PLC0415
+    from bearing_rig_sim.monitoring import SlipMonitor
+    from bearing_rig_sim.offline.analysis import analyse_bag
+    from bearing_rig_sim.offline.report import write_report
 
     spent = [0.0]
 
-    def timed(method):  # noqa: ANN001, ANN202 - the monitor's time, apart from the analysis' own
-        def wrapper(*args, **kwargs):  # noqa: ANN002, ANN003, ANN202
+    def timed(method):
+        def wrapper(*args, **kwargs):
             begin = time.perf_counter()
             try:
                 return method(*args, **kwargs)

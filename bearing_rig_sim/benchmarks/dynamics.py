@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 import statistics
 import time
-from typing import Iterator
+from collections.abc import Iterator
 
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters

@@ -36,7 +36,8 @@ import time
 from bisect import bisect_left, bisect_right
 from collections import OrderedDict
 from pathlib import Path
-from typing import Any, Iterator
+from typing import Any
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -71,14 +72,14 @@ class _Probe:
     reception times (a node that is not spun; its queues are taken by :meth:`take`)."""
 
     def __init__(self, context: Any) -> None:
-        from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand  # noqa: PLC0415
-        from rclpy.node import Node  # noqa: PLC0415
-        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy  # noqa: PLC0415
-        from rosgraph_msgs.msg import Clock  # noqa: PLC0415
-        from sensor_msgs.msg import JointState  # noqa: PLC0415
-        from std_msgs.msg import Float64  # noqa: PLC0415
+        from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
+        from rclpy.node import Node
+        from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+        from rosgraph_msgs.msg import Clock
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import Float64
 
-        from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS  # noqa: PLC0415
+        from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS
 
         self.node = Node("bench_rig_probe", context=context)
         self.tap = Node("bench_rig_probe_queues", context=context)
@@ -156,7 +157,7 @@ class _Series:
         self.seen: dict[str, int] = {}
 
     def add(self, taken: dict[str, list[tuple[int, bytes]]], types: dict[str, type]) -> None:
-        from rclpy.serialization import deserialize_message  # noqa: PLC0415
+        from rclpy.serialization import deserialize_message
 
         for name, items in taken.items():
             self.seen[name] = self.seen.get(name, 0) + len(items)
@@ -191,7 +192,7 @@ def _percentile(values: list[float], q: float) -> float | None:
 
 def _configured_speed_rate() -> float:
     """The simulator's configured /rig/speeds rate, Hz of sim time (at most one per chunk)."""
-    from bearing_rig_sim.simulation.settings import shipped_parameters  # noqa: PLC0415
+    from bearing_rig_sim.simulation.settings import shipped_parameters
 
     params = shipped_parameters()
     return min(float(params["speeds_rate_hz"]), 1.0 / float(params["chunk_s"]))
@@ -201,8 +202,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
     """Start the nodes, measure, stop them; yield the rows of the module documentation."""
     if not args.seconds > 0 or not args.warmup >= 0:
         raise RigError(f"bench rig: --seconds must be > 0 and --warmup >= 0, got {args.seconds}, {args.warmup}")
-    import rclpy  # noqa: PLC0415
-    from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
+    import rclpy
+    from rclpy.signals import SignalHandlerOptions
 
     logs = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-rig-"))
     env, lease = session_environment(os.environ)
@@ -251,7 +252,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
     duration = mono_end - mono_start
     yield from _rows(args, series, wall_start, wall_end, duration)
     for name in NODES:
-        used = None if cpu_start[name] is None or cpu_end[name] is None else cpu_end[name] - cpu_start[name]
+        start, end = cpu_start[name], cpu_end[name]
+        used = None if start is None or end is None else end - start
         yield {"bench": "rig", "case": "cpu", "node": name, "cpu_pct": None if used is None else round(100.0 * used / duration, 1)}
     own = (own_end.user + own_end.system) - (own_start.user + own_start.system)
     yield {"bench": "rig", "case": "cpu", "node": "bench_probe", "cpu_pct": round(100.0 * own / duration, 1)}

@@ -27,10 +27,10 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Analyse the bag and write the report."""
-    from bearing_rig_sim.commands.bag import bag_warnings_as_lines  # noqa: PLC0415 - keeps --help fast
-    from bearing_rig_sim.monitoring import MonitorSettings, MonitorState  # noqa: PLC0415
-    from bearing_rig_sim.recording.offline import analyse_bag  # noqa: PLC0415
-    from bearing_rig_sim.recording.report import state_name, write_report  # noqa: PLC0415
+    from bearing_rig_sim.commands.bag import bag_warnings_as_lines
+    from bearing_rig_sim.monitoring import MonitorSettings, MonitorState
+    from bearing_rig_sim.offline.analysis import analyse_bag
+    from bearing_rig_sim.offline.report import state_name, write_report
 
     out = args.out if args.out is not None else Path("out") / "analyze" / args.bag.resolve().name
     settings = MonitorSettings.from_yaml(args.monitor_params) if args.monitor_params is not None else None

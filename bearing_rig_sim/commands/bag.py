@@ -8,7 +8,8 @@ import contextlib
 import sys
 import warnings
 from pathlib import Path
-from typing import Any, Iterator, TextIO
+from typing import Any, TextIO
+from collections.abc import Iterator
 
 PROG = "bearing-rig"
 
@@ -17,7 +18,7 @@ PROG = "bearing-rig"
 def bag_warnings_as_lines(out: TextIO | None = None) -> Iterator[list[str]]:
     """Print each bag warning (damage, unknown types) as one line ``bearing-rig: warning: ...``
     on stderr, once, instead of Python's warning format; yields the list of them."""
-    from bearing_rig_sim.recording.errors import BagWarning  # noqa: PLC0415 - keeps --help fast
+    from bearing_rig_sim.bags.errors import BagWarning
 
     seen: list[str] = []
     stream = out if out is not None else sys.stderr
@@ -80,7 +81,7 @@ def print_info(path: Path, out: TextIO, *, full_metadata: bool = False) -> None:
     Raises:
         BagError: not a bag.
     """
-    from bearing_rig_sim.recording import open_bag  # noqa: PLC0415
+    from bearing_rig_sim.bags import open_bag
 
     with open_bag(path) as bag:
         topics = bag.topics
@@ -117,7 +118,7 @@ def print_info(path: Path, out: TextIO, *, full_metadata: bool = False) -> None:
 def run_info(args: argparse.Namespace) -> int:
     """``bag info``."""
     with warnings.catch_warnings():
-        from bearing_rig_sim.recording.errors import BagWarning  # noqa: PLC0415
+        from bearing_rig_sim.bags.errors import BagWarning
 
         warnings.simplefilter("ignore", BagWarning)  # the problems are listed in the output
         print_info(args.bag, sys.stdout, full_metadata=args.metadata)
@@ -126,7 +127,7 @@ def run_info(args: argparse.Namespace) -> int:
 
 def run_repair(args: argparse.Namespace) -> int:
     """``bag repair``: each bag in turn; exit status 2 if one could not be repaired."""
-    from bearing_rig_sim.recording import BagError, repair_bag  # noqa: PLC0415
+    from bearing_rig_sim.bags import BagError, repair_bag
 
     status = 0
     for path in args.bags:

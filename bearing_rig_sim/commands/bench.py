@@ -18,7 +18,8 @@ import json
 import numbers
 import sys
 from types import ModuleType
-from typing import Any, Iterable, TextIO
+from typing import Any, TextIO
+from collections.abc import Iterable
 
 from bearing_rig_sim.errors import RigError
 

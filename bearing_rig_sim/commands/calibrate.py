@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
+from bearing_rig_sim.studies.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
 from bearing_rig_sim.config import config_path, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE

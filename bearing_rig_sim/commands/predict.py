@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.calibration import steady_states
+from bearing_rig_sim.studies.calibration import steady_states
 from bearing_rig_sim.config import check_number, config_path, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError

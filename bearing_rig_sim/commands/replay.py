@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.interfaces import CLOCK
 from bearing_rig_sim.errors import RigError
 
 
@@ -39,9 +40,9 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Replay the bag; returns the exit status."""
-    from bearing_rig_sim.commands.bag import bag_warnings_as_lines  # noqa: PLC0415 - keeps --help fast
-    from bearing_rig_sim.recording import open_bag  # noqa: PLC0415
-    from bearing_rig_sim.recording.replay import ReplayOptions, RosReplaySink, check_topics, replay_bag  # noqa: PLC0415
+    from bearing_rig_sim.commands.bag import bag_warnings_as_lines
+    from bearing_rig_sim.bags import open_bag
+    from bearing_rig_sim.replay.player import ReplayOptions, RosReplaySink, check_topics, replay_bag
 
     if not args.delay >= 0.0:
         raise RigError(f"--delay must be >= 0 s, got {args.delay!r}")
@@ -58,7 +59,7 @@ def run(args: argparse.Namespace) -> int:
         sink = RosReplaySink(bag.topics)
         try:
             if args.wait_for_subscribers:
-                alone = sink.wait_for_subscribers([t for t in topics if t != "/clock"], args.delay)
+                alone = sink.wait_for_subscribers([t for t in topics if t != CLOCK.name], args.delay)
                 if alone:
                     print(f"bearing-rig: warning: no subscriber after {args.delay:g} s on {', '.join(alone)}; replaying anyway", file=sys.stderr)
             else:

@@ -25,15 +25,15 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run or reuse the experiments and write the outputs."""
     from bearing_rig_sim.config import config_path
-    from bearing_rig_sim.reproduce import reproduce
+    from bearing_rig_sim.studies.reproduction import reproduce
 
     params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
     out = reproduce(args.out, params, workers=args.workers, use_cache=not args.no_cache, progress=not args.quiet)
     print(f"{'reused cached results' if out.cached else 'ran the experiments'}; wrote {len(out.files)} files to {out.out_dir}")
     print(f"validation RMS (twin - bench, 4 rows): {out.validation_rms_pct:.3f} pp")
     for rpm, f in out.load_onsets_n.items():
-        print(f"  {rpm:6.0f} rpm: stable from {'%.0f N' % f if f is not None else 'not reached in 50-700 N'} (k1 = -5e-6 %/N)")
+        print(f"  {rpm:6.0f} rpm: stable from {f'{f:.0f} N' if f is not None else 'not reached in 50-700 N'} (k1 = -5e-6 %/N)")
     for a, t in out.acceleration_onsets_s.items():
-        print(f"  {a:4.0f} rad/s^2: stable from {'%.2f s' % t if t is not None else 'not reached'} (k2 = -3e-2 %/s)")
+        print(f"  {a:4.0f} rad/s^2: stable from {f'{t:.2f} s' if t is not None else 'not reached'} (k2 = -3e-2 %/s)")
     print(f"report: {out.out_dir / 'report.md'}")
     return 0

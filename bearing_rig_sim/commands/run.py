@@ -75,7 +75,7 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the session; returns its exit status."""
-    from bearing_rig_sim.session import SessionOptions, run_session  # noqa: PLC0415 - keeps --help fast
+    from bearing_rig_sim.session import SessionOptions, run_session
 
     program = args.program if args.program is not None else config_path(*DEFAULT_PROGRAM)
     options = SessionOptions(

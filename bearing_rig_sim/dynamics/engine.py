@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.parameters import BearingParameters, DerivedGeometry, derive
+from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.errors import RigError
 
 MODELS = ("reduced", "stiff")
@@ -279,7 +279,3 @@ class BearingDynamics:
             axial_load=self.axial_load,
         )
 
-
-def derived_geometry(params: BearingParameters) -> DerivedGeometry:
-    """Derived geometry of a bearing (groove bottoms, masses, Hertz constants)."""
-    return derive(params)[1]

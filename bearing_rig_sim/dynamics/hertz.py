@@ -1,7 +1,7 @@
 """Elliptical Hertz point contact (Harris and Kotzalas, *Rolling Bearing Analysis*, ch. 6;
 Hamrock and Dowson, *Ball Bearing Lubrication*, ch. 3).
 
-The paper (digest section 3) writes the ball-raceway stiffness with the two-sphere form
+The paper (docs/paper.md section 3) writes the ball-raceway stiffness with the two-sphere form
 K = 4/3 E* sqrt(Re). For a ball in a grooved raceway the contact is elliptical; this module solves
 the classical elliptical problem from the curvature sum and difference, with the complete elliptic
 integrals, and gives the load-deflection constant of Q = K delta^1.5.
@@ -61,7 +61,7 @@ class HertzContact:
 
 def reduced_modulus(e1: float, nu1: float, e2: float, nu2: float) -> float:
     """E' = 2 / ((1 - nu1^2)/E1 + (1 - nu2^2)/E2) in Pa (Hamrock and Dowson's convention;
-    the paper's E* of digest section 3 is E'/2)."""
+    the paper's E* of docs/paper.md section 3 is E'/2)."""
     return 2.0 / ((1.0 - nu1 * nu1) / e1 + (1.0 - nu2 * nu2) / e2)
 
 

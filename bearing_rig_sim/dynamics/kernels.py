@@ -95,7 +95,7 @@ MIN_PENETRATION_FOR_JACOBIAN = 1e-10  # m, keeps the quasi-static Jacobian regul
 
 @njit(cache=True)
 def step_function(x: float, x0: float, h0: float, x1: float, h1: float) -> float:
-    """The paper's STEP (digest section 5, typo corrected): cubic from h0 at x0 to h1 at x1."""
+    """The paper's STEP (docs/paper.md section 5, typo corrected): cubic from h0 at x0 to h1 at x1."""
     if x <= x0:
         return h0
     if x >= x1:
@@ -109,7 +109,7 @@ def traction_coefficient(p: np.ndarray, s: float, entrainment: float) -> tuple[f
     """Signed traction coefficient mu(s) and d mu/ds for sliding velocity s (m/s, race relative
     to ball; the force on the ball has the sign of s).
 
-    Model 0, the paper's law (digest section 4, labels corrected): a cubic STEP through zero
+    Model 0, the paper's law (docs/paper.md section 4, labels corrected): a cubic STEP through zero
     from -mu_s to mu_s on |s| < v_s, a STEP from mu_s down to mu_d on v_s..v_d, mu_d beyond.
     Model 1, EHL: mu = mu_max (1 - exp(-|SRR|/SRR0)) sign(s), SRR = s / entrainment speed.
     """

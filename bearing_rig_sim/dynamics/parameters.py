@@ -4,7 +4,7 @@
 everything the kernels need (groove geometry, Hertz constants, masses, inertias, resistance
 coefficients) into a flat float64 vector whose layout is defined in :mod:`.kernels`.
 
-Resistance models (what makes the cage slip; digest section 12), each applied in the kernels:
+Resistance models (what makes the cage slip; docs/paper.md section 12), each applied in the kernels:
 
 * Ball drag in the oil-air mixture (Harris and Kotzalas, *Advanced Concepts*, ch. 7, sphere drag
   with C_d = 24/Re + C_d,inf): F = s (3 pi eta_mix Dw v + 1/2 rho_mix C_d (pi Dw^2/4) v|v|),
@@ -103,7 +103,7 @@ class BearingParameters:
 
     # -- construction --------------------------------------------------------------------------
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None, calibration: str | Path | None = None) -> "BearingParameters":
+    def from_yaml(cls, path: str | Path | None = None, calibration: str | Path | None = None) -> BearingParameters:
         """Load and validate a bearing file (default: the shipped H7006C), optionally with a
         calibration file laid over it (see :func:`overlay_calibration`)."""
         doc = load_yaml(path or config_path("bearings", "h7006c.yaml"))
@@ -112,12 +112,12 @@ class BearingParameters:
         return cls.from_section(doc)
 
     @classmethod
-    def calibrated(cls) -> "BearingParameters":
+    def calibrated(cls) -> BearingParameters:
         """The shipped H7006C with the shipped bench calibration (``config/calibration/``)."""
         return cls.from_yaml(None, config_path("calibration", "h7006c_table3.yaml"))
 
     @classmethod
-    def from_section(cls, doc: Section) -> "BearingParameters":
+    def from_section(cls, doc: Section) -> BearingParameters:
         """Validate a parsed bearing document; errors name file, key and allowed range."""
         g, c = doc.section("geometry"), doc.section("cage")
         mat, con, fr = doc.section("materials"), doc.section("contact"), doc.section("friction")
@@ -186,11 +186,11 @@ class BearingParameters:
         )
         return params
 
-    def replace(self, **changes: object) -> "BearingParameters":
+    def replace(self, **changes: object) -> BearingParameters:
         """A copy with some fields changed (e.g. calibrated scale factors)."""
         return dataclasses.replace(self, **changes)
 
-    def without_resistances(self) -> "BearingParameters":
+    def without_resistances(self) -> BearingParameters:
         """All slip-causing resistances off: no drag, no cage land or pocket friction, no
         rolling hysteresis (used by the kinematic-limit test)."""
         return self.replace(
@@ -201,7 +201,7 @@ class BearingParameters:
             rolling_hysteresis_factor=0.0,
         )
 
-    def conservative(self) -> "BearingParameters":
+    def conservative(self) -> BearingParameters:
         """Friction, damping and resistances off: a conservative system (energy test)."""
         return self.without_resistances().replace(
             static_friction=0.0,
@@ -214,7 +214,7 @@ class BearingParameters:
     # -- derived -------------------------------------------------------------------------------
     @property
     def epicyclic_ratio(self) -> float:
-        """n_s / n_i at the free contact angle (digest Eq. 12), 1."""
+        """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
 
 

@@ -16,7 +16,8 @@ import the layout ``config/foxglove/rig.json`` (README, "Live view in Foxglove")
 
 from __future__ import annotations
 
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 from bearing_rig_sim.errors import RigError
 
@@ -43,7 +44,7 @@ class FoxgloveLiveView:
 
     def __init__(self, port: int, schema_text: Callable[[str], str], name: str = "bearing-rig") -> None:
         try:
-            import foxglove  # noqa: PLC0415 - an optional live view; import only when asked for
+            import foxglove
         except ImportError as exc:  # pragma: no cover - pinned in requirements.lock
             raise RigError(f"--foxglove needs the foxglove-sdk package: {exc}") from None
         if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
@@ -54,7 +55,7 @@ class FoxgloveLiveView:
         self._channels: dict[str, Any] = {}
         try:
             self._server = foxglove.start_server(name=name, host=HOST, port=port, context=self._context)
-        except Exception as exc:  # noqa: BLE001 - the SDK raises its own error types
+        except Exception as exc:
             raise RigError(f"--foxglove: cannot serve on {HOST}:{port}: {' '.join(str(exc).split())}") from None
 
     @property
@@ -112,6 +113,6 @@ class TeeWriter:
             return
         try:
             action(self.view)
-        except Exception as exc:  # noqa: BLE001 - the live view is optional, the bag is not
+        except Exception as exc:
             self.view_error = " ".join(str(exc).split()) or type(exc).__name__
             self.view = None

@@ -48,6 +48,7 @@ from enum import Enum
 from typing import TYPE_CHECKING
 
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.loading import ClutchState, LoadChainState, LoadingChain, LoadingChainConfig, SetpointError
 
 if TYPE_CHECKING:
@@ -71,22 +72,6 @@ class SetpointSource(str, Enum):
     TOPIC = "topic"
     SERVICE = "service"
     PARAMETER = "parameter"
-
-
-class HealthLevel(str, Enum):
-    """Level of the load controller's diagnostic status; compares equal to its string value."""
-
-    OK = "ok"
-    WARN = "warn"
-    ERROR = "error"
-
-
-@dataclass(frozen=True)
-class Health:
-    """What ``/diagnostics`` says about the load controller."""
-
-    level: HealthLevel
-    message: str
 
 
 @dataclass(frozen=True)
@@ -170,10 +155,10 @@ class AxialLoadOperation:
         self._apply_zero_load_rule()
 
     @classmethod
-    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> "AxialLoadOperation":
+    def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> AxialLoadOperation:
         """An operation of a new chain built from ``config``, run as the shipped
         ``config/load_controller.yaml`` says, with ``options`` (constructor keywords) overriding."""
-        from bearing_rig_sim.load_control.settings import LoadControllerSettings  # noqa: PLC0415 - settings import this module
+        from bearing_rig_sim.load_control.settings import LoadControllerSettings
 
         settings = LoadControllerSettings.from_yaml()
         values: dict[str, float | bool] = {
@@ -187,7 +172,7 @@ class AxialLoadOperation:
         return cls(LoadingChain(config), **values)  # type: ignore[arg-type]  # keywords checked by the constructor
 
     @classmethod
-    def from_settings(cls, config: LoadingChainConfig, settings: "LoadControllerSettings") -> "AxialLoadOperation":
+    def from_settings(cls, config: LoadingChainConfig, settings: LoadControllerSettings) -> AxialLoadOperation:
         """An operation of a new chain built from ``config``, run as ``settings`` say."""
         return cls(
             LoadingChain(config),
@@ -347,14 +332,14 @@ class AxialLoadOperation:
         health changed" means something happened; the live values go beside it."""
         chain = self.chain
         if chain.fault:
-            return Health(HealthLevel.ERROR, f"interlock: {chain.fault_reason}")
+            return Health(HealthLevel.ERROR, (f"interlock: {chain.fault_reason}",))
         if self._refusal:
-            return Health(HealthLevel.WARN, self._refusal)
+            return Health(HealthLevel.WARN, (self._refusal,))
         if chain.clutch.state is ClutchState.RELEASED:
-            return Health(HealthLevel.OK, f"clutch released; set-point {chain.setpoint:g} N")
+            return Health(HealthLevel.OK, (f"clutch released; set-point {chain.setpoint:g} N",))
         if chain.setpoint == 0.0:
-            return Health(HealthLevel.OK, "set-point 0 N: brake de-energised")
-        return Health(HealthLevel.OK, f"controlling the axial load; set-point {chain.setpoint:g} N")
+            return Health(HealthLevel.OK, ("set-point 0 N: brake de-energised",))
+        return Health(HealthLevel.OK, (f"controlling the axial load; set-point {chain.setpoint:g} N",))
 
     def mark_reported(self, health: Health | None) -> None:
         """Note that ``health`` was published (diagnostics are due again when it changes;

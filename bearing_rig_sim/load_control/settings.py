@@ -53,7 +53,7 @@ class LoadControllerSettings:
     step_period_s: float
 
     @classmethod
-    def from_section(cls, s: Section) -> "LoadControllerSettings":
+    def from_section(cls, s: Section) -> LoadControllerSettings:
         """Validate the parameters in ``s`` (every key required, none unknown besides
         ``use_sim_time``, which must be true: the chain is stepped on the simulation clock).
 
@@ -81,12 +81,12 @@ class LoadControllerSettings:
         )
 
     @classmethod
-    def from_values(cls, values: dict[str, Any], source: str = "load_controller parameters") -> "LoadControllerSettings":
+    def from_values(cls, values: dict[str, Any], source: str = "load_controller parameters") -> LoadControllerSettings:
         """Validate a flat mapping of parameter values (the node's ROS parameters)."""
         return cls.from_section(Section(dict(values), source))
 
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "LoadControllerSettings":
+    def from_yaml(cls, path: str | Path | None = None) -> LoadControllerSettings:
         """Read ``load_controller: ros__parameters:`` of a parameter file (default: the shipped one).
 
         Raises:

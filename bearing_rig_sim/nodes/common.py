@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
-from typing import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import rclpy
 from builtin_interfaces.msg import Time
@@ -21,6 +21,7 @@ from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.interfaces import Topic
 
 SENSOR_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
@@ -144,10 +145,23 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
 
 def _autostart(node: Node) -> str:
     """Configure then activate a lifecycle node; why it failed, or "" when it is active."""
-    from rclpy.lifecycle import TransitionCallbackReturn  # noqa: PLC0415
+    from rclpy.lifecycle import TransitionCallbackReturn
 
     if node.trigger_configure() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
         return getattr(node, "configure_error", "") or "configure failed"
     if node.trigger_activate() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
         return "activate failed"
     return ""
+
+
+CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {
+    "reliable": RELIABLE_QOS,
+    "sensor_data": SENSOR_QOS,
+    "transient_local": STATUS_QOS,
+}
+"""The rclpy profile of each QoS name of the interface contract (:mod:`bearing_rig_sim.interfaces`)."""
+
+
+def qos_profile(topic: Topic) -> QoSProfile:
+    """The rclpy QoS profile the contract gives ``topic``."""
+    return CONTRACT_QOS_PROFILES[topic.qos]

@@ -48,7 +48,8 @@ does; only reset_fault clears it.
 from __future__ import annotations
 
 import sys
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 from bearing_rig_msgs.msg import AxialLoadState
 from bearing_rig_msgs.srv import SetAxialLoad
@@ -57,7 +58,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock as RosClock
-from rclpy.clock import ClockType
+from rclpy.clock import ClockType, ROSClock
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -187,7 +188,9 @@ class LoadControllerNode(ManagedNode):
         stamp = self._latest_clock()
         if operation is None or stamp is None:
             return
-        self.get_clock().set_ros_time_override(RosTime.from_msg(stamp))
+        clock = self.get_clock()
+        if isinstance(clock, ROSClock):  # the node's clock follows the /clock it steps on
+            clock.set_ros_time_override(RosTime.from_msg(stamp))
         for result in operation.follow(stamp.sec + stamp.nanosec * 1e-9):
             sample = to_stamp(result.time)
             if result.clock_note:

@@ -21,7 +21,8 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.clock import Clock, ClockType
@@ -117,7 +118,7 @@ class MonitorNode(ManagedNode):
                 # A slip window just closed: publish its status now rather than at the next
                 # timer tick, so the status follows the pulse within the processing time.
                 self._publish(self.monitor.status())
-        except Exception as exc:  # noqa: BLE001 - bad data never stops the monitor
+        except Exception as exc:
             if not self.context.ok():
                 raise
             self.get_logger().error(f"{shaft} pulse not processed: {exc}", throttle_duration_sec=1.0)

@@ -34,13 +34,13 @@
 from __future__ import annotations
 
 import functools
-from typing import Any, Callable, Mapping, TypeVar
+from typing import Any, TypeVar
+from collections.abc import Callable, Mapping
 
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterValueException
-from rclpy.lifecycle import LifecycleNode, LifecycleState, TransitionCallbackReturn
+from rclpy.lifecycle import LifecycleNode, LifecyclePublisher, LifecycleState, TransitionCallbackReturn
 from rclpy.node import Node
-from rclpy.publisher import Publisher
 from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
@@ -137,7 +137,7 @@ class ManagedNode(LifecycleNode):
         """True between activate and deactivate: inputs are taken, timers run."""
         self.configure_error = ""
         """Why the last configure failed ("" when it did not)."""
-        self._publishers_made: list[Publisher] = []
+        self._publishers_made: list[LifecyclePublisher] = []
         self._subscriptions_made: list[Subscription] = []
         self._timers_made: list[Timer] = []
 
@@ -160,9 +160,9 @@ class ManagedNode(LifecycleNode):
         """Drop the core (the entities made at configure are destroyed by the base)."""
 
     # -- entities made at configure ----------------------------------------------------------------
-    def publisher(self, msg_type: Any, topic: str, qos: Any, **kwargs: Any) -> Publisher:
+    def publisher(self, msg_type: Any, topic: str, qos: Any, **kwargs: Any) -> LifecyclePublisher:
         """A lifecycle publisher (publishes only while active), destroyed at cleanup."""
-        pub = self.create_lifecycle_publisher(msg_type, topic, qos, **kwargs)
+        pub: LifecyclePublisher = self.create_lifecycle_publisher(msg_type, topic, qos, **kwargs)
         self._publishers_made.append(pub)
         return pub
 
@@ -198,7 +198,7 @@ class ManagedNode(LifecycleNode):
     def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
         try:
             self.configure()
-        except Exception as exc:  # noqa: BLE001 - a failed configure is reported, the node stays up
+        except Exception as exc:
             self.configure_error = one_line(exc)
             self.get_logger().error(f"configure failed: {self.configure_error}")
             self._destroy_entities()
@@ -217,7 +217,7 @@ class ManagedNode(LifecycleNode):
             self.activate()
             for made in self._timers_made:
                 made.reset()
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             self.active = False
             self.get_logger().error(f"activate failed: {one_line(exc)}")
             return TransitionCallbackReturn.FAILURE
@@ -230,7 +230,7 @@ class ManagedNode(LifecycleNode):
             made.cancel()
         try:
             self.deactivate()
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             self.get_logger().error(f"deactivate: {one_line(exc)}")
         self.get_logger().info("inactive")
         return super().on_deactivate(state)
@@ -257,7 +257,7 @@ class ManagedNode(LifecycleNode):
     def _safe_cleanup(self) -> None:
         try:
             self.cleanup()
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:
             self.get_logger().error(f"cleanup: {one_line(exc)}")
 
     def close(self) -> None:

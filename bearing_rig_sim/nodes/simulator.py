@@ -13,7 +13,7 @@ Publishes (interface table, docs/interfaces.md):
 * ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, sensor data, ``truth_rate_hz`` simulated):
   the engine's ground truth with the achieved real-time factor and the overrun count;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
-  on every change of level (see :mod:`bearing_rig_sim.simulation.health`).
+  on every change of level (see :mod:`bearing_rig_sim.health`).
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
 and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable; 1 kHz, so
@@ -37,7 +37,8 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Any, Sequence
+from typing import Any
+from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
@@ -64,7 +65,8 @@ from bearing_rig_sim.nodes.common import (
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
-from bearing_rig_sim.simulation.health import Health, HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import Health, HealthLevel
+from bearing_rig_sim.simulation.health import SimulatorHealth
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
 from bearing_rig_sim.simulation.twin import RigTwin, TickOutput
@@ -136,7 +138,7 @@ class SimulatorNode(ManagedNode):
         self.subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
         # instead of one per message), from a reader on a node no executor spins.
-        self._force_tap = Node(f"{NODE_NAME}_force", context=self.context)
+        self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
         self._force_sub = self._force_tap.create_subscription(
             WrenchStamped, "/rig/bearing/axial_force", _unused, FORCE_QOS,
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
@@ -249,7 +251,7 @@ class SimulatorNode(ManagedNode):
                 time=stamp if stamp > 0.0 else None,
             )
             self.twin.command_spindle(command)
-        except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+        except Exception as exc:
             self._refuse("spindle command", str(exc))
             return
         when = "now" if command.time is None or command.time <= self.twin.time else f"at t = {command.time:.6g} s"
@@ -266,7 +268,7 @@ class SimulatorNode(ManagedNode):
             while (taken := handle.take_message(WrenchStamped, False)) is not None:
                 try:
                     self.twin.set_axial_load(taken[0].wrench.force.z)
-                except Exception as exc:  # noqa: BLE001 - bad input never stops the node
+                except Exception as exc:
                     self._refuse("axial force", str(exc))
 
     def _refuse(self, kind: str, reason: str) -> None:

@@ -1,4 +1,4 @@
-"""Models of the bench around the bearing, without ROS (digest section 8).
+"""Models of the bench around the bearing, without ROS (docs/paper.md section 8).
 
 * :mod:`.fibre_optic`: fibre-optic reflective speed sensors and the pulse counter.
 * :mod:`.loading`: the axial loading chain put together, with its interlocks;

@@ -1,5 +1,5 @@
 """Fibre-optic reflective speed sensors of the bench and the counter that turns their pulses
-into speeds (digest section 8).
+into speeds (docs/paper.md section 8).
 
 Reflective strips are stuck on a shaft (the motor spindle, which carries the inner ring, or the
 cage), equally spaced; a fixed fibre-optic sensor sees one light pulse each time a strip passes.

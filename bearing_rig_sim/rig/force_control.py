@@ -1,5 +1,5 @@
 """Measurement and control of the axial load: the load cell (noise, low-pass) and the PI(D)
-force controller that drives the linear brake's voltage (digest section 8).
+force controller that drives the linear brake's voltage (docs/paper.md section 8).
 
 Units: N, s, V. Parameter values and their sources: ``config/rig.yaml``.
 """

@@ -1,4 +1,4 @@
-"""The bench's axial loading chain (digest section 8) put together, with its interlocks.
+"""The bench's axial loading chain (docs/paper.md section 8) put together, with its interlocks.
 
 A linear brake pulls a wire rope, which moves a lever down; a clutch on the lever, held by a
 permanent magnet, moves the bearing housing down and so presses the bearing axially::
@@ -37,7 +37,8 @@ import math
 from collections import deque
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable, ClassVar
+from typing import ClassVar
+from collections.abc import Callable
 
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.rig.force_control import ForceController, ForceControllerParams, LoadCell, LoadCellParams
@@ -189,7 +190,7 @@ class LoadingChain:
         self._bearing_force = 0.0
 
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "LoadingChain":
+    def from_yaml(cls, path: str | Path | None = None) -> LoadingChain:
         """A chain with the ``loading_chain`` parameters of a rig file (default: shipped)."""
         return cls(LoadingChainConfig.from_yaml(path))
 

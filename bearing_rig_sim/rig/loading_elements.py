@@ -1,4 +1,4 @@
-"""Elements of the bench's axial loading chain (digest section 8): linear brake, wire rope,
+"""Elements of the bench's axial loading chain (docs/paper.md section 8): linear brake, wire rope,
 lever, permanent-magnet clutch and bearing housing; how they are put together and integrated is
 in :mod:`bearing_rig_sim.rig.loading`.
 
@@ -200,14 +200,6 @@ class Lever:
     def ratio(self) -> float:
         """Output force / input force (1)."""
         return self.params.force_ratio
-
-    def output_force(self, input_force: float) -> float:
-        """Force at the output for a force at the input, N."""
-        return self.ratio * input_force
-
-    def input_displacement(self, output_displacement: float) -> float:
-        """Input (rope end) displacement for an output displacement, m."""
-        return self.ratio * output_displacement
 
 
 @dataclass(frozen=True)

@@ -25,7 +25,7 @@ end of the speed change: ``dwell_s`` holds the target speed that long; ``until_s
 the first stable verdict of the monitor, or after ``timeout_s`` without one.
 
 Speeds are given in rpm in the file and converted to rad/s once, at load; everything returned
-is SI (rad/s, rad/s^2, s, N). The drive function is the paper's STEP (digest section 5, paper
+is SI (rad/s, rad/s^2, s, N). The drive function is the paper's STEP (docs/paper.md section 5, paper
 Eq. 10) with its typo corrected: ``D = (t - t0) / (t1 - t0)``.
 """
 
@@ -39,7 +39,7 @@ from pathlib import Path
 from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rpm_to_rad_s
 
 STABILITY_CRITERIA = ("time", "axial_load")
-"""Abscissas of the slope criterion (digest section 7): slip vs time, or slip vs axial load."""
+"""Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
 
 SEGMENT_KEYS = ("name", "speed_rpm", "ramp_s", "acceleration_rad_s2", "axial_load_n", "dwell_s", "until_stable", "timeout_s")
 PROGRAM_KEYS = ("name", "description", "bearing", "stability_criterion", "initial_speed_rpm", "segments")
@@ -60,7 +60,7 @@ def _step_fraction(t: float, t0: float, t1: float) -> float | None:
 
 
 def step_ramp(t: float, t0: float, x0: float, t1: float, x1: float) -> float:
-    """The paper's STEP drive function (digest section 5, Eq. 10, typo corrected).
+    """The paper's STEP drive function (docs/paper.md section 5, Eq. 10, typo corrected).
 
     ``x0`` for ``t <= t0``; ``x1`` for ``t >= t1``; between, the cubic
     ``x0 + (x1 - x0) D^2 (3 - 2 D)`` with ``D = (t - t0)/(t1 - t0)``: monotonic, with zero slope

@@ -18,9 +18,9 @@ from __future__ import annotations
 
 import re
 import shlex
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from pathlib import Path
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.rig.program import TestProgram
@@ -41,7 +41,7 @@ def make_run_id(program_name: str, start: datetime) -> str:
     if start.tzinfo is None:
         raise ValueError("make_run_id: the start time needs a time zone")
     name = re.sub(r"[^A-Za-z0-9._-]", "_", program_name) or "program"
-    return f"{start.astimezone(timezone.utc):%Y%m%dT%H%M%SZ}-{name}"
+    return f"{start.astimezone(UTC):%Y%m%dT%H%M%SZ}-{name}"
 
 
 def _text(path: Path) -> str:
@@ -63,7 +63,7 @@ def run_context(
     program_file = Path(program.source)
     context = {
         "run_id": run_id,
-        "started_utc": start.astimezone(timezone.utc).isoformat(),
+        "started_utc": start.astimezone(UTC).isoformat(),
         "command_line": shlex.join(command_line),
         "program_file": str(program_file),
         "program": _text(program_file),

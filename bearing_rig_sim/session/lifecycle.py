@@ -17,7 +17,7 @@ output and log, and a ``/diagnostics`` status.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 __all__ = [
     "GOAL",

@@ -9,7 +9,8 @@ answered within its time limit fails (the node is named, with "no answer within 
 from __future__ import annotations
 
 import time
-from typing import Any, Callable, Sequence
+from typing import Any
+from collections.abc import Callable, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from lifecycle_msgs.msg import Transition

@@ -13,10 +13,9 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
-import math
-import time
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
 from diagnostic_msgs.msg import DiagnosticArray
@@ -29,6 +28,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
+from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -120,8 +120,8 @@ class SessionNode(Node):
         self.runner = runner
         self.on_event = on_event
         self.live = LiveValues()
-        self._spindle = self.create_publisher(SpindleCommand, "/rig/spindle/command", STATUS_QOS)
-        self._setpoint = self.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
+        self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
+        self._setpoint = self.create_publisher(Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
         self.tap = Node(f"{name}_recorder", context=context)
         self._recorded = [
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
@@ -163,15 +163,15 @@ class SessionNode(Node):
         missing = {}
         if self.clock_count == 0:
             missing["simulator"] = "no /clock received"
-        elif self.subscribers_besides_recorder("/rig/spindle/command") == 0:
+        elif self.subscribers_besides_recorder(SPINDLE_COMMAND.name) == 0:
             missing["simulator"] = "nobody subscribes /rig/spindle/command"
         if self.live.state_count == 0:
             missing["load_controller"] = "no /rig/axial_load/state received"
-        elif self.subscribers_besides_recorder("/rig/axial_load/setpoint") == 0:
+        elif self.subscribers_besides_recorder(AXIAL_LOAD_SETPOINT.name) == 0:
             missing["load_controller"] = "nobody subscribes /rig/axial_load/setpoint"
-        if self.count_publishers("/rig/slip_status") == 0:
+        if self.count_publishers(SLIP_STATUS.name) == 0:
             missing["monitor"] = "nobody publishes /rig/slip_status"
-        elif self.subscribers_besides_recorder("/rig/cage/pulses") == 0:
+        elif self.subscribers_besides_recorder(CAGE_PULSES.name) == 0:
             missing["monitor"] = "nobody subscribes /rig/cage/pulses"
         return missing
 
@@ -193,7 +193,7 @@ class SessionNode(Node):
             return 0
         batch.sort(key=lambda item: (item[0], item[1]))
         for _, _, name, raw, msgtype in batch:
-            if name == "/clock":
+            if name == CLOCK.name:
                 stamp = header_stamp_ns(raw)
                 if stamp is not None:
                     self.sim_time_ns = stamp
@@ -222,9 +222,9 @@ class SessionNode(Node):
         return self.sim_time_ns * 1e-9
 
     def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
-        if name == "/rig/speeds":
+        if name == SPEEDS.name:
             self.live.speeds_raw = raw
-        elif name == "/rig/slip_status":
+        elif name == SLIP_STATUS.name:
             msg = deserialize_message(raw, msgtype)
             self.runner.observe_status(
                 SlipObservation(
@@ -236,14 +236,14 @@ class SessionNode(Node):
                     window_revolutions=msg.window_revolutions,
                 )
             )
-        elif name == "/rig/truth":
+        elif name == TRUTH.name:
             msg = deserialize_message(raw, msgtype)
             self.runner.observe_truth(from_stamp(msg.header.stamp), msg.slip_rate)
-        elif name == "/rig/axial_load/state":
+        elif name == AXIAL_LOAD_STATE.name:
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1
             self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
-        elif name == "/diagnostics":
+        elif name == DIAGNOSTICS.name:
             self._diagnostics_events(deserialize_message(raw, msgtype))
 
     def _diagnostics_events(self, msg: Any) -> None:
@@ -260,12 +260,3 @@ class SessionNode(Node):
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun
     """Callback of the recorder's subscriptions; their queues are taken by ``drain``."""
 
-
-def wall_now() -> float:
-    """Monotonic wall time, s."""
-    return time.monotonic()
-
-
-def finite_or_none(value: float | None) -> float | None:
-    """``value`` when it is a finite number, else None."""
-    return value if value is not None and math.isfinite(value) else None

@@ -40,7 +40,8 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, Iterator, Mapping, Sequence
+from typing import IO
+from collections.abc import Iterator, Mapping, Sequence
 
 from bearing_rig_sim.errors import RigError
 
@@ -135,12 +136,12 @@ def node_command(spec: NodeSpec) -> list[str]:
     if found:
         return [found]
     try:
-        from ament_index_python.packages import get_package_prefix  # noqa: PLC0415
+        from ament_index_python.packages import get_package_prefix
 
         installed = Path(get_package_prefix("bearing_rig_sim")) / "lib" / "bearing_rig_sim" / spec.name
         if installed.is_file():
             return [str(installed)]
-    except Exception:  # noqa: BLE001 - no ament index, or the package is not in it
+    except Exception:
         pass
     raise RigError(
         f"cannot find the {spec.name} node's executable {spec.script!r} next to {sys.executable}, on PATH "
@@ -186,7 +187,7 @@ class NodeProcess:
             RigError: it could not be started.
         """
         self.log_path.parent.mkdir(parents=True, exist_ok=True)
-        self._log = open(self.log_path, "wb")  # noqa: SIM115 - closed in stop()
+        self._log = open(self.log_path, "wb")
         try:
             self._process = subprocess.Popen(
                 self.command,
@@ -195,7 +196,7 @@ class NodeProcess:
                 stdout=self._log,
                 stderr=subprocess.STDOUT,
                 start_new_session=True,
-                preexec_fn=_prepare_child if sys.platform.startswith("linux") else None,  # noqa: PLW1509
+                preexec_fn=_prepare_child if sys.platform.startswith("linux") else None,
             )
         except OSError as exc:
             self._log.close()
@@ -329,7 +330,7 @@ def lease_domain(ids: Sequence[int] = SESSION_DOMAIN_IDS) -> DomainLease:
     ordered = list(ids)
     start = random.randrange(len(ordered))
     for domain_id in ordered[start:] + ordered[:start]:
-        handle = open(DOMAIN_LOCK_DIR / f"{domain_id}.lock", "a+", encoding="utf-8")  # noqa: SIM115
+        handle = open(DOMAIN_LOCK_DIR / f"{domain_id}.lock", "a+", encoding="utf-8")
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:

@@ -19,7 +19,8 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
-from typing import Sequence, TextIO
+from typing import TextIO
+from collections.abc import Sequence
 
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.session.runner import SegmentOutcome, StatusState

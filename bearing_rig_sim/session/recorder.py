@@ -2,7 +2,7 @@
 
 Every topic of the interface table (README) is recorded as the serialized CDR the publisher sent
 (:data:`RECORDED_TOPICS`), into anything with ``add_topic`` and ``write`` (the project's
-:class:`~bearing_rig_sim.recording.BagWriter`, or a fake in tests).
+:class:`~bearing_rig_sim.bags.BagWriter`, or a fake in tests).
 
 **Log time** (the bag's timeline; the MCAP ``log_time``), simulation time in ns:
 
@@ -21,8 +21,10 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
 from __future__ import annotations
 
 import struct
-from dataclasses import dataclass
-from typing import Iterable, Protocol, Sequence
+from typing import Protocol
+from collections.abc import Iterable, Sequence
+
+from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",
@@ -38,40 +40,17 @@ PLAUSIBLE_SPAN_NS = 10_000_000_000
 """A stamp more than 10 s from the last ``/clock`` is not sim time: the clock's time is used."""
 
 
-@dataclass(frozen=True)
-class RecordedTopic:
-    """A topic the session records."""
+RecordedTopic = Topic
+"""A topic the session records: a topic of the interface contract."""
 
-    name: str
-    msgtype: str
-    """``pkg/msg/Name``."""
-    qos: str
-    """The publisher's offered profile: ``"reliable"``, ``"sensor_data"`` or ``"transient_local"``."""
-    stamped: bool
-    """The message starts with a time stamp (``header.stamp``, or ``clock``)."""
+RECORDED_TOPICS: tuple[Topic, ...] = TOPICS
+"""Every topic of the interface contract (services are not recorded)."""
 
-
-RECORDED_TOPICS: tuple[RecordedTopic, ...] = (
-    RecordedTopic("/clock", "rosgraph_msgs/msg/Clock", "reliable", True),
-    RecordedTopic("/rig/spindle/command", "bearing_rig_msgs/msg/SpindleCommand", "transient_local", True),
-    RecordedTopic("/rig/spindle/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data", True),
-    RecordedTopic("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data", True),
-    RecordedTopic("/rig/speeds", "sensor_msgs/msg/JointState", "sensor_data", True),
-    RecordedTopic("/rig/truth", "bearing_rig_msgs/msg/SimulatorTruth", "sensor_data", True),
-    RecordedTopic("/rig/axial_load/setpoint", "std_msgs/msg/Float64", "reliable", False),
-    RecordedTopic("/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", True),
-    RecordedTopic("/rig/axial_load/force", "geometry_msgs/msg/WrenchStamped", "sensor_data", True),
-    RecordedTopic("/rig/bearing/axial_force", "geometry_msgs/msg/WrenchStamped", "reliable", True),
-    RecordedTopic("/rig/slip_status", "bearing_rig_msgs/msg/SlipStatus", "transient_local", True),
-    RecordedTopic("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", True),
-)
-"""Every topic of the interface table (the service ``/rig/axial_load/set`` is not a topic)."""
-
-CLOCK_TOPIC = "/clock"
+CLOCK_TOPIC = CLOCK.name
 
 
 class MessageWriter(Protocol):
-    """What the recorder writes into (:class:`~bearing_rig_sim.recording.BagWriter`'s methods)."""
+    """What the recorder writes into (:class:`~bearing_rig_sim.bags.BagWriter`'s methods)."""
 
     def add_topic(self, name: str, msgtype: str, qos: str) -> None: ...
 

@@ -37,15 +37,16 @@ import signal
 import sys
 import time
 from dataclasses import dataclass, field
-from datetime import datetime, timezone
+from datetime import datetime, UTC
 from enum import Enum
 from pathlib import Path
 from types import FrameType
-from typing import Any, Sequence, TextIO
+from typing import Any, TextIO
+from collections.abc import Sequence
 
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.recording import BagWriter
+from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.loading import LoadingChainConfig
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import make_run_id, run_context
@@ -123,7 +124,7 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
             raise RigError(f"--params-file: no such file: {params}")
         for name in commands:
             commands[name] = commands[name] + ["--ros-args", "--params-file", str(params.resolve())]
-    start = datetime.now(timezone.utc)
+    start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)
     env, lease = session_environment(os.environ)
@@ -139,8 +140,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         apply_transport_profile(env, writer.path / "logs")
         view = None
         if options.foxglove_port is not None:
-            from bearing_rig_sim.live.foxglove import FoxgloveLiveView  # noqa: PLC0415
-            from bearing_rig_sim.recording.typestore import msg_definition_text  # noqa: PLC0415
+            from bearing_rig_sim.live.foxglove import FoxgloveLiveView
+            from bearing_rig_sim.bags.typestore import msg_definition_text
 
             view = FoxgloveLiveView(options.foxglove_port, msg_definition_text)
         try:
@@ -195,7 +196,7 @@ class _Session:
         self.runner = ProgramRunner(program)
         self.view = view
         if view is not None:
-            from bearing_rig_sim.live.foxglove import TeeWriter  # noqa: PLC0415
+            from bearing_rig_sim.live.foxglove import TeeWriter
 
             self.recorder = SessionRecorder(TeeWriter(writer, view))
         else:
@@ -207,21 +208,21 @@ class _Session:
         self.status: int | None = None
         self.failure = ""
         self.signal_received: int | None = None
-        self.node = None
+        self.node: Any = None
         self.manager: Any = None
         self.bringing_up = False
         self.deadline = 0.0
         logs.mkdir(parents=True, exist_ok=True)
-        self.session_log = open(logs / "session.log", "a", encoding="utf-8")  # noqa: SIM115 - closed in _report
+        self.session_log = open(logs / "session.log", "a", encoding="utf-8")
 
     # -- main -------------------------------------------------------------------------------------
     def run(self) -> int:
-        import rclpy  # noqa: PLC0415 - ROS is needed only once the session really starts
-        from rclpy.executors import SingleThreadedExecutor  # noqa: PLC0415
-        from rclpy.signals import SignalHandlerOptions  # noqa: PLC0415
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.signals import SignalHandlerOptions
 
-        from bearing_rig_sim.session.manager import LifecycleManager  # noqa: PLC0415
-        from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode  # noqa: PLC0415
+        from bearing_rig_sim.session.manager import LifecycleManager
+        from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode
 
         segments = len(self.program.segments)
         self._event(
@@ -405,7 +406,7 @@ class _Session:
 
     def _event(self, line: str) -> None:
         if not self.session_log.closed:
-            self.session_log.write(f"{datetime.now(timezone.utc):%Y-%m-%dT%H:%M:%S.%fZ} {line}\n")
+            self.session_log.write(f"{datetime.now(UTC):%Y-%m-%dT%H:%M:%S.%fZ} {line}\n")
             self.session_log.flush()
         if not self.options.quiet:
             self.printer.message(line)

@@ -11,7 +11,8 @@
 """
 
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleCommandError, SpindleDrive
-from bearing_rig_sim.simulation.health import Health, HealthLevel, SimulatorHealth
+from bearing_rig_sim.health import Health, HealthLevel
+from bearing_rig_sim.simulation.health import SimulatorHealth
 from bearing_rig_sim.simulation.pacing import PacerError, RealTimePacer
 from bearing_rig_sim.simulation.settings import SimulatorSettings
 from bearing_rig_sim.simulation.twin import (

@@ -9,7 +9,7 @@ profile's speed at the chunk's end. The engine's speed therefore equals the prof
 chunk boundary (whatever small drift it had is corrected in the next chunk), and within a chunk
 it is the chord of the profile:
 
-* STEP ramp (the paper's drive function, digest section 5): ``w`` is
+* STEP ramp (the paper's drive function, docs/paper.md section 5): ``w`` is
   :func:`~bearing_rig_sim.rig.program.step_ramp`; its slope is zero at both ends, so the first
   and last chunks of a ramp accelerate gently. A ramp time of 0 is a jump, spread over one
   chunk (a motor cannot jump; one chunk is 1 ms by default).

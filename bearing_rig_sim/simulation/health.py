@@ -13,29 +13,9 @@ Times are the wall clock's (s), given by the caller.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from enum import IntEnum
+from bearing_rig_sim.health import Health, HealthLevel
 
-
-class HealthLevel(IntEnum):
-    """Levels of ``diagnostic_msgs/DiagnosticStatus`` (OK 0, WARN 1, ERROR 2)."""
-
-    OK = 0
-    WARN = 1
-    ERROR = 2
-
-
-@dataclass(frozen=True)
-class Health:
-    """A level and the reasons for it (empty when OK)."""
-
-    level: HealthLevel
-    reasons: tuple[str, ...]
-
-    @property
-    def message(self) -> str:
-        """One line for the diagnostics' message."""
-        return "; ".join(self.reasons) if self.reasons else "running"
+__all__ = ["Health", "HealthLevel", "SimulatorHealth"]
 
 
 class SimulatorHealth:

@@ -87,7 +87,7 @@ class SimulatorSettings:
     fault_hold_s: float
 
     @classmethod
-    def from_section(cls, s: Section) -> "SimulatorSettings":
+    def from_section(cls, s: Section) -> SimulatorSettings:
         """Validate the parameters in ``s`` (every key required, none unknown).
 
         Raises:
@@ -131,12 +131,12 @@ class SimulatorSettings:
         )
 
     @classmethod
-    def from_values(cls, values: dict[str, Any], source: str = "simulator parameters") -> "SimulatorSettings":
+    def from_values(cls, values: dict[str, Any], source: str = "simulator parameters") -> SimulatorSettings:
         """Validate a flat mapping of parameter values (the node's ROS parameters)."""
         return cls.from_section(Section(dict(values), source))
 
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> "SimulatorSettings":
+    def from_yaml(cls, path: str | Path | None = None) -> SimulatorSettings:
         """Read ``simulator: ros__parameters:`` of a parameter file (default: the shipped one).
 
         Raises:

@@ -2,7 +2,7 @@
 
 :class:`RigTwin` advances the dynamics engine by one chunk (1 ms by default) at the current axial
 load, with the inner-ring acceleration the :class:`~bearing_rig_sim.simulation.drive.SpindleDrive`
-asks for, then shows the motion to the two fibre-optic sensors of the bench (digest section 8):
+asks for, then shows the motion to the two fibre-optic sensors of the bench (docs/paper.md section 8):
 
 * spindle sensor: the inner-ring angle (the spindle carries the inner ring);
 * cage sensor: the angle of the cage segment carrying the reflective strip
@@ -216,7 +216,7 @@ class RigTwin:
         *,
         model: str = "reduced",
         **options: float,
-    ) -> "RigTwin":
+    ) -> RigTwin:
         """A twin from a bearing file, an optional calibration overlay and a rig file.
 
         Args:

@@ -1,0 +1,353 @@
+"""The rosbag2 bag directory: ``metadata.yaml`` (format version 9) and the MCAP file names.
+
+A bag is a directory ``<name>/`` holding ``metadata.yaml`` and one or more storage files
+``<name>_0.mcap``, ``<name>_1.mcap``... (split by size). ``metadata.yaml`` lists the files, every
+topic with its type, serialization format (``cdr``), offered QoS profiles and RIHS01 type hash,
+message counts and the time range; ``custom_data`` holds string key/value pairs (the project puts
+its run context there too).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path, PurePath
+from typing import Any, Callable
+
+import yaml
+from rosbags.interfaces import Qos
+from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
+
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.storage import STORAGE_FORMATS
+from bearing_rig_sim.bags.mcapfile import FileIndex
+
+METADATA_FILE = "metadata.yaml"
+RUN_METADATA_RECORD = "bearing_rig_sim"
+"""Name of the MCAP metadata record holding the run context."""
+BAG_VERSION = 9
+ROS_DISTRO = "jazzy"
+
+
+@dataclass
+class TopicEntry:
+    """One topic of ``metadata.yaml``.
+
+    Attributes:
+        name: topic name, e.g. ``/rig/speeds``.
+        msgtype: message type, e.g. ``sensor_msgs/msg/JointState``.
+        qos: offered QoS profiles (usually one), kept exactly as stored.
+        type_hash: RIHS01 type description hash, empty when unknown.
+        message_count: messages stored on the topic.
+        serialization_format: ``cdr`` for every bag the project reads.
+    """
+
+    name: str
+    msgtype: str
+    qos: list[Qos] = field(default_factory=list)
+    type_hash: str = ""
+    message_count: int = 0
+    serialization_format: str = "cdr"
+
+
+@dataclass
+class FileEntry:
+    """One storage file of ``metadata.yaml``: relative path, start (ns), duration (ns), count."""
+
+    path: str
+    start_ns: int = 0
+    duration_ns: int = 0
+    message_count: int = 0
+
+
+@dataclass
+class BagLayout:
+    """The content of a ``metadata.yaml``."""
+
+    topics: list[TopicEntry] = field(default_factory=list)
+    files: list[FileEntry] = field(default_factory=list)
+    custom_data: dict[str, str] = field(default_factory=dict)
+    storage_identifier: str = "mcap"
+    version: int = BAG_VERSION
+    ros_distro: str = ROS_DISTRO
+    compression_mode: str = ""
+    compression_format: str = ""
+    stated_message_count: int | None = None
+    """The top-level ``message_count`` of a ``metadata.yaml`` that was read (None when built)."""
+
+    @property
+    def message_count(self) -> int:
+        """Messages in all files (the stated count when the files section lacks them)."""
+        counted = sum(f.message_count for f in self.files)
+        return counted if counted or self.stated_message_count is None else self.stated_message_count
+
+    @property
+    def start_ns(self) -> int:
+        """Earliest message time (ns); 0 for an empty bag."""
+        used = [f for f in self.files if f.message_count]
+        return min((f.start_ns for f in used), default=0)
+
+    @property
+    def duration_ns(self) -> int:
+        """Time from the earliest to the latest message (ns)."""
+        used = [f for f in self.files if f.message_count]
+        if not used:
+            return 0
+        return max(f.start_ns + f.duration_ns for f in used) - self.start_ns
+
+
+def storage_file_name(bag_dir: Path, index: int) -> str:
+    """Name of the ``index``-th storage file of a bag, rosbag2 style: ``<dir name>_<index>.mcap``."""
+    return f"{bag_dir.name}_{index}.mcap"
+
+
+def storage_file_index(name: str) -> int:
+    """Split index from a storage file name (``run_3.mcap`` -> 3), -1 when it has none."""
+    match = re.search(r"_(\d+)\.mcap$", name)
+    return int(match.group(1)) if match else -1
+
+
+def _qos_dicts(profiles: list[Qos]) -> list[dict[str, Any]]:
+    return dump_qos_v9(list(profiles))  # type: ignore[return-value]
+
+
+def qos_yaml(profiles: list[Qos]) -> str:
+    """Offered QoS profiles as the YAML text rosbag2 stores in an MCAP channel's metadata."""
+    return yaml.safe_dump(_qos_dicts(profiles), sort_keys=False, default_flow_style=False).strip()
+
+
+def parse_qos_profiles(value: Any, source: str) -> list[Qos]:
+    """QoS profiles from ``metadata.yaml`` (v9 list, v8 YAML text) or MCAP channel metadata.
+
+    Raises:
+        BagError: the text is not a list of QoS profiles.
+    """
+    if value in (None, "", []):
+        return []
+    try:
+        return parse_qos(value)
+    except Exception as exc:  # noqa: BLE001 - rosbags raises KeyError/TypeError/ReaderError here
+        raise BagError(f"{source}: offered_qos_profiles is not a list of QoS profiles ({exc})") from None
+
+
+def layout_to_dict(layout: BagLayout) -> dict[str, Any]:
+    """The ``metadata.yaml`` document of a layout."""
+    return {
+        "rosbag2_bagfile_information": {
+            "version": layout.version,
+            "storage_identifier": layout.storage_identifier,
+            "duration": {"nanoseconds": layout.duration_ns},
+            "starting_time": {"nanoseconds_since_epoch": layout.start_ns},
+            "message_count": layout.message_count,
+            "topics_with_message_count": [
+                {
+                    "topic_metadata": {
+                        "name": t.name,
+                        "type": t.msgtype,
+                        "serialization_format": t.serialization_format,
+                        "offered_qos_profiles": _qos_dicts(t.qos),
+                        "type_description_hash": t.type_hash,
+                    },
+                    "message_count": t.message_count,
+                }
+                for t in layout.topics
+            ],
+            "compression_format": layout.compression_format,
+            "compression_mode": layout.compression_mode,
+            "relative_file_paths": [f.path for f in layout.files],
+            "files": [
+                {
+                    "path": f.path,
+                    "starting_time": {"nanoseconds_since_epoch": f.start_ns},
+                    "duration": {"nanoseconds": f.duration_ns},
+                    "message_count": f.message_count,
+                }
+                for f in layout.files
+            ],
+            "custom_data": dict(layout.custom_data) or None,
+            "ros_distro": layout.ros_distro,
+        }
+    }
+
+
+def same_layout(a: BagLayout, b: BagLayout) -> bool:
+    """True when both would write the same ``metadata.yaml``."""
+    return layout_to_dict(a) == layout_to_dict(b)
+
+
+def write_layout(bag_dir: Path, layout: BagLayout) -> None:
+    """Write ``metadata.yaml`` atomically (a reader never sees a half-written file)."""
+    target = bag_dir / METADATA_FILE
+    tmp = target.with_name(METADATA_FILE + ".tmp")
+    tmp.write_text(yaml.safe_dump(layout_to_dict(layout), sort_keys=False, default_flow_style=False), encoding="utf-8")
+    os.replace(tmp, target)
+
+
+def _get(mapping: Any, key: str, source: str, kind: type | tuple[type, ...], where: str) -> Any:
+    if not isinstance(mapping, dict) or key not in mapping:
+        raise BagError(f"{source}: key {where}{key} is missing")
+    value = mapping[key]
+    if not isinstance(value, kind) or (kind is int and isinstance(value, bool)):
+        raise BagError(f"{source}: key {where}{key} has the wrong type ({type(value).__name__})")
+    return value
+
+
+def read_layout(bag_dir: Path) -> BagLayout:
+    """Parse ``<bag_dir>/metadata.yaml``.
+
+    Raises:
+        BagError: the file is missing, not YAML, or misses keys a reader needs; the storage is
+            not MCAP; the bag uses rosbag2 file or message compression.
+    """
+    path = bag_dir / METADATA_FILE
+    source = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise BagError(
+            f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory (if a recording was "
+            "interrupted, `repair_bag` rebuilds it from the .mcap files)"
+        ) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise BagError(f"{source}: cannot read ({exc})") from None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        at = f" at line {mark.line + 1}" if mark else ""
+        raise BagError(f"{source}: not valid YAML{at} (corrupt metadata; `repair_bag` rebuilds it)") from None
+    info = _get(doc, "rosbag2_bagfile_information", source, dict, "")
+    where = "rosbag2_bagfile_information."
+    version = _get(info, "version", source, int, where)
+    storage = _get(info, "storage_identifier", source, str, where)
+    if storage not in STORAGE_FORMATS:
+        raise BagError(f"{source}: storage {storage!r} is not supported (this project reads: {', '.join(STORAGE_FORMATS)})")
+    mode = str(info.get("compression_mode") or "").lower()
+    if mode not in ("", "none"):
+        raise BagError(
+            f"{source}: rosbag2 {mode}-level compression is not supported (record with MCAP chunk "
+            "compression instead, or decompress with `ros2 bag convert`)"
+        )
+    paths = _get(info, "relative_file_paths", source, list, where)
+    file_info = {str(PurePath(str(f.get("path", ""))).name): f for f in info.get("files") or [] if isinstance(f, dict)}
+    files = []
+    for raw in paths:
+        name = PurePath(str(raw)).name
+        entry = file_info.get(name, {})
+        files.append(
+            FileEntry(
+                path=name,
+                start_ns=int((entry.get("starting_time") or {}).get("nanoseconds_since_epoch", 0) or 0),
+                duration_ns=int((entry.get("duration") or {}).get("nanoseconds", 0) or 0),
+                message_count=int(entry.get("message_count", 0) or 0),
+            )
+        )
+    topics = []
+    for index, item in enumerate(_get(info, "topics_with_message_count", source, list, where)):
+        at = f"{where}topics_with_message_count[{index}]."
+        meta = _get(item, "topic_metadata", source, dict, at)
+        name = _get(meta, "name", source, str, at + "topic_metadata.")
+        topics.append(
+            TopicEntry(
+                name=name,
+                msgtype=_get(meta, "type", source, str, at + "topic_metadata."),
+                qos=parse_qos_profiles(meta.get("offered_qos_profiles"), f"{source}: topic {name}"),
+                type_hash=str(meta.get("type_description_hash") or ""),
+                message_count=int(item.get("message_count", 0) or 0),
+                serialization_format=str(meta.get("serialization_format") or "cdr"),
+            )
+        )
+    custom = info.get("custom_data") or {}
+    return BagLayout(
+        topics=topics,
+        files=files,
+        custom_data={str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {},
+        storage_identifier=storage,
+        version=version,
+        ros_distro=str(info.get("ros_distro") or ""),
+        compression_mode="",
+        compression_format="",
+        stated_message_count=int(info.get("message_count") or 0),
+    )
+
+
+def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | None = None) -> str:
+    """Message type of a channel: its schema's name, else the type ``metadata.yaml`` gives the
+    topic, else empty."""
+    channel = index.channels[channel_id]
+    schema = index.schemas.get(channel.schema_id)
+    if schema is not None and schema.name:
+        return schema.name
+    if previous is not None:
+        for topic in previous.topics:
+            if topic.name == channel.topic:
+                return topic.msgtype
+    return ""
+
+
+def layout_from_indexes(
+    indexes: list[FileIndex],
+    previous: BagLayout | None,
+    report: Callable[[str], None],
+    type_hash_of: Callable[[str], str] = lambda _msgtype: "",
+) -> BagLayout:
+    """The ``metadata.yaml`` content that matches what the storage files really hold.
+
+    Topics come from the files' channels (type from the schema, QoS and type hash from the
+    channel metadata), completed by ``previous`` (the existing ``metadata.yaml``, if any) for
+    topics without messages or values the files lack; ``type_hash_of`` fills hashes still
+    missing. Counts and times come from the file indexes. A channel whose type contradicts an
+    earlier one of the same topic is reported and left out.
+    """
+    topics: dict[str, TopicEntry] = {}
+    for index in indexes:
+        for channel_id in sorted(index.channels):
+            channel = index.channels[channel_id]
+            msgtype = channel_msgtype(index, channel_id, previous)
+            entry = topics.get(channel.topic)
+            if entry is None:
+                try:
+                    qos = parse_qos_profiles(channel.metadata.get("offered_qos_profiles"), f"{index.path.name}: topic {channel.topic}")
+                except BagError as exc:
+                    report(str(exc))
+                    qos = []
+                entry = topics[channel.topic] = TopicEntry(
+                    channel.topic, msgtype, qos, channel.metadata.get("topic_type_hash", ""), 0, channel.message_encoding
+                )
+            elif msgtype and entry.msgtype and msgtype != entry.msgtype:
+                report(f"{index.path.name}: topic {channel.topic} carries {msgtype} here but {entry.msgtype} before; left out")
+                continue
+            entry.msgtype = entry.msgtype or msgtype
+            entry.message_count += index.channel_counts.get(channel_id, 0)
+    if previous is not None:
+        for old in previous.topics:
+            entry = topics.get(old.name)
+            if entry is None:
+                topics[old.name] = TopicEntry(old.name, old.msgtype, list(old.qos), old.type_hash, 0, old.serialization_format)
+                continue
+            entry.msgtype = entry.msgtype or old.msgtype
+            entry.qos = entry.qos or list(old.qos)
+            if not entry.type_hash and entry.msgtype == old.msgtype:
+                entry.type_hash = old.type_hash
+    for entry in topics.values():
+        if not entry.type_hash and entry.msgtype:
+            entry.type_hash = type_hash_of(entry.msgtype)
+    files = [
+        FileEntry(
+            index.path.name,
+            index.start_ns if index.message_count else 0,
+            index.end_ns - index.start_ns if index.message_count else 0,
+            index.message_count,
+        )
+        for index in indexes
+    ]
+    custom: dict[str, str] = dict(previous.custom_data) if previous is not None else {}
+    if not custom:
+        custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), {})
+    return BagLayout(
+        topics=list(topics.values()),
+        files=files,
+        custom_data=custom,
+        ros_distro=previous.ros_distro if previous is not None and previous.ros_distro else ROS_DISTRO,
+    )

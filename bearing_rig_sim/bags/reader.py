@@ -1,0 +1,393 @@
+"""Reading rig bags: rosbag2 directories with MCAP storage, or a single ``.mcap`` file.
+
+::
+
+    with open_bag("bags/run-0001") as bag:
+        print(bag.topics["/rig/speeds"].message_count, bag.run_metadata["project_version"])
+        for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]):
+            ...
+
+Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk
+(memory does not grow with the bag's length). Types are decoded with the definitions the bag
+carries (so an old bag keeps decoding after a message changes), falling back to ROS 2 Jazzy's
+and ``bearing_rig_msgs``' own.
+
+Damage is reported, not fatal: a file whose recording was killed (no summary) is read up to its
+last complete chunk, a corrupt chunk is skipped, a topic whose type is unknown is left out; each
+problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
+:attr:`BagReader.problems`. ``strict=True`` turns them into :class:`BagError`. Padding that
+Fast-CDR leaves after a message (bags from ``ros2 bag record``) is ignored.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from types import TracebackType
+from typing import Any, Callable, Iterable, Iterator, Literal, NamedTuple, cast
+
+from rosbags.interfaces import Nodetype
+from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
+from rosbags.typesys.store import Typestore
+
+from bearing_rig_sim.bags.cdr import make_decoder
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
+from bearing_rig_sim.bags.qos import QosSpec
+from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
+
+
+class BagMessage(NamedTuple):
+    """One message read from a bag."""
+
+    topic: str
+    log_time_ns: int
+    msgtype: str
+    message: object
+    """The decoded rosbags message object (the serialized CDR bytes with ``raw=True``)."""
+
+
+@dataclass(frozen=True)
+class TopicInfo:
+    """A topic of a bag.
+
+    Attributes:
+        name: topic name.
+        msgtype: message type (``pkg/msg/Name``).
+        message_count: messages readable on the topic.
+        qos: first offered QoS profile, None when not stored or not modelled.
+        type_hash: RIHS01 type hash from the bag, empty when not stored.
+        decodable: False when the type is unknown (no definition in the bag, not a known type):
+            :meth:`BagReader.messages` skips the topic unless ``raw=True``.
+    """
+
+    name: str
+    msgtype: str
+    message_count: int
+    qos: QosSpec | None
+    type_hash: str
+    decodable: bool
+
+
+def _dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
+    """The types and every type they use, recursively."""
+    todo, found = list(names), set()
+    while todo:
+        name = todo.pop()
+        if name in found or name not in store.fielddefs:
+            continue
+        found.add(name)
+        for _field, desc in store.fielddefs[name][1]:
+            kind, arg = cast("tuple[Nodetype, Any]", desc)
+            if kind == Nodetype.NAME:
+                todo.append(arg)
+            elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:
+                todo.append(arg[0][1])
+    return found
+
+
+def _same_fields(a: tuple, b: tuple) -> bool:
+    return [(n.lower(), d) for n, d in a[1]] == [(n.lower(), d) for n, d in b[1]]
+
+
+def _parse_definition(msgtype: str, encoding: str, text: str) -> dict:
+    if encoding == "ros2msg":
+        return get_types_from_msg(text, msgtype)
+    types: dict = {}
+    separator = SCHEMA_SEPARATOR + "\n"
+    if text.startswith(separator + "IDL: "):
+        for section in text.split(separator)[1:]:
+            _header, idl = section.split("\n", 1)
+            types.update(get_types_from_idl(idl))
+    else:
+        types.update(get_types_from_idl(text))
+    return types
+
+
+class BagReader:
+    """An open bag (see the module documentation); use :func:`open_bag`.
+
+    Args:
+        path: a bag directory (with ``metadata.yaml``) or a single ``.mcap`` file.
+        strict: raise :class:`BagError` on any damage instead of warning.
+
+    Raises:
+        BagError: the path does not exist or is not a bag, ``metadata.yaml`` is missing or
+            corrupt, a storage file is not MCAP, or (strict) anything is damaged.
+    """
+
+    def __init__(self, path: str | Path, *, strict: bool = False) -> None:
+        self.path = Path(path)
+        self.strict = strict
+        self.problems: list[str] = []
+        """Every problem met so far, one line each (also issued as :class:`BagWarning`)."""
+        self.layout: BagLayout | None = None
+        """The parsed ``metadata.yaml`` (None for a bare ``.mcap`` file)."""
+        self._closed = False
+        if not self.path.exists():
+            raise BagError(f"{self.path}: no such bag (the path does not exist)")
+        if self.path.is_dir():
+            self.layout = read_layout(self.path)
+            files = [self.path / f.path for f in self.layout.files]
+            missing = [f for f in files if not f.is_file()]
+            if files and len(missing) == len(files):
+                raise BagError(f"{self.path}: none of the storage files listed in metadata.yaml exists ({', '.join(f.name for f in missing)})")
+            for f in missing:
+                self._report(f"{f}: listed in metadata.yaml but missing; its messages are not read")
+            files = [f for f in files if f not in missing]
+        else:
+            files = [self.path]
+        self._indexes: list[FileIndex] = [storage_for_file(f).index(f) for f in files]
+        if self._indexes and not any(i.has_header for i in self._indexes):
+            raise BagError(f"{self.path}: nothing readable: " + "; ".join(p for i in self._indexes for p in i.problems))
+        for index in self._indexes:
+            for problem in index.problems:
+                self._report(problem)
+        self._store = self._build_typestore()
+        self._decoders: dict[str, Callable[[bytes], object]] = {}
+        self._channel_topics: list[dict[int, str]] = []
+        self._topics = self._collect_topics()
+        self._check_layout()
+
+    # -- public API -------------------------------------------------------------------------
+
+    @property
+    def files(self) -> list[Path]:
+        """The storage files read."""
+        return [i.path for i in self._indexes]
+
+    @property
+    def topics(self) -> dict[str, TopicInfo]:
+        """Topics by name."""
+        return dict(self._topics)
+
+    @property
+    def message_count(self) -> int:
+        """Messages readable in all files (all topics, decodable or not)."""
+        return sum(i.message_count for i in self._indexes)
+
+    @property
+    def start_ns(self) -> int:
+        """Log time of the earliest message (ns); 0 for an empty bag."""
+        return min((i.start_ns for i in self._indexes if i.message_count), default=0)
+
+    @property
+    def end_ns(self) -> int:
+        """Log time of the latest message (ns); 0 for an empty bag."""
+        return max((i.end_ns for i in self._indexes if i.message_count), default=0)
+
+    @property
+    def duration_ns(self) -> int:
+        """``end_ns - start_ns``."""
+        return self.end_ns - self.start_ns
+
+    @property
+    def run_metadata(self) -> dict[str, str]:
+        """The run context (configuration, calibration, test program, project version...): the
+        MCAP metadata record ``bearing_rig_sim``, else ``metadata.yaml``'s ``custom_data``;
+        empty when the bag has neither."""
+        for index in self._indexes:
+            if RUN_METADATA_RECORD in index.metadata:
+                return dict(index.metadata[RUN_METADATA_RECORD])
+        return dict(self.layout.custom_data) if self.layout is not None else {}
+
+    @property
+    def complete(self) -> bool:
+        """True when every file was finished properly and nothing was found damaged."""
+        return all(i.indexed for i in self._indexes) and not self.problems
+
+    @property
+    def typestore(self) -> Typestore:
+        """The types the messages are decoded with."""
+        return self._store
+
+    def messages(
+        self,
+        topics: Iterable[str] | None = None,
+        *,
+        start_ns: int | None = None,
+        stop_ns: int | None = None,
+        raw: bool = False,
+    ) -> Iterator[BagMessage]:
+        """Messages in log-time order, streamed.
+
+        Args:
+            topics: topic names to read; None for every decodable topic.
+            start_ns / stop_ns: keep messages with ``start_ns <= log_time < stop_ns``.
+            raw: yield the serialized CDR bytes instead of decoded objects (undecodable
+                topics included).
+
+        Raises:
+            BagError: a requested topic is not in the bag; (strict) a damaged chunk or message.
+        """
+        if self._closed:
+            raise BagError(f"{self.path}: the bag is closed")
+        if topics is None:
+            selected = {name for name, info in self._topics.items() if raw or info.decodable}
+        else:
+            selected = set([topics] if isinstance(topics, str) else topics)
+            unknown = sorted(selected - self._topics.keys())
+            if unknown:
+                raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self._topics)) or 'none'})")
+            if not raw:
+                selected = {name for name in selected if self._topics[name].decodable}
+        return self._iterate(selected, start_ns, stop_ns, raw)
+
+    def close(self) -> None:
+        """Mark the reader closed (files are opened only while messages are read)."""
+        self._closed = True
+
+    def __enter__(self) -> BagReader:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> Literal[False]:
+        self.close()
+        return False
+
+    # -- internals --------------------------------------------------------------------------
+
+    def _report(self, problem: str) -> None:
+        if self.strict:
+            raise BagError(problem)
+        self.problems.append(problem)
+        warnings.warn(problem, BagWarning, stacklevel=3)
+
+    def _build_typestore(self) -> Typestore:
+        """The shared rig store when the bag's definitions agree with it, else a store built
+        from the bag's own definitions completed with the rig's."""
+        rig = rig_typestore()
+        bag_types: dict = {}
+        parsed: set[tuple[str, str]] = set()
+        for index in self._indexes:
+            for schema in index.schemas.values():
+                msgtype, encoding = schema.name, schema.encoding
+                text = schema.data.decode("utf-8", errors="replace")
+                if not text or (msgtype, text) in parsed or encoding not in ("ros2msg", "ros2idl", "omgidl"):
+                    continue
+                parsed.add((msgtype, text))
+                try:
+                    bag_types.update(_parse_definition(msgtype, encoding, text))
+                except Exception as exc:  # noqa: BLE001 - rosbags parser errors have several classes
+                    self._report(f"{index.path.name}: the bag's definition of {msgtype} does not parse ({exc}); using the built-in one if any")
+        if all(name in rig.fielddefs and _same_fields(rig.fielddefs[name], d) for name, d in bag_types.items()):
+            return rig
+        store = get_typestore(Stores.EMPTY)
+        try:
+            store.register(bag_types)
+        except Exception as exc:  # noqa: BLE001 - TypesysError and parser errors
+            self._report(f"{self.path}: the bag's message definitions are inconsistent ({exc}); using the built-in ones")
+            return rig
+        needed = {
+            channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels
+        } | ({t.msgtype for t in self.layout.topics} if self.layout else set())
+        missing = {name for name in _dependencies(rig, needed) if name not in store.fielddefs}
+        if missing:
+            try:
+                store.register({name: rig.fielddefs[name] for name in missing})
+            except Exception as exc:  # noqa: BLE001
+                self._report(f"{self.path}: built-in definitions of {', '.join(sorted(missing))} clash with the bag's ({exc})")
+        return store
+
+    def _collect_topics(self) -> dict[str, TopicInfo]:
+        found = layout_from_indexes(self._indexes, self.layout, self._report)
+        types = {t.name: t.msgtype for t in found.topics}
+        for index in self._indexes:
+            self._channel_topics.append(
+                {
+                    cid: channel.topic
+                    for cid, channel in index.channels.items()
+                    if channel_msgtype(index, cid, self.layout) == types.get(channel.topic)
+                }
+            )
+        topics = {}
+        for entry in sorted(found.topics, key=lambda t: t.name):
+            cdr = entry.serialization_format == "cdr"
+            decodable = cdr and bool(entry.msgtype) and entry.msgtype in self._store.fielddefs
+            if not decodable:
+                why = (
+                    f"message encoding {entry.serialization_format!r} is not cdr"
+                    if not cdr
+                    else f"type {entry.msgtype or '(none)'} is unknown: no definition in the bag and not a ROS 2 Jazzy or bearing_rig_msgs type"
+                )
+                self._report(f"{self.path.name}: topic {entry.name}: {why}; its {entry.message_count} messages are skipped")
+            qos = QosSpec.from_rosbags(entry.qos[0]) if entry.qos else None
+            topics[entry.name] = TopicInfo(entry.name, entry.msgtype, entry.message_count, qos, entry.type_hash, decodable)
+        return topics
+
+    def _check_layout(self) -> None:
+        if self.layout is None:
+            return
+        stated = self.layout.message_count
+        held = self.message_count
+        if stated != held:
+            self._report(
+                f"{self.path / 'metadata.yaml'}: states {stated} messages but the files hold {held} readable ones "
+                "(stale metadata after an interrupted recording? `repair_bag` rewrites it)"
+            )
+
+    def _decoder(self, msgtype: str) -> Callable[[bytes], object]:
+        decoder = self._decoders.get(msgtype)
+        if decoder is None:
+            decoder = self._decoders[msgtype] = make_decoder(self._store, msgtype)
+        return decoder
+
+    def _iterate(self, selected: set[str], start_ns: int | None, stop_ns: int | None, raw: bool) -> Iterator[BagMessage]:
+        streams = []
+        routes: list[dict[int, tuple[str, str, Callable[[bytes], object] | None]]] = []
+        for index, topic_of in zip(self._indexes, self._channel_topics):
+            wanted = [cid for cid, name in topic_of.items() if name in selected]
+            if not wanted or not index.message_count:
+                continue
+            tagged = len(routes)
+            routes.append(
+                {
+                    cid: (
+                        topic_of[cid],
+                        self._topics[topic_of[cid]].msgtype,
+                        None if raw else self._decoder(self._topics[topic_of[cid]].msgtype),
+                    )
+                    for cid in wanted
+                }
+            )
+            messages = storage_for_file(index.path).messages(index, wanted, start_ns, stop_ns, self._report)
+            streams.append((index.start_ns, index.end_ns, ((t, tagged, cid, data) for t, cid, _pub, data in messages)))
+        streams.sort(key=lambda s: s[0])
+        in_order = all(b[0] > a[1] for a, b in zip(streams, streams[1:]))
+        generators = [s[2] for s in streams]
+        source = itertools.chain.from_iterable(generators) if in_order else heapq.merge(*generators, key=lambda m: (m[0], m[1]))
+        failed: dict[str, int] = {}
+        for log_time, tagged, channel_id, data in source:
+            name, msgtype, decode = routes[tagged][channel_id]
+            if decode is None:
+                yield BagMessage(name, log_time, msgtype, data)
+                continue
+            try:
+                message = decode(data)
+            except BagError as exc:
+                failed[name] = failed.get(name, 0) + 1
+                if failed[name] == 1:
+                    self._report(f"{self.path.name}: topic {name}: {exc}; such messages are skipped")
+                continue
+            yield BagMessage(name, log_time, msgtype, message)
+        for name, count in failed.items():
+            if count > 1:
+                self._report(f"{self.path.name}: topic {name}: {count} messages could not be decoded in all")
+
+
+def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:
+    """Open a bag for reading (see :class:`BagReader`).
+
+    Raises:
+        BagError: not a bag, unreadable metadata, a storage file that is not MCAP.
+    """
+    return BagReader(path, strict=strict)

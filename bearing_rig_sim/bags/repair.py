@@ -1,0 +1,247 @@
+"""Repairing a bag whose recording was killed.
+
+A recorder killed mid-run (SIGKILL, power loss) leaves MCAP files without summary or footer,
+possibly ending inside a chunk, and a ``metadata.yaml`` with stale counts. The project's reader
+already reads such a bag up to its last complete chunk; other tools (rosbags, ``ros2 bag``,
+Foxglove's indexed loading) need the index back. :func:`repair_bag` rebuilds it:
+
+1. every storage file is indexed and its chunks checked; a finished, undamaged one is left alone;
+2. a damaged one is read up to its last complete chunk (damaged chunks in the middle are
+   skipped) and rewritten as a finished MCAP file with summary and indexes; the original is kept
+   beside it as ``<name>.mcap.orig``; a file that is not MCAP at all is moved aside the same way;
+3. ``metadata.yaml`` is rebuilt from what the files hold (the old one, if any and different, is
+   kept as ``metadata.yaml.orig``).
+
+Repairing a bag that needs nothing changes nothing. From a shell, until the ``bearing-rig``
+command has its ``bag repair`` sub-command: ``python -m bearing_rig_sim.bags repair BAG...``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import IO, Any, Literal, cast
+
+from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
+
+import bearing_rig_sim
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.layout import (
+    METADATA_FILE,
+    BagLayout,
+    layout_from_indexes,
+    qos_yaml,
+    read_layout,
+    same_layout,
+    storage_file_index,
+    write_layout,
+)
+from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import storage_for_file
+from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
+from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink
+
+BACKUP_SUFFIX = ".orig"
+"""Appended to the name of a file the repair replaced (``run_0.mcap.orig``)."""
+
+_COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "": CompressionType.NONE}
+
+
+@dataclass
+class FileRepair:
+    """What the repair did to one storage file.
+
+    Attributes:
+        name: file name inside the bag directory.
+        action: ``"intact"`` (finished properly, untouched), ``"rebuilt"`` (rewritten from its
+            readable part) or ``"removed"`` (not MCAP at all: moved aside).
+        messages_recovered: messages the file holds after the repair.
+        bytes_lost: bytes at the end of the original that belonged to no complete record.
+        backup: where the original was kept, None when untouched.
+        problems: what was found damaged.
+    """
+
+    name: str
+    action: Literal["intact", "rebuilt", "removed"]
+    messages_recovered: int = 0
+    bytes_lost: int = 0
+    backup: Path | None = None
+    problems: list[str] = field(default_factory=list)
+
+
+@dataclass
+class RepairReport:
+    """Outcome of :func:`repair_bag`."""
+
+    path: Path
+    files: list[FileRepair] = field(default_factory=list)
+    metadata_rewritten: bool = False
+    metadata_backup: Path | None = None
+
+    @property
+    def messages_recovered(self) -> int:
+        """Messages in the bag after the repair."""
+        return sum(f.messages_recovered for f in self.files)
+
+    @property
+    def bytes_lost(self) -> int:
+        """Bytes of the originals that could not be used."""
+        return sum(f.bytes_lost for f in self.files)
+
+    @property
+    def changed(self) -> bool:
+        """True when anything was rewritten."""
+        return self.metadata_rewritten or any(f.action != "intact" for f in self.files)
+
+    def summary(self) -> str:
+        """A few lines for a person: what was done, recovered and lost."""
+        if not self.changed:
+            return f"{self.path}: nothing to repair ({self.messages_recovered} messages, all files finished properly)"
+        lines = [f"{self.path}: {self.messages_recovered} messages recovered, {self.bytes_lost} bytes lost"]
+        for f in self.files:
+            kept = f"; original kept as {f.backup.name}" if f.backup else ""
+            lines.append(f"  {f.name}: {f.action}, {f.messages_recovered} messages, {f.bytes_lost} bytes lost{kept}")
+            lines.extend(f"    {p}" for p in f.problems)
+        if self.metadata_rewritten:
+            kept = f" (old one kept as {self.metadata_backup.name})" if self.metadata_backup else ""
+            lines.append(f"  {METADATA_FILE}: rebuilt from the files{kept}")
+        return "\n".join(lines)
+
+
+def _backup_path(path: Path) -> Path:
+    candidate = path.with_name(path.name + BACKUP_SUFFIX)
+    number = 1
+    while candidate.exists():
+        candidate = path.with_name(f"{path.name}{BACKUP_SUFFIX}.{number}")
+        number += 1
+    return candidate
+
+
+def _storage_files(bag_dir: Path, previous: BagLayout | None) -> list[Path]:
+    listed = [bag_dir / f.path for f in previous.files] if previous is not None else []
+    found = sorted(bag_dir.glob("*.mcap"), key=lambda p: (storage_file_index(p.name), p.name))
+    files = [p for p in listed if p.is_file()]
+    files += [p for p in found if p not in files]
+    return files
+
+
+def _type_hash(msgtype: str) -> str:
+    store = rig_typestore()
+    return store.hash_rihs01(msgtype) if msgtype in store.fielddefs else ""
+
+
+def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) -> Path:
+    """Write the readable content of a damaged file to ``<name>.repairing``; returns that path."""
+    target = index.path.with_name(index.path.name + ".repairing")
+    if target.exists():
+        target.unlink()
+    sink = CountingSink(target)
+    writer = Writer(cast(IO[Any], sink), chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
+    try:
+        writer.start(profile=index.profile or "ros2", library=index.library or f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
+        for name, values in index.metadata.items():
+            writer.add_metadata(name, values)
+        schema_ids: dict[int, int] = {}
+        schema_by_name: dict[str, int] = {}
+        for old_id, schema in sorted(index.schemas.items()):
+            schema_ids[old_id] = schema_by_name[schema.name] = writer.register_schema(schema.name, schema.encoding, schema.data)
+        channel_ids: dict[int, int] = {}
+        for old_id, channel in sorted(index.channels.items()):
+            channel_ids[old_id] = writer.register_channel(
+                channel.topic, channel.message_encoding, schema_ids.get(channel.schema_id, 0), dict(channel.metadata)
+            )
+        # Topics metadata.yaml declares but whose channel records were lost with the last chunk.
+        present = {c.topic for c in index.channels.values()}
+        store = rig_typestore()
+        for topic in previous.topics if previous is not None else []:
+            if topic.name in present or topic.msgtype not in store.fielddefs:
+                continue
+            schema_id = schema_by_name.get(topic.msgtype)
+            if schema_id is None:
+                text = msg_definition_text(topic.msgtype, store).encode()
+                schema_id = schema_by_name[topic.msgtype] = writer.register_schema(topic.msgtype, "ros2msg", text)
+            metadata = {"offered_qos_profiles": qos_yaml(topic.qos), "topic_type_hash": topic.type_hash or _type_hash(topic.msgtype)}
+            writer.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
+        for log_time, channel_id, publish_time, data in storage_for_file(index.path).messages(index, report=problems.append):
+            writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
+        writer.finish()
+    except BaseException:
+        sink.close()
+        target.unlink(missing_ok=True)
+        raise
+    sink.close()
+    return target
+
+
+def repair_bag(path: str | Path) -> RepairReport:
+    """Make a bag whose recording was interrupted readable by every tool again (see the module
+    documentation). Originals are kept as ``*.orig``; nothing is deleted.
+
+    Raises:
+        BagError: the path is not a directory, or holds no ``.mcap`` file.
+    """
+    bag_dir = Path(path)
+    if not bag_dir.is_dir():
+        raise BagError(f"{bag_dir}: not a bag directory (repair works on the directory holding metadata.yaml and the .mcap files)")
+    report = RepairReport(path=bag_dir)
+    try:
+        previous: BagLayout | None = read_layout(bag_dir)
+    except BagError:
+        previous = None
+    files = _storage_files(bag_dir, previous)
+    if not files:
+        raise BagError(f"{bag_dir}: no .mcap file, nothing to repair")
+    indexes: list[FileIndex] = []
+    for file in files:
+        try:
+            index = storage_for_file(file).index(file)
+        except BagError as exc:
+            backup = _backup_path(file)
+            os.replace(file, backup)
+            report.files.append(FileRepair(file.name, "removed", backup=backup, problems=[str(exc)]))
+            continue
+        if index.indexed and not index.problems:
+            index.problems.extend(storage_for_file(file).check(index))
+        if index.indexed and not index.problems:
+            report.files.append(FileRepair(file.name, "intact", index.message_count))
+            indexes.append(index)
+            continue
+        entry = FileRepair(file.name, "rebuilt", bytes_lost=index.bytes_lost, problems=list(index.problems))
+        rebuilt = _rewrite(index, previous, entry.problems)
+        entry.backup = _backup_path(file)
+        os.replace(file, entry.backup)
+        os.replace(rebuilt, file)
+        index = storage_for_file(file).index(file)
+        entry.messages_recovered = index.message_count
+        report.files.append(entry)
+        indexes.append(index)
+    problems: list[str] = []
+    layout = layout_from_indexes(indexes, previous, problems.append, _type_hash)
+    if problems and report.files:
+        report.files[0].problems.extend(problems)
+    if previous is None or not same_layout(previous, layout):
+        old = bag_dir / METADATA_FILE
+        if old.exists():
+            report.metadata_backup = _backup_path(old)
+            os.replace(old, report.metadata_backup)
+        write_layout(bag_dir, layout)
+        report.metadata_rewritten = True
+    return report
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Repair each bag named in ``argv`` and say what was done; exit status 2 if a path is not
+    a bag (``python -m bearing_rig_sim.bags repair BAG...``)."""
+    parser = argparse.ArgumentParser(description="Restore the index of bags whose recording was interrupted.")
+    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="bag directory")
+    status = 0
+    for bag in parser.parse_args(argv).bags:
+        try:
+            print(repair_bag(bag).summary())
+        except BagError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            status = 2
+    return status

@@ -1,0 +1,109 @@
+"""The message types a rig bag may hold: ROS 2 Jazzy's plus ``bearing_rig_msgs``.
+
+The recorder and the readers never import the generated ``bearing_rig_msgs`` Python package: the
+custom types are built into a rosbags type store from their ``.msg`` text, found in the source tree
+(``msg_defs/msg``) or, in an installed ROS package, under ``share/bearing_rig_msgs/msg``.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from rosbags.typesys.store import Typestore
+
+from bearing_rig_sim.bags.errors import BagError
+
+RIG_MSG_PACKAGE = "bearing_rig_msgs"
+"""ROS package name of the project's custom messages."""
+
+SCHEMA_SEPARATOR = "=" * 80
+"""Line between a type's definition and each of its dependencies in a ``ros2msg`` schema."""
+
+
+def msg_folder() -> Path:
+    """Folder holding the ``bearing_rig_msgs`` ``.msg`` files.
+
+    The source tree's ``msg_defs/msg`` first, then the installed ``share/bearing_rig_msgs/msg``
+    found through the ament index.
+
+    Raises:
+        BagError: neither exists.
+    """
+    local = Path(__file__).resolve().parents[2] / "msg_defs" / "msg"
+    if local.is_dir():
+        return local
+    try:
+        from ament_index_python.packages import get_package_share_directory  # noqa: PLC0415
+
+        installed = Path(get_package_share_directory(RIG_MSG_PACKAGE)) / "msg"
+        if installed.is_dir():
+            return installed
+    except Exception:  # noqa: BLE001 - ament index absent or package not installed
+        pass
+    raise BagError(
+        f"cannot find the {RIG_MSG_PACKAGE} message definitions: neither {local} nor an installed "
+        f"share/{RIG_MSG_PACKAGE}/msg exists"
+    )
+
+
+@functools.cache
+def rig_message_texts() -> dict[str, str]:
+    """``{"bearing_rig_msgs/msg/<Name>": <.msg file text>}`` for every custom message."""
+    folder = msg_folder()
+    return {
+        f"{RIG_MSG_PACKAGE}/msg/{path.stem}": path.read_text(encoding="utf-8")
+        for path in sorted(folder.glob("*.msg"))
+    }
+
+
+@functools.cache
+def rig_typestore() -> Typestore:
+    """ROS 2 Jazzy's types plus the ``bearing_rig_msgs`` types (cached, shared).
+
+    Treat the result as read-only: register extra types into a store of your own
+    (:func:`new_rig_typestore`).
+    """
+    return new_rig_typestore()
+
+
+def new_rig_typestore() -> Typestore:
+    """A fresh, unshared store with the same types as :func:`rig_typestore`."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    types: dict = {}
+    for name, text in rig_message_texts().items():
+        try:
+            types.update(get_types_from_msg(text, name))
+        except Exception as exc:  # noqa: BLE001 - rosbags parse errors have several classes
+            raise BagError(f"{name}: cannot parse its .msg definition: {exc}") from exc
+    store.register(types)
+    return store
+
+
+def msg_definition_text(msgtype: str, typestore: Typestore | None = None) -> str:
+    """The ``ros2msg`` schema text of a type, as rosbag2 stores it in MCAP files.
+
+    The type's own definition, then for each type it uses a line of 80 ``=``, a line
+    ``MSG: pkg/Name`` and that type's definition. For ``bearing_rig_msgs`` types the original
+    ``.msg`` text is kept, comments (units) included, so that a bag viewer shows them.
+
+    Raises:
+        BagError: the type is unknown to the store.
+    """
+    store = typestore if typestore is not None else rig_typestore()
+    if msgtype not in store.fielddefs:
+        raise BagError(f"unknown message type {msgtype!r}: not a ROS 2 Jazzy type nor one of {RIG_MSG_PACKAGE}")
+    text, _ = store.generate_msgdef(msgtype, ros_version=2)
+    original = rig_message_texts().get(msgtype) if msgtype.startswith(f"{RIG_MSG_PACKAGE}/") else None
+    if original is None:
+        return text
+    sections = text.split(SCHEMA_SEPARATOR + "\n")
+    own = original if original.endswith("\n") else original + "\n"
+    return (SCHEMA_SEPARATOR + "\n").join([own, *sections[1:]])
+
+
+def type_hash(msgtype: str, typestore: Typestore | None = None) -> str:
+    """The type's RIHS01 hash (the ``type_description_hash`` rosidl generates)."""
+    store = typestore if typestore is not None else rig_typestore()
+    return store.hash_rihs01(msgtype)

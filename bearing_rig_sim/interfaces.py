@@ -1,0 +1,260 @@
+"""The interface contract of the rig, written once: every topic and service, with its type, QoS,
+rate, unit and publisher.
+
+Nodes, the session, the recorder, replay, offline analysis and the benchmarks take topic names,
+types and QoS profiles from here; ``docs/interfaces.md`` and the README's interface table are
+generated from :func:`markdown_table` (a test checks that both agree with it). The same topics
+are carried by the physical bench's pulse counter and load cell, so that the monitor and every
+subscriber work unchanged on either.
+
+Units on the wire are SI (rad/s, N, s); the slip rate is in percent. Message definitions live in
+``msg_defs/msg/*.msg`` (package ``bearing_rig_msgs``) with every field's unit in a comment.
+
+No ROS import: :mod:`bearing_rig_sim.nodes.common` turns a :class:`Topic`'s profile name into an
+rclpy ``QoSProfile``; :mod:`bearing_rig_sim.bags.qos` into the profile stored in a bag.
+
+Adding a topic: one :class:`Topic` constant below, added to :data:`TOPICS`; then regenerate the two
+tables (``python -m bearing_rig_sim.interfaces`` rewrites them in place) and wire the publisher in its node.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+QosName = Literal["reliable", "sensor_data", "transient_local"]
+"""The contract's three QoS profiles (see :data:`QOS_DESCRIPTIONS`)."""
+
+QOS_DESCRIPTIONS: dict[str, str] = {
+    "reliable": "reliable, volatile, depth 10",
+    "sensor_data": "sensor data (best effort, depth 100)",
+    "transient_local": "reliable, transient local, depth 10",
+}
+"""What each profile is, as the interface table says it."""
+
+
+@dataclass(frozen=True)
+class Topic:
+    """One topic of the contract.
+
+    Attributes:
+        name: the topic name, e.g. ``/rig/slip_status``.
+        msgtype: the message type as ``pkg/msg/Name``.
+        qos: the publisher's QoS profile (:data:`QosName`).
+        rate: how often it is published, in words (sim or wall time as said).
+        unit: the units of its fields.
+        publisher: who publishes it (on the twin; on the bench where that differs).
+        stamped: the message starts with a time stamp (``header.stamp``, or ``clock``).
+        note: what the type column adds (field names), or empty.
+    """
+
+    name: str
+    msgtype: str
+    qos: QosName
+    rate: str
+    unit: str
+    publisher: str
+    stamped: bool = True
+    note: str = ""
+
+    @property
+    def short_type(self) -> str:
+        """The type as ``pkg/Name`` (the table's spelling)."""
+        package, _, name = self.msgtype.split("/")
+        return f"{package}/{name}"
+
+
+@dataclass(frozen=True)
+class Service:
+    """One service of the contract.
+
+    Attributes:
+        name: the service name.
+        srvtype: the service type as ``pkg/srv/Name``.
+        unit: the units of its fields.
+        server: who serves it, and what it does.
+    """
+
+    name: str
+    srvtype: str
+    unit: str
+    server: str
+
+
+CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", "reliable", "1 kHz (sim)", "s", "simulator, replay")
+SPINDLE_COMMAND = Topic(
+    "/rig/spindle/command",
+    "bearing_rig_msgs/msg/SpindleCommand",
+    "transient_local",
+    "one per segment (stamp: its start)",
+    "rad/s, rad/s^2, s",
+    "program runner",
+)
+SPINDLE_PULSES = Topic(
+    "/rig/spindle/pulses",
+    "bearing_rig_msgs/msg/FibreOpticPulse",
+    "sensor_data",
+    "strips x rev/s",
+    "s",
+    "simulator (bench: pulse counter)",
+)
+CAGE_PULSES = Topic(
+    "/rig/cage/pulses",
+    "bearing_rig_msgs/msg/FibreOpticPulse",
+    "sensor_data",
+    "strips x rev/s",
+    "s",
+    "simulator (bench: pulse counter)",
+)
+SPEEDS = Topic(
+    "/rig/speeds",
+    "sensor_msgs/msg/JointState",
+    "sensor_data",
+    "1 kHz",
+    "rad/s (velocity), rad (position)",
+    "simulator (bench: pulse counter)",
+    note="names `inner_ring`, `cage`",
+)
+TRUTH = Topic("/rig/truth", "bearing_rig_msgs/msg/SimulatorTruth", "sensor_data", "100 Hz", "see msg", "simulator only")
+AXIAL_LOAD_SETPOINT = Topic(
+    "/rig/axial_load/setpoint",
+    "std_msgs/msg/Float64",
+    "reliable",
+    "one per segment",
+    "N",
+    "program runner, user",
+    stamped=False,
+)
+AXIAL_LOAD_STATE = Topic(
+    "/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", "100 Hz (sim)", "N, A", "load controller"
+)
+AXIAL_LOAD_FORCE = Topic(
+    "/rig/axial_load/force",
+    "geometry_msgs/msg/WrenchStamped",
+    "sensor_data",
+    "each `/clock` advance (up to 1 kHz)",
+    "N",
+    "load controller (bench: load cell)",
+    note="force.z",
+)
+BEARING_AXIAL_FORCE = Topic(
+    "/rig/bearing/axial_force",
+    "geometry_msgs/msg/WrenchStamped",
+    "reliable",
+    "each `/clock` advance (up to 1 kHz)",
+    "N",
+    "load controller -> simulator",
+    note="force.z",
+)
+SLIP_STATUS = Topic(
+    "/rig/slip_status",
+    "bearing_rig_msgs/msg/SlipStatus",
+    "transient_local",
+    "10 Hz + each closed slip window (one per cage revolution)",
+    "rad/s, %",
+    "monitor",
+)
+DIAGNOSTICS = Topic(
+    "/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node"
+)
+
+TOPICS: tuple[Topic, ...] = (
+    CLOCK,
+    SPINDLE_COMMAND,
+    SPINDLE_PULSES,
+    CAGE_PULSES,
+    SPEEDS,
+    TRUTH,
+    AXIAL_LOAD_SETPOINT,
+    AXIAL_LOAD_STATE,
+    AXIAL_LOAD_FORCE,
+    BEARING_AXIAL_FORCE,
+    SLIP_STATUS,
+    DIAGNOSTICS,
+)
+"""Every topic of the contract, in the table's order. The session records all of them."""
+
+PULSE_TOPICS: dict[str, Topic] = {"spindle": SPINDLE_PULSES, "cage": CAGE_PULSES}
+"""The two fibre-optic pulse streams by shaft."""
+
+AXIAL_LOAD_SET = Service(
+    "/rig/axial_load/set", "bearing_rig_msgs/srv/SetAxialLoad", "N", "load controller (server)"
+)
+AXIAL_LOAD_RESET_FAULT = Service(
+    "/rig/axial_load/reset_fault",
+    "std_srvs/srv/Trigger",
+    "-",
+    "load controller (server): clears a latched interlock once its cause is gone",
+)
+AXIAL_LOAD_CLUTCH = Service(
+    "/rig/axial_load/clutch",
+    "std_srvs/srv/SetBool",
+    "-",
+    "load controller (server): engage (true) / release the magnet clutch",
+)
+
+SERVICES: tuple[Service, ...] = (AXIAL_LOAD_SET, AXIAL_LOAD_RESET_FAULT, AXIAL_LOAD_CLUTCH)
+"""Every service of the contract."""
+
+_BY_NAME: dict[str, Topic] = {t.name: t for t in TOPICS}
+
+
+def topic(name: str) -> Topic:
+    """The contract's topic of that name.
+
+    Raises:
+        KeyError: no such topic in the contract (the message names it).
+    """
+    try:
+        return _BY_NAME[name]
+    except KeyError:
+        raise KeyError(f"{name!r} is not a topic of the interface contract") from None
+
+
+def contract_qos(name: str) -> QosName | None:
+    """The QoS profile name the contract gives a topic, or None for a topic outside it."""
+    found = _BY_NAME.get(name)
+    return found.qos if found is not None else None
+
+
+def markdown_table() -> str:
+    """The interface table (markdown) of ``docs/interfaces.md`` and the README, services placed
+    after the set-point topic as the table has always shown them."""
+    rows = [
+        "| topic | type | QoS | rate | unit | publisher |",
+        "|---|---|---|---|---|---|",
+    ]
+    for t in TOPICS:
+        kind = f"`{t.short_type}`" + (f" ({t.note})" if t.note else "")
+        rows.append(f"| `{t.name}` | {kind} | {QOS_DESCRIPTIONS[t.qos]} | {t.rate} | {t.unit} | {t.publisher} |")
+        if t is AXIAL_LOAD_SETPOINT:
+            for s in SERVICES:
+                rows.append(f"| `{s.name}` (service) | `{s.srvtype}` | service | on request | {s.unit} | {s.server} |")
+    return "\n".join(rows) + "\n"
+
+
+TABLE_DOCUMENTS = ("docs/interfaces.md", "README.md")
+"""The documents, relative to the repository, that carry :func:`markdown_table`."""
+
+_TABLE_PATTERN = r"\| topic \| type \| QoS \| rate \| unit \| publisher \|\n(?:\|.*\|\n)+"
+
+
+def write_tables(root: Path) -> list[Path]:
+    """Replace the interface table in each of :data:`TABLE_DOCUMENTS` under ``root`` by
+    :func:`markdown_table`; returns the files that changed."""
+    changed = []
+    for name in TABLE_DOCUMENTS:
+        path = root / name
+        text = path.read_text(encoding="utf-8")
+        new = re.sub(_TABLE_PATTERN, lambda _m: markdown_table(), text, count=1)
+        if new != text:
+            path.write_text(new, encoding="utf-8")
+            changed.append(path)
+    return changed
+
+
+if __name__ == "__main__":  # pragma: no cover - the docs' regeneration command
+    for changed_file in write_tables(Path(__file__).resolve().parent.parent):
+        print(f"updated {changed_file}")

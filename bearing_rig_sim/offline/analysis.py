@@ -1,0 +1,564 @@
+"""Deterministic offline analysis of a rig bag: the monitor's verdicts without a ROS graph.
+
+::
+
+    result = analyse_bag("bags/20250612T093015Z-validation", csv_dir="reports/run")
+    print(result.final_status.state, [s.final_state for s in result.segments])
+
+The two fibre-optic pulse topics are read in log-time order and fed, in lockstep, into the same
+:class:`~bearing_rig_sim.monitoring.SlipMonitor` the monitor node wraps, so the slip windows and
+verdicts offline are the monitor's. Nothing depends on a wall clock: two runs over one bag give
+bit-identical results.
+
+**The clock.** The monitor node takes the pulse stamps as its time base; it calls
+:meth:`SlipMonitor.check` (where the Gaussian refits run) and publishes a status
+``status_rate_hz`` times a second, and publishes one more as each slip window closes. Offline,
+before each pulse ``check`` runs at every tick ``t0 + k / status_rate_hz`` up to the pulse's time
+(``t0``: the first pulse), each followed by a status row, and each closed window emits a row at
+once. A pulse further back than ``clock_jump_tolerance_s`` restarts the ticks (the monitor
+resets itself on it). After the last pulse one final ``check`` and row close the series.
+
+**What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
+of the five fields the monitor needs (little-endian CDR; other encodings through the reader's
+general decoder); the 1 kHz topics (speeds, load cell, bearing force) are not decoded message by
+message but their latest bytes are kept and decoded when a status row samples them. Memory does
+not grow with the bag's length: rows and windows stream to CSV files as they are made, and only
+a decimated copy of the rows (at most ``max_points``) and the state changes are kept for plots.
+
+**The topics** (:data:`PULSE_TOPICS` required, :data:`CONTEXT_TOPICS` used when present; the
+bench records the same contract, and bags without the simulator's truth are analysed alike):
+
+* ``/rig/spindle/pulses``, ``/rig/cage/pulses``: ``bearing_rig_msgs/msg/FibreOpticPulse``;
+* ``/rig/speeds``: ``sensor_msgs/msg/JointState`` (``velocity`` of ``inner_ring`` and ``cage``);
+* ``/rig/truth``: ``bearing_rig_msgs/msg/SimulatorTruth`` (twin only);
+* ``/rig/slip_status``: ``bearing_rig_msgs/msg/SlipStatus`` (the monitor's recorded verdicts);
+* ``/rig/spindle/command``: ``bearing_rig_msgs/msg/SpindleCommand`` (program segments);
+* ``/rig/axial_load/state`` (``bearing_rig_msgs/msg/AxialLoadState``),
+  ``/rig/axial_load/setpoint`` (``std_msgs/msg/Float64``), ``/rig/axial_load/force`` and
+  ``/rig/bearing/axial_force`` (``geometry_msgs/msg/WrenchStamped``, ``force.z``).
+
+**Segments** (:mod:`.segments`): program segments from the spindle commands when the bag has
+them, else constant-speed stretches found in the monitor's windows.
+
+Units: SI inside (s, rad/s, N), slip in percent; the CSV files speak rpm, percent and N.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import struct
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+from collections.abc import Callable
+
+import yaml
+
+from bearing_rig_sim.config import ConfigError, Section, ros_parameters
+from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, shipped_parameters
+from bearing_rig_sim.bags.cdr import make_decoder
+from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.reader import BagReader, open_bag
+from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary, SegmentTracker, program_segment_names, write_segments_csv
+from bearing_rig_sim.offline.series import (
+    STATUS_CSV,
+    WINDOWS_CSV,
+    CsvWriter,
+    RowDecimator,
+    SlipWindowRow,
+    StatusRow,
+    csv_columns,
+)
+from bearing_rig_sim.rig.fibre_optic import Pulse
+
+PULSE_TYPE = "bearing_rig_msgs/msg/FibreOpticPulse"
+PULSE_TOPICS: dict[str, str] = {"spindle": "/rig/spindle/pulses", "cage": "/rig/cage/pulses"}
+"""Shaft -> pulse topic: what the analysis cannot do without."""
+
+SPEEDS, TRUTH, STATUS, COMMAND = "/rig/speeds", "/rig/truth", "/rig/slip_status", "/rig/spindle/command"
+LOAD_STATE, LOAD_SETPOINT, LOAD_CELL, BEARING_FORCE = (
+    "/rig/axial_load/state",
+    "/rig/axial_load/setpoint",
+    "/rig/axial_load/force",
+    "/rig/bearing/axial_force",
+)
+CONTEXT_TOPICS: dict[str, str] = {
+    SPEEDS: "sensor_msgs/msg/JointState",
+    TRUTH: "bearing_rig_msgs/msg/SimulatorTruth",
+    STATUS: "bearing_rig_msgs/msg/SlipStatus",
+    COMMAND: "bearing_rig_msgs/msg/SpindleCommand",
+    LOAD_STATE: "bearing_rig_msgs/msg/AxialLoadState",
+    LOAD_SETPOINT: "std_msgs/msg/Float64",
+    LOAD_CELL: "geometry_msgs/msg/WrenchStamped",
+    BEARING_FORCE: "geometry_msgs/msg/WrenchStamped",
+}
+"""Topics read when present, with the type they must carry."""
+
+MONITOR_PARAMETERS_KEY = f"parameters/{NODE_NAME}"
+"""Run-context key holding the monitor's parameter file of the run."""
+
+PLAUSIBLE_STAMP_S = 10.0
+"""A recorded status or command stamped further than this from the pulse clock was stamped on
+another clock (s); see :meth:`OfflineAnalysis._decoded`."""
+MAX_TRANSITIONS = 20_000
+"""State changes kept per source; further ones are counted, not kept (1)."""
+DEFAULT_MAX_POINTS = 2000
+"""Rows kept for plots (1)."""
+
+_NAN = math.nan
+
+
+# ---------------------------------------------------------------------------------------------
+# Pulses: a decoder of the fields the monitor uses
+# ---------------------------------------------------------------------------------------------
+_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
+_U32 = struct.Struct("<I")
+_STRIPS = struct.Struct("<HH")
+_COUNTS = struct.Struct("<QQ")
+
+
+def decode_pulse(data: bytes | memoryview) -> Pulse:
+    """A little-endian CDR ``FibreOpticPulse`` as a :class:`Pulse` (time = ``sec + nanosec * 1e-9``).
+
+    Raises:
+        BagError: not little-endian CDR, or the bytes end before the message does.
+    """
+    if bytes(data[:2]) != b"\x00\x01":
+        raise BagError(f"{PULSE_TYPE}: not little-endian CDR (encapsulation {bytes(data[:4]).hex()})")
+    try:
+        sec, nanosec, length = _HEAD.unpack_from(data, 4)
+        pos = (12 + length + 3) & ~3  # body offsets; the body starts at byte 4
+        (length,) = _U32.unpack_from(data, 4 + pos)
+        sensor = bytes(data[8 + pos : 8 + pos + max(length - 1, 0)]).decode("utf-8")
+        pos = (pos + 4 + length + 1) & ~1
+        strip_id, strip_count = _STRIPS.unpack_from(data, 4 + pos)
+        pos = (pos + 4 + 7) & ~7
+        revolution, pulse_index = _COUNTS.unpack_from(data, 4 + pos)
+    except (struct.error, UnicodeDecodeError) as exc:
+        raise BagError(f"{PULSE_TYPE}: malformed message of {len(data)} bytes ({exc})") from None
+    return Pulse(sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensor)
+
+
+def _pulse_from_message(message: Any) -> Pulse:
+    stamp = message.header.stamp
+    return Pulse(
+        stamp.sec + stamp.nanosec * 1e-9,
+        int(message.strip_id),
+        int(message.strip_count),
+        int(message.revolution),
+        int(message.pulse_index),
+        str(message.sensor_id),
+    )
+
+
+# ---------------------------------------------------------------------------------------------
+# The result
+# ---------------------------------------------------------------------------------------------
+@dataclass
+class OfflineResult:
+    """Everything the offline analysis of one bag found (see :func:`analyse_bag`)."""
+
+    path: Path
+    run_metadata: dict[str, str]
+    topics: dict[str, tuple[str, int]]
+    """Every topic of the bag: name -> (type, message count)."""
+    complete: bool
+    """False when the bag was damaged or truncated: the results cover what could be read."""
+    problems: list[str]
+    """Every problem met (the reader's and the analysis'), one line each."""
+    settings_source: str
+    """Where the monitor's parameters came from."""
+    segment_source: str
+    """``"program"`` (spindle commands) or ``"stretches"`` (detected constant speeds)."""
+    bag_start: float
+    bag_end: float
+    """Log-time range of the bag, s."""
+    first_time: float = _NAN
+    last_time: float = _NAN
+    """Rig time of the first and last pulse analysed, s."""
+    pulses: dict[str, int] = field(default_factory=lambda: dict.fromkeys(PULSE_TOPICS, 0))
+    windows: int = 0
+    status_rows: int = 0
+    recorded_statuses: int = 0
+    state_durations: dict[int, float] = field(default_factory=dict)
+    """Rig seconds spent in each offline state (between status rows)."""
+    final_status: MonitorStatus | None = None
+    final_recorded_state: int = -1
+    rows: list[StatusRow] = field(default_factory=list)
+    """Decimated status rows (at most ``max_points``, evenly spread, the last one included)."""
+    transitions: list[tuple[float, int]] = field(default_factory=list)
+    """Offline state changes (rig time, state), the first row included."""
+    recorded_transitions: list[tuple[float, int]] = field(default_factory=list)
+    """State changes of the recorded ``/rig/slip_status`` (stamp on the pulse clock, state)."""
+    transitions_dropped: int = 0
+    segments: list[SegmentSummary] = field(default_factory=list)
+    csv_files: list[Path] = field(default_factory=list)
+
+
+# ---------------------------------------------------------------------------------------------
+# Helpers
+# ---------------------------------------------------------------------------------------------
+class _Latest:
+    """The latest message of a topic, decoded only when asked for (a message that does not
+    decode is counted in :attr:`failed` and leaves the value unknown)."""
+
+    def __init__(self, decode: Callable[[bytes], Any]) -> None:
+        self._decode = decode
+        self._raw: bytes | None = None
+        self._value: Any = None
+        self.failed = 0
+
+    def put(self, _log_time_ns: int, raw: bytes) -> None:
+        self._raw, self._value = raw, None
+
+    def get(self) -> Any:
+        if self._value is None and self._raw is not None:
+            try:
+                self._value = self._decode(self._raw)
+            except BagError:
+                self._raw = None
+                self.failed += 1
+        return self._value
+
+
+def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> MonitorSettings | None:
+    """The monitor's parameters of the run: the parameter file recorded in the run context
+    (:data:`MONITOR_PARAMETERS_KEY`) over the shipped defaults, as the node reads them; None when
+    the bag records none.
+
+    Raises:
+        ConfigError: the recorded parameters are invalid (naming the key).
+    """
+    text = run_metadata.get(MONITOR_PARAMETERS_KEY)
+    if not text:
+        return None
+    try:
+        doc = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ConfigError(source, "", f"not valid YAML ({exc})") from None
+    if not isinstance(doc, dict):
+        raise ConfigError(source, "", "top level must be a mapping")
+    recorded = ros_parameters(Section(doc, source), NODE_NAME).data
+    return MonitorSettings.from_values({**shipped_parameters(), **recorded}, source)
+
+
+# ---------------------------------------------------------------------------------------------
+# The analysis
+# ---------------------------------------------------------------------------------------------
+class OfflineAnalysis:
+    """One pass over a bag (see the module documentation); use :func:`analyse_bag`."""
+
+    def __init__(
+        self,
+        bag: BagReader,
+        settings: MonitorSettings | None,
+        *,
+        csv_dir: Path | None,
+        max_points: int,
+        on_row: Callable[[StatusRow], None] | None,
+        on_window: Callable[[SlipWindowRow], None] | None,
+    ) -> None:
+        self.bag = bag
+        self._problems: list[str] = []
+        self._check_topics()
+        source = "given"
+        if settings is None:
+            settings, source = self._run_settings()
+        self.settings = settings
+        self.monitor = SlipMonitor(settings.kinematics(), settings)
+        self.period = 1.0 / settings.status_rate_hz
+        topics = bag.topics
+        self.result = OfflineResult(
+            path=bag.path,
+            run_metadata=bag.run_metadata,
+            topics={n: (t.msgtype, t.message_count) for n, t in sorted(topics.items())},
+            complete=bag.complete,
+            problems=[],
+            settings_source=source,
+            segment_source="program" if topics.get(COMMAND) and topics[COMMAND].message_count else "stretches",
+            bag_start=bag.start_ns * 1e-9,
+            bag_end=bag.end_ns * 1e-9,
+        )
+        self._rows = RowDecimator(max_points)
+        self._on_row, self._on_window = on_row, on_window
+        self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context}
+        self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
+        self._bad_pulses = 0
+        self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
+        self._origin: float | None = None
+        self._tick = 0
+        self._clock = -math.inf
+        self._last_row: StatusRow | None = None
+        self._recorded: Any = None
+        self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata))
+        self._sinks: list[CsvWriter] = []
+        self._csv_dir = csv_dir
+        if csv_dir is not None:
+            csv_dir.mkdir(parents=True, exist_ok=True)
+            self._status_csv = CsvWriter(csv_dir / STATUS_CSV, csv_columns(StatusRow))
+            self._windows_csv = CsvWriter(csv_dir / WINDOWS_CSV, csv_columns(SlipWindowRow))
+            self._sinks = [self._status_csv, self._windows_csv]
+
+    # -- set-up --------------------------------------------------------------------------------
+    def _report(self, problem: str) -> None:
+        self._problems.append(problem)
+        warnings.warn(problem, BagWarning, stacklevel=4)
+
+    def _check_topics(self) -> None:
+        topics = self.bag.topics
+        missing = [t for t in PULSE_TOPICS.values() if t not in topics]
+        if missing:
+            raise BagError(
+                f"{self.bag.path}: no fibre-optic pulse topic {' nor '.join(missing)} ({PULSE_TYPE}) in the bag, "
+                f"so no slip can be computed (the bag has: {', '.join(sorted(topics)) or 'no topics'})"
+            )
+        for topic in PULSE_TOPICS.values():
+            if topics[topic].msgtype != PULSE_TYPE:
+                raise BagError(f"{self.bag.path}: topic {topic} carries {topics[topic].msgtype}, not {PULSE_TYPE}")
+            if not topics[topic].message_count:
+                self._report(f"{self.bag.path.name}: topic {topic} has no messages: no slip window can be formed")
+        self._context = []
+        for name, msgtype in CONTEXT_TOPICS.items():
+            info = topics.get(name)
+            if info is None:
+                continue
+            if info.msgtype != msgtype:
+                self._report(f"{self.bag.path.name}: topic {name} carries {info.msgtype}, not {msgtype}; not used")
+            else:
+                self._context.append(name)
+
+    def _run_settings(self) -> tuple[MonitorSettings, str]:
+        source = f"{self.bag.path} run context {MONITOR_PARAMETERS_KEY}"
+        try:
+            recorded = monitor_settings_from_run(self.bag.run_metadata, source)
+        except ConfigError as exc:
+            self._report(f"{exc}; using the shipped config/monitor.yaml")
+            recorded = None
+        if recorded is not None:
+            return recorded, "the bag's run context (parameters/monitor)"
+        return MonitorSettings.from_yaml(), "the shipped config/monitor.yaml (the bag records none)"
+
+    # -- the pass ------------------------------------------------------------------------------
+    def run(self) -> OfflineResult:
+        """Read the bag once and return the result; CSV files are closed whatever happens."""
+        handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
+        for name in self._context:
+            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
+        try:
+            for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
+                handlers[topic](log_time_ns, data)
+            self._finish()
+        finally:
+            for sink in self._sinks:
+                sink.close()
+        result = self.result
+        if self._bad_pulses > 1:
+            self._report(f"{self.bag.path.name}: {self._bad_pulses} pulses could not be decoded in all")
+        for name, latest in self._latest.items():
+            if latest.failed:
+                self._report(f"{self.bag.path.name}: topic {name}: {latest.failed} message(s) could not be decoded; not used")
+        result.complete = self.bag.complete and not self._problems
+        result.problems = list(dict.fromkeys(self.bag.problems + self._problems))
+        result.rows = self._rows.result()
+        if self._csv_dir is not None:
+            result.csv_files = [sink.path for sink in self._sinks] + [write_segments_csv(self._csv_dir / SEGMENTS_CSV, result.segments)]
+        return result
+
+    def _on_pulse(self, topic: str, _log_time_ns: int, data: bytes) -> None:
+        try:
+            pulse = decode_pulse(data) if data[:2] == b"\x00\x01" else _pulse_from_message(self._decode_pulse_message(data))
+        except BagError as exc:
+            self._bad_pulses += 1
+            if self._bad_pulses == 1:
+                self._report(f"{self.bag.path.name}: topic {topic}: {exc}; such pulses are skipped")
+            return
+        shaft = self._shaft_of[topic]
+        self.result.pulses[shaft] += 1
+        t = pulse.time
+        if math.isfinite(t):
+            self._advance(t)
+        if self.monitor.add_pulse(shaft, pulse):
+            latest = self.monitor.latest_window
+            assert latest is not None
+            window = SlipWindowRow(latest.start_time, latest.end_time, latest.inner_ring_speed, latest.cage_speed, latest.slip_rate)
+            self.result.windows += 1
+            if self._sinks:
+                self._windows_csv.write(window)
+            if self._on_window is not None:
+                self._on_window(window)
+            self._emit(self._clock, "window", self.monitor.status())
+
+    def _advance(self, t: float) -> None:
+        """Run the checks of every tick up to ``t``; restart the ticks on a clock jump back."""
+        if self._origin is None or t < self._clock - self.settings.clock_jump_tolerance_s:
+            self._origin, self._tick, self._clock = t, 0, t
+        while (tick := self._origin + self._tick * self.period) <= t:
+            self.monitor.check(tick)
+            self._emit(tick, "tick", self.monitor.status())
+            self._tick += 1
+        self._clock = max(self._clock, t)
+        if not math.isfinite(self.result.first_time):
+            self.result.first_time = t
+        self.result.last_time = self._clock
+
+    def _finish(self) -> None:
+        if self._origin is not None:
+            self.monitor.check(self._clock)
+            self._emit(self._clock, "end", self.monitor.status())
+            self.result.final_status = self.monitor.status()
+        self.result.segments = self._segments.finish()
+
+    # -- context topics ------------------------------------------------------------------------
+    def _decoded(self, topic: str, log_time_ns: int, data: bytes) -> tuple[Any, float]:
+        """The message (None if it does not decode) and its time on the pulse clock, s: its
+        ``header.stamp``, unless that lies more than :data:`PLAUSIBLE_STAMP_S` from the pulse
+        clock (or, before the first pulse, from the log time): a stamp on another clock, such as
+        the monitor's status before its first window. The pulse clock (or log time) is used then."""
+        latest = self._latest[topic]
+        latest.put(log_time_ns, data)
+        message = latest.get()
+        if message is None:
+            return None, _NAN
+        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+        reference = self._clock if self._origin is not None else log_time_ns * 1e-9
+        return message, stamp if abs(stamp - reference) <= PLAUSIBLE_STAMP_S else reference
+
+    def _on_recorded_status(self, log_time_ns: int, data: bytes) -> None:
+        message, stamp = self._decoded(STATUS, log_time_ns, data)
+        if message is None:
+            return
+        state = int(message.state)
+        result = self.result
+        result.recorded_statuses += 1
+        if result.final_recorded_state != state:
+            self._transition(result.recorded_transitions, stamp, state)
+        result.final_recorded_state = state
+        self._recorded = message
+        self._segments.recorded(stamp, state)
+
+    def _on_command(self, log_time_ns: int, data: bytes) -> None:
+        command, start = self._decoded(COMMAND, log_time_ns, data)
+        if command is None:
+            return
+        window = self.monitor.latest_window
+        self._segments.command(
+            start,
+            float(command.target_speed),
+            int(command.profile),
+            float(command.ramp_time),
+            float(command.acceleration),
+            window.inner_ring_speed if window is not None else 0.0,
+        )
+
+    def _transition(self, where: list[tuple[float, int]], time: float, state: int) -> None:
+        if len(where) < MAX_TRANSITIONS:
+            where.append((time, state))
+        else:
+            self.result.transitions_dropped += 1
+
+    # -- rows ----------------------------------------------------------------------------------
+    def _context_values(self) -> dict[str, Any]:
+        values: dict[str, Any] = {}
+        get = {name: latest.get() for name, latest in self._latest.items() if name not in (STATUS, COMMAND)}
+        speeds = get.get(SPEEDS)
+        if speeds is not None:
+            velocity = dict(zip(speeds.name, speeds.velocity))
+            values["counter_inner_ring_speed"] = float(velocity.get("inner_ring", _NAN))
+            values["counter_cage_speed"] = float(velocity.get("cage", _NAN))
+        truth = get.get(TRUTH)
+        if truth is not None:
+            values.update(
+                truth_inner_ring_speed=float(truth.inner_ring_speed),
+                truth_cage_speed=float(truth.cage_speed),
+                truth_slip_rate=float(truth.slip_rate),
+                truth_axial_load=float(truth.axial_load),
+            )
+        state = get.get(LOAD_STATE)
+        if state is not None:
+            values.update(
+                axial_load_setpoint=float(state.setpoint),
+                load_cell_force=float(state.load_cell_force),
+                bearing_force=float(state.bearing_force),
+            )
+        if get.get(LOAD_SETPOINT) is not None:
+            values["axial_load_setpoint"] = float(get[LOAD_SETPOINT].data)
+        if get.get(LOAD_CELL) is not None:
+            values["load_cell_force"] = float(get[LOAD_CELL].wrench.force.z)
+        if get.get(BEARING_FORCE) is not None:
+            values["bearing_force"] = float(get[BEARING_FORCE].wrench.force.z)
+        if self._recorded is not None:
+            values["recorded_state"] = int(self._recorded.state)
+            values["recorded_slip_rate"] = float(self._recorded.slip_rate)
+        return values
+
+    def _emit(self, time: float, reason: str, status: MonitorStatus) -> None:
+        row = StatusRow(
+            time=time,
+            reason=reason,
+            state=int(status.state),
+            window_end=_NAN if status.time is None else status.time,
+            inner_ring_speed=status.inner_ring_speed,
+            cage_speed=status.cage_speed,
+            theoretical_cage_speed=status.theoretical_cage_speed,
+            slip_rate=status.slip_rate,
+            fitted_slope=status.fitted_slope,
+            confidence=status.confidence,
+            windows=status.windows,
+            detail=status.detail,
+            **self._context_values(),
+        )
+        result = self.result
+        previous = self._last_row
+        if previous is None or previous.state != row.state:
+            self._transition(result.transitions, time, row.state)
+        if previous is not None:
+            result.state_durations[previous.state] = result.state_durations.get(previous.state, 0.0) + (time - previous.time)
+        result.status_rows += 1
+        self._last_row = row
+        self._rows.offer(row)
+        if self._sinks:
+            self._status_csv.write(row)
+        if self._on_row is not None:
+            self._on_row(row)
+        self._segments.row(row)
+
+
+def analyse_bag(
+    path: str | Path,
+    *,
+    settings: MonitorSettings | None = None,
+    csv_dir: str | Path | None = None,
+    max_points: int = DEFAULT_MAX_POINTS,
+    on_row: Callable[[StatusRow], None] | None = None,
+    on_window: Callable[[SlipWindowRow], None] | None = None,
+) -> OfflineResult:
+    """Run the monitor offline over a bag's pulses (see the module documentation).
+
+    Args:
+        path: bag directory or ``.mcap`` file.
+        settings: the monitor's parameters; default: those recorded in the bag's run context
+            (``parameters/monitor``), else the shipped ``config/monitor.yaml``.
+        csv_dir: when given, every status row and slip window is written there as it is made
+            (:data:`STATUS_CSV`, :data:`WINDOWS_CSV`).
+        max_points: status rows kept in memory for plots (>= 2).
+        on_row / on_window: called with every status row / slip window, in order.
+
+    Raises:
+        BagError: not a bag, or a bag without both pulse topics (the message names the missing
+            topics); damage is warned about (:class:`BagWarning`) and the result covers what
+            could be read (``result.complete`` False).
+        ConfigError: the given settings file is invalid.
+    """
+    with open_bag(path) as bag:
+        analysis = OfflineAnalysis(
+            bag,
+            settings,
+            csv_dir=None if csv_dir is None else Path(csv_dir),
+            max_points=max_points,
+            on_row=on_row,
+            on_window=on_window,
+        )
+        return analysis.run()
+

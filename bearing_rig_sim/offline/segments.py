@@ -1,0 +1,229 @@
+"""Program segments and constant-speed stretches of a run, accumulated from the status rows.
+
+:class:`SegmentTracker` cuts the run as it streams:
+
+* **program segments**, when the bag has spindle commands: each command starts a segment; its
+  ramp ends ``ramp_time`` after the command's stamp (STEP profile) or after
+  ``|target - previous target| / acceleration`` (constant acceleration); names come from the run's
+  test program when it has as many segments as there were commands;
+* **constant-speed stretches** otherwise (bench bags): consecutive slip windows whose inner-ring
+  speed stays within :data:`STRETCH_TOLERANCE` of the stretch's mean, kept when they last at
+  least :data:`STRETCH_MIN_DURATION_S`; the ramp end is the stretch's start.
+
+A segment's means are taken over the rows from its ramp end on; its verdicts are the last state
+in it; its time to stable runs from the ramp end to the end of the first stable window (the
+window must end after the ramp: a stable verdict from before belongs to the previous speed).
+
+Units: s, rad/s, N; slip in percent.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import yaml
+
+from bearing_rig_sim.monitoring import MonitorState
+from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
+
+SEGMENTS_CSV = "segments.csv"
+STRETCH_TOLERANCE = 0.01
+"""A window further than this fraction from its stretch's mean inner-ring speed ends it (1)."""
+STRETCH_MIN_DURATION_S = 2.0
+"""Shorter constant-speed stretches (ramps, hesitations) are not reported, s."""
+PROFILE_CONSTANT_ACCELERATION = 1
+"""SpindleCommand.msg's ``PROFILE_CONSTANT_ACCELERATION``."""
+
+_NAN = math.nan
+
+
+@dataclass(frozen=True)
+class SegmentSummary:
+    """A program segment or a constant-speed stretch.
+
+    Attributes:
+        name: program segment name, ``segment <n>`` or ``stretch <n>``.
+        start_time / ramp_end / end_time: rig time, s (the means cover ``ramp_end .. end_time``).
+        target_speed: commanded inner-ring speed, rad/s (NaN for a stretch).
+        inner_ring_speed: mean measured inner-ring speed (monitor windows), rad/s.
+        axial_load: mean axial load (:attr:`StatusRow.axial_load`), N.
+        slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
+            status / simulator truth, %.
+        final_state / final_recorded_state: state at the segment's end (recorded: -1 if none).
+        time_to_stable / recorded_time_to_stable: first stable verdict whose window ends at or
+            after the ramp end, minus the ramp end, s (None without one).
+        rows: status rows after the ramp end (1).
+    """
+
+    name: str
+    start_time: float
+    ramp_end: float
+    end_time: float
+    target_speed: float
+    inner_ring_speed: float
+    axial_load: float
+    slip_rate: float
+    recorded_slip_rate: float
+    truth_slip_rate: float
+    final_state: int
+    final_recorded_state: int
+    time_to_stable: float | None
+    recorded_time_to_stable: float | None
+    rows: int
+
+
+class _Segment:
+    """Accumulates one segment's figures from the status rows after its ramp end."""
+
+    def __init__(self, name: str, start: float, ramp_end: float, target: float) -> None:
+        self.name, self.start, self.ramp_end, self.target = name, start, ramp_end, target
+        self.end = start
+        self.sums: dict[str, list[float]] = {}
+        self.rows = 0
+        self.final_state = int(MonitorState.UNKNOWN)
+        self.final_recorded = -1
+        self.stable_at: float | None = None
+        self.recorded_stable_at: float | None = None
+
+    def _add(self, key: str, value: float) -> None:
+        if math.isfinite(value):
+            entry = self.sums.setdefault(key, [0.0, 0])
+            entry[0] += value
+            entry[1] += 1
+
+    def mean(self, key: str) -> float:
+        total, count = self.sums.get(key, (0.0, 0))
+        return total / count if count else _NAN
+
+    def add_row(self, row: StatusRow) -> None:
+        self.end = row.time
+        self.final_state = row.state
+        self.final_recorded = row.recorded_state
+        if row.state == MonitorState.STABLE and self.stable_at is None and row.window_end >= self.ramp_end:
+            self.stable_at = row.window_end
+        if row.time < self.ramp_end:
+            return
+        self.rows += 1
+        for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
+            self._add(key, getattr(row, key))
+
+    def add_recorded(self, stamp: float, state: int) -> None:
+        if state == MonitorState.STABLE and self.recorded_stable_at is None and stamp >= self.ramp_end:
+            self.recorded_stable_at = stamp
+
+    def summary(self) -> SegmentSummary:
+        return SegmentSummary(
+            name=self.name,
+            start_time=self.start,
+            ramp_end=self.ramp_end,
+            end_time=self.end,
+            target_speed=self.target,
+            inner_ring_speed=self.mean("inner_ring_speed"),
+            axial_load=self.mean("axial_load"),
+            slip_rate=self.mean("slip_rate"),
+            recorded_slip_rate=self.mean("recorded_slip_rate"),
+            truth_slip_rate=self.mean("truth_slip_rate"),
+            final_state=self.final_state,
+            final_recorded_state=self.final_recorded,
+            time_to_stable=None if self.stable_at is None else self.stable_at - self.ramp_end,
+            recorded_time_to_stable=None if self.recorded_stable_at is None else self.recorded_stable_at - self.ramp_end,
+            rows=self.rows,
+        )
+
+
+def program_segment_names(run_metadata: dict[str, str]) -> list[str]:
+    """Segment names of the run's test program (run context key ``program``); [] when absent or
+    unreadable."""
+    try:
+        doc = yaml.safe_load(run_metadata.get("program", "") or "")
+        return [str(s.get("name", "")) for s in doc["segments"]]
+    except (yaml.YAMLError, TypeError, KeyError, AttributeError):
+        return []
+
+
+def write_segments_csv(path: Path, segments: list[SegmentSummary]) -> Path:
+    """The segment table as CSV (speeds in rpm); returns ``path``."""
+    sink = CsvWriter(path, csv_columns(SegmentSummary))
+    try:
+        for segment in segments:
+            sink.write(segment)
+    finally:
+        sink.close()
+    return path
+
+
+
+
+class SegmentTracker:
+    """Segments of a run from its status rows (see the module documentation).
+
+    Args:
+        by_program: cut at spindle commands (:meth:`command`); else find constant-speed stretches.
+        names: the test program's segment names (used when their count matches).
+    """
+
+    def __init__(self, by_program: bool, names: list[str]) -> None:
+        self.by_program = by_program
+        self.names = names
+        self.segments: list[SegmentSummary] = []
+        self._open: _Segment | None = None
+        self._previous_target = _NAN
+        self._windows = 0
+        self._stretch_sum = 0.0
+        self._stretch_windows = 0
+
+    def command(self, start: float, target: float, profile: int, ramp_time: float, acceleration: float, speed_now: float) -> None:
+        """A spindle command stamped ``start`` (s): ``target`` (rad/s) reached by a STEP ramp of
+        ``ramp_time`` (s) or at ``acceleration`` (rad/s^2) from the previous target (the first
+        time: from ``speed_now``, rad/s)."""
+        previous = self._previous_target if math.isfinite(self._previous_target) else speed_now
+        if profile == PROFILE_CONSTANT_ACCELERATION and acceleration > 0.0:
+            ramp = abs(target - previous) / acceleration
+        else:
+            ramp = max(ramp_time, 0.0)
+        self._previous_target = target
+        index = len(self.segments) + (self._open is not None)
+        self._close()
+        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target)
+
+    def row(self, row: StatusRow) -> None:
+        """One status row, in time order."""
+        if not self.by_program and row.windows != self._windows:
+            self._windows = row.windows
+            inner = row.inner_ring_speed
+            if not math.isfinite(inner):
+                self._close()
+            else:
+                mean = self._stretch_sum / self._stretch_windows if self._stretch_windows else _NAN
+                if self._open is None or abs(inner - mean) > STRETCH_TOLERANCE * mean:
+                    self._close()
+                    self._open = _Segment("", row.time, row.time, _NAN)
+                    self._stretch_sum, self._stretch_windows = 0.0, 0
+                self._stretch_sum += inner
+                self._stretch_windows += 1
+        if self._open is not None:
+            self._open.add_row(row)
+
+    def recorded(self, stamp: float, state: int) -> None:
+        """A recorded slip status (its stamp, s, and state)."""
+        if self._open is not None:
+            self._open.add_recorded(stamp, state)
+
+    def finish(self) -> list[SegmentSummary]:
+        """Close the last segment; returns every segment."""
+        self._close()
+        if self.by_program and len(self.names) == len(self.segments):
+            self.segments = [replace(segment, name=name) for segment, name in zip(self.segments, self.names)]
+        return self.segments
+
+    def _close(self) -> None:
+        segment, self._open = self._open, None
+        if segment is None:
+            return
+        if not self.by_program:
+            if segment.end - segment.start < STRETCH_MIN_DURATION_S:
+                return
+            segment.name = f"stretch {len(self.segments) + 1}"
+        self.segments.append(segment.summary())

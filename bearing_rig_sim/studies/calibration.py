@@ -1,0 +1,257 @@
+"""Steady operating points of the engine, calibration to bench data, and prediction.
+
+The engine's uncertain parameters are the lubricant resistances (the paper's dry model has
+none; docs/paper.md section 12). :func:`calibrate` fits the chosen ones (by default the cage-land
+viscous scale and the ball-drag scale) to measured (inner-ring speed, axial load, slip) rows by
+nonlinear least squares on the logarithm of the scale factors, running the engine to a steady
+state at every row. The slip of the bench rows and of the engine is the paper's S_c (paper
+Eq. 11-12) at the nominal contact angle, computed from cage and inner-ring speeds.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import multiprocessing
+import os
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from collections.abc import Callable, Iterable, Sequence
+
+import numpy as np
+import yaml
+from scipy.optimize import least_squares
+
+from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.config import check_number, rad_s_to_rpm, rpm_to_rad_s
+from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
+from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
+from bearing_rig_sim.errors import RigError
+
+DEFAULT_FITTED: tuple[str, ...] = ("cage_land_viscous_scale", "ball_drag_scale")
+"""Parameters fitted by default: a viscous (speed-proportional) and a quadratic resistance, the
+two shapes the bench's slip-speed curve needs (slip = a + b n, docs/paper.md section 9)."""
+
+DEFAULT_FIXED: dict[str, float] = {"stiction_velocity": 0.3}
+"""Held fixed during the fit (m/s): see ``config/calibration/h7006c_table3.yaml`` for why."""
+
+SETTLE_S = 0.15
+"""Simulated settling time before averaging, s: the traction and pocket dynamics settle in a
+few milliseconds; the margin covers light-load points where the cage takes longer."""
+AVERAGE_S = 0.05
+"""Averaging window of the steady cage speed, s."""
+
+
+class CalibrationError(RigError):
+    """Bench data or calibration request that cannot be used."""
+
+
+@dataclass(frozen=True)
+class BenchPoint:
+    """One measured operating point: inner-ring speed (rad/s), axial load (N), slip (%)."""
+
+    inner_ring_speed: float
+    axial_load: float
+    slip_pct: float
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Steady operating point of the engine (SI; slip in percent at the nominal angle)."""
+
+    inner_ring_speed: float
+    axial_load: float
+    cage_speed: float
+    slip_pct: float
+
+    def as_row(self) -> dict[str, float]:
+        """The point at the edge: rpm, N, %."""
+        return {
+            "rpm": round(rad_s_to_rpm(self.inner_ring_speed), 6),
+            "axial_load_n": self.axial_load,
+            "cage_rpm": round(rad_s_to_rpm(self.cage_speed), 4),
+            "slip_pct": round(self.slip_pct, 4),
+        }
+
+
+@dataclass(frozen=True)
+class CalibrationResult:
+    """Outcome of :func:`calibrate`."""
+
+    fitted: dict[str, float]
+    fixed: dict[str, float]
+    points: tuple[BenchPoint, ...]
+    predicted: tuple[SteadyState, ...]
+    rms_pct: float
+    evaluations: int
+    params: BearingParameters = field(repr=False)
+
+
+def read_bench_csv(path: str | Path) -> list[BenchPoint]:
+    """Read ``inner_ring_rpm,axial_load_n,slip_pct`` rows (``#`` starts a comment line).
+
+    Raises:
+        CalibrationError: naming file, line and column of the first bad value.
+    """
+    path = Path(path)
+    try:
+        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    except OSError as exc:
+        raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    reader = csv.DictReader(lines)
+    need = ("inner_ring_rpm", "axial_load_n", "slip_pct")
+    if reader.fieldnames is None or any(k not in reader.fieldnames for k in need):
+        raise CalibrationError(f"{path}: header must name the columns {', '.join(need)}, got {reader.fieldnames}")
+    points = []
+    for i, row in enumerate(reader, start=2):
+        try:
+            rpm = check_number(float(row["inner_ring_rpm"]), str(path), f"line {i}: inner_ring_rpm", gt=0.0)
+            load = check_number(float(row["axial_load_n"]), str(path), f"line {i}: axial_load_n", ge=1.0)
+            slip = check_number(float(row["slip_pct"]), str(path), f"line {i}: slip_pct", gt=-100.0, lt=100.0)
+        except (TypeError, ValueError) as exc:
+            raise CalibrationError(f"{path}: line {i}: {exc}") from exc
+        points.append(BenchPoint(rpm_to_rad_s(rpm), load, slip))
+    if not points:
+        raise CalibrationError(f"{path}: no data rows")
+    return points
+
+
+def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load: float) -> SteadyState:
+    """Run the default engine from the rolling start to a steady state; average the speeds."""
+    engine = BearingDynamics(params)
+    engine.initialise(inner_ring_speed, axial_load)
+    engine.advance(SETTLE_S)
+    avg = engine.advance(AVERAGE_S)
+    kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
+    slip = float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
+    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip)
+
+
+def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyState:
+    return steady_state(*job)
+
+
+def steady_states(
+    params: BearingParameters,
+    points: Iterable[tuple[float, float]],
+    workers: int | None = None,
+    pool: ProcessPoolExecutor | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> list[SteadyState]:
+    """Steady states of many (inner-ring speed rad/s, axial load N) points, on ``pool`` or on
+    ``workers`` new processes (default: all cores). Order is kept; results do not depend on
+    the number of processes. ``progress(done, total)`` is called as points complete."""
+    jobs = [(params, float(w), float(f)) for w, f in points]
+    workers = workers or os.cpu_count() or 1
+    if pool is None and (workers <= 1 or len(jobs) <= 1):
+        return _collect(map(_steady_state_job, jobs), len(jobs), progress)
+    if pool is not None:
+        return _collect(pool.map(_steady_state_job, jobs), len(jobs), progress)
+    with process_pool(min(workers, len(jobs))) as new_pool:
+        return _collect(new_pool.map(_steady_state_job, jobs), len(jobs), progress)
+
+
+def _collect(results: Iterable[SteadyState], total: int, progress: Callable[[int, int], None] | None) -> list[SteadyState]:
+    out = []
+    for item in results:
+        out.append(item)
+        if progress is not None:
+            progress(len(out), total)
+    return out
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A pool of forked workers (they inherit the compiled kernels)."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"))
+
+
+class _no_pool:
+    """Context manager standing in for a pool when running in this process."""
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+
+def with_values(params: BearingParameters, values: dict[str, float]) -> BearingParameters:
+    """``params`` with calibratable fields replaced (names of :data:`CALIBRATABLE`)."""
+    unknown = [k for k in values if k not in CALIBRATABLE]
+    if unknown:
+        raise CalibrationError(f"not calibratable: {', '.join(unknown)}; choose from {', '.join(CALIBRATABLE)}")
+    return params.replace(**values)
+
+
+def calibrate(
+    params: BearingParameters,
+    points: Sequence[BenchPoint],
+    fitted: Sequence[str] = DEFAULT_FITTED,
+    fixed: dict[str, float] | None = None,
+    workers: int | None = None,
+) -> CalibrationResult:
+    """Fit ``fitted`` scale parameters so the engine's steady slip matches ``points``.
+
+    Each parameter is fitted as its logarithm (it must stay positive), starting from its value
+    in ``params``; ``fixed`` values are set first. The residuals are slip differences in
+    percentage points.
+    """
+    if len(points) < len(fitted):
+        raise CalibrationError(f"{len(points)} data rows cannot determine {len(fitted)} parameters")
+    fixed = dict(DEFAULT_FIXED if fixed is None else fixed)
+    base = with_values(params, fixed)
+    with_values(base, {k: 1.0 for k in fitted})  # validates the names
+    x0 = np.array([math.log(max(getattr(base, k), 1e-6)) for k in fitted])
+    target = np.array([pt.slip_pct for pt in points])
+    evaluations = 0
+
+    speeds_loads = [(pt.inner_ring_speed, pt.axial_load) for pt in points]
+    workers = workers or os.cpu_count() or 1
+
+    def model(x: np.ndarray, pool: ProcessPoolExecutor | None) -> list[SteadyState]:
+        nonlocal evaluations
+        evaluations += 1
+        trial = with_values(base, {k: float(math.exp(v)) for k, v in zip(fitted, x)})
+        return steady_states(trial, speeds_loads, 1, pool)
+
+    with process_pool(min(workers, len(points))) if workers > 1 else _no_pool() as pool:
+        # Slip is reported to 0.01 %: a relative step of 1e-4 in the log-parameters is ample.
+        fit = least_squares(
+            lambda x: np.array([s.slip_pct for s in model(x, pool)]) - target, x0, diff_step=1e-3, xtol=1e-4, ftol=1e-6, max_nfev=40
+        )
+        values = {k: float(math.exp(v)) for k, v in zip(fitted, fit.x)}
+        final = with_values(base, values)
+        predicted = steady_states(final, speeds_loads, 1, pool)
+    rms = float(np.sqrt(np.mean((np.array([s.slip_pct for s in predicted]) - target) ** 2)))
+    return CalibrationResult(values, fixed, tuple(points), tuple(predicted), rms, evaluations, final)
+
+
+def write_calibration(result: CalibrationResult, path: str | Path, data_name: str) -> None:
+    """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``."""
+    params = {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": float(f"{v:.6g}") for k, v in {**result.fixed, **result.fitted}.items()}
+    doc = {
+        "calibration": {
+            "data": data_name,
+            "fitted": [f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}" for k in result.fitted],
+            "fixed": {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": float(v) for k, v in result.fixed.items()},
+            "rms_slip_pct": round(float(result.rms_pct), 4),
+            "rows": [
+                {
+                    "rpm": round(float(rad_s_to_rpm(p.inner_ring_speed)), 3),
+                    "axial_load_n": float(p.axial_load),
+                    "measured_slip_pct": float(p.slip_pct),
+                    "model_slip_pct": round(float(s.slip_pct), 4),
+                }
+                for p, s in zip(result.points, result.predicted)
+            ],
+        },
+        "parameters": params,
+    }
+    header = (
+        "# Calibration of the twin against bench slip data. Regenerate with `bearing-rig calibrate`.\n"
+        "# stiction_velocity is held fixed: with the paper's 0.1 m/s the bench's 2700 rpm slip lies past\n"
+        "# the traction peak (no steady state; the cage skids), and in the rising branch v_s and the\n"
+        "# resistance scales trade off one for one, so it cannot be fitted from slip data.\n"
+    )
+    Path(path).write_text(header + yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")

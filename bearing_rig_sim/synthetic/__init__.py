@@ -1,0 +1,3 @@
+"""Generated test data: messages and recordings made without a running rig, for round trips,
+benchmarks and scenario tests (:mod:`.traffic`: rig traffic at the bench's rates).
+"""

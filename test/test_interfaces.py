@@ -1,0 +1,62 @@
+"""The interface contract is written once (bearing_rig_sim.interfaces): the docs agree with it,
+the recorder records it, replay offers its QoS, and every type exists as a message definition."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from bearing_rig_sim import interfaces
+from bearing_rig_sim.bags.typestore import rig_typestore
+from bearing_rig_sim.session.recorder import RECORDED_TOPICS
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+@pytest.mark.parametrize("doc", ["docs/interfaces.md", "README.md"])
+def test_docs_carry_the_contract_table_unchanged(doc: str) -> None:
+    text = (ROOT / doc).read_text(encoding="utf-8")
+    assert interfaces.markdown_table() in text, f"{doc}: regenerate with python -m bearing_rig_sim.interfaces"
+
+
+def test_every_topic_and_service_name_is_unique_and_absolute() -> None:
+    names = [t.name for t in interfaces.TOPICS] + [s.name for s in interfaces.SERVICES]
+    assert len(names) == len(set(names))
+    assert all(name.startswith("/") for name in names)
+
+
+def test_every_topic_type_is_known_to_the_bag_typestore() -> None:
+    store = rig_typestore()
+    for topic in interfaces.TOPICS:
+        assert topic.msgtype in store.fielddefs, topic.msgtype
+
+
+def test_stamped_flag_matches_the_message_definition() -> None:
+    store = rig_typestore()
+    for topic in interfaces.TOPICS:
+        first_field = store.fielddefs[topic.msgtype][1][0][0]
+        assert topic.stamped == (first_field in ("header", "clock")), topic.name
+
+
+def test_recorder_records_every_contract_topic() -> None:
+    assert {t.name for t in RECORDED_TOPICS} == {t.name for t in interfaces.TOPICS}
+
+
+def test_unknown_topic_is_named_in_the_error() -> None:
+    with pytest.raises(KeyError, match="/rig/nothing"):
+        interfaces.topic("/rig/nothing")
+    assert interfaces.contract_qos("/rig/nothing") is None
+    assert interfaces.contract_qos("/rig/cage/pulses") == "sensor_data"
+
+
+def test_write_tables_replaces_a_stale_table(tmp_path: Path) -> None:
+    stale = "# t\n\n| topic | type | QoS | rate | unit | publisher |\n|---|---|---|---|---|---|\n| `/old` | x | y | z | - | - |\n\nafter\n"
+    for name in interfaces.TABLE_DOCUMENTS:
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(stale, encoding="utf-8")
+    changed = interfaces.write_tables(tmp_path)
+    assert len(changed) == len(interfaces.TABLE_DOCUMENTS)
+    text = (tmp_path / "README.md").read_text(encoding="utf-8")
+    assert "/old" not in text and interfaces.markdown_table() in text and text.endswith("\nafter\n")
+    assert interfaces.write_tables(tmp_path) == []

@@ -208,3 +208,20 @@ def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_pat
     assert "monitor.log" in err and "summary (failed)" in out
     counts = check_bag_decodes(the_bag(tmp_path))
     assert counts.get("/rig/speeds", 0) > 0
+
+
+def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:
+    """What launch/rig.launch.py does: nodes brought up elsewhere, the program run by
+    ``bearing-rig run --attach --no-record`` on the environment's domain."""
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    rows = summary_rows(out)
+    assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
+    assert "not recorded (--no-record)" in out
+    assert not any(line.startswith("lifecycle: ") for line in out.splitlines())
+    (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
+    assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()

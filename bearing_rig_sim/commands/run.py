@@ -69,6 +69,12 @@ def register(subparsers: Any) -> None:
         metavar="FILE",
         help="ROS 2 parameter file given to every node (a block per node name), over config/<node>.yaml",
     )
+    parser.add_argument(
+        "--attach",
+        action="store_true",
+        help="run the program on nodes already running and managed elsewhere (launch/rig.launch.py): start no processes",
+    )
+    parser.add_argument("--no-record", action="store_true", help="record no bag (where ros2 bag record records)")
     add_foxglove_argument(parser)
     parser.set_defaults(func=run)
 
@@ -86,6 +92,8 @@ def run(args: argparse.Namespace) -> int:
         startup_timeout_s=args.startup_timeout,
         params_file=args.params_file,
         foxglove_port=args.foxglove,
+        attach=args.attach,
+        record=not args.no_record,
         command_line=["bearing-rig", *sys.argv[1:]],
     )
     return run_session(options)

@@ -68,6 +68,7 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
+from bearing_rig_sim.interfaces import AXIAL_LOAD_CLUTCH, AXIAL_LOAD_FORCE, AXIAL_LOAD_RESET_FAULT, AXIAL_LOAD_SET, AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
@@ -128,22 +129,22 @@ class LoadControllerNode(ManagedNode):
         # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
         # walks on every wake-up; an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
-        self._force_pub = self.publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS, event_callbacks=quiet)
-        self._load_cell_pub = self.publisher(WrenchStamped, "/rig/axial_load/force", SENSOR_QOS, event_callbacks=quiet)
-        self._state_pub = self.publisher(AxialLoadState, "/rig/axial_load/state", RELIABLE_QOS, event_callbacks=quiet)
-        self._diagnostics_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS, event_callbacks=quiet)
+        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
+        self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
         self.subscription(
-            Float64, "/rig/axial_load/setpoint", self._on_setpoint, RELIABLE_QOS,
+            Float64, AXIAL_LOAD_SETPOINT.name, self._on_setpoint, RELIABLE_QOS,
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
         )
         self._rig_services = [
-            self.create_service(SetAxialLoad, "/rig/axial_load/set", self._on_set_service),
-            self.create_service(Trigger, "/rig/axial_load/reset_fault", self._on_reset_fault),
-            self.create_service(SetBool, "/rig/axial_load/clutch", self._on_clutch),
+            self.create_service(SetAxialLoad, AXIAL_LOAD_SET.name, self._on_set_service),
+            self.create_service(Trigger, AXIAL_LOAD_RESET_FAULT.name, self._on_reset_fault),
+            self.create_service(SetBool, AXIAL_LOAD_CLUTCH.name, self._on_clutch),
         ]
         self._clock_tap = Node(f"{NODE_NAME}_clock", context=self.context)
         self._clock_sub = self._clock_tap.create_subscription(
-            Clock, "/clock", _unused, CLOCK_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
+            Clock, CLOCK.name, _unused, CLOCK_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
         )
         self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
         self._bearing_msg = WrenchStamped()

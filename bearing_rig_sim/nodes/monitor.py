@@ -28,6 +28,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from rclpy.clock import Clock, ClockType
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
+from bearing_rig_sim.interfaces import CAGE_PULSES, DIAGNOSTICS, SLIP_STATUS, SPINDLE_PULSES
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.monitoring import (
     NODE_NAME,
@@ -82,10 +83,10 @@ class MonitorNode(ManagedNode):
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
 
-        self._status_pub = self.publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
-        self._diag_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self._status_pub = self.publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
+        self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), SENSOR_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)

@@ -50,6 +50,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SpindleCommand as SpindleCommandMsg
+from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SPEEDS, SPINDLE_COMMAND, SPINDLE_PULSES, TRUTH
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
@@ -127,20 +128,20 @@ class SimulatorNode(ManagedNode):
         self._last_level: HealthLevel | None = None
         self._anchor = True
 
-        self._clock_pub = self.publisher(ClockMsg, "/clock", RELIABLE_QOS)
+        self._clock_pub = self.publisher(ClockMsg, CLOCK.name, RELIABLE_QOS)
         self._pulse_pubs = {
-            "spindle": self.publisher(FibreOpticPulse, "/rig/spindle/pulses", SENSOR_QOS),
-            "cage": self.publisher(FibreOpticPulse, "/rig/cage/pulses", SENSOR_QOS),
+            "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, SENSOR_QOS),
+            "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, SENSOR_QOS),
         }
-        self._speeds_pub = self.publisher(JointState, "/rig/speeds", SENSOR_QOS)
-        self._truth_pub = self.publisher(SimulatorTruth, "/rig/truth", SENSOR_QOS)
-        self._diag_pub = self.publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
+        self._speeds_pub = self.publisher(JointState, SPEEDS.name, SENSOR_QOS)
+        self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, SENSOR_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
         # instead of one per message), from a reader on a node no executor spins.
         self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
         self._force_sub = self._force_tap.create_subscription(
-            WrenchStamped, "/rig/bearing/axial_force", _unused, FORCE_QOS,
+            WrenchStamped, BEARING_AXIAL_FORCE.name, _unused, FORCE_QOS,
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
         )
 

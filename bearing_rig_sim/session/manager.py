@@ -17,6 +17,7 @@ from lifecycle_msgs.msg import Transition
 from lifecycle_msgs.srv import ChangeState
 from rclpy.node import Node
 
+from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.nodes.common import OK, ERROR, RELIABLE_QOS, diagnostic_array, diagnostic_status, to_stamp
 from bearing_rig_sim.session.lifecycle import GOAL, TRANSITION_IDS, Step, TransitionRecord
 
@@ -50,7 +51,7 @@ class LifecycleManager:
         self.failed: TransitionRecord | None = None
         """The transition that failed (the queue is dropped then), else None."""
         self._clients = {name: node.create_client(ChangeState, f"/{name}/change_state") for name in names}
-        self._diagnostics = node.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
+        self._diagnostics = node.create_publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
         self._on_record = on_record
         self._sim_time = sim_time
         self._queue: list[Step] = []

@@ -53,6 +53,7 @@ from bearing_rig_sim.session.context import make_run_id, run_context
 from bearing_rig_sim.session.lifecycle import TransitionRecord, bring_up, shut_down
 from bearing_rig_sim.session.processes import (
     NODES,
+    DomainLease,
     NodeProcess,
     apply_transport_profile,
     node_command,
@@ -91,6 +92,12 @@ class SessionOptions:
     """The command line, for the run context."""
     params_file: Path | None = None
     """A ROS 2 parameter file given to every node (blocks per node name), over the shipped ones."""
+    attach: bool = False
+    """Run the program on nodes already running and managed elsewhere (``launch/rig.launch.py``):
+    no processes started, no lifecycle transitions, the environment's ROS domain as it is."""
+    record: bool = True
+    """Record the bag; False (``--no-record``, where ``ros2 bag record`` records): only the
+    session log and summary."""
     foxglove_port: int | None = None
     """Serve the recorded topics live to the Foxglove app on this port of 127.0.0.1 (0: any
     free port); None: no live view."""
@@ -115,8 +122,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     err = err if err is not None else sys.stderr
     chain = LoadingChainConfig.from_yaml()
     program = load_program(options.program, max_axial_load_n=chain.max_setpoint_n)
-    commands = {name: node_command(spec) for name, spec in NODES.items()}
-    if not options.realtime:
+    commands = {} if options.attach else {name: node_command(spec) for name, spec in NODES.items()}
+    if not options.realtime and not options.attach:
         commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
     if options.params_file is not None:
         params = Path(options.params_file)
@@ -127,7 +134,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)
-    env, lease = session_environment(os.environ)
+    env, lease = (dict(os.environ), DomainLease(int(os.environ.get("ROS_DOMAIN_ID") or 0), None)) if options.attach else session_environment(os.environ)
+    env.setdefault("ROS_DOMAIN_ID", str(lease.domain_id))
     context = run_context(
         program,
         run_id=run_id,
@@ -136,8 +144,9 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         extra={"ros_domain_id": env["ROS_DOMAIN_ID"], "realtime": str(options.realtime).lower()},
     )
     try:
-        writer = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE)
-        apply_transport_profile(env, writer.path / "logs")
+        writer: Any = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE) if options.record else _NoBag(bag_path)
+        if not options.attach:
+            apply_transport_profile(env, writer.path / "logs")
         view = None
         if options.foxglove_port is not None:
             from bearing_rig_sim.live.foxglove import FoxgloveLiveView
@@ -152,6 +161,23 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
                 view.close()
     finally:
         lease.release()
+
+
+class _NoBag:
+    """The writer of a session that records nothing (``--no-record``): its folder holds the logs."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        (self.path / "logs").mkdir(parents=True, exist_ok=True)
+
+    def add_topic(self, name: str, msgtype: str, qos: str) -> None:
+        """Nothing to set up."""
+
+    def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
+        """Nothing kept."""
+
+    def close(self) -> None:
+        """Nothing to finalise."""
 
 
 def _failure_line(output: str, transition: str) -> str:
@@ -179,7 +205,7 @@ class _Session:
         self,
         options: SessionOptions,
         program: TestProgram,
-        writer: BagWriter,
+        writer: Any,
         env: dict[str, str],
         commands: dict[str, list[str]],
         out: TextIO,
@@ -203,7 +229,7 @@ class _Session:
             self.recorder = SessionRecorder(writer)
         self.rtf = RealTimeFactor()
         logs = writer.path / "logs"
-        self.children = [NodeProcess(name, commands[name], logs / f"{name}.log") for name in NODES]
+        self.children = [NodeProcess(name, commands[name], logs / f"{name}.log") for name in NODES if name in commands]
         self.phase = _Phase.STARTING
         self.status: int | None = None
         self.failure = ""
@@ -244,7 +270,8 @@ class _Session:
                 rclpy.init(args=[], context=context, domain_id=int(self.env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
                 self.node = SessionNode(self.recorder, self.runner, context=context, on_event=self._event)
                 node = self.node
-                self.manager = LifecycleManager(node, list(NODES), self._on_transition, lambda: node.sim_time)
+                if not self.options.attach:
+                    self.manager = LifecycleManager(node, list(NODES), self._on_transition, lambda: node.sim_time)
             executor = SingleThreadedExecutor(context=context)
             executor.add_node(self.node)
             self.node.create_timer(DRAIN_PERIOD_S, self._tick)
@@ -331,7 +358,8 @@ class _Session:
     def _bring_up(self) -> bool:
         """Drive the lifecycle bring-up; True once every node is active."""
         manager = self.manager
-        assert manager is not None
+        if manager is None:  # attached to nodes managed elsewhere
+            return True
         manager.poll()
         if not self.bringing_up:
             missing = manager.services_missing()
@@ -480,6 +508,10 @@ class _Session:
         self.out.write(format_summary(self.runner.outcomes) + "\n")
         counts = self.recorder.counts
         total = sum(counts.values())
+        if not self.options.record:
+            self.out.write(f"\nnot recorded (--no-record); session log in {self.writer.path / 'logs'}\n")
+            self.out.flush()
+            return status
         self.out.write(
             f"\nbag: {self.writer.path} ({total} messages; /clock {counts.get('/clock', 0)}, /rig/speeds "
             f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "

@@ -227,3 +227,82 @@ def test_a_live_session_serves_speeds_and_slip_status(ros_graph: Any, tmp_path: 
         session.send_signal(signal.SIGINT)
         session.communicate(timeout=60)
     assert session.returncode == 130
+
+
+class _Sent:
+    """A replay sink keeping what it is given."""
+
+    def __init__(self) -> None:
+        self.sent: list[str] = []
+
+    def can_publish(self, topic: str) -> bool:
+        return True
+
+    def publish(self, topic: str, data: bytes) -> None:
+        self.sent.append(topic)
+
+
+def test_a_replay_is_shown_with_its_stamps(tmp_path: Path) -> None:
+    from test_replay_player import TIMES_NS, write_pulse_bag  # the replay tests' bag of cage pulses
+
+    from bearing_rig_sim.bags import open_bag
+    from bearing_rig_sim.live.foxglove import LiveReplaySink
+    from bearing_rig_sim.replay.player import ReplayOptions, replay_bag
+
+    bag_path = tmp_path / "pulses"
+    write_pulse_bag(bag_path, TIMES_NS, with_clock=True)
+    view = FoxgloveLiveView(0, msg_definition_text)
+    client = None
+    try:
+        with open_bag(bag_path) as bag:
+            inner = _Sent()
+            sink = LiveReplaySink(inner, view, {name: info.msgtype for name, info in bag.topics.items()})
+            client = ProtocolClient(view.url)
+            assert client.pump_until(lambda: {c["topic"] for c in client.channels.values()} == {"/clock", "/rig/cage/pulses"}, 10.0)
+            client.subscribe("/rig/cage/pulses")
+            assert client.pump_until(lambda: bool(client.received), 30.0, also=lambda: replay_bag(bag, sink, ReplayOptions(rate=100.0)))
+        pulses = client.decoded("/rig/cage/pulses")
+        assert all(p.sensor_id for p in pulses)
+        stamps = {t for topic, t, _ in client.received if topic == "/rig/cage/pulses"}
+        assert stamps <= set(TIMES_NS) and stamps  # log time = the pulse's own stamp
+        assert inner.sent.count("/rig/cage/pulses") >= len(TIMES_NS)  # still published to ROS
+    finally:
+        if client is not None:
+            client.close()
+        view.close()
+
+
+def test_the_shipped_layout_plots_fields_that_exist() -> None:
+    """config/foxglove/rig.json: every panel of the tree is configured, and every plotted path
+    names a topic of the interface contract and a field of its message type."""
+    from bearing_rig_sim.config import config_path
+    from bearing_rig_sim.interfaces import TOPICS
+
+    layout = json.loads(config_path("foxglove", "rig.json").read_text(encoding="utf-8"))
+    panels: list[str] = []
+
+    def walk(node: Any) -> None:
+        if isinstance(node, str):
+            panels.append(node)
+        else:
+            walk(node["first"])
+            walk(node["second"])
+
+    walk(layout["layout"])
+    assert sorted(panels) == sorted(layout["configById"])
+    types = {t.name: t.msgtype for t in TOPICS}
+    store = rig_typestore()
+    paths = [p["value"] for config in layout["configById"].values() for p in config.get("paths", [])]
+    assert paths and layout["configById"]["DiagnosticSummary!rig"]["topicToRender"] == "/diagnostics"
+    for path in paths:
+        topic, *fields = path.split(".")
+        assert topic in types, path
+        msgtype = types[topic]
+        for field in fields:
+            name = field.split("[")[0]
+            names = [f[0] for f in store.fielddefs[msgtype][1]]
+            assert name in names, (path, names)
+            kind = dict(store.fielddefs[msgtype][1])[name]
+            msgtype = kind[1] if kind[0].name == "NAME" else (kind[1][0][1] if kind[0].name in ("ARRAY", "SEQUENCE") and kind[1][0][0].name == "NAME" else "")
+    for topic in ("/rig/speeds", "/rig/slip_status", "/rig/axial_load/state"):
+        assert any(p.startswith(topic + ".") for p in paths), topic

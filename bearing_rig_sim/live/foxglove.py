@@ -20,6 +20,7 @@ from typing import Any
 from collections.abc import Callable
 
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import CLOCK
 
 __all__ = ["DEFAULT_PORT", "HOST", "FoxgloveLiveView", "TeeWriter"]
 
@@ -116,3 +117,35 @@ class TeeWriter:
         except Exception as exc:
             self.view_error = " ".join(str(exc).split()) or type(exc).__name__
             self.view = None
+
+
+class LiveReplaySink:
+    """A replay sink (:class:`~bearing_rig_sim.replay.player.ReplaySink`) that also shows what it
+    publishes in a live view: ``bearing-rig replay --foxglove``. Each message goes to the view
+    with its own stamp as log time (the one the recording used), a message without a stamp (a
+    set-point) with the latest ``/clock``'s.
+
+    Args:
+        inner: the sink that publishes (the ROS one).
+        view: the live view.
+        msgtypes: ``pkg/msg/Name`` of each topic that may be published.
+    """
+
+    def __init__(self, inner: Any, view: FoxgloveLiveView, msgtypes: dict[str, str]) -> None:
+        self.inner = inner
+        self.view = view
+        self._clock_ns = 0
+        for name, msgtype in msgtypes.items():
+            view.add_topic(name, msgtype)
+
+    def can_publish(self, topic: str) -> bool:
+        return bool(self.inner.can_publish(topic))
+
+    def publish(self, topic: str, data: bytes) -> None:
+        from bearing_rig_sim.session.recorder import header_stamp_ns
+
+        self.inner.publish(topic, data)
+        stamp = header_stamp_ns(data)
+        if topic == CLOCK.name and stamp is not None:
+            self._clock_ns = stamp
+        self.view.write(topic, stamp if stamp else self._clock_ns, data)

@@ -270,6 +270,7 @@ class AxialLoadOperation:
         previous = self._time
         note = ""
         stepped = 0.0
+        state: LoadChainState | None = None
         if previous is None:
             self._schedule_from(sim_time)
         elif sim_time < previous:
@@ -280,9 +281,10 @@ class AxialLoadOperation:
             if stepped > self.max_clock_gap:
                 note = f"clock advanced {stepped:.3f} s at once: stepping {self.max_clock_gap:g} s (max_clock_gap_s)"
                 stepped = self.max_clock_gap
-            self.chain.step(stepped)
+            state = self.chain.step(stepped)  # the state after the step
         self._time = float(sim_time)
-        state = self.chain.state()
+        if state is None:
+            state = self.chain.state()
         state_due = sim_time >= self._next_state - 1e-9
         if state_due:
             self._next_state = _next_multiple(sim_time, self.state_period)

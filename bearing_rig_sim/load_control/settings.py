@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import NodeSettingsFile, Section, config_path
 
 __all__ = ["NODE_NAME", "SHIPPED_FILE", "LoadControllerSettings", "shipped_parameters"]
 
@@ -26,7 +26,7 @@ SHIPPED_FILE = "load_controller.yaml"
 
 
 @dataclass(frozen=True)
-class LoadControllerSettings:
+class LoadControllerSettings(NodeSettingsFile):
     """The load controller's validated parameters (SI units; the unit is in each name).
 
     Attributes:
@@ -42,6 +42,9 @@ class LoadControllerSettings:
         step_period_s: wall time between two wake-ups that step the chain to the ``/clock``
             time in force samples, s.
     """
+
+    NODE_NAME: ClassVar[str] = NODE_NAME
+    SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     rig_file: Path
     axial_load_setpoint_n: float
@@ -80,20 +83,6 @@ class LoadControllerSettings:
             step_period_s=s.number("step_period_s", ge=0.001, le=0.1),
         )
 
-    @classmethod
-    def from_values(cls, values: dict[str, Any], source: str = "load_controller parameters") -> LoadControllerSettings:
-        """Validate a flat mapping of parameter values (the node's ROS parameters)."""
-        return cls.from_section(Section(dict(values), source))
-
-    @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> LoadControllerSettings:
-        """Read ``load_controller: ros__parameters:`` of a parameter file (default: the shipped one).
-
-        Raises:
-            ConfigError: naming the file and the key.
-        """
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
-
 
 def shipped_parameters() -> dict[str, Any]:
     """The raw values of the shipped ``config/load_controller.yaml`` (the node's declared defaults).
@@ -101,6 +90,4 @@ def shipped_parameters() -> dict[str, Any]:
     Raises:
         ConfigError: the shipped file is missing or malformed.
     """
-    section = ros_parameters(load_yaml(config_path(SHIPPED_FILE)), NODE_NAME)
-    LoadControllerSettings.from_section(section)  # the defaults themselves must be valid
-    return dict(section.data)
+    return LoadControllerSettings.shipped_parameters()

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import NodeSettingsFile, Section, config_path
 from bearing_rig_sim.dynamics.engine import MODELS
 
 NODE_NAME = "simulator"
@@ -33,7 +33,7 @@ def resolve_config_file(value: str) -> Path | None:
 
 
 @dataclass(frozen=True)
-class SimulatorSettings:
+class SimulatorSettings(NodeSettingsFile):
     """The simulator node's validated parameters (SI units; the unit is in each name).
 
     Attributes:
@@ -62,6 +62,9 @@ class SimulatorSettings:
         diagnostics_rate_hz: rate of /diagnostics (besides every change), wall Hz.
         fault_hold_s: a refused command or force keeps /diagnostics at ERROR this long, wall s.
     """
+
+    NODE_NAME: ClassVar[str] = NODE_NAME
+    SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     bearing_file: Path
     calibration_file: Path | None
@@ -130,20 +133,6 @@ class SimulatorSettings:
             fault_hold_s=s.number("fault_hold_s", ge=0.0),
         )
 
-    @classmethod
-    def from_values(cls, values: dict[str, Any], source: str = "simulator parameters") -> SimulatorSettings:
-        """Validate a flat mapping of parameter values (the node's ROS parameters)."""
-        return cls.from_section(Section(dict(values), source))
-
-    @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> SimulatorSettings:
-        """Read ``simulator: ros__parameters:`` of a parameter file (default: the shipped one).
-
-        Raises:
-            ConfigError: naming the file and the key.
-        """
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
-
 
 def shipped_parameters() -> dict[str, Any]:
     """The raw values of the shipped ``config/simulator.yaml`` (the node's declared defaults).
@@ -151,7 +140,4 @@ def shipped_parameters() -> dict[str, Any]:
     Raises:
         ConfigError: the shipped file is missing or malformed.
     """
-    section = ros_parameters(load_yaml(config_path(SHIPPED_FILE)), NODE_NAME)
-    SimulatorSettings.from_section(section)  # the defaults themselves must be valid
-    return dict(section.data)
-
+    return SimulatorSettings.shipped_parameters()

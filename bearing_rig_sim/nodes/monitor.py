@@ -14,6 +14,11 @@ simulator's /clock), the system clock on the bench (``-p use_sim_time:=false``).
 back resets the monitor. Timers run on the steady clock, so a source that stops (and takes
 /clock with it) is still noticed: the rig time used for the sensor-loss check is the later of the
 node's clock and the latest pulse's time plus the wall time since it arrived.
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the slip monitor,
+publishers, subscriptions and timers are made at configure; pulses are taken and statuses
+published only while active. A sensor loss or invalid data is a FAULT state on the status and an
+ERROR on /diagnostics with the node staying active (it recovers when the pulses return).
 """
 
 from __future__ import annotations

@@ -40,7 +40,8 @@ the reset. The clutch is engaged at configure (``engage_clutch_on_start``).
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the chain, the
 publishers, the services and the timer are made at configure; stepping and publishing run only
-while active. An interlock fault does not deactivate the node: the brake is de-energised, and the
+while active. The services answer in every configured state (a set-point given while inactive
+takes effect at activation); the set-point topic is taken only while active. An interlock fault does not deactivate the node: the brake is de-energised, and the
 node goes on publishing the (falling) force, the ERROR and the state, as the bench's controller
 does; only reset_fault clears it.
 """

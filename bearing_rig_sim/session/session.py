@@ -102,7 +102,8 @@ class SessionOptions:
     """Serve the recorded topics live to the Foxglove app on this port of 127.0.0.1 (0: any
     free port); None: no live view."""
     transition_timeout_s: float = 10.0
-    """Longest wait for a node to answer a lifecycle transition other than configure, wall s."""
+    """Longest wait for a node to answer a deactivate or cleanup, wall s (bring-up transitions
+    have ``startup_timeout_s``: a first configure compiles the engine's kernels)."""
 
 
 class _Phase(Enum):
@@ -365,7 +366,7 @@ class _Session:
             missing = manager.services_missing()
             if not missing:
                 self.bringing_up = True
-                manager.run(bring_up(list(NODES)), self.options.transition_timeout_s)
+                manager.run(bring_up(list(NODES)), self.options.startup_timeout_s)  # configure compiles the kernels on a first run
                 manager.poll()
             elif time.monotonic() > self.deadline:
                 name = missing[0]

@@ -63,26 +63,102 @@ def config_path(*parts: str) -> Path:
     return local
 
 
-def load_yaml(path: str | Path) -> Section:
-    """Read a YAML file whose top level is a mapping.
+MAX_YAML_BYTES: int = 4 * 1024 * 1024
+"""Largest YAML document read, bytes (the shipped files are a few kB; a bag's metadata a few
+tens of kB)."""
+
+MAX_YAML_DEPTH: int = 32
+"""Deepest nesting of mappings and lists accepted (the shipped files nest 4 levels)."""
+
+
+class _BoundedSafeLoader(yaml.SafeLoader):
+    """PyYAML's safe loader with aliases refused and nesting bounded.
+
+    Aliases (``*name``) are what makes a "billion laughs" document of a few hundred bytes expand
+    to gigabytes; no configuration or bag metadata of this project needs them. Deep nesting
+    would otherwise end in a RecursionError deep inside the constructor.
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent: Any, index: Any) -> Any:
+        """PyYAML's hook for each node: refuse an alias, count the depth."""
+        if self.check_event(yaml.AliasEvent):
+            event = self.peek_event()
+            raise yaml.composer.ComposerError(None, None, "aliases (*name) are not accepted", event.start_mark)
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(
+                    None, None, f"nested deeper than {MAX_YAML_DEPTH} levels", event.start_mark
+                )
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
+def parse_yaml(text: str | bytes, source: str) -> Any:
+    """Parse one YAML document safely: no Python objects, no aliases, bounded size and depth.
+
+    Args:
+        text: the document; bytes must be UTF-8.
+        source: file name (or other origin) for error messages.
 
     Raises:
-        ConfigError: the file is missing, unreadable, not YAML, or not a mapping.
+        ConfigError: one line naming ``source`` and what is wrong (not UTF-8, too large, an
+            alias, too deep, not valid YAML).
     """
-    source = str(path)
+    if isinstance(text, bytes):
+        if len(text) > MAX_YAML_BYTES:
+            raise ConfigError(source, "", f"larger than {MAX_YAML_BYTES} bytes ({len(text)})")
+        try:
+            text = text.decode("utf-8")
+        except UnicodeDecodeError as exc:
+            raise ConfigError(source, "", f"not UTF-8 text (byte {exc.start})") from None
+    if len(text) > MAX_YAML_BYTES:
+        raise ConfigError(source, "", f"larger than {MAX_YAML_BYTES} characters ({len(text)})")
+    loader = _BoundedSafeLoader(text)
     try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ConfigError(source, "", f"cannot read file ({exc.strerror or exc})") from exc
-    try:
-        data = yaml.safe_load(text)
+        return loader.get_single_data()
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        raise ConfigError(source, "", f"not valid YAML{at}: {getattr(exc, 'problem', exc)}") from exc
+        raise ConfigError(source, "", f"not valid YAML{at}: {getattr(exc, 'problem', exc)}") from None
+    except RecursionError:
+        raise ConfigError(source, "", "nested too deeply") from None
+    finally:
+        loader.dispose()
+
+
+def read_yaml_file(path: str | Path) -> Any:
+    """Read and :func:`parse_yaml` a file (any top-level type).
+
+    Raises:
+        ConfigError: the file is missing or unreadable, or see :func:`parse_yaml`.
+    """
+    source = str(path)
+    try:
+        with open(path, "rb") as stream:
+            raw = stream.read(MAX_YAML_BYTES + 1)
+    except OSError as exc:
+        raise ConfigError(source, "", f"cannot read file ({exc.strerror or exc})") from None
+    return parse_yaml(raw, source)
+
+
+def load_yaml(path: str | Path) -> Section:
+    """Read a YAML file whose top level is a mapping (see :func:`parse_yaml` for the limits).
+
+    Raises:
+        ConfigError: the file is missing, unreadable, not UTF-8, not YAML, has aliases, is too
+            large or too deep, or is not a mapping.
+    """
+    data = read_yaml_file(path)
     if not isinstance(data, dict):
-        raise ConfigError(source, "", f"top level must be a mapping, got {type(data).__name__}")
-    return Section(data, source)
+        raise ConfigError(str(path), "", f"top level must be a mapping, got {type(data).__name__}")
+    return Section(data, str(path))
 
 
 _MISSING = object()

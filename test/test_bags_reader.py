@@ -6,6 +6,7 @@ import gc
 import os
 import shutil
 import struct
+import time
 import tracemalloc
 import warnings
 from pathlib import Path
@@ -297,14 +298,28 @@ def test_empty_file_of_a_split_bag_is_reported(tmp_path: Path, traffic_bag: tupl
         ("something_else: {}", "rosbag2_bagfile_information is missing"),
         ("rosbag2_bagfile_information: {version: 9, storage_identifier: sqlite3}", "storage 'sqlite3' is not supported"),
         ("rosbag2_bagfile_information: {version: 9, storage_identifier: mcap}", "relative_file_paths is missing"),
+        # hostile metadata: an alias bomb (a few hundred bytes, gigabytes once expanded) and nesting
+        # that used to end in a RecursionError
+        (
+            "a: &a [x, x, x, x, x, x, x, x, x]\n"
+            + "".join(f"{chr(98 + i)}: &{chr(98 + i)} [{', '.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8))
+            + "rosbag2_bagfile_information: *i\n",
+            "aliases",
+        ),
+        ("rosbag2_bagfile_information: " + "[" * 100000 + "]" * 100000, "nested deeper than 32 levels"),
+        (b"rosbag2_bagfile_information: caf\xe9", "not UTF-8"),
     ],
 )
-def test_corrupt_metadata_yaml(tmp_path: Path, traffic_bag: tuple[Path, int], text: str, problem: str) -> None:
+def test_corrupt_metadata_yaml(tmp_path: Path, traffic_bag: tuple[Path, int], text: str | bytes, problem: str) -> None:
     bag = tmp_path / "traffic"
     shutil.copytree(traffic_bag[0], bag)
-    (bag / "metadata.yaml").write_text(text)
-    with pytest.raises(BagError, match=problem):
+    path = bag / "metadata.yaml"
+    path.write_bytes(text if isinstance(text, bytes) else text.encode())
+    started = time.process_time()
+    with pytest.raises(BagError, match=problem) as info:
         open_bag(bag)
+    assert time.process_time() - started < 1.0  # CPU s: refused at once, not after expanding
+    assert "\n" not in str(info.value)
 
 
 def test_reading_streams(tmp_path: Path) -> None:

@@ -203,8 +203,27 @@ def test_corrupt_chunk_is_dropped_by_the_repair(tmp_path: Path) -> None:
     assert report.files[0].action == "rebuilt"
     assert any(f"chunk at offset {start}" in p for p in report.files[0].problems)
     assert report.messages_recovered == total - lost
+    # truthful loss figures: the chunk's messages and bytes (mcap's own chunk index), not "0 bytes"
+    assert report.messages_lost == lost > 0
+    assert report.bytes_lost == end - start
+    assert f"{lost} messages and {end - start} bytes lost" in report.summary()
     with AnyReader([bag]) as reader:
         assert sum(1 for _ in reader.messages()) == total - lost
+
+
+def test_every_chunk_damaged_is_every_message_lost(tmp_path: Path) -> None:
+    bag = tmp_path / "run"
+    record_traffic(bag)
+    file = bag / "run_0.mcap"
+    chunks = chunk_bounds(file)
+    with open(file, "r+b") as stream:
+        for _start, end, _n in chunks:
+            stream.seek(end - 32)
+            stream.write(bytes(32))
+    report = repair_bag(bag)
+    total = sum(n for _s, _e, n in chunks)
+    assert report.messages_recovered == 0 and report.messages_lost == total
+    assert report.bytes_lost == sum(end - start for start, end, _n in chunks)
 
 
 def test_empty_file_left_at_a_rollover_gets_the_topics(tmp_path: Path) -> None:

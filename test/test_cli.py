@@ -184,3 +184,73 @@ def test_installed_console_script() -> None:
     assert unknown.stdout == ""
     lines = unknown.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("bearing-rig: error: unknown benchmark 'no-such-benchmark'")
+
+
+# -- user errors of the commands: one line, exit status 2, before any long work ---------------------
+def one_line_error(argv: list[str], capsys: pytest.CaptureFixture[str]) -> str:
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("bearing-rig: error: ") and len(err.strip().splitlines()) == 1, err
+    return err
+
+
+def test_non_utf8_program_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    program = tmp_path / "p.yaml"
+    program.write_bytes("name: caf\u00e9\n".encode("latin-1"))
+    assert "not UTF-8 text" in one_line_error(["run", str(program)], capsys)
+    data = tmp_path / "bench.csv"
+    data.write_bytes("inner_ring_rpm,axial_load_n,slip_pct\n900,100,3.2\u00e9\n".encode("latin-1"))
+    assert "not UTF-8 text" in one_line_error(["calibrate", str(data), "--out", str(tmp_path / "c.yaml")], capsys)
+
+
+@pytest.mark.parametrize("value, problem", [("nan", "must be finite"), ("inf", "must be finite"), ("0", "must be > 0"), ("1e9", "must be <= 3600")])
+def test_startup_timeout_is_bounded(value: str, problem: str, capsys: pytest.CaptureFixture[str]) -> None:
+    err = one_line_error(["run", "--startup-timeout", value], capsys)
+    assert "--startup-timeout" in err and problem in err
+
+
+def test_analyze_out_that_cannot_be_a_folder(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("")
+    bag = tmp_path / "bag"
+    bag.mkdir()  # not read: the output folder is checked first
+    err = one_line_error(["analyze", str(bag), "--out", str(in_the_way / "sub")], capsys)
+    assert f"--out {in_the_way / 'sub'}: cannot create the folder" in err
+
+
+def test_calibrate_writes_under_out_by_default_and_never_replaces_a_file_unasked(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The shipped calibration (config/calibration/h7006c_table3.yaml) used to be the default
+    output of ``calibrate config/calibration/h7006c_table3.csv``: overwritten without a word."""
+    import hashlib
+
+    from bearing_rig_sim.config import config_path
+
+    shipped = config_path("calibration", "h7006c_table3.yaml")
+    before = hashlib.sha256(shipped.read_bytes()).hexdigest()
+    data = config_path("calibration", "h7006c_table3.csv")
+    monkeypatch.chdir(tmp_path)
+    default = tmp_path / "out" / "calibration" / "h7006c_table3.yaml"
+    default.parent.mkdir(parents=True)
+    default.write_text("earlier result\n")
+    err = one_line_error(["calibrate", str(data)], capsys)  # refused before the fit starts
+    assert "out/calibration/h7006c_table3.yaml: exists; give --force" in err
+    err = one_line_error(["calibrate", str(data), "--out", str(shipped)], capsys)
+    assert "exists; give --force" in err
+    assert default.read_text() == "earlier result\n"
+    assert hashlib.sha256(shipped.read_bytes()).hexdigest() == before
+
+
+def test_run_refuses_a_program_beyond_the_shipped_rig_naming_the_segment(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Checked at start, before any node runs: config/rig.yaml's spindle goes to 10 000 rpm."""
+    program = tmp_path / "fast.yaml"
+    program.write_text(
+        "name: fast\nbearing: bearings/h7006c.yaml\nstability_criterion: time\nsegments:\n"
+        "  - {name: n5000, speed_rpm: 5000, ramp_s: 1.0, axial_load_n: 100, dwell_s: 1.0}\n"
+        "  - {name: n12000, speed_rpm: 12000, ramp_s: 2.0, axial_load_n: 100, dwell_s: 1.0}\n",
+        encoding="utf-8",
+    )
+    err = one_line_error(["run", str(program), "--bag-dir", str(tmp_path / "bags")], capsys)
+    assert "segments[1].speed_rpm: segment 'n12000': 12000 rpm is above the rig's limit of 10000 rpm" in err
+    assert not (tmp_path / "bags").exists()  # nothing started, nothing recorded

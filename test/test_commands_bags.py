@@ -130,3 +130,45 @@ def test_replay_unknown_topic_and_bad_rate(steady_bag: Path, capsys: pytest.Capt
     assert "no topic /rig/nothing in the bag" in capsys.readouterr().err
     assert main(["replay", str(steady_bag), "--rate", "0"]) == 2
     assert "replay: rate: must be > 0.0, got 0.0" in capsys.readouterr().err
+
+
+def test_bag_info_checks_every_chunk(steady_bag: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A chunk zeroed after the recording: the index is intact, so only reading the chunks shows
+    it; bag info names the chunk and counts the messages it cost (mcap's own reader for the count)."""
+    from mcap.reader import make_reader
+
+    bag = tmp_path / "steady"
+    shutil.copytree(steady_bag, bag)
+    mcap = bag / "steady_0.mcap"
+    with open(mcap, "rb") as stream:
+        reader = make_reader(stream)
+        total = reader.get_summary().statistics.message_count
+        chunk = sorted(reader.get_summary().chunk_indexes, key=lambda c: c.chunk_start_offset)[1]
+        in_chunk = sum(1 for _ in reader.iter_messages(start_time=chunk.message_start_time, ending_at=chunk.message_end_time))
+    with open(mcap, "r+b") as stream:
+        stream.seek(chunk.chunk_start_offset + chunk.chunk_length - 32)
+        stream.write(bytes(32))
+    assert main(["bag", "info", str(bag)]) == 0
+    out = capsys.readouterr().out
+    assert "DAMAGED" in out and f"chunk at offset {chunk.chunk_start_offset}" in out
+    assert f"{in_chunk} of {total} messages" in out
+    assert main(["bag", "info", "--index-only", str(bag)]) == 0
+    assert "index only; chunks not checked" in capsys.readouterr().out
+
+
+def test_bag_info_reports_log_time_outliers(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """One /clock recorded at 2^31 - 1 s among a second of traffic: an outlier, not 'problems: none'."""
+    from bearing_rig_sim.bags import rig_typestore
+
+    types = rig_typestore().types
+    bag = tmp_path / "outlier"
+    with BagWriter(bag) as writer:
+        writer.add_topic("/clock", "rosgraph_msgs/msg/Clock")
+        for k in range(1000):
+            writer.write_message("/clock", k * 1_000_000, types["rosgraph_msgs/msg/Clock"](clock=types["builtin_interfaces/msg/Time"](sec=0, nanosec=k * 1_000_000)))
+        far = (2**31 - 1) * 1_000_000_000
+        writer.write_message("/clock", far, types["rosgraph_msgs/msg/Clock"](clock=types["builtin_interfaces/msg/Time"](sec=2**31 - 1, nanosec=0)))
+    assert main(["bag", "info", str(bag)]) == 0
+    out = capsys.readouterr().out
+    assert "log-time outliers: 1 message(s) at 2147483647.000-2147483647.000 s" in out
+    assert "the main timeline (0.000-0.999 s, 1000 messages)" in out and "DAMAGED" in out

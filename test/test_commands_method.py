@@ -18,7 +18,10 @@ def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[
     assert main(["predict", "--rpm", "1200", "2400", "--load", "100", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [r["rpm"] for r in rows] == [1200.0, 2400.0]
-    assert set(rows[0]) == {"rpm", "axial_load_n", "cage_rpm", "slip_pct"}
+    assert set(rows[0]) == {"rpm", "axial_load_n", "cage_rpm", "slip_pct", "friction_torque_nm", "power_loss_w", "film_min_um", "lambda_ratio"}
+    assert rows[1]["power_loss_w"] > rows[0]["power_loss_w"] > 0.0
+    assert rows[0]["power_loss_w"] == pytest.approx(rows[0]["friction_torque_nm"] * 1200 * 2 * 3.141592653589793 / 60, rel=1e-3)
+    assert 0.0 < rows[0]["film_min_um"]["inner"] < 1.0 and 0.0 < rows[0]["film_min_um"]["outer"] < 1.0
     for r in rows:  # cage speed and slip are consistent with Eq. 11-12 at the nominal angle
         ratio = BearingParameters.from_yaml().epicyclic_ratio
         assert r["slip_pct"] == pytest.approx((1 - r["cage_rpm"] / (ratio * r["rpm"])) * 100, abs=2e-3)
@@ -35,9 +38,22 @@ def test_calibrate_writes_a_usable_file_and_prints_the_rms(tmp_path: Path, capsy
     out = tmp_path / "cal.yaml"
     assert main(["calibrate", str(config_path("calibration", "h7006c_table3.csv")), "--out", str(out), "--json"]) == 0
     result = json.loads(capsys.readouterr().out)
-    assert result["rms_slip_pct"] < 0.15 and set(result["fitted"]) == {"cage_land_viscous_scale", "ball_drag_scale"}
+    assert result["rms_slip_pct"] < 0.15 and set(result["fitted"]) == {"yield_stress", "consistency"}
     params = BearingParameters.from_yaml(None, out)
-    assert params.ball_drag_scale == pytest.approx(result["fitted"]["ball_drag_scale"], rel=1e-5)
+    assert params.lubricant is not None
+    assert params.lubricant.consistency == pytest.approx(result["fitted"]["consistency"], rel=1e-5)
+
+
+def test_calibrate_refuses_a_fit_outside_the_physical_range(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """Bench slip far above what any plausible grease gives: non-zero exit naming the parameter,
+    no file written."""
+    data = tmp_path / "skid.csv"
+    data.write_text("inner_ring_rpm,axial_load_n,slip_pct\n900,700,30\n2700,700,40\n")
+    out = tmp_path / "cal.yaml"
+    assert main(["calibrate", str(data), "--out", str(out)]) != 0
+    err = capsys.readouterr().err
+    assert ("yield_stress" in err or "consistency" in err) and "range" in err
+    assert not out.exists()
 
 
 def test_reproduce_writes_csvs_figures_and_report_then_reuses_its_cache(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

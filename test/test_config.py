@@ -212,3 +212,64 @@ def test_shipped_bearing_file_loads() -> None:
     path = config_path("bearings", "h7006c.yaml")
     assert path.is_file()
     assert isinstance(load_yaml(path), Section)
+
+
+# -- hostile documents: bounded, safe parsing ------------------------------------------------
+BILLION_LAUGHS = (
+    'a: &a ["x","x","x","x","x","x","x","x","x"]\n'
+    + "".join(f"{chr(98 + i)}: &{chr(98 + i)} [{','.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8))
+)
+"""The classic alias bomb: 9 levels of 9 references each, about 390 million strings once
+expanded, from a document of a few hundred bytes."""
+
+
+def test_alias_bomb_is_refused_quickly_and_without_memory(tmp_path: Path) -> None:
+    import resource
+    import time
+
+    path = write(tmp_path, BILLION_LAUGHS)
+    assert len(BILLION_LAUGHS) < 1024
+    before_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    started = time.process_time()
+    err = error_of(load_yaml, path)
+    cpu_s = time.process_time() - started
+    grown_mb = (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before_kb) / 1024
+    assert "aliases (*name) are not accepted" in str(err)
+    assert str(err).startswith(f"{path}: not valid YAML at line 2")
+    assert cpu_s < 1.0  # CPU time, not wall time: the limit of the acceptance, unaffected by load
+    assert grown_mb < 100.0
+
+
+def test_a_single_alias_is_refused_too(tmp_path: Path) -> None:
+    path = write(tmp_path, "base: &b {x: 1}\nother: *b\n")
+    assert "aliases (*name) are not accepted" in str(error_of(load_yaml, path))
+
+
+def test_deep_nesting_is_refused_with_one_line(tmp_path: Path) -> None:
+    from bearing_rig_sim.config import MAX_YAML_DEPTH
+
+    path = write(tmp_path, "a: " + "[" * 5000 + "]" * 5000 + "\n")
+    message = str(error_of(load_yaml, path))
+    assert f"nested deeper than {MAX_YAML_DEPTH} levels" in message
+    assert "\n" not in message
+    ok = write(tmp_path, "a: " + "[" * (MAX_YAML_DEPTH - 1) + "]" * (MAX_YAML_DEPTH - 1) + "\n", "ok.yaml")
+    assert "a" in load_yaml(ok)
+
+
+def test_non_utf8_is_one_line_naming_the_byte(tmp_path: Path) -> None:
+    path = tmp_path / "latin1.yaml"
+    path.write_bytes("name: caf\u00e9\n".encode("latin-1"))
+    assert str(error_of(load_yaml, path)) == f"{path}: not UTF-8 text (byte 9)"
+
+
+def test_oversized_document_is_refused(tmp_path: Path) -> None:
+    from bearing_rig_sim.config import MAX_YAML_BYTES
+
+    path = tmp_path / "big.yaml"
+    path.write_bytes(b"#" * (MAX_YAML_BYTES + 10))
+    assert f"larger than {MAX_YAML_BYTES} bytes" in str(error_of(load_yaml, path))
+
+
+def test_python_tags_are_refused(tmp_path: Path) -> None:
+    path = write(tmp_path, "x: !!python/object/apply:os.system ['true']\n")
+    assert "not valid YAML" in str(error_of(load_yaml, path))

@@ -118,9 +118,11 @@ def test_slip_rises_with_speed_at_100_n(calibrated: BearingParameters) -> None:
     assert all(b > a for a, b in zip(slips, slips[1:])), slips
 
 
-def test_slip_falls_with_axial_load_at_3000_rpm(calibrated: BearingParameters) -> None:
-    """Physics test 5b (docs/paper.md section 10): slip falls as the axial load grows, 50 to 700 N."""
-    slips = [nominal_slip_pct(calibrated, run(calibrated, 3000, f).last.cage_speed, 3000 * RPM) for f in (50, 100, 200, 400, 700)]
+@pytest.mark.parametrize("rpm", [900, 3000, 9000])
+def test_slip_falls_with_axial_load(calibrated: BearingParameters, rpm: float) -> None:
+    """Physics test 5b (docs/paper.md section 10): slip falls as the axial load grows, 50 to
+    700 N, at every speed."""
+    slips = [nominal_slip_pct(calibrated, run(calibrated, rpm, f).last.cage_speed, rpm * RPM) for f in (50, 100, 200, 400, 700)]
     assert all(b < a for a, b in zip(slips, slips[1:])), slips
 
 
@@ -148,11 +150,13 @@ def test_acceleration_raises_slip_above_steady_slip_at_the_same_speed(calibrated
     assert excess[1] > 2.0 * excess[0]
 
 
-def test_high_speed_light_load_skids_and_more_load_stabilises(calibrated: BearingParameters) -> None:
-    """Digest section 10: the higher the speed, the larger the load needed for stable (small)
-    slip. At 9000 rpm a light load lets the cage skid; 700 N brings it back to rolling."""
+def test_no_gross_skid_at_9000_rpm_from_400_n_and_light_load_slips_more(calibrated: BearingParameters) -> None:
+    """Issue 13: with the shipped bench file and calibration the cage does not skid grossly
+    (slip < 10 %) at 9000 rpm from 400 N up; at 100 N, below the SKF minimum axial load of this
+    size at 9000 rpm (of the order of 200 N), the traction reserve is smaller and the slip larger
+    (the resistance budget at 9000 rpm is in docs/model.md)."""
     light = nominal_slip_pct(calibrated, run(calibrated, 9000, 100.0).last.cage_speed, 9000 * RPM)
-    heavy = nominal_slip_pct(calibrated, run(calibrated, 9000, 700.0).last.cage_speed, 9000 * RPM)
-    moderate_speed = nominal_slip_pct(calibrated, run(calibrated, 3000, 100.0).last.cage_speed, 3000 * RPM)
-    assert light > 20.0 and heavy < 5.0
-    assert moderate_speed < light
+    for load in (400.0, 700.0):
+        heavy = nominal_slip_pct(calibrated, run(calibrated, 9000, load).last.cage_speed, 9000 * RPM)
+        assert heavy < 10.0, (load, heavy)
+        assert light > heavy

@@ -196,3 +196,53 @@ def test_bad_options_and_clock_times_are_refused(config: LoadingChainConfig, opt
     op = AxialLoadOperation.from_config(config)
     with pytest.raises(RigError, match="clock time"):
         op.advance_to(bad if bad != 0.0 else -0.5)
+
+
+def test_release_engage_then_200_n_reaches_200_n_within_the_settle_bound(config: LoadingChainConfig) -> None:
+    """The audit's case: loaded at 200 N, clutch released (the brake's decaying current pulls the
+    lever down until the plunger meets its stop), engaged again: the bearing must see 200 N again
+    within the chain's stated settle bound, not stay at 0 N with the health OK."""
+    op = AxialLoadOperation.from_config(config)
+    op.advance_to(0.0)
+    op.request_setpoint(200.0, SetpointSource.TOPIC)
+    drive(op, 0.0, 0.5, 0.001)
+    assert op.set_clutch(False).accepted
+    drive(op, 0.5, 1.0, 0.001)
+    assert op.chain.state().bearing_force == 0.0
+    assert op.chain.lever_position > 4e-3  # m: the free lever ran down to where the rope runs out
+    assert op.set_clutch(True).accepted
+    bound = settle_time_bound(config, 0.0, 200.0)
+    steps = math.ceil(bound / 0.001)
+    results = drive(op, 1.0, 1.0 + steps * 0.001, 0.001)
+    assert results[-1].state.bearing_force == pytest.approx(200.0, rel=0.02)
+    assert all(r.state.bearing_force <= config.interlocks.max_force_n for r in results)
+    assert op.health().level is HealthLevel.OK
+    # and once more: a second cycle does not use up the lever's travel
+    op.set_clutch(False)
+    drive(op, 1.0 + steps * 0.001, 2.0, 0.001)
+    op.set_clutch(True)
+    drive(op, 2.0, 2.0 + steps * 0.001, 0.001)
+    assert op.chain.state().bearing_force == pytest.approx(200.0, rel=0.02)
+
+
+def test_a_set_point_the_chain_cannot_reach_is_an_error_after_the_settle_bound(config: LoadingChainConfig) -> None:
+    """A brake driver limited to 1 A (50 N/A: 50 N at the brake, 150 N at the bearing through the
+    lever ratio 3) is asked for 600 N. The health says so once the stated bound has passed, not
+    before, and clears once a reachable set-point is reached (the PI integrator, wound up
+    against the current limit, takes some 0.6 s to come back)."""
+    weak = dataclasses.replace(config, brake=dataclasses.replace(config.brake, current_limit_a=1.0))
+    # 1 A: about 50 N at the brake, 150 N through the lever ratio 3: 600 N is out of reach
+    op = AxialLoadOperation.from_config(weak)
+    op.advance_to(0.0)
+    op.request_setpoint(600.0, SetpointSource.TOPIC)
+    bound = settle_time_bound(weak, 0.0, 600.0)
+    drive(op, 0.0, 0.5 * bound, 0.0005)
+    assert op.health().level is HealthLevel.OK  # still within the bound
+    drive(op, 0.5 * bound, bound + 0.01, 0.0005)
+    health = op.health()
+    assert health.level is HealthLevel.ERROR and "set-point 600 N not reached" in health.message
+    assert op.chain.state().bearing_force < 200.0
+    op.request_setpoint(100.0, SetpointSource.TOPIC)  # reachable: the error clears once in the band
+    drive(op, bound + 0.01, bound + 1.5, 0.0005)
+    assert op.chain.state().bearing_force == pytest.approx(100.0, abs=5.0)
+    assert op.health().level is HealthLevel.OK

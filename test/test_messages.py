@@ -74,6 +74,8 @@ SAMPLES: dict[str, dict[str, Any]] = {
         "real_time_factor": 1.0625,
         "step_count": 2**35 + 11,
         "overruns": 3_000_000_000,
+        "friction_torque": 0.0152,
+        "power_loss": 42.75,
     },
     "AxialLoadState": {
         "header": {"stamp": {"sec": 99, "nanosec": 1}, "frame_id": "load_cell"},

@@ -17,6 +17,7 @@ rclpy = pytest.importorskip("rclpy")
 
 from bearing_rig_msgs.msg import AxialLoadState  # noqa: E402
 from bearing_rig_msgs.srv import SetAxialLoad  # noqa: E402
+from builtin_interfaces.msg import Time  # noqa: E402
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
 from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from rcl_interfaces.srv import SetParameters  # noqa: E402
@@ -236,10 +237,32 @@ def test_interlock_trip_refused_reset_then_reset(ros_graph: Any, tmp_path: Path)
         (["-p", "rig_file:=/nonexistent/rig.yaml"], "/nonexistent/rig.yaml"),
         (["-p", "state_rate_hz:=0.0"], "state_rate_hz: must be > 0"),
         (["-p", "state_rate_hz:=5000.0"], "range: > 0 and <= 1000"),
+        (["-p", "state_rate_hz:=fast"], "state_rate_hz: must be a number, got 'fast'"),
+        (["--params-file", "{tmp}/broken.yaml"], "ROS arguments refused: failed to initialize rcl: Couldn't parse params file"),
     ],
 )
-def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, ros_args: list[str], expected: str) -> None:
+def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, tmp_path: Path, ros_args: list[str], expected: str) -> None:
+    (tmp_path / "broken.yaml").write_text("load_controller:\n  ros__parameters:\n    state_rate_hz: [1,\n")
+    ros_args = [arg.replace("{tmp}", str(tmp_path)) for arg in ros_args]
     process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", *ros_args)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 2, err[-2000:]
     assert "load_controller: error:" in err and expected in err and "Traceback" not in err
+
+
+def test_negative_and_far_future_clock_stamps_are_refused_and_the_node_lives_on(ros_graph: Any) -> None:
+    """One /clock before 1970 used to end the node (rclpy's ValueError in its time source); one
+    at 2^31 - 1 s moved its time to 2038. Both are refused: the node keeps stepping on the good
+    clock, and nothing it publishes is stamped on the bad ones."""
+    rig = Harness(ros_graph)
+    rig.setpoint.publish(Float64(data=200.0))
+    rig.run(0.3)
+    good = rig.time
+    for bad in (Clock(clock=Time(sec=-5, nanosec=0)), Clock(clock=Time(sec=2**31 - 1, nanosec=0))):
+        for _ in range(3):  # the node's /clock input is best effort: send each a few times
+            rig.clock.publish(bad)
+    samples = rig.run(0.2)  # every tick of the good clock still gets its force
+    assert rig.process.poll() is None, rig.failure("the load controller stopped")
+    assert samples[-1][1] == pytest.approx(200.0, rel=0.02)
+    assert max(rig.forces) == round(rig.time / TICK)  # no force stamped after the good clock
+    assert min(rig.forces) > 0 and rig.time == pytest.approx(good + 0.2)

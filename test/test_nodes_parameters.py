@@ -51,6 +51,7 @@ def test_every_parameter_has_a_descriptor_with_unit_and_range(ros_graph: Any, na
     try:
         declared = set(node.list_parameters([], 0).names) - {"use_sim_time", "start_type_description_service"}  # rclpy's own
         assert declared == set(shipped()) - {"use_sim_time"}, "every key of the shipped file is a declared parameter"
+        assert declared == set(NODE_PARAMETERS[name]), "every declared parameter has a spec, every spec a parameter"
         numeric = 0
         for parameter in sorted(declared):
             (descriptor,) = node.describe_parameters([parameter])
@@ -93,7 +94,7 @@ def test_a_start_value_out_of_range_is_one_line_naming_the_parameter(ros_graph: 
 
 
 DEPENDENT = {
-    ("simulator", "initial_speed_rad_s"): "at most max_spindle_speed_rad_s",
+    ("simulator", "initial_speed_rad_s"): "at most the rig file's spindle speed limit",
     ("load_controller", "axial_load_setpoint_n"): "at most the rig file's max_setpoint_n (checked by the chain at configure)",
 }
 """Bounds that depend on another value: their settings check is relative to it."""

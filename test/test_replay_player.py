@@ -334,3 +334,32 @@ def test_ctrl_c_stops_a_looping_replay_cleanly(ros_graph, tmp_path: Path) -> Non
     out, err = process.communicate(timeout=10.0)
     assert process.returncode == 130, err
     assert "replay interrupted" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "msgtype",
+    [
+        "venv.__main__/msg/X",  # the audit's bag: importing it ran the venv module
+        "this/msg/Zen",  # a valid package name, but not an interface package: never imported
+        "json/msg/Decoder",
+        "os/msg/System",
+        "../evil/msg/X",
+        "std_msgs/msg/string",  # not a message type name
+    ],
+)
+def test_crafted_type_names_are_not_imported(msgtype: str) -> None:
+    import sys
+
+    top = msgtype.split("/")[0].split(".")[0]
+    was_loaded = {name for name in sys.modules if name == top or name.startswith(f"{top}.")}
+    assert message_class(msgtype) is None
+    now_loaded = {name for name in sys.modules if name == top or name.startswith(f"{top}.")}
+    assert now_loaded == was_loaded  # nothing of it was imported
+
+
+def test_interface_packages_are_told_apart_without_importing_them() -> None:
+    from bearing_rig_sim.replay.player import is_interface_package
+
+    assert is_interface_package("std_msgs") and is_interface_package("bearing_rig_msgs")
+    assert not is_interface_package("this") and not is_interface_package("rclpy")
+    assert not is_interface_package("venv.__main__") and not is_interface_package("")

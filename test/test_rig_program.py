@@ -15,6 +15,7 @@ from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.rig.program import (
     SegmentSpeed,
     SpeedProfileKind,
+    RigLimits,
     load_program,
     step_ramp,
     step_ramp_rate,
@@ -119,7 +120,7 @@ def test_profile_kind_message_codes() -> None:
 # -- shipped programs ----------------------------------------------------------------------------
 @pytest.mark.parametrize("name", ["validation", "load_sweep", "acceleration"])
 def test_shipped_programs_load(name: str) -> None:
-    program = load_program(config_path("programs", f"{name}.yaml"), max_speed_rpm=12000.0, max_axial_load_n=1000.0)
+    program = load_program(config_path("programs", f"{name}.yaml"))  # against the shipped rig
     assert program.name == name and program.bearing_file.is_file() and program.segments
 
 
@@ -185,6 +186,18 @@ def test_good_probe_program_loads_in_si_units(tmp_path: Path) -> None:
         ("stability_criterion: time", "stability_criterion: speed", "stability_criterion", "one of"),
         ("bearings/h7006c.yaml", "bearings/nope.yaml", "bearing", "not found"),
         ("name: probe", "name: probe\nauthor: me", "author", "unknown key"),
+        # programs checked against the rig they run on, and bounded
+        # 600 rpm (62.8 rad/s) at 1e-300 rad/s^2 would take 6e301 s
+        ("acceleration_rad_s2: 40", "acceleration_rad_s2: 1.0e-300", "segments[1].acceleration_rad_s2", "more than the 600 s allowed"),
+        ("acceleration_rad_s2: 40", "acceleration_rad_s2: 5000", "segments[1].acceleration_rad_s2", "above the rig's limit of 1000 rad/s^2"),
+        # 900 rpm = 94.25 rad/s in 0.1 s: peak 1.5 * 94.25 / 0.1 = 1414 rad/s^2 > 1000
+        ("ramp_s: 1.0", "ramp_s: 0.1", "segments[0].ramp_s", "peak acceleration of 1414 rad/s^2"),
+        ("ramp_s: 1.0", "ramp_s: 0.0", "segments[0].ramp_s", "give ramp_s > 0"),
+        ("ramp_s: 1.0", "ramp_s: 1.0e9", "segments[0].ramp_s", "<= 600"),
+        ("dwell_s: 2.0", "dwell_s: 1.0e9", "segments[0].dwell_s", "<= 3600"),
+        ("timeout_s: 5", "timeout_s: 1.0e9", "segments[1].timeout_s", "<= 3600"),
+        ("name: a,", "name: 'a/../../x',", "segments[0].name", "letters, digits"),
+        ("name: probe", "name: ''", "name", "non-empty"),
     ],
 )
 def test_malformed_programs_name_file_and_key(tmp_path: Path, old: str, new: str, key: str, problem: str) -> None:
@@ -202,12 +215,42 @@ def test_rig_limits_and_yaml_syntax_errors(tmp_path: Path) -> None:
     path = tmp_path / "probe.yaml"
     path.write_text(GOOD)
     with pytest.raises(ConfigError) as info:
-        load_program(path, max_axial_load_n=50.0)
-    assert info.value.key == "segments[0].axial_load_n" and "<= 50" in info.value.problem
+        load_program(path, RigLimits(2000 * RPM, 1000.0, 50.0, "small.yaml"))
+    assert info.value.key == "segments[0].axial_load_n"
+    assert info.value.problem == "segment 'a': 100 N is above the rig's limit of 50 N (loading_chain.max_setpoint_n in small.yaml)"
     with pytest.raises(ConfigError) as info:
-        load_program(path, max_speed_rpm=1000.0)
+        load_program(path, RigLimits(1000 * RPM, 1000.0, 1000.0, "small.yaml"))
     assert info.value.key == "segments[1].speed_rpm"
+    assert "segment 'b': 1500 rpm is above the rig's limit of 1000 rpm (spindle.max_speed_rad_s in small.yaml)" == info.value.problem
     path.write_text(GOOD + "  - {name: c, speed_rpm: [\n")
     with pytest.raises(ConfigError, match="not valid YAML") as info:
         load_program(path)
     assert info.value.source == str(path)
+
+
+# -- programs checked against the rig they run on ------------------------------------------------
+SHIPPED_RIG = RigLimits.from_rig_file()
+
+
+def test_shipped_rig_limits_come_from_rig_yaml() -> None:
+    # config/rig.yaml: a 10 000 rpm spindle (the paper's load sweep reaches 9000 rpm), 1000 rad/s^2,
+    # the loading chain's 1000 N largest set-point.
+    assert SHIPPED_RIG.max_speed_rad_s == pytest.approx(10000 * 2 * math.pi / 60)
+    assert SHIPPED_RIG.max_acceleration_rad_s2 == 1000.0
+    assert SHIPPED_RIG.max_axial_load_n == 1000.0
+
+
+def test_a_9000_rpm_program_is_refused_on_a_6000_rpm_rig_naming_the_segment() -> None:
+    six_thousand = RigLimits(6000 * 2 * math.pi / 60, 1000.0, 1000.0, "rig.yaml")
+    with pytest.raises(ConfigError) as info:
+        load_program(config_path("programs", "load_sweep.yaml"), six_thousand)
+    # the first segment above 6000 rpm is the 25th (index 24), n7000_f050
+    assert info.value.key == "segments[24].speed_rpm"
+    assert "segment 'n7000_f050': 7000 rpm is above the rig's limit of 6000 rpm" in info.value.problem
+
+
+def test_the_shortest_allowed_step_ramp_is_accepted(tmp_path: Path) -> None:
+    # 0 -> 900 rpm: peak 1.5 * 94.25 / T <= 1000 rad/s^2 for T >= 0.1414 s
+    path = tmp_path / "fast.yaml"
+    path.write_text(GOOD.replace("ramp_s: 1.0", "ramp_s: 0.142", 1))
+    assert load_program(path).segments[0].ramp_time == 0.142

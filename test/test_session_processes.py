@@ -115,3 +115,26 @@ def test_run_id_and_run_context() -> None:
     assert any(key.startswith("calibration/h7006c_") for key in context)
     assert context["command_line"] == "bearing-rig run 'a b'" and context["k"] == "v"
     assert all(isinstance(v, str) for v in context.values())
+
+
+def test_the_programs_bearing_is_the_one_the_nodes_use(tmp_path: Path) -> None:
+    """A program naming another bearing file gets it passed to the simulator and the monitor,
+    uncalibrated (the shipped calibration is the H7006C's); the shipped bearing needs nothing."""
+    from bearing_rig_sim.config import load_yaml, ros_parameters
+    from bearing_rig_sim.session.context import node_parameters
+
+    defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
+    shipped = load_program(config_path("programs", "validation.yaml"))
+    assert node_parameters(shipped, defaults) == {}
+    other = tmp_path / "h7006c_copy.yaml"
+    other.write_text(config_path("bearings", "h7006c.yaml").read_text(encoding="utf-8"), encoding="utf-8")
+    program = tmp_path / "p.yaml"
+    program.write_text(
+        config_path("programs", "validation.yaml").read_text(encoding="utf-8").replace("bearings/h7006c.yaml", str(other)),
+        encoding="utf-8",
+    )
+    overrides = node_parameters(load_program(program), defaults)
+    assert overrides == {
+        "simulator": {"bearing_file": str(other.resolve()), "calibration_file": ""},
+        "monitor": {"bearing_file": str(other.resolve())},
+    }

@@ -60,15 +60,29 @@ def test_summary_table_rows_and_alignment() -> None:
         outcome(2, "n1200", 1200.0, Verdict.TIMEOUT, time_to_stable=None),
     ])
     lines = table.splitlines()
-    assert lines[0].split() == ["#", "segment", "speed", "rpm", "load", "N", "F_bearing", "N", "slip", "%", "meas",
-                                "slip", "%", "truth", "verdict", "t_stable", "s"]
+    assert lines[0].split() == ["#", "segment", "speed", "rpm", "meas", "rpm", "load", "N", "F_bearing", "N", "slip", "%",
+                                "meas", "slip", "%", "truth", "verdict", "t_stable", "s", "conditions"]
     assert set(lines[1]) <= {"-", " "}
-    assert lines[2].split() == ["1", "load_up", "0", "100", "99.9", "-", "-", "unknown", "-"]
-    assert lines[3].split() == ["2", "n0900", "900", "100", "99.9", "3.215", "3.220", "stable", "2.31"]
-    assert lines[4].split()[-2:] == ["timeout", "-"]
+    assert lines[2].split() == ["1", "load_up", "0", "-", "100", "99.9", "-", "-", "unknown", "-", "ok"]
+    assert lines[3].split() == ["2", "n0900", "900", "-", "100", "99.9", "3.215", "3.220", "stable", "2.31", "ok"]
+    assert lines[4].split()[-3:] == ["timeout", "-", "ok"]
     # numbers right-aligned: the column ends line up
     end = lines[0].index("speed rpm") + len("speed rpm")
     assert lines[3][end - 3 : end] == "900" and lines[2][end - 1 : end] == "0"
+
+
+def test_segments_whose_conditions_were_not_met_are_marked_and_explained() -> None:
+    table = format_summary([
+        outcome(0, "n7000", 7000.0, Verdict.STABLE, measured_speed=rpm_to_rad_s(5000.0),
+                conditions=("speed 5000 rpm measured, 7000 rpm commanded",)),
+        outcome(1, "n0900", 900.0, Verdict.STABLE, measured_speed=rpm_to_rad_s(900.0), bearing_force=30.0,
+                conditions=("load 30.0 N on the bearing, 100 N commanded", "disturbed: a message on /rig/axial_load/setpoint not sent by this session")),
+    ])
+    lines = table.splitlines()
+    assert lines[2].split()[3] == "5000" and lines[2].split()[-1] == "speed"
+    assert lines[3].split()[-1] == "load,disturbed"
+    assert "conditions not met in segment 1 n7000: speed 5000 rpm measured, 7000 rpm commanded" in table
+    assert "conditions not met in segment 2 n0900: load 30.0 N on the bearing, 100 N commanded; disturbed: " in table
 
 
 def test_empty_summary_says_so() -> None:

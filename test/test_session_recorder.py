@@ -126,3 +126,22 @@ def test_through_the_bag_writer_and_back(tmp_path: Path) -> None:
     times = [t for _, t in got]
     assert all(b > a for a, b in zip(times, times[1:]))
     assert got[0] == ("/clock", S) and got[1] == ("/rig/axial_load/setpoint", S + 1)
+
+
+def test_hostile_clock_stamps_stay_off_the_timeline(fake: tuple[FakeWriter, SessionRecorder]) -> None:
+    """A /clock stamped at 2^31 - 1 s (2038) and one before 1970, among a 1 kHz clock: both are recorded
+    (the bag holds what was on the wire) at the last good clock's time; the timeline goes on."""
+    writer, rec = fake
+    ms = 1_000_000
+    for k in range(5):
+        rec.record("/clock", stamped(k * ms))
+    assert rec.record("/clock", stamped((2**31 - 1) * S)) == 4 * ms + 1  # the largest int32 seconds
+    assert rec.record("/rig/speeds", stamped(5 * ms, b"s")) == 5 * ms  # the header's own stamp
+    assert rec.record("/clock", stamped(-3 * S)) == 5 * ms + 1
+    assert rec.record("/clock", stamped(6 * ms)) == 6 * ms
+    assert rec.sim_time == pytest.approx(0.006)
+    assert rec.rule.clock_guard.refused == 2
+    assert len(rec.rule.clock_notes) == 2 and "negative" in rec.rule.clock_notes[1]
+    times = [t for _, t, _ in writer.written]
+    assert max(times) == 6 * ms and all(b > a for a, b in zip(times, times[1:]))
+    assert rec.counts["/clock"] == 8  # every message kept

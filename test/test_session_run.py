@@ -2,12 +2,20 @@
 shortened validation program without real time, recorded into tmp_path. It runs to the end with a
 stable verdict and a bag that both readers decode; SIGINT in the middle leaves a complete,
 readable bag, the summary so far and exit status 130; a node killed in the middle is named, with
-the bag finalised and exit status 1.
+the bag finalised and exit status 1; a hostile /clock (far future, negative) during a session is
+refused and reported, the load controller lives on, the bag's timeline stays whole; a session
+without real time loses no pulse.
+
+No test here waits for a duration and then expects the session to have got somewhere: each
+waits for the line that says the session got there (a segment's start, its hold phase), and the
+programs hold that segment for far longer than the test needs to act, so the signal lands where
+the assertion expects it on any machine, however loaded.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -38,12 +46,27 @@ segments:
   - {name: n1500, speed_rpm: 1500, ramp_s: 1.0, axial_load_n: 100, until_stable: true, timeout_s: 8.0}
 """
 
+LONG_HOLD_PROGRAM = """
+name: long_hold
+description: load up, then 900 rpm held for ten minutes of sim time (a session to stop midway)
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, dwell_s: 600.0}
+  - {name: n1500, speed_rpm: 1500, ramp_s: 1.0, axial_load_n: 100, dwell_s: 1.0}
+"""
+
 SENSOR_TOPICS = ("/rig/speeds", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/slip_status")
 
+VERDICT, CONDITIONS = 8, 10
+"""Columns of a summary row split on whitespace: # segment speed meas load F_bearing slip slip
+verdict t_stable conditions."""
 
-def start_session(ros_graph: Any, tmp_path: Path, *extra: str) -> subprocess.Popen[str]:
-    program = tmp_path / "short_validation.yaml"
-    program.write_text(SHORT_PROGRAM, encoding="utf-8")
+
+def start_session(ros_graph: Any, tmp_path: Path, *extra: str, program_text: str = SHORT_PROGRAM) -> subprocess.Popen[str]:
+    program = tmp_path / "program.yaml"
+    program.write_text(program_text, encoding="utf-8")
     return subprocess.Popen(
         [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), *extra],
         env=ros_graph.env,
@@ -91,7 +114,8 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     rows = summary_rows(out)
     assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
-    assert rows[-1][7] == "stable", out[-3000:]
+    assert rows[-1][VERDICT] == "stable", out[-3000:]
+    assert [row[CONDITIONS] for row in rows] == ["ok", "ok", "ok"], out[-3000:]
     assert "segment 2/3 n0900" in out and "[3/3 n1500" in out  # events and progress lines
     bag = the_bag(tmp_path)
     counts = check_bag_decodes(bag)
@@ -182,23 +206,25 @@ def child_pid(parent: int, script: str) -> int:
 
 
 def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_path: Path) -> None:
-    session = start_session(ros_graph, tmp_path)
-    seen = read_until(session, "segment 2/3 n0900:")
-    time.sleep(1.0)
+    """SIGINT once n0900 holds its speed (its progress line says "hold"): the ramp is over, so
+    pulses were recorded; the segment holds for 600 s of sim time, so the signal lands in it."""
+    session = start_session(ros_graph, tmp_path, program_text=LONG_HOLD_PROGRAM)
+    seen = read_until(session, "[2/3 n0900 hold]")
     session.send_signal(signal.SIGINT)
     rest, err = session.communicate(timeout=60)
     out = "".join(seen) + rest
     assert session.returncode == 130, f"{out[-3000:]}\n{err[-3000:]}"
     assert "summary (interrupted)" in out and "stopped by SIGINT" in err
     rows = summary_rows(out)
-    assert rows[0][1] == "load_up" and rows[-1][1] == "n0900" and rows[-1][7] == "interrupted"
+    assert [row[1] for row in rows] == ["load_up", "n0900"]
+    assert rows[-1][VERDICT] == "interrupted"
     counts = check_bag_decodes(the_bag(tmp_path))
     for topic in SENSOR_TOPICS[:3]:
         assert counts.get(topic, 0) > 0, f"no {topic} in {counts}"
 
 
 def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_path: Path) -> None:
-    session = start_session(ros_graph, tmp_path)
+    session = start_session(ros_graph, tmp_path, program_text=LONG_HOLD_PROGRAM)
     seen = read_until(session, "segment 2/3 n0900:")
     os.kill(child_pid(session.pid, "bearing-rig-monitor"), signal.SIGKILL)
     rest, err = session.communicate(timeout=60)
@@ -208,6 +234,83 @@ def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_pat
     assert "monitor.log" in err and "summary (failed)" in out
     counts = check_bag_decodes(the_bag(tmp_path))
     assert counts.get("/rig/speeds", 0) > 0
+
+
+def test_hostile_clock_stamps_during_a_session_are_refused_and_reported(ros_graph: Any, tmp_path: Path) -> None:
+    """The audit's attacks: one /clock at 2^31 - 1 s hung a session and moved 98 % of its bag to
+    2038; one before 1970 killed the load controller. Now the session ends normally (the load
+    controller would be named if it died), the refusals are counted under the summary, and the
+    bag's timeline holds no outlier."""
+    from builtin_interfaces.msg import Time
+    from rosgraph_msgs.msg import Clock
+
+    from bearing_rig_sim.nodes.common import RELIABLE_QOS
+
+    session = start_session(ros_graph, tmp_path)
+    seen = read_until(session, "segment 2/3 n0900:")
+    node = ros_graph.node("clock_attacker")
+    clock = node.create_publisher(Clock, "/clock", RELIABLE_QOS)
+    # the recorder and the load controller (at least) subscribe /clock; the recorder (reliable) matched
+    assert ros_graph.spin_until(
+        lambda: node.count_subscribers("/clock") >= 2 and clock.get_subscription_count() >= 2, timeout=30.0, nodes=[node]
+    )
+    for _ in range(3):
+        clock.publish(Clock(clock=Time(sec=2**31 - 1, nanosec=0)))
+        clock.publish(Clock(clock=Time(sec=-5, nanosec=0)))
+    rest, err = session.communicate(timeout=150)
+    out = "".join(seen) + rest
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    found = re.search(r"^clock: (\d+) /clock stamp\(s\) refused \(kept off the bag's timeline\)", out, re.MULTILINE)
+    assert found is not None, out[-3000:]
+    assert int(found.group(1)) >= 2  # at least one of each reached the recorder (reliable)
+    assert "refused a negative stamp" in out and "ahead of the last accepted" in out  # event lines
+    with open_bag(the_bag(tmp_path)) as bag:
+        assert bag.end_ns < 100 * 1_000_000_000  # sim time of a short program, not 2038
+        check = bag.verify()
+        assert check.outliers == [] and check.messages_unreadable == 0
+
+
+NO_GAP_PROGRAM = """
+name: no_gap
+description: 5000 rpm for some 20 s of sim time without real time
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n5000, speed_rpm: 5000, ramp_s: 2.0, axial_load_n: 100, dwell_s: 18.0}
+"""
+
+
+def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> None:
+    """Every pulse the simulator emitted is in the bag: its own pulse_index counts every pulse
+    since it started (pulse_drop_probability is 0 in config/rig.yaml), so the bag's indices must
+    start at 0 (the spindle is at rest until the program starts) and run without a gap to the
+    last; and /clock has every 1 ms chunk from the first the recorder received (the simulator
+    starts before the session's recorder has matched it, at rest)."""
+    from bearing_rig_sim.bags import open_bag as open_rig_bag
+
+    session = start_session(ros_graph, tmp_path, program_text=NO_GAP_PROGRAM)
+    out, err = session.communicate(timeout=400)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    indices: dict[str, list[int]] = {"/rig/spindle/pulses": [], "/rig/cage/pulses": []}
+    clock_ns: list[int] = []
+    with open_rig_bag(the_bag(tmp_path)) as bag:
+        for message in bag.messages(topics=[*indices, "/clock"]):
+            if message.topic == "/clock":
+                stamp = message.message.clock  # type: ignore[attr-defined]
+                clock_ns.append(stamp.sec * 1_000_000_000 + stamp.nanosec)
+            else:
+                indices[message.topic].append(int(message.message.pulse_index))  # type: ignore[attr-defined]
+    for topic, seen in indices.items():
+        assert len(seen) > 500, f"{topic}: only {len(seen)} pulses"
+        ordered = sorted(seen)
+        assert ordered[0] == 0, f"{topic}: the first pulse in the bag is number {ordered[0]}"
+        gaps = [(a, b) for a, b in zip(ordered, ordered[1:]) if b != a + 1]
+        assert not gaps, f"{topic}: {len(gaps)} gaps in pulse_index, first {gaps[:5]}"
+    # stamps are whole microseconds of a float clock: a step may read 0.999999 ms
+    gaps = [(a, b) for a, b in zip(clock_ns, clock_ns[1:]) if round((b - a) / 1_000_000) != 1]
+    assert not gaps, f"/clock: {len(gaps)} gaps, first {gaps[:5]}"
+    assert clock_ns[-1] - clock_ns[0] >= 20 * 1_000_000_000
 
 
 def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:

@@ -163,6 +163,7 @@ def test_mean_bearing_force_counts_after_the_ramp(program: TestProgram) -> None:
     runner = ProgramRunner(program)
     runner.start(0.0)
     runner.update(1.0)  # n0900 ramp 1.0 .. 2.5
+    runner.observe_axial_setpoint(1.0, 100.0)  # the load controller has the segment's set-point
     runner.observe_load(0.5, 1000.0)  # previous segment: not counted
     runner.observe_load(2.0, 50.0)  # during the ramp: not counted
     for t in (2.5, 2.6, 2.7):
@@ -180,3 +181,99 @@ def test_interrupt_ends_the_running_segment(program: TestProgram) -> None:
     assert runner.finished and runner.current is None and runner.update(9.0) == []
     with pytest.raises(RuntimeError):
         runner.start(10.0)
+
+
+# -- conditions: measured beside commanded, disturbances from outside ------------------------------
+def test_a_speed_the_spindle_did_not_reach_is_marked(program: TestProgram) -> None:
+    """The audit's load sweep: the drive refused 7000 rpm and stayed at 5000; the row said
+    "stable". Here n0900 is measured at 600 rpm (62.8 rad/s against 94.2)."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
+    slow = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(600.0), cage_speed=40.0, window_revolutions=1)
+    runner.observe_status(slow)
+    runner.observe_status(SlipObservation(**{**slow.__dict__, "time": 3.5, "state": StatusState.STABLE}))
+    runner.update(3.6)
+    outcome = runner.outcomes[-1]
+    assert outcome.verdict is Verdict.STABLE
+    assert outcome.measured_speed == pytest.approx(rpm_to_rad_s(600.0))
+    assert outcome.conditions == ("speed 600 rpm measured, 900 rpm commanded",)
+    assert not outcome.conditions_met
+
+
+def test_speed_within_one_percent_meets_the_conditions(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    near = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(900.0) * 0.995, cage_speed=40.0, window_revolutions=1)
+    runner.observe_status(near)
+    runner.observe_status(SlipObservation(**{**near.__dict__, "time": 3.5, "state": StatusState.STABLE}))
+    runner.update(3.6)
+    assert runner.outcomes[-1].conditions_met
+
+
+def test_a_load_off_its_set_point_is_marked_once_settled(program: TestProgram) -> None:
+    """The audit's case: 30 N on the bearing against a 100 N set-point, summary "stable"."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_axial_setpoint(0.05, 100.0)
+    runner.observe_load(0.1, 0.0)  # the load still rising: not judged (LOAD_SETTLE_S = 0.5 s)
+    for k in range(5):
+        runner.observe_load(0.6 + 0.1 * k, 30.0)
+    runner.update(1.0)
+    outcome = runner.outcomes[-1]
+    assert outcome.bearing_force == pytest.approx(30.0)
+    assert outcome.conditions == ("load 30.0 N on the bearing, 100 N commanded",)
+
+
+def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_axial_setpoint(0.2, 0.0)  # before the program's set-point can have arrived: not judged
+    runner.observe_axial_setpoint(0.7, 100.0)  # the program's own
+    runner.update(1.0)
+    assert runner.outcomes[-1].conditions_met
+    runner.observe_axial_setpoint(1.6, 30.0)  # n0900 (starts at 1.0): someone called the service
+    runner.observe_disturbance(1.7, "a message on /rig/spindle/command not sent by this session")
+    runner.observe_disturbance(1.8, "a message on /rig/spindle/command not sent by this session")  # once
+    runner.interrupt(2.0)
+    assert runner.outcomes[-1].conditions == (
+        "disturbed: the load controller's set-point was 30 N, not the program's 100 N",
+        "disturbed: a message on /rig/spindle/command not sent by this session",
+    )
+
+
+def test_a_set_point_that_reaches_the_load_controller_late_is_not_a_disturbance(program: TestProgram) -> None:
+    """Without real time the simulator runs ahead of the session: the load controller's state can
+    show the previous segment's set-point well into the next segment's sim time."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.observe_axial_setpoint(0.1, 100.0)
+    runner.update(1.0)  # n0900, 100 N
+    runner.observe_axial_setpoint(1.1, 100.0)
+    run_until(runner, 1.0, 2.6)
+    runner.observe_status(status(5.0, StatusState.SLIPPING))
+    runner.observe_status(status(6.0, StatusState.STABLE))
+    runner.update(6.0)  # n1200, 150 N, starts at 6.0
+    runner.observe_axial_setpoint(6.9, 100.0)  # still the previous segment's, 0.9 s in
+    for k in range(10):
+        runner.observe_load(7.0 + 0.1 * k, 100.0)  # not judged: the set-point has not arrived
+    runner.observe_axial_setpoint(8.0, 150.0)
+    for k in range(10):
+        runner.observe_load(8.5 + 0.1 * k, 150.0)
+    runner.interrupt(9.5)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "n1200" and outcome.conditions_met
+    assert outcome.bearing_force == pytest.approx(150.0)
+
+
+def test_a_segment_too_short_for_the_load_to_settle_is_not_judged_on_it(tmp_path: Path) -> None:
+    path = tmp_path / "short.yaml"
+    path.write_text(PROGRAM.replace("dwell_s: 1.0}", "dwell_s: 0.3}", 1), encoding="utf-8")
+    runner = ProgramRunner(load_program(path))
+    runner.start(0.0)
+    for k in range(3):
+        runner.observe_load(0.1 * k, 30.0 * k)  # still rising when the segment ends
+    runner.update(0.3)
+    outcome = runner.outcomes[-1]
+    assert outcome.bearing_force == pytest.approx(30.0) and outcome.conditions_met

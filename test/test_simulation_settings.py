@@ -36,7 +36,7 @@ def test_integers_are_accepted_for_numbers_and_an_empty_calibration_means_none()
         ("rate", 0.0, "rate: must be > 0"),
         ("realtime", "yes", "realtime: must be true or false"),
         ("max_batch_chunks", 0, "max_batch_chunks: must be >= 1"),
-        ("initial_speed_rad_s", 1e4, "initial_speed_rad_s: must be <= 628"),
+        ("initial_speed_rad_s", 1e4, "initial_speed_rad_s: must be <= 1047.19"),  # rig.yaml: 10 000 rpm
         ("initial_axial_load_n", float("nan"), "initial_axial_load_n: must be finite"),
         ("model", "fast", "model: must be one of reduced, stiff"),
         ("bearing_file", "bearings/none.yaml", "bearing_file: file not found"),
@@ -80,3 +80,24 @@ def test_no_realtime_flag_becomes_a_parameter_override():
     assert node_arguments(["simulator", "--no-realtime", "--ros-args", "-p", "rate:=2.0"]) == [
         "simulator", "--ros-args", "-p", "rate:=2.0", "--ros-args", "-p", "realtime:=false",
     ]
+
+
+def test_spindle_limits_come_from_the_rig_file_not_the_node_parameters(tmp_path):
+    """The drive's limits are the rig's (config/rig.yaml, section spindle), so a program checked
+    against the rig file is checked against what the simulator will accept."""
+    import math
+
+    from bearing_rig_sim.config import config_path
+
+    settings = SimulatorSettings.from_yaml()
+    assert settings.max_spindle_speed_rad_s == pytest.approx(10000 * 2 * math.pi / 60)
+    assert settings.max_spindle_acceleration_rad_s2 == 1000.0
+    rig = tmp_path / "rig.yaml"
+    rig.write_text(
+        config_path("rig.yaml").read_text().replace("max_speed_rad_s: 1047.1975511965977", "max_speed_rad_s: 314.159"),
+        encoding="utf-8",
+    )
+    values = {**shipped_parameters(), "rig_file": str(rig)}
+    assert SimulatorSettings.from_values(values).max_spindle_speed_rad_s == 314.159
+    with pytest.raises(ConfigError, match="max_spindle_speed_rad_s: unknown key"):
+        SimulatorSettings.from_values({**shipped_parameters(), "max_spindle_speed_rad_s": 1.0})

@@ -22,6 +22,7 @@ from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.storage import STORAGE_FORMATS
 from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.config import ConfigError, parse_yaml
 
 METADATA_FILE = "metadata.yaml"
 RUN_METADATA_RECORD = "bearing_rig_sim"
@@ -203,20 +204,18 @@ def read_layout(bag_dir: Path) -> BagLayout:
     path = bag_dir / METADATA_FILE
     source = str(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_bytes()
     except FileNotFoundError:
         raise BagError(
             f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory (if a recording was "
             "interrupted, `repair_bag` rebuilds it from the .mcap files)"
         ) from None
-    except (OSError, UnicodeDecodeError) as exc:
+    except OSError as exc:
         raise BagError(f"{source}: cannot read ({exc})") from None
     try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}" if mark else ""
-        raise BagError(f"{source}: not valid YAML{at} (corrupt metadata; `repair_bag` rebuilds it)") from None
+        doc = parse_yaml(text, source)
+    except ConfigError as exc:
+        raise BagError(f"{exc} (corrupt metadata; `repair_bag` rebuilds it)") from None
     info = _get(doc, "rosbag2_bagfile_information", source, dict, "")
     where = "rosbag2_bagfile_information."
     version = _get(info, "version", source, int, where)

@@ -110,6 +110,8 @@ class FileIndex:
     file_size: int = 0
     compression: str = ""
     problems: list[str] = field(default_factory=list)
+    damaged_bytes: int = 0
+    """Bytes of the chunks :func:`check_chunks` found damaged."""
 
     @property
     def bytes_lost(self) -> int:
@@ -426,15 +428,31 @@ def index_file(path: Path) -> FileIndex:
 
 
 def check_chunks(index: FileIndex) -> list[str]:
-    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk."""
+    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk. The
+    bytes those chunks occupy (to the end of the file for one whose length cannot be read) are
+    left in ``index.damaged_bytes``."""
     problems = []
+    index.damaged_bytes = 0
     with open(index.path, "rb") as stream:
         for ref in index.chunks:
             try:
                 read_chunk_messages(stream, ref)
             except DamagedRecord as exc:
                 problems.append(f"{index.path.name}: chunk at offset {ref.offset}: {exc}")
+                index.damaged_bytes += _record_size(stream, ref, index.file_size)
     return problems
+
+
+def _record_size(stream: BinaryIO, ref: ChunkRef, file_size: int) -> int:
+    """Bytes of the chunk record (or loose run) at ``ref``, bounded by the end of the file."""
+    if ref.loose_end is not None:
+        return max(0, min(ref.loose_end, file_size) - ref.offset)
+    stream.seek(ref.offset)
+    head = stream.read(9)
+    if len(head) != 9:
+        return max(0, file_size - ref.offset)
+    _opcode, length = _RECORD_HEAD.unpack(head)
+    return max(0, min(ref.offset + 9 + length, file_size) - ref.offset)
 
 
 def _lazy_chunk(

@@ -40,6 +40,7 @@ from bearing_rig_sim.bags.mcapfile import FileIndex
 from bearing_rig_sim.bags.storage import storage_for_file
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
+from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
 
 
 class BagMessage(NamedTuple):
@@ -195,6 +196,11 @@ class BagReader:
             if RUN_METADATA_RECORD in index.metadata:
                 return dict(index.metadata[RUN_METADATA_RECORD])
         return dict(self.layout.custom_data) if self.layout is not None else {}
+
+    def verify(self) -> BagCheck:
+        """Read every chunk: checksums, unreadable messages, log-time outliers (see
+        :mod:`.verify`); slower than opening, which reads the index only."""
+        return verify_indexes(self._indexes)
 
     @property
     def complete(self) -> bool:

@@ -59,7 +59,10 @@ class FileRepair:
         action: ``"intact"`` (finished properly, untouched), ``"rebuilt"`` (rewritten from its
             readable part) or ``"removed"`` (not MCAP at all: moved aside).
         messages_recovered: messages the file holds after the repair.
-        bytes_lost: bytes at the end of the original that belonged to no complete record.
+        messages_lost: messages the original's index counted that the repair could not recover
+            (0 when the original had no index: what lay after the damage is unknown).
+        bytes_lost: bytes of the original that could not be used: its damaged chunks and the
+            end of the file that belonged to no complete record.
         backup: where the original was kept, None when untouched.
         problems: what was found damaged.
     """
@@ -67,6 +70,7 @@ class FileRepair:
     name: str
     action: Literal["intact", "rebuilt", "removed"]
     messages_recovered: int = 0
+    messages_lost: int = 0
     bytes_lost: int = 0
     backup: Path | None = None
     problems: list[str] = field(default_factory=list)
@@ -92,6 +96,11 @@ class RepairReport:
         return sum(f.bytes_lost for f in self.files)
 
     @property
+    def messages_lost(self) -> int:
+        """Messages the originals' indexes counted that were not recovered."""
+        return sum(f.messages_lost for f in self.files)
+
+    @property
     def changed(self) -> bool:
         """True when anything was rewritten."""
         return self.metadata_rewritten or any(f.action != "intact" for f in self.files)
@@ -100,10 +109,16 @@ class RepairReport:
         """A few lines for a person: what was done, recovered and lost."""
         if not self.changed:
             return f"{self.path}: nothing to repair ({self.messages_recovered} messages, all files finished properly)"
-        lines = [f"{self.path}: {self.messages_recovered} messages recovered, {self.bytes_lost} bytes lost"]
+        lines = [
+            f"{self.path}: {self.messages_recovered} messages recovered, {self.messages_lost} messages and "
+            f"{self.bytes_lost} bytes lost"
+        ]
         for f in self.files:
             kept = f"; original kept as {f.backup.name}" if f.backup else ""
-            lines.append(f"  {f.name}: {f.action}, {f.messages_recovered} messages, {f.bytes_lost} bytes lost{kept}")
+            lines.append(
+                f"  {f.name}: {f.action}, {f.messages_recovered} messages, {f.messages_lost} messages and "
+                f"{f.bytes_lost} bytes lost{kept}"
+            )
             lines.extend(f"    {p}" for p in f.problems)
         if self.metadata_rewritten:
             kept = f" (old one kept as {self.metadata_backup.name})" if self.metadata_backup else ""
@@ -203,19 +218,23 @@ def repair_bag(path: str | Path) -> RepairReport:
             os.replace(file, backup)
             report.files.append(FileRepair(file.name, "removed", backup=backup, problems=[str(exc)]))
             continue
+        chunk_bytes_lost = 0
         if index.indexed and not index.problems:
             index.problems.extend(storage_for_file(file).check(index))
+            chunk_bytes_lost = index.damaged_bytes
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)
             continue
-        entry = FileRepair(file.name, "rebuilt", bytes_lost=index.bytes_lost, problems=list(index.problems))
+        counted = index.message_count if index.indexed else 0
+        entry = FileRepair(file.name, "rebuilt", bytes_lost=index.bytes_lost + chunk_bytes_lost, problems=list(index.problems))
         rebuilt = _rewrite(index, previous, entry.problems)
         entry.backup = _backup_path(file)
         os.replace(file, entry.backup)
         os.replace(rebuilt, file)
         index = storage_for_file(file).index(file)
         entry.messages_recovered = index.message_count
+        entry.messages_lost = max(0, counted - index.message_count)
         report.files.append(entry)
         indexes.append(index)
     problems: list[str] = []

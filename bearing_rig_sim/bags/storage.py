@@ -53,7 +53,8 @@ class StorageFormat(Protocol):
         ...
 
     def check(self, index: FileIndex) -> list[str]:
-        """Read and verify every message group (checksums, decompression): a line per damaged one."""
+        """Read and verify every message group (checksums, decompression): a line per damaged one;
+        the bytes of the damaged groups are left in ``index.damaged_bytes``."""
         ...
 
 

@@ -14,6 +14,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import output_folder
+
 
 def register(subparsers: Any) -> None:
     """Add ``analyze`` to the ``bearing-rig`` parser."""
@@ -34,6 +36,7 @@ def run(args: argparse.Namespace) -> int:
 
     out = args.out if args.out is not None else Path("out") / "analyze" / args.bag.resolve().name
     settings = MonitorSettings.from_yaml(args.monitor_params) if args.monitor_params is not None else None
+    output_folder(out, "--out")  # before the analysis, not after it
     with bag_warnings_as_lines():
         result = analyse_bag(args.bag, settings=settings, csv_dir=out, max_points=args.max_points)
         files = write_report(result, out)

@@ -8,7 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.studies.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
-from bearing_rig_sim.config import config_path, rad_s_to_rpm
+from bearing_rig_sim.commands import output_file
+from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 
@@ -19,7 +20,14 @@ def register(subparsers: Any) -> None:
     p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")
-    p.add_argument("--out", type=Path, default=None, help="calibration file to write (default: config/calibration/<data>.yaml)")
+    p.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="calibration file to write (default: out/calibration/<data>.yaml; the shipped config/calibration/ "
+        "files change only when named here)",
+    )
+    p.add_argument("--force", action="store_true", help="replace the --out file if it exists")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.set_defaults(func=run)
 
@@ -27,8 +35,8 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Calibrate, write the calibration file, print the RMS difference."""
     points = read_bench_csv(args.data)
+    out = output_file(args.out or Path("out") / "calibration" / f"{args.data.stem}.yaml", "--out", overwrite=args.force)
     result = calibrate(BearingParameters.from_yaml(args.bearing), points, fitted=tuple(args.fit))
-    out = args.out or config_path("calibration", args.data.stem + ".yaml")
     write_calibration(result, out, args.data.name)
     if args.json:
         print(json.dumps({"fitted": result.fitted, "fixed": result.fixed, "rms_slip_pct": result.rms_pct, "file": str(out)}))

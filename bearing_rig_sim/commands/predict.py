@@ -37,7 +37,13 @@ def run(args: argparse.Namespace) -> int:
     params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
     for s in states:
-        row = s.as_row()
+        row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
-        print(json.dumps(row) if args.json else f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %")
+        row.update(s.losses_row(params.composite_roughness))
+        print(
+            json.dumps(row)
+            if args.json
+            else f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %"
+            f"   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm   power {row['power_loss_w']:7.2f} W"
+        )
     return 0

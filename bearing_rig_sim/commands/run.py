@@ -14,7 +14,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.config import check_number, config_path
+
+MAX_STARTUP_TIMEOUT_S = 3600.0
+"""Longest ``--startup-timeout`` accepted, s: an hour covers the slowest first start (kernel
+compilation on a loaded machine); NaN or infinity would never time out."""
 
 FOXGLOVE_PORT = 8765
 """Default port of ``--foxglove``: the Foxglove app's default."""
@@ -89,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
         realtime=not args.no_realtime,
         bag_dir=args.bag_dir,
         quiet=args.quiet,
-        startup_timeout_s=args.startup_timeout,
+        startup_timeout_s=check_number(args.startup_timeout, "bearing-rig run", "--startup-timeout", gt=0.0, le=MAX_STARTUP_TIMEOUT_S),
         params_file=args.params_file,
         foxglove_port=args.foxglove,
         attach=args.attach,

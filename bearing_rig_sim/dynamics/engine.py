@@ -21,6 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.hertz import raceway_contacts
+from bearing_rig_sim.dynamics.lubrication import film_thickness
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.errors import RigError
 
@@ -259,6 +261,50 @@ class BearingDynamics:
     def energy(self) -> float:
         """Total mechanical energy, J (meaningful for the stiff model, whose state is complete)."""
         return float(kn.mechanical_energy(self.vector, self.ball, self.cage, self.ring, self.axial_load))
+
+    def power_loss(self) -> float:
+        """Power dissipated in the bearing at the last step, W: raceway contacts (sliding, spin,
+        Heathcote), rolling resistances, pocket friction and drag of every ball, plus the cage
+        land. With the outer ring fixed it equals the friction torque times the inner-ring speed."""
+        v, z = self.vector, self.params.ball_count
+        land = 0.0
+        for k in range(z):
+            w = float(self.cage[k, kn.C_OMEGA])
+            tl, _ = kn.cage_land_torque(v, w, z)
+            land += abs(tl * w)
+        return float(np.sum(self.out[:, kn.O_POWER])) + land
+
+    def friction_torque(self) -> float:
+        """Bearing friction torque on the inner ring, N m (power loss over inner-ring speed)."""
+        w = self.inner_ring_speed
+        return self.power_loss() / w if w > 0.0 else 0.0
+
+    def minimum_films(self) -> tuple[float, float]:
+        """Minimum film thickness (m) of the inner and outer contacts at the mean ball load and
+        speed (Hamrock-Dowson with thermal and starvation reductions); (nan, nan) without a
+        lubricant file."""
+        p = self.params
+        lub = p.lubricant
+        if lub is None:
+            return math.nan, math.nan
+        o = self.out
+        alpha_i, alpha_o = float(np.mean(o[:, kn.O_AI])), float(np.mean(o[:, kn.O_AO]))
+        inner, outer = raceway_contacts(
+            p.ball_diameter, p.pitch_diameter, 0.5 * (alpha_i + alpha_o), p.inner_curvature_ratio, p.outer_curvature_ratio,
+            p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson,
+        )
+        r, rm = 0.5 * p.ball_diameter, 0.5 * p.pitch_diameter
+        wm = float(np.mean(self.ball[:, kn.B_OMEGA]))
+        films = []
+        for con, q, alpha, speed, sign in (
+            (inner, float(np.mean(o[:, kn.O_QI])), alpha_i, abs(self.inner_ring_speed - wm) * (rm - r * math.cos(alpha_i)), -1.0),
+            (outer, float(np.mean(o[:, kn.O_QO])), alpha_o, wm * (rm + r * math.cos(alpha_o)), 1.0),
+        ):
+            rx = r * (1.0 + sign * p.ball_diameter * math.cos(alpha) / p.pitch_diameter)
+            _, b = con.semi_axes(q)
+            film = film_thickness(lub, p.lubricant_temperature, con.reduced_modulus, rx, con.ellipticity, b, con.max_pressure(q), speed, q)
+            films.append(film.minimum)
+        return films[0], films[1]
 
     def observe(self) -> Observation:
         """The current state as an :class:`Observation` (copies)."""

@@ -34,6 +34,8 @@ import math
 import numpy as np
 from numba import njit
 
+from bearing_rig_sim.dynamics.traction import table_lookup, table_power
+
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
 P_RBALL = 1  # ball radius, m
@@ -74,7 +76,15 @@ P_LAND_COULOMB = 35  # cage land boundary friction torque (whole cage), N m
 P_M_INNER = 36  # inner ring axial mass, kg (stiff model)
 P_HYST_IN = 37  # (3/16) alpha_h b(1 N) K_in^(4/3): hysteresis moment per penetration^2, N/m
 P_HYST_OUT = 38  # same for the outer contact, N/m
-P_SIZE = 39
+P_DRAG_YIELD = 39  # ball drag, plastic (yield-stress) term, N
+P_DRAG_POW = 40  # ball drag, power-law term coefficient, N (s/m)^n
+P_DRAG_N = 41  # ball drag, power-law exponent n
+P_LAND_POW = 42  # cage land torque, power-law coefficient (whole cage), N m (s/rad)^n
+P_LAND_N = 43  # cage land torque, power-law exponent
+P_FR_IN = 44  # Houpert rolling force of the inner contact at 1 m/s and 1 N, N: F = c u^0.66 Q^0.47
+P_FR_OUT = 45  # same, outer contact
+P_TABLE = 46  # index of the rheology traction table in this vector (0: none; see traction.py)
+P_SIZE = 47
 
 B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
 NB = 7
@@ -82,14 +92,15 @@ C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME = 0, 1, 2, 3, 4
 NR = 5
-O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO = 0, 1, 2, 3, 4, 5, 6, 7, 8
-NO = 9
+O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
+NO = 10
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
 NS = 3
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
 
 SPIN_SIGN_SPEED = 1.0  # rad/s, smoothing speed of the sign of resistance moments and torques
+DRAG_SIGN_SPEED = 0.01  # m/s, smoothing speed of the sign of the plastic (grease) ball drag
 MIN_PENETRATION_FOR_JACOBIAN = 1e-10  # m, keeps the quasi-static Jacobian regular at zero load
 
 
@@ -129,6 +140,31 @@ def traction_coefficient(p: np.ndarray, s: float, entrainment: float) -> tuple[f
     e = math.exp(-srr / p[P_EHL_SRR])
     mu = p[P_EHL_MU] * (1.0 - e)
     return (mu if s >= 0.0 else -mu), p[P_EHL_MU] * e / (p[P_EHL_SRR] * ue)
+
+
+@njit(cache=True)
+def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float]:
+    """Traction coefficient, d mu/ds (s/m) and Houpert rolling force (N) of raceway contact
+    ``contact`` (0 inner, 1 outer) at sliding velocity ``s`` (m/s), entrainment speed (m/s) and
+    load (N). Model 2 interpolates the rheology table; models 0 and 1 use
+    :func:`traction_coefficient` and leave the rolling force to :func:`spin_resistance` (0)."""
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        mu, slope, rolling = table_lookup(p, int(p[P_TABLE]), contact, s / ue, ue, load)
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling
+    mu, dmu = traction_coefficient(p, s, entrainment)
+    return mu, dmu, 0.0
+
+
+@njit(cache=True)
+def contact_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> float:
+    """Power (W) dissipated at a raceway contact: the rheology table's sliding, spin and
+    Heathcote losses (model 2), else |mu Q s|."""
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        return table_power(p, int(p[P_TABLE]), contact, s / ue, ue, load) * load * ue
+    mu, _ = traction_coefficient(p, s, entrainment)
+    return abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -274,8 +310,9 @@ def ball_kinematics(p: np.ndarray, nir: float, niz: float, nor: float, noz: floa
 
     Contact angles: cos(alpha_i) = -n_i,r, sin(alpha_i) = -n_i,z; cos(alpha_o) = n_o,r,
     sin(alpha_o) = n_o,z. The rolling axis pitch angle beta follows
-    tan(beta) = sin(alpha)/(cos(alpha) + gamma), gamma = Dw cos(alpha)/dm with dm = 2 r_b and
-    alpha the mean of the two contact angles (Harris and Kotzalas).
+    tan(beta) = sin(alpha)/(cos(alpha) + Dw/dm) with dm = 2 r_b and alpha the mean of the two
+    contact angles (outer-raceway control, Harris and Kotzalas; equivalently
+    tan(alpha - beta) = sin(alpha)/(dm/Dw + cos(alpha)), zero spin at the outer contact).
     Sliding velocities (race relative to ball, along e_t) are
     s_i = omega_i r_ci - A_im omega_m - A_ia omega_a and s_o = -A_om omega_m + A_oa omega_a,
     omega_a the absolute spin about the rolling axis; the rolling speed relative to the orbiting
@@ -289,7 +326,7 @@ def ball_kinematics(p: np.ndarray, nir: float, niz: float, nor: float, noz: floa
     nm = math.sqrt(cm * cm + sm * sm)
     cm /= nm
     sm /= nm
-    den = cm + r * cm / rb
+    den = cm + r / rb
     h = math.sqrt(sm * sm + den * den)
     cb, sb = den / h, sm / h
     ci = cai * cb + sai * sb
@@ -309,10 +346,20 @@ def smooth_sign(x: float) -> float:
 @njit(cache=True)
 def spin_resistance(p: np.ndarray, di: float, do: float, fpocket: float, omega_roll: float) -> float:
     """Moment (N m) resisting the ball's rolling: elastic hysteresis (3/16) alpha_h Q b at both
-    raceways (written with the penetrations: Q b = b(1 N) K^(4/3) delta^2) plus pocket
-    friction mu_p |F_p| R, with a smoothed sign of the rolling speed."""
-    hyst = p[P_HYST_IN] * max(di, 0.0) ** 2 + p[P_HYST_OUT] * max(do, 0.0) ** 2
-    return (hyst + p[P_MU_POCKET] * abs(fpocket) * p[P_RBALL]) * smooth_sign(omega_roll)
+    raceways (written with the penetrations: Q b = b(1 N) K^(4/3) delta^2), Houpert's EHL
+    rolling force F_R = c u^0.66 Q^0.47 at both raceways with the lever R (u = R |omega_roll|,
+    Q = K delta^1.5; with the rheology model the steppers add it from the contacts' entrainment
+    speeds instead), plus pocket friction mu_p |F_p| R, with a smoothed sign of the rolling
+    speed."""
+    dip, dop = max(di, 0.0), max(do, 0.0)
+    hyst = p[P_HYST_IN] * dip**2 + p[P_HYST_OUT] * dop**2
+    r = p[P_RBALL]
+    if p[P_FRIC_MODEL] != 2.0 and (p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0):  # model 2: from the table lookup
+        u066 = (r * abs(omega_roll)) ** 0.66
+        qi = p[P_K_IN] * dip * math.sqrt(dip)
+        qo = p[P_K_OUT] * dop * math.sqrt(dop)
+        hyst += r * u066 * (p[P_FR_IN] * qi**0.47 + p[P_FR_OUT] * qo**0.47)
+    return (hyst + p[P_MU_POCKET] * abs(fpocket) * r) * smooth_sign(omega_roll)
 
 
 @njit(cache=True)
@@ -353,6 +400,11 @@ def cage_land_torque(p: np.ndarray, omega: float, z: int) -> tuple[float, float]
     q = 1.0 / math.sqrt(1.0 + y * y)
     t = (p[P_LAND_COULOMB] * y * q + p[P_LAND_VISC] * omega) / z
     dt = (p[P_LAND_COULOMB] * q * q * q / SPIN_SIGN_SPEED + p[P_LAND_VISC]) / z
+    if p[P_LAND_POW] > 0.0:
+        a = max(abs(omega), SPIN_SIGN_SPEED)
+        an = math.sqrt(a) if p[P_LAND_N] == 0.5 else a ** p[P_LAND_N]
+        t += p[P_LAND_POW] * an * y * q / z
+        dt += p[P_LAND_POW] * p[P_LAND_N] * an / a / z
     return t, dt
 
 
@@ -367,18 +419,19 @@ def link_strain(cage: np.ndarray, k: int, z: int) -> float:
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
-    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta): traction
-    forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for the
-    implicit step), sliding velocities (m/s) and the lever arms of :func:`ball_kinematics`.
+    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll):
+    traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for
+    the implicit step), sliding velocities (m/s), the lever arms of :func:`ball_kinematics` and
+    the sum of the two contacts' Houpert rolling forces (N; model 2 only, else 0).
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
     wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
-    mui, dmui = traction_coefficient(p, si, abs((omega_i - wm) * r_ci))
-    muo, dmuo = traction_coefficient(p, so, abs(wm * r_co))
-    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb
+    mui, dmui, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    muo, dmuo, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
+    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
 
 
 @njit(cache=True)
@@ -402,10 +455,30 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 
 
 @njit(cache=True)
+def ball_power(p: np.ndarray, wm: float, rb: float, omega_i: float, qi: float, qo: float, si: float, so: float, r_ci: float, r_co: float, mres: float, omega_roll: float, fd: float) -> float:
+    """Power (W) dissipated at ball j: both raceway contacts (sliding, spin and Heathcote
+    losses), the rolling-resistance and pocket moments on its rolling, and its drag."""
+    pi = contact_power(p, 0, si, abs((omega_i - wm) * r_ci), qi)
+    po = contact_power(p, 1, so, abs(wm * r_co), qo)
+    return pi + po + abs(mres * omega_roll) + abs(fd * rb * wm)
+
+
+@njit(cache=True)
 def ball_drag(p: np.ndarray, v: float) -> tuple[float, float]:
-    """Drag on a ball moving at ``v`` (m/s) through the oil-air mixture and its derivative:
-    F = c1 v + c2 v|v| (N), dF/dv (N s/m)."""
-    return p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v), p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
+    """Drag on a ball moving at ``v`` (m/s) through the cavity's lubricant and its derivative:
+    F = c1 v + c2 v|v| + (c_y + c_n |v|^n) sgn(v) (N; the sign smoothed over 1 cm/s),
+    dF/dv (N s/m)."""
+    f = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
+    df = p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
+    if p[P_DRAG_YIELD] > 0.0 or p[P_DRAG_POW] > 0.0:
+        y = v / DRAG_SIGN_SPEED
+        q = 1.0 / math.sqrt(1.0 + y * y)
+        a = max(abs(v), DRAG_SIGN_SPEED)
+        an = math.sqrt(a) if p[P_DRAG_N] == 0.5 else a ** p[P_DRAG_N]
+        plastic = p[P_DRAG_YIELD] + p[P_DRAG_POW] * an
+        f += plastic * y * q
+        df += plastic * q * q * q / DRAG_SIGN_SPEED + p[P_DRAG_POW] * p[P_DRAG_N] * an / a
+    return f, df
 
 
 @njit(cache=True)
@@ -468,12 +541,12 @@ def step_reduced(
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm)
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
             gm = rb * (fi + fo - fd) - rm * fs
             ga = r * (ci * fi - co * fo) - mres
             jmm = rb * (-kti * aim - kto * aom - dfd * rb)
@@ -498,6 +571,7 @@ def step_reduced(
             work[j, w0 + 6] = fs
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
         diag = work[:, w0 + 7]
         rhs = work[:, w0 + 8]
         d_omega = work[:, w0 + 9]
@@ -573,11 +647,11 @@ def step_stiff(
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
-            mres = spin_resistance(p, di, do, fs, wa + cb * wm)
+            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
             # momenta at the current positions (p_theta first: p_r's update needs it)
             ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
             wnew = ptheta / (m * rb * rb)
@@ -594,6 +668,7 @@ def step_stiff(
             torque[j] = rm * fs
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)
             torque[k] += tau

@@ -19,15 +19,19 @@ Resistance models (what makes the cage slip; docs/paper.md section 12), each app
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 
 from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
+from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
+from bearing_rig_sim.dynamics.traction import ContactKinematics, build_table
 
 GRAVITY = 9.80665
 """Standard gravity, m/s^2 (CGPM 1901)."""
@@ -99,6 +103,11 @@ class BearingParameters:
     reduced_time_step: float
     stiff_time_step: float
     dynamic_load_rating: float = 13000.0
+    lubricant: Lubricant | None = None
+    lubricant_temperature: float = 40.0
+    ehl_rolling_scale: float = 1.0
+    composite_roughness: float = 0.0
+    spindle_axis: str = "horizontal"
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -130,8 +139,9 @@ class BearingParameters:
         c_out = c.number("outer_diameter_m", gt=dm, lt=2.0 * dm)
         if doc.section("cage").choice("guidance", ["outer_land"]) != "outer_land":  # pragma: no cover
             raise c.error("guidance", "only outer_land is modelled")
-        friction_model = fr.choice("model", ["coulomb_step", "ehl_traction"])
+        friction_model = fr.choice("model", list(FRICTION_MODELS))
         v_s = fr.number("stiction_velocity_m_s", gt=0.0)
+        lubricant, temperature = _lubricant(lub)
         params = cls(
             name=doc.section("bearing").string("name"),
             ball_diameter=dw,
@@ -168,11 +178,11 @@ class BearingParameters:
             ehl_max_coefficient=fr.number("ehl_max_coefficient", ge=0.0, le=0.5),
             ehl_reference_srr=fr.number("ehl_reference_slide_roll_ratio", gt=0.0, le=1.0),
             pocket_friction=fr.number("pocket_coefficient", ge=0.0, le=1.0),
-            oil_density=lub.number("oil_density_kg_m3", gt=0.0),
-            oil_viscosity=lub.number("oil_viscosity_pa_s", gt=0.0),
+            oil_density=lubricant.density(temperature) if lubricant else lub.number("oil_density_kg_m3", gt=0.0),
+            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else lub.number("oil_viscosity_pa_s", gt=0.0),
             air_density=lub.number("air_density_kg_m3", gt=0.0),
             air_viscosity=lub.number("air_viscosity_pa_s", gt=0.0),
-            oil_volume_fraction=lub.number("oil_volume_fraction", ge=0.0, le=1.0),
+            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else lub.number("oil_volume_fraction", ge=0.0, le=1.0),
             ball_drag_coefficient=res.number("ball_drag_coefficient", ge=0.0, le=5.0),
             ball_drag_scale=res.number("ball_drag_scale", ge=0.0),
             cage_land_viscous_scale=res.number("cage_land_viscous_scale", ge=0.0),
@@ -182,13 +192,20 @@ class BearingParameters:
             reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=1e-3),
             stiff_time_step=integ.number("stiff_time_step_s", gt=0.0, le=1e-5),
             dynamic_load_rating=doc.section("bearing").number("dynamic_load_rating_n", gt=0.0, default=13000.0),
+            lubricant=lubricant,
+            lubricant_temperature=temperature,
+            ehl_rolling_scale=res.number("ehl_rolling_scale", ge=0.0, default=1.0),
+            composite_roughness=g.number("composite_roughness_rq_m", ge=0.0, lt=1e-5, default=0.0),
+            spindle_axis=doc.section("installation", default={}).choice("spindle_axis", SPINDLE_AXES, default="horizontal"),
             source=doc.source,
         )
+        if friction_model == "rheology" and lubricant is None:
+            raise fr.error("model", "rheology needs a lubricant file (lubricant.file)")
         return params
 
     def replace(self, **changes: object) -> BearingParameters:
         """A copy with some fields changed (e.g. calibrated scale factors)."""
-        return dataclasses.replace(self, **changes)
+        return dataclasses.replace(self, **cast(dict[str, Any], changes))
 
     def without_resistances(self) -> BearingParameters:
         """All slip-causing resistances off: no drag, no cage land or pocket friction, no
@@ -199,11 +216,13 @@ class BearingParameters:
             cage_land_boundary_torque_scale=0.0,
             pocket_friction=0.0,
             rolling_hysteresis_factor=0.0,
+            ehl_rolling_scale=0.0,
         )
 
     def conservative(self) -> BearingParameters:
         """Friction, damping and resistances off: a conservative system (energy test)."""
         return self.without_resistances().replace(
+            friction_model="paper",
             static_friction=0.0,
             dynamic_friction=0.0,
             ehl_max_coefficient=0.0,
@@ -212,10 +231,45 @@ class BearingParameters:
         )
 
     # -- derived -------------------------------------------------------------------------------
+    def with_lubricant(self, **changes: float) -> BearingParameters:
+        """A copy whose lubricant has some rheology fields changed (calibrated values)."""
+        if self.lubricant is None:
+            raise ValueError("this bearing has no lubricant file")
+        return self.replace(lubricant=self.lubricant.replace_rheology(**changes))
+
     @property
     def epicyclic_ratio(self) -> float:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+
+SPINDLE_AXES = ("horizontal", "vertical")
+"""Orientation of the bearing axis: with a horizontal axis the cage's weight presses it on its
+land (boundary friction mu m_c g r); with a vertical axis the weight acts along the axis and the
+land carries none of it (the balls' and cage's weights, about 0.2 N, are negligible against the
+axial load and are not added to it)."""
+
+FRICTION_MODELS = {"paper": 0.0, "coulomb_step": 0.0, "ehl_traction": 1.0, "rheology": 2.0}
+"""Traction laws (``friction.model``) and their kernel codes: ``paper`` (alias ``coulomb_step``)
+the paper's stepped Coulomb law in the sliding speed; ``ehl_traction`` an exponential fit in the
+slide-to-roll ratio; ``rheology`` the film rheology integrated over the Hertz ellipse
+(:mod:`.traction`), which needs a lubricant file."""
+
+LUBRICANT_OVERRIDES = {"yield_stress_pa": "yield_stress", "consistency_pa_sn": "consistency", "fill_fraction": "fill_fraction", "eyring_stress_pa": "eyring_stress"}
+"""Keys of the bearing file's ``lubricant:`` section that override the lubricant file (a
+calibration sets them): key -> :class:`Lubricant` field."""
+
+
+def _lubricant(lub: Section) -> tuple[Lubricant | None, float]:
+    """The lubricant named by ``lubricant.file`` (with overrides) and the operating temperature
+    (degC) of the bearing file's ``lubricant:`` section; (None, 40) for the legacy inline form."""
+    temperature = lub.number("temperature_c", ge=-40.0, le=200.0, default=40.0)
+    if "file" not in lub:
+        return None, temperature
+    lubricant = Lubricant.from_yaml(lub.string("file"))
+    bounds = {"yield_stress_pa": (0.0, 5e3), "consistency_pa_sn": (0.0, 1e3), "fill_fraction": (0.0, 1.0), "eyring_stress_pa": (1e5, 5e7)}
+    changes = {field: lub.number(key, ge=bounds[key][0], le=bounds[key][1]) for key, field in LUBRICANT_OVERRIDES.items() if key in lub}
+    return (lubricant.replace_rheology(**changes) if changes else lubricant), temperature
 
 
 CALIBRATABLE: dict[str, tuple[str, str]] = {
@@ -226,6 +280,10 @@ CALIBRATABLE: dict[str, tuple[str, str]] = {
     "cage_land_boundary_torque_scale": ("resistances", "cage_land_boundary_torque_scale"),
     "rolling_hysteresis_factor": ("resistances", "rolling_hysteresis_factor"),
     "oil_volume_fraction": ("lubricant", "oil_volume_fraction"),
+    "yield_stress": ("lubricant", "yield_stress_pa"),
+    "consistency": ("lubricant", "consistency_pa_sn"),
+    "fill_fraction": ("lubricant", "fill_fraction"),
+    "eyring_stress": ("lubricant", "eyring_stress_pa"),
 }
 """Parameters a calibration file may set: field name -> (section, key) in the bearing file."""
 
@@ -234,9 +292,11 @@ def overlay_calibration(bearing: Section, calibration: Section) -> Section:
     """Lay a calibration file over a bearing document.
 
     A calibration file has a ``calibration:`` section (provenance: data file, fitted parameter
-    names, RMS) and, under ``parameters:``, values keyed ``section.key`` as in the bearing file
-    (e.g. ``resistances.ball_drag_scale: 3641.7``). Only the keys of :data:`CALIBRATABLE` are
-    accepted; the merged document is validated as a whole by :meth:`BearingParameters.from_section`.
+    names, RMS) and, under ``parameters:``, entries keyed ``section.key`` as in the bearing file.
+    An entry is either a number or a physical quantity ``{value, unit, range: [lo, hi], source}``
+    whose value must lie in its range (the physically plausible interval). Only the keys of
+    :data:`CALIBRATABLE` are accepted; the merged document is validated as a whole by
+    :meth:`BearingParameters.from_section`.
     """
     allowed = {f"{sec}.{key}" for sec, key in CALIBRATABLE.values()}
     values = calibration.section("parameters")
@@ -245,8 +305,53 @@ def overlay_calibration(bearing: Section, calibration: Section) -> Section:
         if name not in allowed:
             raise values.error(name, f"not a calibratable parameter; allowed: {', '.join(sorted(allowed))}")
         sec, key = name.split(".", 1)
-        merged.setdefault(sec, {})[key] = values.number(name, ge=0.0)
+        if isinstance(values.data[name], dict):
+            entry = values.section(name)
+            lo, hi = entry.number_list("range", min_len=2)[:2]
+            value = entry.number("value", ge=lo, le=hi)
+            entry.string("unit")
+            entry.string("source")
+        else:
+            value = values.number(name, ge=0.0)
+        merged.setdefault(sec, {})[key] = value
     return Section(merged, f"{bearing.source} + {calibration.source}")
+
+
+@functools.lru_cache(maxsize=8)
+def _traction_table(p: BearingParameters) -> np.ndarray:
+    lub = p.lubricant
+    assert lub is not None
+    dw, dm, a0 = p.ball_diameter, p.pitch_diameter, p.contact_angle
+    inner, outer = raceway_contacts(
+        dw, dm, a0, p.inner_curvature_ratio, p.outer_curvature_ratio, p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson
+    )
+    gamma = dw * math.cos(a0) / dm
+    rx_in, rx_out = 0.5 * dw * (1.0 - gamma), 0.5 * dw * (1.0 + gamma)
+    return build_table(
+        (
+            ContactKinematics(inner, rx_in, p.inner_curvature_ratio * dw, True),
+            ContactKinematics(outer, rx_out, p.outer_curvature_ratio * dw, False),
+        ),
+        lub,
+        p.lubricant_temperature,
+        ball_count=p.ball_count,
+        free_angle=a0,
+        ball_diameter=dw,
+        pitch_diameter=dm,
+        total_curvature=p.inner_curvature_ratio + p.outer_curvature_ratio - 1.0,
+        combined_constant=(inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5,
+    )
+
+
+def traction_table(p: BearingParameters) -> np.ndarray:
+    """The rheology traction table of a bearing (:func:`.traction.build_table`), built once per
+    distinct geometry and film rheology (the grease's bulk rheology and the resistances do not
+    enter it; a copy is returned)."""
+    lub = p.lubricant
+    assert lub is not None
+    film_only = dataclasses.replace(lub, yield_stress=0.0, consistency=0.0, flow_index=1.0, fill_fraction=1.0)
+    key = p.replace(lubricant=film_only, ball_drag_scale=1.0, cage_land_viscous_scale=1.0, pocket_friction=0.0, rolling_hysteresis_factor=0.0, ehl_rolling_scale=1.0)
+    return _traction_table(key).copy()
 
 
 @dataclass(frozen=True)
@@ -302,14 +407,39 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     link_kt = link_k * r_cage**2  # N m/rad
     link_omega = math.sqrt(4.0 * link_kt / seg_inertia)
     link_ct = p.cage_loss_factor * link_kt / link_omega
-    # Resistances.
-    rho_mix = p.oil_volume_fraction * p.oil_density + (1.0 - p.oil_volume_fraction) * p.air_density
-    eta_mix = p.oil_volume_fraction * p.oil_viscosity + (1.0 - p.oil_volume_fraction) * p.air_viscosity
-    drag_lin = p.ball_drag_scale * 3.0 * math.pi * eta_mix * dw
-    drag_quad = p.ball_drag_scale * 0.5 * rho_mix * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
+    # Resistances (by lubrication mode; see module doc).
     r_land = r_co
-    land_visc = p.cage_land_viscous_scale * 2.0 * math.pi * p.oil_viscosity * r_land**3 * p.land_width / p.land_clearance
-    land_coulomb = p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_mass * GRAVITY * r_land
+    drag_yield = drag_pow = land_pow = 0.0
+    drag_n = land_n = 1.0
+    lub = p.lubricant
+    if lub is not None and lub.kind == "grease":
+        # Sphere in a Herschel-Bulkley grease: plastic drag 3.5 pi Dw^2 tau_y (Beris et al. 1985,
+        # J. Fluid Mech. 158:219) plus Stokes drag with the apparent viscosity at v/Dw.
+        fill = lub.fill_fraction
+        drag_yield = p.ball_drag_scale * fill * 3.5 * math.pi * dw * dw * lub.yield_stress
+        drag_pow = p.ball_drag_scale * fill * 3.0 * math.pi * lub.consistency * dw ** (2.0 - lub.flow_index)
+        drag_n = lub.flow_index
+        drag_lin = 0.0
+        drag_quad = p.ball_drag_scale * fill * 0.5 * lub.density(p.lubricant_temperature) * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
+        # Land: wall stress of the sheared grease film, tau_y + K (r omega / c)^n, on 2 pi r L.
+        land_area_r = 2.0 * math.pi * r_land**2 * p.land_width * p.cage_land_viscous_scale * fill
+        land_visc = 0.0
+        land_yield = land_area_r * lub.yield_stress
+        land_pow = land_area_r * lub.consistency * (r_land / p.land_clearance) ** lub.flow_index
+        land_n = lub.flow_index
+    else:
+        fill = lub.fill_fraction if lub is not None else 1.0
+        if lub is not None and lub.kind == "oil_bath":
+            rho_mix, eta_mix = fill * p.oil_density, fill * p.oil_viscosity
+        else:
+            rho_mix = p.oil_volume_fraction * p.oil_density + (1.0 - p.oil_volume_fraction) * p.air_density
+            eta_mix = p.oil_volume_fraction * p.oil_viscosity + (1.0 - p.oil_volume_fraction) * p.air_viscosity
+        drag_lin = p.ball_drag_scale * 3.0 * math.pi * eta_mix * dw
+        drag_quad = p.ball_drag_scale * 0.5 * rho_mix * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
+        land_visc = p.cage_land_viscous_scale * fill * 2.0 * math.pi * p.oil_viscosity * r_land**3 * p.land_width / p.land_clearance
+        land_yield = 0.0
+    cage_weight_on_land = cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
+    land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_weight_on_land * r_land
     b_in = inner.semi_axes(1.0)[1]
     b_out = outer.semi_axes(1.0)[1]
 
@@ -333,7 +463,7 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_HC_A] = p.hunt_crossley_coefficient
     v[kn.P_HC_N] = p.hunt_crossley_exponent
     v[kn.P_HC_D] = p.full_damping_penetration
-    v[kn.P_FRIC_MODEL] = 0.0 if p.friction_model == "coulomb_step" else 1.0
+    v[kn.P_FRIC_MODEL] = FRICTION_MODELS[p.friction_model]
     v[kn.P_MU_S] = p.static_friction
     v[kn.P_V_S] = p.stiction_velocity
     v[kn.P_MU_D] = p.dynamic_friction
@@ -352,6 +482,21 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     # Q b = b(1 N) Q^(4/3) = b(1 N) K^(4/3) delta^2
     v[kn.P_HYST_IN] = 0.1875 * p.rolling_hysteresis_factor * b_in * inner.stiffness ** (4.0 / 3.0)
     v[kn.P_HYST_OUT] = 0.1875 * p.rolling_hysteresis_factor * b_out * outer.stiffness ** (4.0 / 3.0)
+    v[kn.P_DRAG_YIELD] = drag_yield
+    v[kn.P_DRAG_POW] = drag_pow
+    v[kn.P_DRAG_N] = drag_n
+    v[kn.P_LAND_POW] = land_pow
+    v[kn.P_LAND_N] = land_n
+    gamma = dw * math.cos(a0) / dm
+    rx_in, rx_out = rball * (1.0 - gamma), rball * (1.0 + gamma)
+    if lub is not None:
+        # Houpert rolling force F_R = c u^0.66 Q^0.47 per contact, c from the value at 1 m/s, 1 N.
+        eta0 = lub.dynamic_viscosity(p.lubricant_temperature)
+        for idx, con, rx in ((kn.P_FR_IN, inner, rx_in), (kn.P_FR_OUT, outer, rx_out)):
+            v[idx] = p.ehl_rolling_scale * rolling_force(eta0, lub.pressure_viscosity, con.reduced_modulus, rx, con.ellipticity, 1.0, 1.0)
+    if p.friction_model == "rheology" and lub is not None:
+        v[kn.P_TABLE] = kn.P_SIZE
+        v = np.concatenate([v, traction_table(p)])
     geo = DerivedGeometry(
         inner_groove_bottom_diameter=2.0 * (ci_r - ri),
         outer_groove_bottom_diameter=2.0 * (co_r + ro),

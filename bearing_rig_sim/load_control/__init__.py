@@ -9,6 +9,7 @@ from bearing_rig_sim.load_control.operation import (
     Reply,
     SetpointSource,
     closed_loop_time_constant,
+    settle_band,
     settle_time_bound,
 )
 from bearing_rig_sim.load_control.settings import NODE_NAME, LoadControllerSettings, shipped_parameters
@@ -23,6 +24,7 @@ __all__ = [
     "Reply",
     "SetpointSource",
     "closed_loop_time_constant",
+    "settle_band",
     "settle_time_bound",
     "shipped_parameters",
 ]

@@ -35,6 +35,11 @@ Policies (the node's documentation repeats them):
   holding force (else it would slip again at once). A set-point given while a fault is latched is
   accepted and stored, and takes effect after the reset; it does not clear the fault by itself
   (a latched interlock wants an explicit acknowledgement).
+* **The force on the bearing is watched.** While the loop controls (clutch engaged, no fault,
+  set-point above 0 N), a load-cell reading (in series with the bearing) outside
+  :func:`settle_band` of the set-point for longer than :func:`settle_time_bound` of that step is
+  an ERROR naming the set-point and the bound, until the force is back in the band. A new
+  set-point, an engagement or a reset starts the count again from the force at that moment.
 
 Units: N, s throughout.
 """
@@ -62,6 +67,7 @@ __all__ = [
     "Reply",
     "SetpointSource",
     "closed_loop_time_constant",
+    "settle_band",
     "settle_time_bound",
 ]
 
@@ -150,6 +156,10 @@ class AxialLoadOperation:
         self._next_diagnostics = 0.0
         self._refusal = ""
         self._reported: Health | None = None
+        self._watched: tuple[float, bool, bool] | None = None
+        self._off_since: float | None = None
+        self._off_bound = 0.0
+        self._unmet = ""
         if engage:
             chain.engage()
         self._apply_zero_load_rule()
@@ -285,6 +295,7 @@ class AxialLoadOperation:
         self._time = float(sim_time)
         if state is None:
             state = self.chain.state()
+        self._watch_force(float(sim_time), state)
         state_due = sim_time >= self._next_state - 1e-9
         if state_due:
             self._next_state = _next_multiple(sim_time, self.state_period)
@@ -322,6 +333,40 @@ class AxialLoadOperation:
         last = round(sim_time * 1e9) // period
         return [self.advance_to(k * period * 1e-9) for k in range(first, last + 1)]
 
+    def _settle_bound(self, start_n: float, target_n: float) -> float:
+        # a band wider than half the set-point (small set-points) is stated as half of it
+        return settle_time_bound(self.chain.config, start_n, target_n, min(settle_band(target_n) / target_n, 0.5))
+
+    def _watch_force(self, now: float, state: LoadChainState) -> None:
+        """The settle rule of the module documentation."""
+        chain = self.chain
+        target = chain.setpoint
+        controlling = chain.clutch.engaged and not chain.fault and target > 0.0
+        watched = (target, chain.clutch.engaged, chain.fault)
+        if not controlling:
+            self._watched, self._off_since, self._unmet = watched, None, ""
+            return
+        band = settle_band(target)
+        force = state.load_cell_force
+        if watched != self._watched:  # a new target: the step starts now
+            self._watched, self._unmet = watched, ""
+            self._off_since, self._off_bound = None, 0.0
+            if abs(force - target) > band:
+                self._off_since = now
+                self._off_bound = self._settle_bound(max(force, 0.0), target)
+            return
+        if abs(force - target) <= band:
+            self._off_since, self._unmet = None, ""
+            return
+        if self._off_since is None:  # left the band: the loop has a step's bound to restore it
+            self._off_since = now
+            self._off_bound = self._settle_bound(max(force, 0.0), target)
+        if now - self._off_since > self._off_bound and not self._unmet:
+            self._unmet = (
+                f"set-point {target:g} N not reached: the load cell read outside {target:g} +- {band:.3g} N for longer "
+                f"than the settle bound {self._off_bound:.3g} s"
+            )
+
     def _schedule_from(self, sim_time: float) -> None:
         self._next_state = sim_time
         self._next_diagnostics = sim_time
@@ -335,6 +380,8 @@ class AxialLoadOperation:
         chain = self.chain
         if chain.fault:
             return Health(HealthLevel.ERROR, (f"interlock: {chain.fault_reason}",))
+        if self._unmet:
+            return Health(HealthLevel.ERROR, (self._unmet,))
         if self._refusal:
             return Health(HealthLevel.WARN, (self._refusal,))
         if chain.clutch.state is ClutchState.RELEASED:
@@ -371,6 +418,18 @@ def closed_loop_time_constant(config: LoadingChainConfig, force_n: float) -> flo
     slope = brake.force_constant_n_per_a * max(0.0, 1.0 - (brake_force / brake.saturation_force_n) ** 2)
     gain = slope * config.lever.force_ratio / brake.resistance_ohm
     return (brake.inductance_h / brake.resistance_ohm) / (controller.proportional_gain_v_per_n * gain)
+
+
+SETTLE_BAND_FRACTION = 0.02
+"""Settled: within 2 % of the set-point (the band :func:`settle_time_bound` uses by default) ..."""
+SETTLE_BAND_MIN_N = 5.0
+"""... or within 5 N, whichever is wider: five standard deviations of the load cell's noise
+(``noise_std_n`` 1 N), so that noise alone never leaves the band."""
+
+
+def settle_band(target_n: float) -> float:
+    """Half-width of the band the force settles into around a set-point of ``target_n`` N, N."""
+    return max(SETTLE_BAND_FRACTION * target_n, SETTLE_BAND_MIN_N)
 
 
 def settle_time_bound(config: LoadingChainConfig, start_n: float, target_n: float, band: float = 0.02) -> float:

@@ -10,7 +10,7 @@ clutch, PI gains, interlock levels) are in the rig file, section ``loading_chain
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -63,7 +63,7 @@ class LoadControllerSettings(NodeSettingsFile):
         Raises:
             ConfigError: naming the source, the key and the allowed range.
         """
-        s.reject_unknown([*cls.__dataclass_fields__, "use_sim_time"])
+        s.reject_unknown([*(f.name for f in fields(cls)), "use_sim_time"])
         if s.data.get("use_sim_time") is False:
             raise s.error("use_sim_time", "steps the loading chain on the simulation clock: use_sim_time must be true")
         raw = s.data.get("rig_file")

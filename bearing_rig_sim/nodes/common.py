@@ -9,6 +9,7 @@ and starts through :func:`run_node`, which uses a ``SingleThreadedExecutor`` (th
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 from collections.abc import Callable, Mapping, Sequence
@@ -16,11 +17,14 @@ from collections.abc import Callable, Mapping, Sequence
 import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy._rclpy_pybind11 import RCLError
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import Topic
 
 SENSOR_QOS = QoSProfile(
@@ -32,6 +36,22 @@ RELIABLE_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
 )
 """Commands, set-points, /clock, /diagnostics, the force to the simulator: reliable, depth 10."""
+
+RELIABLE_STREAM_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=5000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
+)
+"""The publishers of the 1 kHz reliable streams (``/clock``, the force on the bearing): reliable
+like :data:`RELIABLE_QOS` (and compatible with its readers), but a reliable writer drops a sample
+its readers have not acknowledged once ``depth`` newer ones are written. At depth 10 a recorder
+held up for 10 ms (a busy host) lost stretches of ``/clock``; 5000 covers 5 s of it."""
+
+PULSE_READER_QOS = QoSProfile(
+    history=HistoryPolicy.KEEP_LAST, depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
+)
+"""The monitor's pulse subscriptions: sensor data, but deep. A reader's history drops the oldest
+sample once ``depth`` are waiting; at 100 a monitor held up for a fraction of a second (niced
+below the simulator on a busy host, or a fit at a window's end) lost bursts of pulses and reported
+a FAULT for pulses the bag held. 10000 is some 20 s of pulses at 9000 rpm."""
 
 STATUS_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
@@ -101,6 +121,11 @@ def split_autostart(argv: Sequence[str]) -> tuple[list[str], bool]:
     return [a for a in args if a != AUTOSTART_FLAG], AUTOSTART_FLAG in args
 
 
+def _rcl_message(exc: Exception) -> str:
+    """rcl's error text without the C source locations it appends (", at /path/file.c:123")."""
+    return re.sub(r", at [^,]*\.c:\d+", "", " ".join(str(exc).split()))
+
+
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Initialise rclpy (with the node's shipped parameter file), spin the node made by
     ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
@@ -112,14 +137,21 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
         The process exit status: 0, or 2 when ``--autostart`` could not configure or activate.
 
     Raises:
-        RigError: the node could not be made (a parameter given at start out of its range).
+        RigError: malformed ROS arguments; the node could not be made (a parameter given at
+            start out of its range or of the wrong type).
     """
     args, autostart = split_autostart(sys.argv if argv is None else argv)
-    rclpy.init(args=ros_args_with_defaults(node_name, args))
+    try:
+        rclpy.init(args=ros_args_with_defaults(node_name, args))
+    except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
+        raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
     executor = SingleThreadedExecutor()
     try:
-        node = factory()
+        try:
+            node = factory()
+        except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+            raise RigError(f"parameter refused: {exc}") from None
         if autostart and hasattr(node, "trigger_configure"):
             failed = _autostart(node)
             if failed:

@@ -70,6 +70,7 @@ from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
 from bearing_rig_sim.interfaces import AXIAL_LOAD_CLUTCH, AXIAL_LOAD_FORCE, AXIAL_LOAD_RESET_FAULT, AXIAL_LOAD_SET, AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS
+from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
@@ -77,6 +78,7 @@ from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
     RELIABLE_QOS,
+    RELIABLE_STREAM_QOS,
     SENSOR_QOS,
     WARN,
     diagnostic_array,
@@ -90,8 +92,9 @@ from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
 SETPOINT_PARAMETER = "axial_load_setpoint_n"
 DIAGNOSTIC_NAME = "load_controller: axial load"
-CLOCK_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.BEST_EFFORT)
-"""The /clock reader's QoS: only the latest tick matters (as rclpy's time source reads it)."""
+CLOCK_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
+"""The /clock reader's QoS: every tick of a step period kept (100 ms of a 1 kHz clock), so that
+the clock guard sees the stamps in a row it needs to confirm a restarted clock."""
 
 _LEVELS = {HealthLevel.OK: OK, HealthLevel.WARN: WARN, HealthLevel.ERROR: ERROR}
 
@@ -115,6 +118,8 @@ class LoadControllerNode(ManagedNode):
         if self.get_parameter("use_sim_time").value:
             self._time_source.detach_node()
         self._clock_tap: Node | None = None
+        self.clock_guard = ClockGuard(name=f"{NODE_NAME}: /clock")
+        """Negative and far-jumping /clock stamps are refused (see :mod:`bearing_rig_sim.clock_guard`)."""
 
     def configure(self) -> None:
         """Validate the parameters; build the chain, publishers, services and the step timer."""
@@ -130,7 +135,7 @@ class LoadControllerNode(ManagedNode):
         # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
         # walks on every wake-up; an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
-        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, RELIABLE_STREAM_QOS, event_callbacks=quiet)
         self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
         self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
         self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
@@ -175,12 +180,19 @@ class LoadControllerNode(ManagedNode):
 
     # -- clock ------------------------------------------------------------------------------------
     def _latest_clock(self) -> Time | None:
-        """The latest /clock stamp queued since the last call (None when none came)."""
+        """The latest /clock stamp queued since the last call that the clock guard accepts
+        (None when none came): negative and far-jumping stamps are refused and logged."""
         latest = None
         handle = self._clock_sub.handle
+        guard = self.clock_guard
         with handle:
             while (taken := handle.take_message(Clock, False)) is not None:
-                latest = taken[0].clock
+                stamp = taken[0].clock
+                verdict = guard.check(stamp.sec * 1_000_000_000 + stamp.nanosec)
+                if verdict.note:
+                    self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
+                if verdict.accepted:
+                    latest = stamp
         return latest
 
     @survives_shutdown

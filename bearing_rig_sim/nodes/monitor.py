@@ -46,8 +46,8 @@ from bearing_rig_sim.monitoring import (
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
+    PULSE_READER_QOS,
     RELIABLE_QOS,
-    SENSOR_QOS,
     STATUS_QOS,
     WARN,
     diagnostic_array,
@@ -57,6 +57,7 @@ from bearing_rig_sim.nodes.common import (
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
+from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 LEVELS = {MonitorState.STABLE: OK, MonitorState.SLIPPING: WARN, MonitorState.UNKNOWN: WARN, MonitorState.FAULT: ERROR}
@@ -74,6 +75,7 @@ class MonitorNode(ManagedNode):
         super().__init__(NODE_NAME, **node_options)
         self._defaults = shipped_parameters()
         declare_described(self, NODE_NAME, self._defaults)
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
     def configure(self) -> None:
         """Validate the parameters; build the slip monitor, publishers, subscriptions, timers."""
@@ -90,8 +92,8 @@ class MonitorNode(ManagedNode):
 
         self._status_pub = self.publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
-        self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), SENSOR_QOS)
-        self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), SENSOR_QOS)
+        self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), PULSE_READER_QOS)
+        self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), PULSE_READER_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)

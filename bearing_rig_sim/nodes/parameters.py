@@ -97,8 +97,6 @@ SIMULATOR = [
     ParameterSpec("rtf_window_s", "sliding window of the reported real-time factor (wall clock)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("initial_speed_rad_s", "spindle speed at start", "rad/s", 0.0, 1000.0),
     ParameterSpec("initial_axial_load_n", "axial load until the loading chain's first force message", "N", 0.0, 10_000.0),
-    ParameterSpec("max_spindle_speed_rad_s", "highest spindle target speed accepted", "rad/s", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("max_spindle_acceleration_rad_s2", "highest constant spindle acceleration accepted", "rad/s^2", 0.0, 1e5, low_exclusive=True),
     ParameterSpec("max_command_lead_s", "how far ahead of the rig clock a command's stamp may be", "s", 0.0, 3600.0),
     ParameterSpec("counter_timeout_s", "the pulse counters show 0 after this long without a pulse", "s", 0.0, 60.0, low_exclusive=True),
     ParameterSpec("speeds_rate_hz", "rate of /rig/speeds in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),

@@ -55,6 +55,7 @@ from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
     RELIABLE_QOS,
+    RELIABLE_STREAM_QOS,
     SENSOR_QOS,
     STATUS_QOS,
     diagnostic_array,
@@ -128,7 +129,7 @@ class SimulatorNode(ManagedNode):
         self._last_level: HealthLevel | None = None
         self._anchor = True
 
-        self._clock_pub = self.publisher(ClockMsg, CLOCK.name, RELIABLE_QOS)
+        self._clock_pub = self.publisher(ClockMsg, CLOCK.name, RELIABLE_STREAM_QOS)
         self._pulse_pubs = {
             "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, SENSOR_QOS),
             "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, SENSOR_QOS),
@@ -234,6 +235,8 @@ class SimulatorNode(ManagedNode):
             real_time_factor=float(self.pacer.real_time_factor),
             step_count=t.step_count,
             overruns=min(self.pacer.overruns, MAX_UINT32),
+            friction_torque=t.friction_torque,
+            power_loss=t.power_loss,
         )
         msg.header.stamp = to_stamp(t.time)
         msg.header.frame_id = "bearing"

@@ -54,9 +54,8 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Callable
 
-import yaml
 
-from bearing_rig_sim.config import ConfigError, Section, ros_parameters
+from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, shipped_parameters
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -234,10 +233,7 @@ def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> Moni
     text = run_metadata.get(MONITOR_PARAMETERS_KEY)
     if not text:
         return None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        raise ConfigError(source, "", f"not valid YAML ({exc})") from None
+    doc = parse_yaml(text, source)
     if not isinstance(doc, dict):
         raise ConfigError(source, "", "top level must be a mapping")
     recorded = ros_parameters(Section(doc, source), NODE_NAME).data

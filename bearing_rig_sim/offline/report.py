@@ -23,10 +23,9 @@ from pathlib import Path
 from typing import Any
 from collections.abc import Sequence
 
-import yaml
 
 import bearing_rig_sim
-from bearing_rig_sim.config import RPM_TO_RAD_S
+from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
 from bearing_rig_sim.monitoring import MonitorState
 from bearing_rig_sim.offline.analysis import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
@@ -205,8 +204,8 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
 # ---------------------------------------------------------------------------------------------
 def _program_name(metadata: dict[str, str]) -> str:
     try:
-        doc = yaml.safe_load(metadata.get("program", "") or "")
-    except yaml.YAMLError:
+        doc = parse_yaml(metadata.get("program", "") or "", "run context: program")
+    except ConfigError:
         return ""
     return str(doc.get("name", "")) if isinstance(doc, dict) else ""
 

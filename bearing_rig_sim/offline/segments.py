@@ -23,8 +23,7 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import yaml
-
+from bearing_rig_sim.config import ConfigError, parse_yaml
 from bearing_rig_sim.monitoring import MonitorState
 from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
 
@@ -137,9 +136,9 @@ def program_segment_names(run_metadata: dict[str, str]) -> list[str]:
     """Segment names of the run's test program (run context key ``program``); [] when absent or
     unreadable."""
     try:
-        doc = yaml.safe_load(run_metadata.get("program", "") or "")
+        doc = parse_yaml(run_metadata.get("program", "") or "", "run context: program")
         return [str(s.get("name", "")) for s in doc["segments"]]
-    except (yaml.YAMLError, TypeError, KeyError, AttributeError):
+    except (ConfigError, TypeError, KeyError, AttributeError):
         return []
 
 

@@ -31,11 +31,14 @@ from __future__ import annotations
 
 import heapq
 import importlib
+import importlib.util
 import itertools
+import re
 import struct
 import time
 import warnings
 from dataclasses import dataclass, field
+from pathlib import Path
 from types import TracebackType
 from typing import Any, Literal, Protocol, cast
 from collections.abc import Iterable, Iterator
@@ -260,11 +263,40 @@ def replay_bag(
 # ---------------------------------------------------------------------------------------------
 # The ROS side
 # ---------------------------------------------------------------------------------------------
+PACKAGE_NAME = re.compile(r"[a-z][a-z0-9_]*")
+"""A ROS package name (REP 144): lower-case letters, digits and underscores, a letter first."""
+MESSAGE_NAME = re.compile(r"[A-Z][A-Za-z0-9]*")
+"""A message type name: CamelCase letters and digits."""
+
+
+def is_interface_package(name: str) -> bool:
+    """Whether ``name`` is an installed ROS interface package, found without running any of it.
+
+    A bag names its types itself, so a crafted bag could name any module (``venv.__main__``):
+    only a valid package name whose installed folder holds the ``msg`` subpackage and the C type
+    support library rosidl generates (``<name>_s__rosidl_typesupport_c*``) counts.
+    """
+    if not PACKAGE_NAME.fullmatch(name):
+        return False
+    try:
+        spec = importlib.util.find_spec(name)  # a top-level name: located, not executed
+    except (ImportError, ValueError):
+        return False
+    if spec is None or not spec.submodule_search_locations:
+        return False
+    for location in spec.submodule_search_locations:
+        folder = Path(location)
+        if (folder / "msg" / "__init__.py").is_file() and any(folder.glob(f"{name}_s__rosidl_typesupport_c*")):
+            return True
+    return False
+
+
 def message_class(msgtype: str) -> type | None:
     """The generated Python class of ``pkg/msg/Name`` from the installed interface packages;
-    None when the package or the type is not installed."""
+    None when the name is malformed, or the package is not an installed interface package
+    (:func:`is_interface_package`: nothing else is imported), or the type is not in it."""
     parts = msgtype.split("/")
-    if len(parts) != 3 or parts[1] != "msg":
+    if len(parts) != 3 or parts[1] != "msg" or not MESSAGE_NAME.fullmatch(parts[2]) or not is_interface_package(parts[0]):
         return None
     try:
         module = importlib.import_module(f"{parts[0]}.msg")

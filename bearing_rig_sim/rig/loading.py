@@ -96,10 +96,6 @@ class LoadingChainConfig(ParameterRecord):
 
     SECTION: ClassVar[str] = "loading_chain"
 
-    max_setpoint_n: float = bounded(gt=0.0)
-    """Largest axial-load set-point accepted, N."""
-    max_substep_s: float = bounded(gt=0.0, le=0.01)
-    """Longest internal integration step, s; longer calls to ``step`` are subdivided."""
     brake: LinearBrakeParams
     rope: WireRopeParams
     lever: LeverParams
@@ -108,6 +104,12 @@ class LoadingChainConfig(ParameterRecord):
     load_cell: LoadCellParams
     controller: ForceControllerParams
     interlocks: InterlockParams
+    # the bounded numbers after the nested records: a dataclass field with a (typing) default
+    # may not precede one without
+    max_setpoint_n: float = bounded(gt=0.0)
+    """Largest axial-load set-point accepted, N."""
+    max_substep_s: float = bounded(gt=0.0, le=0.01)
+    """Longest internal integration step, s; longer calls to ``step`` are subdivided."""
 
     def check_consistency(self, error: Callable[[str, str], ConfigError]) -> None:
         """The load-limit trip must sit above the largest set-point."""
@@ -238,9 +240,21 @@ class LoadingChain:
         self._manual_voltage = float(voltage)
 
     def engage(self) -> None:
-        """Close the clutch: it grips the lever where it is, with the housing unloaded.
-        No effect if already engaged."""
+        """Close the clutch, the lever re-seated at its home first; no effect if engaged.
+
+        Released, the lever is free: the brake's decaying current pulls it down until the rope
+        runs out of plunger stroke (some 4.5 mm at the shipped values), and a clutch gripping
+        there would leave no travel to load the bearing with. So engaging is the bench's
+        procedure, done with nothing reaching the bearing: the lever is lifted back to its home
+        (output at 0, the position of the first engagement), the plunger to its start (rope
+        just taut, no tension), both at rest; then the magnet grips the housing, unloaded. The
+        lifting itself is not integrated (a manual step of the bench, not part of a test).
+        """
         if not self.clutch.engaged:
+            if self.lever_position > 0.0:  # below home: no return spring brings it back
+                self.lever_position, self.lever_velocity = 0.0, 0.0
+                self.plunger_position, self.plunger_velocity = 0.0, 0.0
+                self._tension = 0.0
             self.clutch.engage(self.lever_position)
             self.controller.reset(self.load_cell.value)
 

@@ -32,11 +32,15 @@ Eq. 10) with its typo corrected: ``D = (t - t0) / (t1 - t0)``.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass
 from enum import Enum
 from pathlib import Path
 
-from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rpm_to_rad_s
+from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rad_s_to_rpm, rpm_to_rad_s
+from bearing_rig_sim.rig.loading import LoadingChainConfig
+from bearing_rig_sim.rig.parameters import RIG_FILE
+from bearing_rig_sim.rig.spindle import SpindleConfig
 
 STABILITY_CRITERIA = ("time", "axial_load")
 """Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
@@ -213,71 +217,166 @@ class TestProgram:
         return sum(seg.longest_duration(v0) for seg, v0 in zip(self.segments, self.start_speeds()))
 
 
-def load_program(
-    path: str | Path, *, max_speed_rpm: float | None = None, max_axial_load_n: float | None = None
-) -> TestProgram:
-    """Read and validate a test program.
+MAX_RAMP_S: float = 600.0
+"""Longest speed change of one segment (STEP ramp, or speed change over acceleration), s: ten
+minutes, far beyond the paper's 1-2 s ramps and 75 s run-ups; bounds a tiny acceleration."""
+MAX_DWELL_S: float = 3600.0
+"""Longest hold of one segment, s (one hour: a bag of some 2 GB at the rig's traffic)."""
+MAX_TIMEOUT_S: float = 3600.0
+"""Longest ``until_stable`` wait of one segment, s."""
+MAX_SEGMENTS: int = 1000
+"""Most segments in one program."""
+STEP_PEAK_FACTOR: float = 1.5
+"""Peak over mean acceleration of the STEP ramp: ``6 D (1 - D)`` is 1.5 at ``D = 1/2``."""
+NAME_PATTERN = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,63}")
+"""Program and segment names: letters, digits, ``_ . -``; at most 64 characters (they name
+bag directories and CSV rows)."""
+
+
+@dataclass(frozen=True)
+class RigLimits:
+    """What the rig a program runs on accepts (SI units)."""
+
+    max_speed_rad_s: float
+    """Highest inner-ring speed of the spindle drive, rad/s (``spindle.max_speed_rad_s``)."""
+    max_acceleration_rad_s2: float
+    """Highest angular acceleration of the drive, rad/s^2 (``spindle.max_acceleration_rad_s2``)."""
+    max_axial_load_n: float
+    """Largest axial-load set-point of the loading chain, N (``loading_chain.max_setpoint_n``)."""
+    source: str = RIG_FILE
+    """The rig file the limits come from (for messages)."""
+
+    @classmethod
+    def from_rig_file(cls, path: str | Path | None = None) -> RigLimits:
+        """The limits of a rig file (default: the shipped ``config/rig.yaml``).
+
+        Raises:
+            ConfigError: the rig file's ``spindle`` or ``loading_chain`` section is invalid.
+        """
+        spindle = SpindleConfig.from_yaml(path)
+        chain = LoadingChainConfig.from_yaml(path)
+        name = Path(path).name if path is not None else RIG_FILE
+        return cls(spindle.max_speed_rad_s, spindle.max_acceleration_rad_s2, chain.max_setpoint_n, name)
+
+
+def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
+    """Read and validate a test program against the rig it will run on.
 
     Args:
         path: the program's YAML file.
-        max_speed_rpm: the rig's highest spindle speed, rpm; None: no upper bound.
-        max_axial_load_n: the loading chain's largest set-point, N; None: no upper bound.
+        rig: the rig's limits; None: the shipped ``config/rig.yaml``.
 
     Raises:
-        ConfigError: naming the file, the key (``segments[2].axial_load_n``) and what was allowed.
+        ConfigError: naming the file, the key (``segments[2].axial_load_n``), the segment and the
+            limit that was exceeded.
     """
+    rig = rig if rig is not None else RigLimits.from_rig_file()
     doc = load_yaml(path)
     doc.reject_unknown(PROGRAM_KEYS)
+    name = _name(doc, "name")
     bearing = doc.string("bearing")
     bearing_file = config_path(*Path(bearing).parts) if not Path(bearing).is_absolute() else Path(bearing)
     if not bearing_file.is_file():
         raise doc.error("bearing", f"bearing file not found: {bearing!r} (looked for {bearing_file})")
-    initial = doc.number("initial_speed_rpm", ge=0.0, le=max_speed_rpm, default=0.0)
-    segments = tuple(_segment(s, max_speed_rpm, max_axial_load_n) for s in doc.sections("segments"))
+    max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
+    initial = doc.number("initial_speed_rpm", ge=0.0, default=0.0)
+    if initial > max_rpm * (1.0 + 1e-12):
+        raise doc.error("initial_speed_rpm", f"{initial:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})")
+    sections = doc.sections("segments")
+    if len(sections) > MAX_SEGMENTS:
+        raise doc.error("segments", f"at most {MAX_SEGMENTS} segments, got {len(sections)}")
+    segments: list[Segment] = []
+    start_speed = rpm_to_rad_s(initial)
     seen: set[str] = set()
-    for i, seg in enumerate(segments):
+    for i, section in enumerate(sections):
+        seg = _segment(section, rig, start_speed)
         if seg.name in seen:
             raise ConfigError(doc.source, f"segments[{i}].name", f"duplicate segment name {seg.name!r}")
         seen.add(seg.name)
+        segments.append(seg)
+        start_speed = seg.target_speed
     description = doc.data.get("description", "")
     if not isinstance(description, str):
         raise doc.error("description", f"must be a string, got {description!r}")
     return TestProgram(
-        name=doc.string("name"),
+        name=name,
         description=description.strip(),
         bearing_file=bearing_file,
         stability_criterion=doc.choice("stability_criterion", STABILITY_CRITERIA),
         initial_speed=rpm_to_rad_s(initial),
-        segments=segments,
+        segments=tuple(segments),
         source=doc.source,
     )
 
 
-def _segment(s: Section, max_speed_rpm: float | None, max_load_n: float | None) -> Segment:
-    """One validated segment."""
+def _name(s: Section, key: str) -> str:
+    value = s.string(key)
+    if not NAME_PATTERN.fullmatch(value):
+        raise s.error(key, f"must be 1-64 letters, digits, '_', '.' or '-' (starting with a letter or digit), got {value!r}")
+    return value
+
+
+def _limit(rig: RigLimits, key: str) -> str:
+    return f"{key} in {rig.source}"
+
+
+def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
+    """One validated segment, starting from ``start_speed`` (rad/s)."""
     s.reject_unknown(SEGMENT_KEYS)
-    name = s.string("name")
+    name = _name(s, "name")
+
+    def beyond(key: str, problem: str) -> ConfigError:
+        return s.error(key, f"segment {name!r}: {problem}")
+
     if "speed_rpm" not in s.data:
-        raise s.error("speed_rpm", "missing (required): the target speed, with ramp_s or acceleration_rad_s2")
-    speed = rpm_to_rad_s(s.number("speed_rpm", ge=0.0, le=max_speed_rpm))
+        raise beyond("speed_rpm", "missing (required): the target speed, with ramp_s or acceleration_rad_s2")
+    rpm = s.number("speed_rpm", ge=0.0)
+    max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
+    if rpm > max_rpm * (1.0 + 1e-12):
+        raise beyond("speed_rpm", f"{rpm:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})")
+    speed = rpm_to_rad_s(rpm)
+    change = abs(speed - start_speed)
     if "ramp_s" in s.data and "acceleration_rad_s2" in s.data:
-        raise s.error("acceleration_rad_s2", "give either ramp_s (STEP ramp) or acceleration_rad_s2, not both")
+        raise beyond("acceleration_rad_s2", "give either ramp_s (STEP ramp) or acceleration_rad_s2, not both")
+    max_accel = rig.max_acceleration_rad_s2
+    accel_limit = f"the rig's limit of {max_accel:g} rad/s^2 ({_limit(rig, 'spindle.max_acceleration_rad_s2')})"
     if "acceleration_rad_s2" in s.data:
         profile, ramp, accel = SpeedProfileKind.CONSTANT_ACCELERATION, 0.0, s.number("acceleration_rad_s2", gt=0.0)
+        if accel > max_accel:
+            raise beyond("acceleration_rad_s2", f"{accel:g} rad/s^2 is above {accel_limit}")
+        if change / accel > MAX_RAMP_S:
+            raise beyond(
+                "acceleration_rad_s2",
+                f"{accel:g} rad/s^2 takes {change / accel:.3g} s for the speed change, more than the {MAX_RAMP_S:g} s allowed",
+            )
     else:
-        profile, ramp, accel = SpeedProfileKind.STEP, s.number("ramp_s", ge=0.0, default=0.0), 0.0
-    load = s.number("axial_load_n", ge=0.0, le=max_load_n)
+        profile, ramp, accel = SpeedProfileKind.STEP, s.number("ramp_s", ge=0.0, le=MAX_RAMP_S, default=0.0), 0.0
+        if change > 0.0 and ramp == 0.0:
+            raise beyond("ramp_s", f"the speed changes by {rad_s_to_rpm(change):g} rpm: give ramp_s > 0 (a jump exceeds {accel_limit})")
+        if change > 0.0 and STEP_PEAK_FACTOR * change / ramp > max_accel:
+            shortest = STEP_PEAK_FACTOR * change / max_accel
+            raise beyond(
+                "ramp_s",
+                f"{ramp:g} s gives a peak acceleration of {STEP_PEAK_FACTOR * change / ramp:.4g} rad/s^2, above "
+                f"{accel_limit}; the shortest ramp is {shortest:.3g} s",
+            )
+    load = s.number("axial_load_n", ge=0.0)
+    if load > rig.max_axial_load_n:
+        raise beyond(
+            "axial_load_n",
+            f"{load:g} N is above the rig's limit of {rig.max_axial_load_n:g} N ({_limit(rig, 'loading_chain.max_setpoint_n')})",
+        )
     until_stable = s.boolean("until_stable", default=False)
     if "until_stable" in s.data and not until_stable:
-        raise s.error("until_stable", "must be true when given; use dwell_s for a fixed duration")
+        raise beyond("until_stable", "must be true when given; use dwell_s for a fixed duration")
     if until_stable:
         if "dwell_s" in s.data:
-            raise s.error("dwell_s", "give either dwell_s or until_stable, not both")
-        dwell, timeout = None, s.number("timeout_s", gt=0.0)
+            raise beyond("dwell_s", "give either dwell_s or until_stable, not both")
+        dwell, timeout = None, s.number("timeout_s", gt=0.0, le=MAX_TIMEOUT_S)
     else:
         if "timeout_s" in s.data:
-            raise s.error("timeout_s", "only with until_stable: true")
+            raise beyond("timeout_s", "only with until_stable: true")
         if "dwell_s" not in s.data:
-            raise s.error("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
-        dwell, timeout = s.number("dwell_s", gt=0.0), None
+            raise beyond("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
+        dwell, timeout = s.number("dwell_s", gt=0.0, le=MAX_DWELL_S), None
     return Segment(name, speed, profile, ramp, accel, load, dwell, until_stable, timeout)

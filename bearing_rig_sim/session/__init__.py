@@ -15,6 +15,6 @@ simulation clock, recorded to a bag, shown live and summarised.
 Importing this package does not import ROS; :func:`run_session` does, when it starts.
 """
 
-from bearing_rig_sim.session.session import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, SessionOptions, run_session
+from bearing_rig_sim.session.session import EXIT_CONDITIONS, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_OK, SessionOptions, run_session
 
-__all__ = ["EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
+__all__ = ["EXIT_CONDITIONS", "EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]

@@ -5,7 +5,9 @@ bag goes to ``<bag dir>/<run id>/``. The context (:func:`run_context`) travels i
 metadata as string key/value pairs, so a bag says how it was made:
 
 * ``program``, ``program_file``: the test program's text and where it was read;
-* ``bearing``, ``bearing_file``: the bearing data file's text and path;
+* ``bearing``, ``bearing_file``: the bearing data file's text and path: the program's ``bearing``,
+  which :func:`node_parameters` hands to the simulator and the monitor, so it is the bearing the
+  run simulated;
 * ``calibration/<file>``: every file of ``config/calibration/`` named after the bearing file
   (``h7006c_*``: the calibration the simulator applies, with its data);
 * ``rig``: ``config/rig.yaml`` (loading chain, sensors);
@@ -25,10 +27,34 @@ from collections.abc import Mapping, Sequence
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.rig.program import TestProgram
 
-__all__ = ["NODE_PARAMETER_FILES", "make_run_id", "run_context"]
+__all__ = ["NODE_PARAMETER_FILES", "make_run_id", "node_parameters", "run_context"]
 
 NODE_PARAMETER_FILES = ("simulator", "load_controller", "monitor")
 """Nodes whose ``config/<node>.yaml`` is recorded."""
+
+
+def node_parameters(program: TestProgram, simulator_defaults: Mapping[str, object]) -> dict[str, dict[str, str]]:
+    """``-p`` overrides per node that make the nodes use the program's bearing file.
+
+    The simulator and the monitor read their bearing file from their parameters; a program that
+    names another one gets it passed to both. The shipped calibration belongs to the bearing the
+    simulator's parameters name, so with another bearing the run is uncalibrated
+    (``calibration_file`` empty) rather than calibrated for a different bearing.
+
+    Args:
+        program: the validated program.
+        simulator_defaults: the simulator's shipped parameter values (``bearing_file`` relative
+            to ``config/`` unless absolute).
+    """
+    shipped = Path(str(simulator_defaults.get("bearing_file", "")))
+    shipped = shipped if shipped.is_absolute() else config_path(*shipped.parts)
+    if shipped.resolve() == program.bearing_file.resolve():
+        return {}
+    bearing = str(program.bearing_file.resolve())
+    return {
+        "simulator": {"bearing_file": bearing, "calibration_file": ""},
+        "monitor": {"bearing_file": bearing},
+    }
 
 
 def make_run_id(program_name: str, start: datetime) -> str:
@@ -72,7 +98,7 @@ def run_context(
         "rig": _text(config_path("rig.yaml")),
     }
     calibration = config_path("calibration")
-    if calibration.is_dir():
+    if calibration.is_dir() and not (extra or {}).get("calibration") == "none":
         for path in sorted(calibration.glob(f"{program.bearing_file.stem}_*")):
             if path.is_file():
                 context[f"calibration/{path.name}"] = _text(path)

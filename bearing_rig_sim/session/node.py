@@ -13,9 +13,10 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
+from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
-from collections.abc import Callable
 
 from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
 from diagnostic_msgs.msg import DiagnosticArray
@@ -28,6 +29,7 @@ from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
+from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
@@ -37,6 +39,9 @@ __all__ = ["DRAIN_PERIOD_S", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
 
 DRAIN_PERIOD_S = 0.02
 """Wall time between two takes of the recorder's queues, s."""
+
+MAX_CLOCK_EVENTS = 10
+"""Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
 RECORDER_DEPTH = 5000
 """Reader queue depth of each recorded topic: 5 s of a 1 kHz topic in real time, 1 s at 5x."""
@@ -132,9 +137,14 @@ class SessionNode(Node):
         self.sim_time_ns = 0
         """Stamp of the last ``/clock`` taken, ns."""
         self.clock_count = 0
-        """``/clock`` messages taken."""
+        """``/clock`` messages taken (and accepted by :attr:`clock_guard`)."""
+        self.clock_guard = ClockGuard()
+        """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
+        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter()}
+        """Serialized commands and set-points this session published, not yet seen by its recorder:
+        any other on those topics came from outside and marks the running segment."""
 
     def close(self) -> None:
         """Destroy the recorder's node (the session node is destroyed by its owner)."""
@@ -150,8 +160,11 @@ class SessionNode(Node):
         command.profile = plan.segment.profile.message_code
         command.ramp_time = plan.segment.ramp_time
         command.acceleration = plan.segment.acceleration
+        setpoint = Float64(data=plan.segment.axial_load)
+        self._own[SPINDLE_COMMAND.name][repr(command)] += 1
+        self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._spindle.publish(command)
-        self._setpoint.publish(Float64(data=plan.segment.axial_load))
+        self._setpoint.publish(setpoint)
 
     # -- readiness --------------------------------------------------------------------------------
     def subscribers_besides_recorder(self, topic: str) -> int:
@@ -195,7 +208,10 @@ class SessionNode(Node):
         for _, _, name, raw, msgtype in batch:
             if name == CLOCK.name:
                 stamp = header_stamp_ns(raw)
-                if stamp is not None:
+                verdict = self.clock_guard.check(stamp) if stamp is not None else None
+                if verdict is not None and verdict.note and self.clock_guard.refused <= MAX_CLOCK_EVENTS:
+                    self.on_event(verdict.note if self.clock_guard.refused < MAX_CLOCK_EVENTS else f"{verdict.note}; further ones only counted")
+                if stamp is not None and verdict is not None and verdict.accepted:
                     self.sim_time_ns = stamp
                     self.clock_count += 1
             else:
@@ -222,6 +238,13 @@ class SessionNode(Node):
         return self.sim_time_ns * 1e-9
 
     def _observe(self, name: str, raw: bytes, msgtype: type) -> None:
+        own = self._own.get(name)
+        if own is not None:
+            key = repr(deserialize_message(raw, msgtype))  # the fields, whatever the serializer's padding
+            if own[key] > 0:
+                own[key] -= 1
+            else:
+                self.runner.observe_disturbance(self.sim_time, f"a message on {name} not sent by this session")
         if name == SPEEDS.name:
             self.live.speeds_raw = raw
         elif name == SLIP_STATUS.name:
@@ -242,6 +265,7 @@ class SessionNode(Node):
         elif name == AXIAL_LOAD_STATE.name:
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1
+            self.runner.observe_axial_setpoint(from_stamp(msg.header.stamp), msg.setpoint)
             self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
         elif name == DIAGNOSTICS.name:
             self._diagnostics_events(deserialize_message(raw, msgtype))

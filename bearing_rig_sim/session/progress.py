@@ -81,28 +81,41 @@ def format_progress(snap: ProgressSnapshot) -> str:
     )
 
 
-SUMMARY_COLUMNS = ("#", "segment", "speed rpm", "load N", "F_bearing N", "slip % meas", "slip % truth", "verdict", "t_stable s")
-_LEFT = {"segment", "verdict"}
+SUMMARY_COLUMNS = (
+    "#", "segment", "speed rpm", "meas rpm", "load N", "F_bearing N", "slip % meas", "slip % truth", "verdict",
+    "t_stable s", "conditions",
+)
+_LEFT = {"segment", "verdict", "conditions"}
+
+
+def condition_marks(outcome: SegmentOutcome) -> str:
+    """The ``conditions`` cell: ``ok``, or what was off (``speed``, ``load``, ``disturbed``)."""
+    marks = [kind for kind in ("speed", "load", "disturbed") if any(c.startswith(kind) for c in outcome.conditions)]
+    return ",".join(marks) or "ok"
 
 
 def format_summary(outcomes: Sequence[SegmentOutcome]) -> str:
     """The summary table, one row per segment, columns aligned (numbers right, words left).
 
-    ``speed rpm`` is the segment's target speed; ``load N`` its set-point; ``F_bearing N`` the mean
-    force on the bearing after the ramp; the slips are the monitor's and the simulator's truth
-    over the same window; ``t_stable s`` the time from the ramp end to the stable verdict.
+    ``speed rpm`` is the segment's target speed, ``meas rpm`` the monitor's measured speed after
+    the ramp; ``load N`` its set-point, ``F_bearing N`` the mean force on the bearing once settled;
+    the slips are the monitor's and the simulator's truth over the same window; ``t_stable s`` the
+    time from the ramp end to the stable verdict; ``conditions`` ``ok``, or what was off (the
+    lines under the table say how).
     """
     rows = [
         [
             str(o.index + 1),
             o.name,
             f"{rad_s_to_rpm(o.target_speed):.0f}",
+            _number(None if o.measured_speed is None else rad_s_to_rpm(o.measured_speed), ".0f"),
             f"{o.axial_load:g}",
             _number(o.bearing_force, ".1f"),
             _number(o.measured_slip, ".3f"),
             _number(o.truth_slip, ".3f"),
             o.verdict.value,
             _number(o.time_to_stable, ".2f"),
+            condition_marks(o),
         ]
         for o in outcomes
     ]
@@ -115,6 +128,10 @@ def format_summary(outcomes: Sequence[SegmentOutcome]) -> str:
     out.extend(line(r) for r in rows)
     if not rows:
         out.append("(no segment ran)")
+    off = [o for o in outcomes if o.conditions]
+    if off:
+        out.append("")
+        out.extend(f"conditions not met in segment {o.index + 1} {o.name}: {'; '.join(o.conditions)}" for o in off)
     return "\n".join(out)
 
 

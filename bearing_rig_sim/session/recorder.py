@@ -8,6 +8,10 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
 
 1. the message's own stamp when it has one (``header.stamp``; ``clock`` for ``/clock``): the first
    ``builtin_interfaces/Time`` after the 4-byte CDR encapsulation header, read without decoding;
+   a ``/clock`` stamp the :class:`~bearing_rig_sim.clock_guard.ClockGuard` refuses (negative, or a
+   jump back or far ahead that the next stamps do not confirm) is recorded at the time of the
+   last accepted ``/clock`` and does not move the rule's clock: a stray publisher cannot put the
+   bag's timeline in 2038;
 2. else (``std_msgs/Float64`` set-points), or when the stamp is zero (not set) or more than
    :data:`PLAUSIBLE_SPAN_NS` away from the last ``/clock`` (a wall-clock stamp from some other
    publisher), the time of the last ``/clock`` received before it;
@@ -25,6 +29,8 @@ from typing import Protocol
 from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
+
+from bearing_rig_sim.clock_guard import ClockGuard
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",
@@ -47,6 +53,9 @@ RECORDED_TOPICS: tuple[Topic, ...] = TOPICS
 """Every topic of the interface contract (services are not recorded)."""
 
 CLOCK_TOPIC = CLOCK.name
+
+MAX_CLOCK_NOTES = 20
+"""Most notes about refused ``/clock`` stamps kept (the count is kept whole)."""
 
 
 class MessageWriter(Protocol):
@@ -81,14 +90,22 @@ class LogTimeRule:
         """Time of the last ``/clock`` seen, ns (0 before the first)."""
         self.clock_count = 0
         """``/clock`` messages seen."""
+        self.clock_guard = ClockGuard()
+        """Validates each ``/clock`` stamp; its ``refused`` counts the stamps kept off the timeline."""
+        self.clock_notes: list[str] = []
+        """The guard's notes (refusals, confirmed jumps), the first :data:`MAX_CLOCK_NOTES`."""
 
     def sim_time_ns(self, topic: RecordedTopic, data: bytes | bytearray | memoryview) -> int:
         """The message's sim time, ns; a ``/clock`` message also advances the rule's clock."""
         stamp = header_stamp_ns(data) if topic.stamped else None
         if topic.name == CLOCK_TOPIC:
-            if stamp is not None and stamp >= 0:
-                self.last_clock_ns = stamp
-                self.clock_count += 1
+            if stamp is not None:
+                verdict = self.clock_guard.check(stamp)
+                if verdict.note and len(self.clock_notes) < MAX_CLOCK_NOTES:
+                    self.clock_notes.append(verdict.note)
+                if verdict.accepted:
+                    self.last_clock_ns = stamp
+                    self.clock_count += 1
             return self.last_clock_ns
         if stamp is None or stamp <= 0 or abs(stamp - self.last_clock_ns) > self.plausible_span_ns:
             return self.last_clock_ns

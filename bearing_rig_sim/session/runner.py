@@ -27,7 +27,16 @@ Rules (simulation time throughout, s):
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
   two are compared over the same stretch of time. Bearing force: mean of the load controller's
-  bearing force after the ramp end.
+  bearing force once the load has settled (after the ramp end and at least
+  :data:`LOAD_SETTLE_S` after the load controller's state first shows the segment's set-point).
+  Measured speed: the monitor's inner-ring speed in the deciding status (else the segment's last),
+  when it is stamped after the ramp end.
+* Conditions: a segment whose measured speed or bearing force is off the commanded one by more
+  than the tolerance (:func:`speed_tolerance`, :func:`~bearing_rig_sim.load_control.settle_band`),
+  or during which a command, a set-point or the load controller's set-point came from outside
+  the session (:meth:`ProgramRunner.observe_disturbance`,
+  :meth:`ProgramRunner.observe_axial_setpoint`), is marked: its ``conditions`` say what, and the
+  session's exit status says so. Its verdict is what the monitor said, under other conditions.
 """
 
 from __future__ import annotations
@@ -37,6 +46,8 @@ from collections import deque
 from dataclasses import dataclass, field
 from enum import Enum, IntEnum
 
+from bearing_rig_sim.config import rad_s_to_rpm
+from bearing_rig_sim.load_control import settle_band
 from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
 
 __all__ = [
@@ -50,6 +61,22 @@ __all__ = [
 
 TRUTH_HISTORY = 6000
 """True-slip samples kept (60 s at the simulator's 100 Hz): enough for any status window."""
+
+LOAD_SETTLE_S = 0.5
+"""Sim time after a segment's start before its load is judged, s: the loading chain's stated
+settle bound is under 0.37 s for any step within 0-1000 N (``settle_time_bound``), and a set-point
+sent at the start reaches the load controller within this too."""
+
+SPEED_TOLERANCE_FRACTION = 0.01
+"""The measured speed may differ from the commanded by 1 % ..."""
+SPEED_TOLERANCE_RAD_S = 1.0
+"""... or by 1 rad/s (9.5 rpm), whichever is wider: the pulse counter's resolution near rest."""
+
+
+def speed_tolerance(target_speed: float) -> float:
+    """Largest difference between measured and commanded inner-ring speed still meeting the
+    segment's conditions, rad/s."""
+    return max(SPEED_TOLERANCE_FRACTION * target_speed, SPEED_TOLERANCE_RAD_S)
 
 
 class StatusState(IntEnum):
@@ -159,7 +186,17 @@ class SegmentOutcome:
     truth_slip: float | None
     """Simulator's true slip over the same window, %."""
     bearing_force: float | None
-    """Mean axial force on the bearing after the ramp end, N."""
+    """Mean axial force on the bearing once settled (see the module documentation), N."""
+    measured_speed: float | None = None
+    """Mean inner-ring speed the monitor measured after the ramp end, rad/s."""
+    conditions: tuple[str, ...] = ()
+    """What was off: speed or load not as commanded, disturbances from outside; empty when the
+    segment ran under its own conditions."""
+
+    @property
+    def conditions_met(self) -> bool:
+        """Nothing was off."""
+        return not self.conditions
 
 
 @dataclass
@@ -174,6 +211,9 @@ class _SegmentData:
     statuses: int = field(default=0)
     unsettled_after_ramp: bool = False
     """A status other than stable, stamped after the ramp end, has come."""
+    disturbances: list[str] = field(default_factory=list)
+    setpoint_seen: float | None = None
+    """When the load controller's state first showed the segment's set-point, s of sim time."""
 
 
 class ProgramRunner:
@@ -274,12 +314,18 @@ class ProgramRunner:
             time_to_stable: float | None = data.stable.time - plan.ramp_end
         else:
             time_to_stable = None
+        settled = data.force_count > 0
         if data.force_count:
             force: float | None = data.force_sum / data.force_count
         elif data.force_count_all:
             force = data.force_sum_all / data.force_count_all
         else:
             force = None
+        measured_speed = (
+            decisive.inner_ring_speed
+            if decisive is not None and decisive.time >= plan.ramp_end and math.isfinite(decisive.inner_ring_speed)
+            else None
+        )
         outcome = SegmentOutcome(
             index=plan.index,
             name=plan.segment.name,
@@ -293,6 +339,8 @@ class ProgramRunner:
             measured_slip=decisive.slip_rate if decisive is not None else None,
             truth_slip=self.truth_slip_over(decisive) if decisive is not None else None,
             bearing_force=force,
+            measured_speed=measured_speed,
+            conditions=_conditions(plan.segment, measured_speed, force if settled else None, data.disturbances, verdict),
         )
         self.outcomes.append(outcome)
         self._data = None
@@ -330,9 +378,36 @@ class ProgramRunner:
             return
         data.force_sum_all += bearing_force
         data.force_count_all += 1
-        if time >= data.plan.ramp_end:
+        seen = data.setpoint_seen
+        if seen is not None and time >= max(data.plan.ramp_end, seen + LOAD_SETTLE_S):
             data.force_sum += bearing_force
             data.force_count += 1
+
+    def observe_axial_setpoint(self, time: float, setpoint: float) -> None:
+        """The load controller's set-point in force (N) at ``time`` (s of sim time), from its
+        state. The segment's own set-point starts the load's settling time (the simulator may run
+        ahead of the session, so the set-point can arrive well after the segment's start in sim
+        time); any other, once the segment's was seen, or one that is neither the segment's nor
+        the previous segment's, was set from outside."""
+        data = self._data
+        if data is None or time < data.plan.start_time:
+            return
+        own = data.plan.segment.axial_load
+        if setpoint == own:
+            if data.setpoint_seen is None:
+                data.setpoint_seen = time
+            return
+        index = data.plan.index
+        previous = self.program.segments[index - 1].axial_load if index > 0 else None
+        if data.setpoint_seen is not None or (previous is not None and setpoint != previous):
+            self.observe_disturbance(time, f"the load controller's set-point was {setpoint:g} N, not the program's {own:g} N")
+
+    def observe_disturbance(self, time: float, what: str) -> None:
+        """Something from outside the session changed the rig's conditions at ``time`` (s of sim
+        time): the running segment is marked (each distinct ``what`` once)."""
+        data = self._data
+        if data is not None and what not in data.disturbances:
+            data.disturbances.append(what)
 
     def truth_slip_over(self, status: SlipObservation) -> float | None:
         """Mean true slip (%) over the window of ``status``; the last sample at or before its
@@ -343,3 +418,21 @@ class ProgramRunner:
             return sum(inside) / len(inside)
         before = [s for t, s in self._truth if t <= status.time]
         return before[-1] if before else None
+
+
+def _conditions(
+    segment: Segment, measured_speed: float | None, bearing_force: float | None, disturbances: list[str], verdict: Verdict
+) -> tuple[str, ...]:
+    """What was off in a segment (see the module documentation). An interrupted segment's speed
+    and load are not judged, nor a measurement that is missing (a segment shorter than
+    :data:`LOAD_SETTLE_S` has no settled load)."""
+    off: list[str] = []
+    if verdict is not Verdict.INTERRUPTED:
+        target = segment.target_speed
+        if measured_speed is not None and abs(measured_speed - target) > speed_tolerance(target):
+            off.append(f"speed {rad_s_to_rpm(measured_speed):.0f} rpm measured, {rad_s_to_rpm(target):.0f} rpm commanded")
+        load = segment.axial_load
+        if bearing_force is not None and abs(bearing_force - load) > settle_band(load):
+            off.append(f"load {bearing_force:.1f} N on the bearing, {load:g} N commanded")
+    off.extend(f"disturbed: {what}" for what in disturbances)
+    return tuple(off)

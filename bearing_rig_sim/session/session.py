@@ -44,12 +44,11 @@ from types import FrameType
 from typing import Any, TextIO
 from collections.abc import Sequence
 
-from bearing_rig_sim.config import rad_s_to_rpm
+from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bags import BagWriter
-from bearing_rig_sim.rig.loading import LoadingChainConfig
 from bearing_rig_sim.rig.program import TestProgram, load_program
-from bearing_rig_sim.session.context import make_run_id, run_context
+from bearing_rig_sim.session.context import make_run_id, node_parameters, run_context
 from bearing_rig_sim.session.lifecycle import TransitionRecord, bring_up, shut_down
 from bearing_rig_sim.session.processes import (
     NODES,
@@ -65,9 +64,12 @@ from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, 
 from bearing_rig_sim.session.recorder import SessionRecorder
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentOutcome, SegmentPlan
 
-__all__ = ["EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
+__all__ = ["EXIT_CONDITIONS", "EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
 
-EXIT_OK, EXIT_FAILED, EXIT_INTERRUPTED = 0, 1, 130
+EXIT_OK, EXIT_FAILED, EXIT_CONDITIONS, EXIT_INTERRUPTED = 0, 1, 3, 130
+"""Exit statuses: all segments ran under their conditions; a node or the session failed; the
+program ran to its end but some segment's speed or load was not as commanded, or was changed from
+outside (the summary marks which); stopped by a signal."""
 
 CHUNK_SIZE = 256 * 1024
 """Uncompressed bytes per bag chunk: about 0.5 s of the rig's traffic, the most a killed session
@@ -121,11 +123,14 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     """
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
-    chain = LoadingChainConfig.from_yaml()
-    program = load_program(options.program, max_axial_load_n=chain.max_setpoint_n)
+    program = load_program(options.program)  # checked against the shipped rig, as the nodes use it
     commands = {} if options.attach else {name: node_command(spec) for name, spec in NODES.items()}
+    simulator_defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
+    overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime and not options.attach:
-        commands["simulator"] = commands["simulator"] + ["--ros-args", "-p", "realtime:=false"]
+        overrides.setdefault("simulator", {})["realtime"] = "false"
+    for name, values in overrides.items():
+        commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
     if options.params_file is not None:
         params = Path(options.params_file)
         if not params.is_file():
@@ -142,7 +147,11 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         run_id=run_id,
         start=start,
         command_line=options.command_line or sys.argv,
-        extra={"ros_domain_id": env["ROS_DOMAIN_ID"], "realtime": str(options.realtime).lower()},
+        extra={
+            "ros_domain_id": env["ROS_DOMAIN_ID"],
+            "realtime": str(options.realtime).lower(),
+            **({"calibration": "none"} if overrides.get("simulator", {}).get("calibration_file") == "" else {}),
+        },
     )
     try:
         writer: Any = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE) if options.record else _NoBag(bag_path)
@@ -354,7 +363,11 @@ class _Session:
         for plan in started:
             self._start_segment(plan)
         if self.runner.finished:
-            self._end(EXIT_OK)
+            off = [o.name for o in self.runner.outcomes if o.conditions]
+            if off:
+                self._end(EXIT_CONDITIONS, f"conditions not met in {len(off)} segment(s): {', '.join(off)}")
+            else:
+                self._end(EXIT_OK)
 
     def _bring_up(self) -> bool:
         """Drive the lifecycle bring-up; True once every node is active."""
@@ -502,9 +515,16 @@ class _Session:
         status = EXIT_FAILED if self.status is None else self.status
         if status == EXIT_FAILED:
             self.err.write(f"bearing-rig run: {self.failure}\n")
+        elif status == EXIT_CONDITIONS:
+            self.err.write(f"bearing-rig run: {self.failure} (see the summary)\n")
         elif status == EXIT_INTERRUPTED:
             self.err.write(f"bearing-rig run: {self.failure}; the summary so far and the bag are complete to this point\n")
-        heading = {EXIT_OK: "summary", EXIT_INTERRUPTED: "summary (interrupted)", EXIT_FAILED: "summary (failed)"}[status]
+        heading = {
+            EXIT_OK: "summary",
+            EXIT_CONDITIONS: "summary (conditions not met)",
+            EXIT_INTERRUPTED: "summary (interrupted)",
+            EXIT_FAILED: "summary (failed)",
+        }[status]
         self.out.write(f"\n{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n")
         self.out.write(format_summary(self.runner.outcomes) + "\n")
         counts = self.recorder.counts
@@ -518,5 +538,12 @@ class _Session:
             f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "
             f"{self.writer.path / 'logs'}\n"
         )
+        rule = self.recorder.rule
+        if rule.clock_guard.refused or rule.clock_guard.jumps:
+            first = f"; first: {rule.clock_notes[0]}" if rule.clock_notes else ""
+            self.out.write(
+                f"clock: {rule.clock_guard.refused} /clock stamp(s) refused (kept off the bag's timeline), "
+                f"{rule.clock_guard.jumps} confirmed jump(s){first}\n"
+            )
         self.out.flush()
         return status

@@ -10,12 +10,13 @@ File parameters (bearing, calibration, rig) are relative to ``config/`` unless a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar
 
 from bearing_rig_sim.config import NodeSettingsFile, Section, config_path
 from bearing_rig_sim.dynamics.engine import MODELS
+from bearing_rig_sim.rig.spindle import SpindleConfig
 
 NODE_NAME = "simulator"
 """The simulator node's name: the key of its block in a ROS 2 parameter file."""
@@ -53,8 +54,10 @@ class SimulatorSettings(NodeSettingsFile):
         rtf_window_s: sliding window of the real-time factor, wall s.
         initial_speed_rad_s: spindle speed at the start, rad/s.
         initial_axial_load_n: axial load until the first force message, N.
-        max_spindle_speed_rad_s: highest spindle target speed accepted, rad/s.
-        max_spindle_acceleration_rad_s2: highest constant acceleration accepted, rad/s^2.
+        max_spindle_speed_rad_s: highest spindle target speed accepted, rad/s (from the rig
+            file's ``spindle`` section, not a node parameter).
+        max_spindle_acceleration_rad_s2: highest constant acceleration accepted, rad/s^2 (from
+            the rig file's ``spindle`` section).
         max_command_lead_s: how far ahead of the rig clock a command's stamp may be, s.
         counter_timeout_s: the counters show 0 after this long without a pulse, s.
         speeds_rate_hz: rate of /rig/speeds, in simulated time, Hz (at most one per chunk).
@@ -96,7 +99,8 @@ class SimulatorSettings(NodeSettingsFile):
         Raises:
             ConfigError: naming the source, the key and the allowed range.
         """
-        names = [f for f in cls.__dataclass_fields__]
+        from_rig = ("max_spindle_speed_rad_s", "max_spindle_acceleration_rad_s2")
+        names = [f.name for f in fields(cls) if f.name not in from_rig]
         s.reject_unknown([*names, "use_sim_time"])
         files = {}
         for key in ("bearing_file", "calibration_file", "rig_file"):
@@ -107,11 +111,14 @@ class SimulatorSettings(NodeSettingsFile):
             if path is not None and not path.is_file():
                 raise s.error(key, f"file not found: {raw!r} (looked for {path})")
             files[key] = path
-        max_speed = s.number("max_spindle_speed_rad_s", gt=0.0)
+        bearing_file, rig_file = files["bearing_file"], files["rig_file"]
+        assert bearing_file is not None and rig_file is not None  # only calibration_file may be ""
+        spindle = SpindleConfig.from_yaml(rig_file)
+        max_speed = spindle.max_speed_rad_s
         return cls(
-            bearing_file=files["bearing_file"],
+            bearing_file=bearing_file,
             calibration_file=files["calibration_file"],
-            rig_file=files["rig_file"],
+            rig_file=rig_file,
             model=s.choice("model", MODELS),
             chunk_s=s.number("chunk_s", gt=0.0, le=0.1),
             realtime=s.boolean("realtime"),
@@ -124,7 +131,7 @@ class SimulatorSettings(NodeSettingsFile):
             initial_speed_rad_s=s.number("initial_speed_rad_s", ge=0.0, le=max_speed),
             initial_axial_load_n=s.number("initial_axial_load_n", ge=0.0),
             max_spindle_speed_rad_s=max_speed,
-            max_spindle_acceleration_rad_s2=s.number("max_spindle_acceleration_rad_s2", gt=0.0),
+            max_spindle_acceleration_rad_s2=spindle.max_acceleration_rad_s2,
             max_command_lead_s=s.number("max_command_lead_s", ge=0.0),
             counter_timeout_s=s.number("counter_timeout_s", gt=0.0),
             speeds_rate_hz=s.number("speeds_rate_hz", gt=0.0),

@@ -78,6 +78,7 @@ class TruthSummary:
     Speeds rad/s, acceleration rad/s^2, loads N, angles rad, displacement m, slip percent.
     ``slip_rate`` is NaN while the inner ring is at rest (the slip rate is undefined there).
     Contact angles are means over the balls with a non-zero contact load (NaN if none).
+    Friction torque N m and power loss W: the engine's dissipation at the chunk's last step.
     """
 
     time: float
@@ -96,6 +97,8 @@ class TruthSummary:
     outer_contact_angle: float
     inner_ring_axial_displacement: float
     step_count: int
+    friction_torque: float = 0.0
+    power_loss: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -373,4 +376,6 @@ class RigTwin:
             outer_contact_angle=_mean_where_loaded(obs.outer_contact_angles, qo),
             inner_ring_axial_displacement=obs.inner_ring_axial_displacement,
             step_count=self.step_count,
+            friction_torque=self.engine.friction_torque(),
+            power_loss=self.engine.power_loss(),
         )

@@ -1,10 +1,11 @@
 """Steady operating points of the engine, calibration to bench data, and prediction.
 
-The engine's uncertain parameters are the lubricant resistances (the paper's dry model has
-none; docs/paper.md section 12). :func:`calibrate` fits the chosen ones (by default the cage-land
-viscous scale and the ball-drag scale) to measured (inner-ring speed, axial load, slip) rows by
-nonlinear least squares on the logarithm of the scale factors, running the engine to a steady
-state at every row. The slip of the bench rows and of the engine is the paper's S_c (paper
+The engine's uncertain parameters are physical properties of the lubricant (the paper's dry
+model has none; docs/paper.md section 12). :func:`calibrate` fits at most two of them (by default the
+grease's yield stress and consistency, see :data:`PHYSICAL_RANGES`) to measured (inner-ring
+speed, axial load, slip) rows by nonlinear least squares on their logarithms, running the engine
+to a steady state at every row; a best fit outside a parameter's physically plausible range is
+an error, not a result. The slip of the bench rows and of the engine is the paper's S_c (paper
 Eq. 11-12) at the nominal contact angle, computed from cage and inner-ring speeds.
 """
 
@@ -29,12 +30,34 @@ from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.errors import RigError
 
-DEFAULT_FITTED: tuple[str, ...] = ("cage_land_viscous_scale", "ball_drag_scale")
-"""Parameters fitted by default: a viscous (speed-proportional) and a quadratic resistance, the
-two shapes the bench's slip-speed curve needs (slip = a + b n, docs/paper.md section 9)."""
+DEFAULT_FITTED: tuple[str, ...] = ("yield_stress", "consistency")
+"""Parameters fitted by default: the Herschel-Bulkley yield stress and consistency of the grease
+the balls and cage shear (a speed-independent and a speed-dependent resistance)."""
 
-DEFAULT_FIXED: dict[str, float] = {"stiction_velocity": 0.3}
-"""Held fixed during the fit (m/s): see ``config/calibration/h7006c_table3.yaml`` for why."""
+DEFAULT_FIXED: dict[str, float] = {}
+"""Held fixed during the fit."""
+
+MAX_FITTED = 2
+"""At most this many parameters are fitted (more are not identifiable from slip alone)."""
+
+
+@dataclass(frozen=True)
+class PhysicalRange:
+    """Unit, plausible interval and its reason, for a calibratable physical quantity."""
+
+    unit: str
+    low: float
+    high: float
+    reason: str
+
+
+PHYSICAL_RANGES: dict[str, PhysicalRange] = {
+    "yield_stress": PhysicalRange("Pa", 50.0, 2000.0, "rheometer yield stress of NLGI 1-3 lithium greases, sheared, 20-60 degC"),
+    "consistency": PhysicalRange("Pa s^n", 1.0, 100.0, "Herschel-Bulkley consistency of NLGI 1-3 lithium greases (flow index 0.3-0.7)"),
+    "fill_fraction": PhysicalRange("1", 0.02, 1.0, "share of the swept volume holding grease: channelled 0.02-0.1, running-in up to 1"),
+    "eyring_stress": PhysicalRange("Pa", 2e6, 1e7, "Eyring stress of mineral and ester base oils (Johnson and Tevaarwerk 1977)"),
+}
+"""Physical quantities :func:`calibrate` may fit, with their plausible ranges."""
 
 SETTLE_S = 0.15
 """Simulated settling time before averaging, s: the traction and pocket dynamics settle in a
@@ -64,6 +87,10 @@ class SteadyState:
     axial_load: float
     cage_speed: float
     slip_pct: float
+    friction_torque: float = math.nan
+    power_loss: float = math.nan
+    film_min_inner: float = math.nan
+    film_min_outer: float = math.nan
 
     def as_row(self) -> dict[str, float]:
         """The point at the edge: rpm, N, %."""
@@ -73,6 +100,18 @@ class SteadyState:
             "cage_rpm": round(rad_s_to_rpm(self.cage_speed), 4),
             "slip_pct": round(self.slip_pct, 4),
         }
+
+    def losses_row(self, composite_roughness: float = 0.0) -> dict[str, object]:
+        """Torque (N m), power (W), minimum films (um) and, with a composite roughness (m), the
+        film parameter lambda = h_min / sigma of the thinner contact."""
+        row: dict[str, object] = {
+            "friction_torque_nm": round(self.friction_torque, 6),
+            "power_loss_w": round(self.power_loss, 4),
+            "film_min_um": {"inner": round(self.film_min_inner * 1e6, 4), "outer": round(self.film_min_outer * 1e6, 4)},
+        }
+        if composite_roughness > 0.0:
+            row["lambda_ratio"] = round(min(self.film_min_inner, self.film_min_outer) / composite_roughness, 3)
+        return row
 
 
 @dataclass(frozen=True)
@@ -99,6 +138,8 @@ def read_bench_csv(path: str | Path) -> list[BenchPoint]:
         lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     except OSError as exc:
         raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     reader = csv.DictReader(lines)
     need = ("inner_ring_rpm", "axial_load_n", "slip_pct")
     if reader.fieldnames is None or any(k not in reader.fieldnames for k in need):
@@ -125,7 +166,8 @@ def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load:
     avg = engine.advance(AVERAGE_S)
     kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
     slip = float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
-    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip)
+    h_in, h_out = engine.minimum_films()
+    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip, engine.friction_torque(), engine.power_loss(), h_in, h_out)
 
 
 def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyState:
@@ -176,12 +218,43 @@ class _no_pool:
         return None
 
 
+LUBRICANT_FIELDS = ("yield_stress", "consistency", "fill_fraction", "eyring_stress")
+"""Calibratable names that are properties of the bearing's lubricant."""
+
+
 def with_values(params: BearingParameters, values: dict[str, float]) -> BearingParameters:
     """``params`` with calibratable fields replaced (names of :data:`CALIBRATABLE`)."""
     unknown = [k for k in values if k not in CALIBRATABLE]
     if unknown:
         raise CalibrationError(f"not calibratable: {', '.join(unknown)}; choose from {', '.join(CALIBRATABLE)}")
-    return params.replace(**values)
+    lub = {k: v for k, v in values.items() if k in LUBRICANT_FIELDS}
+    rest = {k: v for k, v in values.items() if k not in LUBRICANT_FIELDS}
+    out = params.replace(**rest) if rest else params
+    if lub:
+        if out.lubricant is None:
+            raise CalibrationError(f"{', '.join(lub)}: the bearing file names no lubricant file")
+        out = out.with_lubricant(**lub)
+    return out
+
+
+def current_value(params: BearingParameters, name: str) -> float:
+    """The value of a calibratable parameter in ``params``."""
+    if name in LUBRICANT_FIELDS:
+        if params.lubricant is None:
+            raise CalibrationError(f"{name}: the bearing file names no lubricant file")
+        return float(getattr(params.lubricant, name))
+    return float(getattr(params, name))
+
+
+def check_in_range(values: dict[str, float]) -> None:
+    """Raise :class:`CalibrationError` naming the first value outside its physical range."""
+    for name, value in values.items():
+        rng = PHYSICAL_RANGES.get(name)
+        if rng is not None and not rng.low <= value <= rng.high:
+            raise CalibrationError(
+                f"best fit of {name} = {value:.4g} {rng.unit} is outside its physical range [{rng.low:g}, {rng.high:g}] {rng.unit} "
+                f"({rng.reason}); nothing written: the model lacks a mechanism the data contain"
+            )
 
 
 def calibrate(
@@ -191,18 +264,24 @@ def calibrate(
     fixed: dict[str, float] | None = None,
     workers: int | None = None,
 ) -> CalibrationResult:
-    """Fit ``fitted`` scale parameters so the engine's steady slip matches ``points``.
+    """Fit ``fitted`` physical parameters so the engine's steady slip matches ``points``.
 
     Each parameter is fitted as its logarithm (it must stay positive), starting from its value
     in ``params``; ``fixed`` values are set first. The residuals are slip differences in
     percentage points.
+
+    Raises:
+        CalibrationError: more than :data:`MAX_FITTED` parameters, or a best fit outside the
+            parameter's :data:`PHYSICAL_RANGES` (the message names it).
     """
     if len(points) < len(fitted):
         raise CalibrationError(f"{len(points)} data rows cannot determine {len(fitted)} parameters")
+    if len(fitted) > MAX_FITTED:
+        raise CalibrationError(f"at most {MAX_FITTED} parameters can be fitted, got {len(fitted)}: {', '.join(fitted)}")
     fixed = dict(DEFAULT_FIXED if fixed is None else fixed)
     base = with_values(params, fixed)
     with_values(base, {k: 1.0 for k in fitted})  # validates the names
-    x0 = np.array([math.log(max(getattr(base, k), 1e-6)) for k in fitted])
+    x0 = np.array([math.log(max(current_value(base, k), 1e-6)) for k in fitted])
     target = np.array([pt.slip_pct for pt in points])
     evaluations = 0
 
@@ -224,12 +303,22 @@ def calibrate(
         final = with_values(base, values)
         predicted = steady_states(final, speeds_loads, 1, pool)
     rms = float(np.sqrt(np.mean((np.array([s.slip_pct for s in predicted]) - target) ** 2)))
+    check_in_range(values)
     return CalibrationResult(values, fixed, tuple(points), tuple(predicted), rms, evaluations, final)
 
 
 def write_calibration(result: CalibrationResult, path: str | Path, data_name: str) -> None:
-    """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``."""
-    params = {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": float(f"{v:.6g}") for k, v in {**result.fixed, **result.fitted}.items()}
+    """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``: each
+    fitted value as ``{value, unit, range, source}``."""
+
+    def entry(name: str, value: float) -> object:
+        rng = PHYSICAL_RANGES.get(name)
+        if rng is None:
+            return float(f"{value:.6g}")
+        return {"value": float(f"{value:.6g}"), "unit": rng.unit, "range": [rng.low, rng.high], "source": f"fitted to {data_name}; range: {rng.reason}"}
+
+    names = {**result.fixed, **result.fitted}
+    params = {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": entry(k, v) for k, v in names.items()}
     doc = {
         "calibration": {
             "data": data_name,
@@ -250,8 +339,8 @@ def write_calibration(result: CalibrationResult, path: str | Path, data_name: st
     }
     header = (
         "# Calibration of the twin against bench slip data. Regenerate with `bearing-rig calibrate`.\n"
-        "# stiction_velocity is held fixed: with the paper's 0.1 m/s the bench's 2700 rpm slip lies past\n"
-        "# the traction peak (no steady state; the cage skids), and in the rising branch v_s and the\n"
-        "# resistance scales trade off one for one, so it cannot be fitted from slip data.\n"
+        "# The fitted quantities are physical properties of the grease the balls and cage shear in the\n"
+        "# bearing's running-in state; each carries its plausible range (a fit outside it fails).\n"
+        "# What they mean and what the bench should measure: docs/model.md, section Calibration.\n"
     )
     Path(path).write_text(header + yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")

@@ -208,6 +208,8 @@ def rig_traffic(
                 real_time_factor=1.0,
                 step_count=step,
                 overruns=0,
+                friction_torque=0.01,
+                power_loss=3.0,
             )
             yield TRUTH_TOPIC, time_ns, bytes(store.serialize_cdr(truth, "bearing_rig_msgs/msg/SimulatorTruth"))
         pulses = []

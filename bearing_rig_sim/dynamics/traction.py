@@ -1,0 +1,238 @@
+"""EHL traction of a ball-raceway contact, integrated over the Hertz ellipse, and its table.
+
+Local law (at each point of the contact ellipse, x rolling direction with the inlet at x = -b,
+y transverse): the film shears at the local sliding speed |u| (race relative to ball) and
+carries the smallest of three stresses (a visco-elasto-plastic film in the manner of Johnson
+and Tevaarwerk 1977, Proc. R. Soc. A 356:215):
+
+* viscous, Eyring: tau_v = tau_0 asinh(eta(p) |u| / (h tau_0)), eta(p) by Roelands;
+* elastic build-up since the inlet: tau_e = G (|u| / u_e) (x + b_x(y)) / h;
+* limiting shear stress: tau_L = Lambda p (Bair and Winer 1979).
+
+Sliding across the ellipse: u_x = u_e (SRR + kappa_H y^2) - omega_s y, u_y = omega_s x, where
+SRR is the slide-to-roll ratio at the contact centre, kappa_H y^2 Heathcote's differential
+slip of a conforming groove (the contact surface, of transverse radius R_c = 2 r_g R/(r_g + R),
+lies nearer the ball centre and farther from the ring axis away from y = 0) and omega_s the spin
+about the contact normal (outer-raceway control: omega_s = omega_i sin(alpha) at the inner
+contact, zero at the outer; Harris and Kotzalas). The film is the Hamrock-Dowson central film
+(uniform; thermal and starvation reductions applied).
+
+Integrated: rolling-direction traction coefficient mu = F_x / Q and dissipated power
+P / (Q u_e) (sliding, spin and Heathcote losses together). The engine tabulates both per
+contact at start-up over SRR x entrainment speed x load (the contact angle, hence spin and
+Heathcote, taken from the thrust-load equilibrium at each load) and interpolates in the kernels.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from bearing_rig_sim.dynamics.hertz import HertzContact
+from bearing_rig_sim.dynamics.lubrication import Lubricant, film_thickness, harris_thrust_angle
+
+GRID = 24
+"""Points per semi-axis direction of the ellipse quadrature (midpoint rule on the unit disc)."""
+SRR_REF = 1e-5
+"""Scale of the table's SRR axis: xi = asinh(SRR / SRR_REF), uniform in xi."""
+SRR_MAX = 1.0
+N_SRR = 97
+N_SPEED = 12
+N_LOAD = 12
+SPEED_RANGE = (0.05, 40.0)
+"""Entrainment speeds of the table, m/s (log-spaced)."""
+LOAD_RANGE = (0.5, 2000.0)
+"""Contact loads of the table, N (log-spaced)."""
+HEADER = 8
+"""Header of a table in the parameter vector: n_srr, n_speed, n_load, xi_max, ln u0, d ln u,
+ln q0, d ln q; then mu[contact, load, speed, srr] and power[contact, load, speed, srr]."""
+
+
+@njit(cache=True)
+def ellipse_traction(
+    p_max: float,
+    a: float,
+    b: float,
+    h: float,
+    eta0: float,
+    z_roelands: float,
+    tau0: float,
+    lam: float,
+    g_mod: float,
+    u_e: float,
+    srr: float,
+    spin: float,
+    heathcote: float,
+) -> tuple[float, float]:
+    """Traction coefficient F_x/Q and dissipation P/(Q u_e) of one contact (see module doc).
+
+    Args: maximum Hertz pressure (Pa), transverse and rolling semi-axes a, b (m), film h (m),
+    inlet viscosity (Pa s), Roelands index, Eyring stress (Pa), limiting shear coefficient,
+    film shear modulus (Pa), entrainment speed (m/s), SRR at the centre, spin per entrainment
+    speed omega_s/u_e (1/m), Heathcote coefficient kappa_H (1/m^2).
+    """
+    ln_eta0 = math.log(eta0)
+    k_r = ln_eta0 + 9.67
+    fx = 0.0
+    pw = 0.0
+    d = 2.0 / GRID
+    omega_s = spin * u_e
+    for i in range(GRID):
+        xi = -1.0 + (i + 0.5) * d
+        for j in range(GRID):
+            yj = -1.0 + (j + 0.5) * d
+            r2 = xi * xi + yj * yj
+            if r2 >= 1.0:
+                continue
+            pr = p_max * math.sqrt(1.0 - r2)
+            x = xi * b
+            y = yj * a
+            ux = u_e * (srr + heathcote * y * y) - omega_s * y
+            uy = omega_s * x
+            us = math.sqrt(ux * ux + uy * uy)
+            if us <= 0.0:
+                continue
+            eta = eta0 * math.exp(k_r * (-1.0 + (1.0 + pr / 1.96e8) ** z_roelands))
+            tau = tau0 * math.asinh(eta * us / (h * tau0))
+            inlet = x + b * math.sqrt(1.0 - yj * yj)
+            tau_e = g_mod * us / u_e * inlet / h
+            if tau_e < tau:
+                tau = tau_e
+            if lam * pr < tau:
+                tau = lam * pr
+            fx += tau * ux / us
+            pw += tau * us
+    area = a * b * d * d
+    q = 2.0 / 3.0 * math.pi * a * b * p_max
+    return fx * area / q, pw * area / (q * u_e)
+
+
+@dataclass(frozen=True)
+class ContactKinematics:
+    """Geometry of a raceway contact that the traction table needs (SI)."""
+
+    hertz: HertzContact
+    rx: float
+    groove_radius: float
+    inner: bool
+
+
+def spin_and_heathcote(contact: ContactKinematics, alpha: float, ball_diameter: float, pitch_diameter: float) -> tuple[float, float]:
+    """(omega_s / u_e in 1/m, kappa_H in 1/m^2) of a contact at the contact angle ``alpha``
+    (rad), outer-raceway control (see module doc)."""
+    r = 0.5 * ball_diameter
+    rm = 0.5 * pitch_diameter
+    rc = 2.0 * contact.groove_radius * r / (contact.groove_radius + r)
+    ratio = 0.5 * (1.0 - ball_diameter * math.cos(alpha) / pitch_diameter)  # omega_m / omega_i
+    if contact.inner:
+        r_race = rm - r * math.cos(alpha)
+        spin = math.sin(alpha) / ((1.0 - ratio) * r_race)
+        return spin, (1.0 / r + math.cos(alpha) / r_race) / (2.0 * rc)
+    r_race = rm + r * math.cos(alpha)
+    return 0.0, -(1.0 / r - math.cos(alpha) / r_race) / (2.0 * rc)
+
+
+def build_table(
+    contacts: tuple[ContactKinematics, ContactKinematics],
+    lub: Lubricant,
+    temperature_c: float,
+    *,
+    ball_count: int,
+    free_angle: float,
+    ball_diameter: float,
+    pitch_diameter: float,
+    total_curvature: float,
+    combined_constant: float,
+) -> np.ndarray:
+    """The traction table of both raceway contacts as a flat float64 array (layout: HEADER)."""
+    xi_max = math.asinh(SRR_MAX / SRR_REF)
+    xis = np.linspace(-xi_max, xi_max, N_SRR)
+    srrs = SRR_REF * np.sinh(xis)
+    lu = np.linspace(math.log(SPEED_RANGE[0]), math.log(SPEED_RANGE[1]), N_SPEED)
+    lq = np.linspace(math.log(LOAD_RANGE[0]), math.log(LOAD_RANGE[1]), N_LOAD)
+    eta0 = lub.dynamic_viscosity(temperature_c)
+    z = lub.roelands_index(temperature_c)
+    mu = np.zeros((2, N_LOAD, N_SPEED, N_SRR))
+    pw = np.zeros_like(mu)
+    for c, contact in enumerate(contacts):
+        for iq, q in enumerate(np.exp(lq)):
+            # contact angle at this load from the thrust equilibrium (no centrifugal force)
+            alpha = harris_thrust_angle(q * ball_count * math.sin(free_angle), ball_count, free_angle, total_curvature, ball_diameter, combined_constant)
+            alpha = harris_thrust_angle(q * ball_count * math.sin(alpha), ball_count, free_angle, total_curvature, ball_diameter, combined_constant)
+            spin, kh = spin_and_heathcote(contact, alpha, ball_diameter, pitch_diameter)
+            a, b = contact.hertz.semi_axes(q)
+            ph = contact.hertz.max_pressure(q)
+            for iu, u in enumerate(np.exp(lu)):
+                film = film_thickness(lub, temperature_c, contact.hertz.reduced_modulus, contact.rx, contact.hertz.ellipticity, b, ph, u, q)
+                h = max(film.central, 1e-9)
+                for k, s in enumerate(srrs):
+                    mu[c, iq, iu, k], pw[c, iq, iu, k] = ellipse_traction(
+                        ph, a, b, h, eta0, z, lub.eyring_stress, lub.limiting_shear_coefficient, lub.shear_modulus, u, s, spin, kh
+                    )
+    head = np.array([N_SRR, N_SPEED, N_LOAD, xi_max, lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
+    return np.concatenate([head, mu.ravel(), pw.ravel()])
+
+
+@njit(cache=True)
+def _table_position(t: np.ndarray, base: int, srr: float, speed: float, load: float) -> tuple[int, int, int, float, float, float, float, float]:
+    """Cell indices and weights of (asinh(SRR/SRR_REF), ln u_e, ln Q) in a table, clamped at
+    its edges, and ln u_e, ln Q."""
+    ns = int(t[base])
+    nu = int(t[base + 1])
+    nq = int(t[base + 2])
+    xi_max = t[base + 3]
+    dxi = 2.0 * xi_max / (ns - 1)
+    xi = math.asinh(srr / SRR_REF)
+    fs = min(max((xi + xi_max) / dxi, 0.0), ns - 1.000001)
+    lu = math.log(max(speed, 1e-9))
+    lq = math.log(max(load, 1e-9))
+    fu = min(max((lu - t[base + 4]) / t[base + 5], 0.0), nu - 1.000001)
+    fq = min(max((lq - t[base + 6]) / t[base + 7], 0.0), nq - 1.000001)
+    i_s, i_u, i_q = int(fs), int(fu), int(fq)
+    return i_s, i_u, i_q, fs - i_s, fu - i_u, fq - i_q, lu, lq
+
+
+@njit(cache=True)
+def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float]:
+    """Interpolate a traction table stored in ``t`` from index ``base``: returns
+    (mu, d mu / d SRR, u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer). Trilinear in
+    (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last value is the
+    speed-load factor of Houpert's rolling force, from the same logarithms."""
+    ns = int(t[base])
+    nu = int(t[base + 1])
+    size = ns * nu * int(t[base + 2])
+    i_s, i_u, i_q, ws, wu, wq, lu, lq = _table_position(t, base, srr, speed, load)
+    mu0 = 0.0
+    mu1 = 0.0
+    for dq in range(2):
+        cq = wq if dq == 1 else 1.0 - wq
+        for du in range(2):
+            cu = wu if du == 1 else 1.0 - wu
+            k = base + HEADER + contact * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s
+            mu0 += cq * cu * t[k]
+            mu1 += cq * cu * t[k + 1]
+    mu = mu0 + ws * (mu1 - mu0)
+    dxi = 2.0 * t[base + 3] / (ns - 1)
+    slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
+    rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
+    return mu, slope, rolling
+
+
+@njit(cache=True)
+def table_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
+    """Interpolated dissipation P / (Q u_e) of ``contact`` (same grid as :func:`table_lookup`)."""
+    ns = int(t[base])
+    nu = int(t[base + 1])
+    size = ns * nu * int(t[base + 2])
+    i_s, i_u, i_q, ws, wu, wq, _, _ = _table_position(t, base, srr, speed, load)
+    pw = 0.0
+    for dq in range(2):
+        cq = wq if dq == 1 else 1.0 - wq
+        for du in range(2):
+            cu = wu if du == 1 else 1.0 - wu
+            k = base + HEADER + (2 + contact) * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s
+            pw += cq * cu * ((1.0 - ws) * t[k] + ws * t[k + 1])
+    return pw

@@ -14,7 +14,8 @@ Interfaces (README, interface table):
   each sample with its stamp. The node wakes 100 times a second instead of once per ``/clock``
   message (rclpy's own time source would dispatch each of the 1000), and keeps up with a
   simulator faster than real time (each wake-up takes whatever sim time passed);
-* subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable);
+* subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable), taken by the step
+  timer before it steps, so a set-point is in force for every sample published after it came;
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
@@ -41,7 +42,8 @@ the reset. The clutch is engaged at configure (``engage_clutch_on_start``).
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the chain, the
 publishers, the services and the timer are made at configure; stepping and publishing run only
 while active. The services answer in every configured state (a set-point given while inactive
-takes effect at activation); the set-point topic is taken only while active. An interlock fault does not deactivate the node: the brake is de-energised, and the
+takes effect at activation); set-points on the topic are taken by the step, so one given while
+inactive waits in the reader's queue and takes effect at activation. An interlock fault does not deactivate the node: the brake is de-energised, and the
 node goes on publishing the (falling) force, the ERROR and the state, as the bench's controller
 does; only reset_fault clears it.
 """
@@ -139,18 +141,20 @@ class LoadControllerNode(ManagedNode):
         self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
         self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
         self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
-        self.subscription(
-            Float64, AXIAL_LOAD_SETPOINT.name, self._on_setpoint, RELIABLE_QOS,
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-        )
         self._rig_services = [
             self.create_service(SetAxialLoad, AXIAL_LOAD_SET.name, self._on_set_service),
             self.create_service(Trigger, AXIAL_LOAD_RESET_FAULT.name, self._on_reset_fault),
             self.create_service(SetBool, AXIAL_LOAD_CLUTCH.name, self._on_clutch),
         ]
-        self._clock_tap = Node(f"{NODE_NAME}_clock", context=self.context)
+        self._clock_tap = Node(f"{NODE_NAME}_inputs", context=self.context)
         self._clock_sub = self._clock_tap.create_subscription(
             Clock, CLOCK.name, _unused, CLOCK_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
+        )
+        # The set-points too are taken by the step, before it steps: one that came since the
+        # last step is in force for every sample this step publishes (a callback of its own
+        # could run after the step and leave a lagging node's samples on the old set-point).
+        self._setpoint_sub = self._clock_tap.create_subscription(
+            Float64, AXIAL_LOAD_SETPOINT.name, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
         )
         self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
         self._bearing_msg = WrenchStamped()
@@ -197,7 +201,12 @@ class LoadControllerNode(ManagedNode):
 
     @survives_shutdown
     def _on_step(self) -> None:
-        """Step the chain to the latest /clock in force samples and publish them."""
+        """Apply the set-points that came, step the chain to the latest /clock in force samples
+        and publish them."""
+        handle = self._setpoint_sub.handle
+        with handle:
+            while (taken := handle.take_message(Float64, False)) is not None:
+                self._on_setpoint(taken[0])
         operation = self.operation
         stamp = self._latest_clock()
         if operation is None or stamp is None:
@@ -285,7 +294,7 @@ class LoadControllerNode(ManagedNode):
             self._mirroring = False
 
     def _on_setpoint(self, msg: Float64) -> None:
-        assert self.operation is not None  # the subscription lives from configure to cleanup
+        assert self.operation is not None  # taken by the step, which runs from activate to deactivate
         if self._apply(self.operation.request_setpoint(msg.data, SetpointSource.TOPIC)).accepted:
             self._mirror_setpoint()
 
@@ -329,8 +338,8 @@ class LoadControllerNode(ManagedNode):
         return SetParametersResult(successful=True)
 
 
-def _unused(_msg: object) -> None:  # pragma: no cover - the clock reader's node is never spun
-    """Callback of the /clock reader; its queue is taken by the step timer."""
+def _unused(_msg: object) -> None:  # pragma: no cover - the readers' node is never spun
+    """Callback of the /clock and set-point readers; their queues are taken by the step timer."""
 
 
 def _as_number(value: object) -> object:

@@ -89,6 +89,18 @@ def declare_described(node: Node, node_name: str, defaults: Mapping[str, Any]) -
             raise RigError(f"{node_name}: parameter {name} refused: {spec.constraints()} ({' '.join(str(exc).split())})") from None
 
 
+def declare_and_read(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
+    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) with dynamic typing
+    and return the values in force: for a plain node whose parameters have no spec in
+    :mod:`bearing_rig_sim.nodes.parameters` yet (the shadow node)."""
+    values: dict[str, Any] = {}
+    for name, default in defaults.items():
+        if name in IMPLICIT:
+            continue
+        values[name] = node.declare_parameter(name, default, ParameterDescriptor(dynamic_typing=True)).value
+    return values
+
+
 def parameter_values(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
     """The values in force of the parameters named in ``defaults`` (and ``use_sim_time``)."""
     return {name: node.get_parameter(name).value for name in defaults if node.has_parameter(name)}

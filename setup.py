@@ -64,6 +64,8 @@ setup(
             "bearing-rig-simulator = bearing_rig_sim.nodes.simulator:main",
             "monitor = bearing_rig_sim.nodes.monitor:main",
             "bearing-rig-monitor = bearing_rig_sim.nodes.monitor:main",
+            "shadow = bearing_rig_sim.nodes.shadow:main",
+            "bearing-rig-shadow = bearing_rig_sim.nodes.shadow:main",
         ],
     },
 )

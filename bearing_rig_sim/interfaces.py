@@ -156,6 +156,23 @@ SLIP_STATUS = Topic(
     "rad/s, %",
     "monitor",
 )
+TWIN_RESIDUAL = Topic(
+    "/twin/residual",
+    "bearing_rig_msgs/msg/ShadowResidual",
+    "reliable",
+    "one per closed slip window",
+    "rad/s, N, %",
+    "shadow",
+    note="measured and predicted slip, residual, band",
+)
+TWIN_ESTIMATE = Topic(
+    "/twin/calibration_estimate",
+    "bearing_rig_msgs/msg/ShadowEstimate",
+    "reliable",
+    "one per steady window (re-calibration on)",
+    "the parameter's",
+    "shadow",
+)
 DIAGNOSTICS = Topic(
     "/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node"
 )
@@ -172,6 +189,8 @@ TOPICS: tuple[Topic, ...] = (
     AXIAL_LOAD_FORCE,
     BEARING_AXIAL_FORCE,
     SLIP_STATUS,
+    TWIN_RESIDUAL,
+    TWIN_ESTIMATE,
     DIAGNOSTICS,
 )
 """Every topic of the contract, in the table's order. The session records all of them."""

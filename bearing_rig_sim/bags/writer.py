@@ -352,6 +352,12 @@ class BagWriter:
                 raise BagError(f"topic {entry.name}: log time must be an integer of nanoseconds, got {log_time_ns!r}") from None
         if log_time_ns < 0 or log_time_ns >= 2**63:
             raise BagError(f"topic {entry.name}: log time {log_time_ns} ns is outside 0 .. 2**63-1")
+        # A full file is closed when the next message comes, not after the last one written, so
+        # that no file is left without messages (and without a chunk) at the end of the bag.
+        if self._max_file_bytes is not None and self._sink is not None and self._sink.position >= self._max_file_bytes and self._files[-1].message_count:
+            self._finish_file()
+            self._start_file()
+            mcap = self._mcap
         log_time = log_time_ns
         if log_time <= self._last_time:
             log_time = self._last_time + 1
@@ -365,9 +371,6 @@ class BagWriter:
             current.start_ns = log_time
         current.duration_ns = log_time - current.start_ns
         current.message_count += 1
-        if self._max_file_bytes is not None and self._sink is not None and self._sink.position >= self._max_file_bytes:
-            self._finish_file()
-            self._start_file()
 
     def _start_file(self) -> None:
         name = storage_file_name(self._path, len(self._files))

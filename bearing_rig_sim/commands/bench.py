@@ -28,6 +28,7 @@ BENCHMARKS: dict[str, str] = {
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
     "rig": "bearing_rig_sim.benchmarks.rig",
     "sweep": "bearing_rig_sim.benchmarks.sweep",
+    "shadow": "bearing_rig_sim.benchmarks.shadow",
 }
 """Benchmark name -> module path (``bearing_rig_sim.benchmarks.<name>``)."""
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand
+from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, ShadowEstimate, ShadowResidual, SimulatorTruth, SlipStatus, SpindleCommand
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.context import Context
@@ -57,6 +57,8 @@ MESSAGE_TYPES: dict[str, type] = {
     "geometry_msgs/msg/WrenchStamped": WrenchStamped,
     "bearing_rig_msgs/msg/SlipStatus": SlipStatus,
     "diagnostic_msgs/msg/DiagnosticArray": DiagnosticArray,
+    "bearing_rig_msgs/msg/ShadowResidual": ShadowResidual,
+    "bearing_rig_msgs/msg/ShadowEstimate": ShadowEstimate,
 }
 """The rclpy class of each recorded type."""
 
@@ -257,6 +259,7 @@ class SessionNode(Node):
                     inner_ring_speed=msg.inner_ring_speed,
                     cage_speed=msg.cage_speed,
                     window_revolutions=msg.window_revolutions,
+                    confidence=msg.confidence,
                 )
             )
         elif name == TRUTH.name:

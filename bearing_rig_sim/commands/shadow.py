@@ -1,0 +1,89 @@
+"""``bearing-rig shadow``: the twin beside the bench, live or over a recorded bag.
+
+* ``bearing-rig shadow`` runs the shadow node on the live topics (the bench's pulse counter and
+  load cell, or the twin's): predictions and residuals on ``/twin/...``, anomalies on
+  ``/diagnostics``; ROS arguments after ``--``: ``bearing-rig shadow -- --ros-args -p
+  warn_after_s:=2.0``.
+* ``bearing-rig shadow --bag BAG --out DIR`` runs the same core over a bag, without ROS and
+  deterministically: ``DIR/residuals.csv`` (one row per slip window), ``DIR/report.md`` and
+  ``DIR/shadow.png``. The bag needs ``/rig/spindle/pulses``, ``/rig/cage/pulses`` and
+  ``/rig/axial_load/force``, from the twin or the physical bench.
+
+The exit status is 0 when no window was flagged, 1 when some were (offline), 2 on an error.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def register(subparsers: Any) -> None:
+    """Add ``shadow`` to the ``bearing-rig`` parser."""
+    p = subparsers.add_parser("shadow", help="the twin beside the bench: predicted slip, residual, anomalies (live or --bag)", description=__doc__)
+    p.add_argument("--bag", type=Path, default=None, metavar="BAG", help="run over this bag instead of the live topics")
+    p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder with --bag (default: out/shadow/<bag name>)")
+    p.add_argument("--params", type=Path, default=None, metavar="FILE", help="shadow parameter file (default: config/shadow.yaml)")
+    p.add_argument("--calibration", type=Path, default=None, metavar="FILE", help="calibration file of the twin (default: the parameter file's)")
+    p.add_argument(
+        "--recalibrate",
+        nargs="?",
+        const="",
+        default=None,
+        metavar="PARAMETER",
+        help="track a calibration parameter online (default: the parameter file's recalibrate_parameter); never written to the calibration file",
+    )
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="live: after --, arguments for the node (-- --ros-args -p name:=value)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run shadow mode live or over a bag."""
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.shadow import ShadowSettings
+    from bearing_rig_sim.shadow.settings import calibration_rms
+
+    settings = ShadowSettings.from_yaml(args.params)
+    if args.calibration is not None:
+        if not args.calibration.is_file():
+            raise ConfigError(str(args.calibration), "calibration", "file not found")
+        rms = calibration_rms(args.calibration)
+        settings = settings.replace(calibration_file=args.calibration.resolve(), calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct)
+    if args.recalibrate is not None:
+        settings = settings.replace(recalibrate=True, recalibrate_parameter=args.recalibrate or settings.recalibrate_parameter)
+    if args.bag is None:
+        return _live(args, settings)
+    from bearing_rig_sim.commands.bag import bag_warnings_as_lines
+    from bearing_rig_sim.shadow.offline import shadow_bag
+
+    out = args.out if args.out is not None else Path("out") / "shadow" / args.bag.resolve().name
+    with bag_warnings_as_lines():
+        result = shadow_bag(args.bag, out, settings)
+    c = result.counts
+    inside = f"{100.0 * result.inside_fraction:.2f} %" if c["compared"] else "-"
+    print(f"{args.bag}: {c['windows']} slip windows, {c['compared']} compared, {inside} inside the band, {c['anomalous']} flagged in {len(result.stretches)} stretch(es)")
+    for s in result.stretches:
+        print(f"  {s.start_s:.3f}-{s.end_s:.3f} s {s.worst.name}: {s.detail}")
+    if result.estimate is not None:
+        e = result.estimate
+        outside = "" if e.in_range or e.range is None else f"; OUTSIDE its plausible range {e.range[0]:g}-{e.range[1]:g}"
+        print(f"re-calibrated {e.name}: {e.value:.6g} +- {e.std:.3g} (calibrated {e.calibrated:.6g}{outside}); not written")
+    print(f"report: {out / 'report.md'}; rows: {out / 'residuals.csv'}")
+    return 1 if c["anomalous"] else 0
+
+
+def _live(args: argparse.Namespace, settings: Any) -> int:
+    from bearing_rig_sim.nodes.shadow import main
+
+    argv = ["shadow", *[a for a in args.ros_args if a != "--"]]
+    extra = []
+    if args.params is not None:
+        extra += ["--params-file", str(args.params)]
+    if args.calibration is not None:
+        extra += ["-p", f"calibration_file:={settings.calibration_file}", "-p", f"calibration_rms_slip_pct:={settings.calibration_rms_slip_pct}"]
+    if args.recalibrate is not None:
+        extra += ["-p", "recalibrate:=true", "-p", f"recalibrate_parameter:={settings.recalibrate_parameter}"]
+    if extra:
+        argv += (["--ros-args"] if "--ros-args" not in argv else []) + extra
+    return main(argv)

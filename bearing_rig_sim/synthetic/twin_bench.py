@@ -1,0 +1,165 @@
+"""A bench recorded from the twin itself: pulses and load-cell samples of a speed-and-load programme,
+for shadow-mode round trips (no ROS).
+
+:func:`twin_bench_run` runs :class:`~bearing_rig_sim.simulation.RigTwin` (engine, spindle drive,
+fibre-optic sensors with their timing jitter) through :class:`Hold` segments, each reached by the
+paper's STEP ramp, and returns what the bench's topics would carry: both pulse streams and the
+load cell's force at 1 kHz with its noise (``config/rig.yaml``: 1 N standard deviation). Stamps
+may be put on a bench system clock (``clock_offset_s``). :func:`write_bench_bag` writes them as a
+bag with the three topics shadow mode needs.
+
+Units: s, rpm and N at this edge (the programme), SI in the events.
+"""
+
+from __future__ import annotations
+
+import random
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, SPINDLE_PULSES
+from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.rig.program import SpeedProfileKind
+from bearing_rig_sim.simulation.drive import SpindleCommand
+from bearing_rig_sim.simulation.twin import RigTwin
+
+
+@dataclass(frozen=True)
+class Hold:
+    """One programme segment: ramp to ``rpm`` over ``ramp_s`` (STEP), hold to ``duration_s`` in
+    all, at ``axial_load_n`` throughout."""
+
+    rpm: float
+    duration_s: float
+    axial_load_n: float = 100.0
+    ramp_s: float = 0.5
+
+
+@dataclass
+class BenchRun:
+    """The bench's topics, each in time order (bench clock, s).
+
+    Attributes:
+        spindle, cage: the pulses of each sensor.
+        forces: load-cell samples (time, force N).
+        truth_slip: the engine's true slip at the end of each hold, percent (for reference only).
+    """
+
+    spindle: list[Pulse]
+    cage: list[Pulse]
+    forces: list[tuple[float, float]]
+    truth_slip: list[float]
+
+    def events(self) -> list[tuple[float, str, object]]:
+        """Every message merged in time order: (time, ``"spindle"``/``"cage"``/``"force"``, payload)."""
+        out: list[tuple[float, str, object]] = [(p.time, "spindle", p) for p in self.spindle]
+        out += [(p.time, "cage", p) for p in self.cage]
+        out += [(t, "force", f) for t, f in self.forces]
+        out.sort(key=lambda e: e[0])
+        return out
+
+
+def twin_bench_run(
+    holds: list[Hold],
+    *,
+    calibration_file: str | Path | None = None,
+    bearing_file: str | Path | None = None,
+    load_noise_std_n: float = 1.0,
+    clock_offset_s: float = 0.0,
+    seed: int = 7,
+) -> BenchRun:
+    """Run the twin through ``holds`` (from rest at 0 s) and record its bench topics.
+
+    Args:
+        holds: the programme.
+        calibration_file: the calibration of the twin playing the bench (default: the shipped).
+        bearing_file: bearing data (default: the shipped H7006C).
+        load_noise_std_n: load-cell noise, N (standard deviation of each 1 kHz sample).
+        clock_offset_s: added to every stamp (a bench system clock), s.
+        seed: of the load-cell noise.
+    """
+    from bearing_rig_sim.config import config_path
+
+    cal = calibration_file if calibration_file is not None else config_path("calibration", "h7006c_table3.yaml")
+    twin = RigTwin.from_files(bearing_file, cal, None, initial_axial_load=holds[0].axial_load_n if holds else 100.0)
+    rng = random.Random(seed)
+    run = BenchRun([], [], [], [])
+
+    def shifted(p: Pulse) -> Pulse:
+        return Pulse(p.time + clock_offset_s, p.strip_id, p.strip_count, p.revolution, p.pulse_index, p.sensor_id)
+
+    for hold in holds:
+        twin.set_axial_load(hold.axial_load_n)
+        twin.command_spindle(SpindleCommand(rpm_to_rad_s(hold.rpm), SpeedProfileKind.STEP, ramp_time=hold.ramp_s))
+        end = twin.time + hold.duration_s
+        while twin.time < end - 1e-9:
+            out = twin.tick(with_truth=False)
+            run.spindle.extend(shifted(p) for p in out.spindle_pulses)
+            run.cage.extend(shifted(p) for p in out.cage_pulses)
+            run.forces.append((out.time + clock_offset_s, hold.axial_load_n + rng.gauss(0.0, load_noise_std_n)))
+        truth = twin.truth()
+        run.truth_slip.append(truth.slip_rate)
+    return run
+
+
+def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
+    """Write ``run`` as a bag (MCAP) with the two pulse topics and the load-cell topic."""
+    from bearing_rig_sim.bags.typestore import rig_typestore
+    from bearing_rig_sim.bags.writer import BagWriter
+
+    store = rig_typestore()
+    types = store.types
+
+    def stamp(t: float) -> Any:
+        ns = int(round(t * 1e9))
+        return types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+
+    with BagWriter(path, typestore=store) as writer:
+        for topic in (SPINDLE_PULSES, CAGE_PULSES, AXIAL_LOAD_FORCE):
+            writer.add_topic(topic.name, topic.msgtype, topic.qos)
+        for t, kind, payload in run.events():
+            header = types["std_msgs/msg/Header"](stamp=stamp(t), frame_id="bench")
+            if kind == "force":
+                vec = types["geometry_msgs/msg/Vector3"]
+                msg = types["geometry_msgs/msg/WrenchStamped"](
+                    header=header,
+                    wrench=types["geometry_msgs/msg/Wrench"](force=vec(x=0.0, y=0.0, z=float(payload)), torque=vec(x=0.0, y=0.0, z=0.0)),  # type: ignore[arg-type]
+                )
+                writer.write_message(AXIAL_LOAD_FORCE.name, int(round(t * 1e9)), msg)
+            else:
+                p = payload
+                assert isinstance(p, Pulse)
+                msg = types["bearing_rig_msgs/msg/FibreOpticPulse"](
+                    header=header, sensor_id=kind, strip_id=p.strip_id, strip_count=p.strip_count, revolution=p.revolution, pulse_index=p.pulse_index
+                )
+                writer.write_message((SPINDLE_PULSES if kind == "spindle" else CAGE_PULSES).name, int(round(t * 1e9)), msg)
+    return Path(path)
+
+
+def scaled_calibration(source: str | Path, key: str, factor: float, dest: str | Path, *, base: float | None = None) -> Path:
+    """A copy of the calibration file ``source`` with parameter ``key`` (as written under its
+    ``parameters:``, e.g. ``lubricant.yield_stress_pa``) multiplied by ``factor``: a bench whose
+    drag or traction has changed. A ``{value: ...}`` entry has its value scaled (its range kept:
+    a value outside it is refused on loading). A key the file does not set (a parameter the
+    calibration left at the bearing file's value) is added as ``base * factor``.
+
+    Raises:
+        KeyError: no such parameter in the file and no ``base``.
+    """
+    import yaml
+
+    doc = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    params = doc["parameters"]
+    if key not in params:
+        if base is None:
+            raise KeyError(f"{source}: no parameter {key!r} (it has {', '.join(params)})")
+        params[key] = float(base) * factor
+    elif isinstance(params[key], dict):
+        params[key]["value"] = float(params[key]["value"]) * factor
+    else:
+        params[key] = float(params[key]) * factor
+    out = Path(dest)
+    out.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    return out

@@ -18,7 +18,7 @@ from bearing_rig_sim.errors import RigError
 
 PROG = "bearing-rig"
 
-COMMANDS: tuple[str, ...] = ("bench", "calibrate", "predict", "reproduce", "run", "replay", "analyze", "bag", "shadow")
+COMMANDS: tuple[str, ...] = ("bench", "calibrate", "predict", "reproduce", "sweep", "run", "replay", "analyze", "bag", "shadow")
 """Sub-command modules under :mod:`bearing_rig_sim.commands`, in the order ``--help`` lists them."""
 
 

@@ -61,7 +61,9 @@ def bisect(f, lo: float, hi: float) -> float:  # type: ignore[no-untyped-def]
 def test_critical_slopes() -> None:
     assert K1_AXIAL_LOAD == -5e-6
     assert K2_TIME == -3e-2
-    assert SlipState.STABLE == "stable" and SlipState.SLIPPING == "slipping" and SlipState.UNKNOWN == "unknown"
+    # the values are SlipStatus.msg's STATE_* constants; the labels are what people read
+    assert (SlipState.UNKNOWN, SlipState.SLIPPING, SlipState.STABLE, SlipState.FAULT) == (0, 1, 2, 3)
+    assert [s.label for s in SlipState] == ["unknown", "slipping", "stable", "fault"]
 
 
 # -- Eq. 14 ----------------------------------------------------------------------------------------

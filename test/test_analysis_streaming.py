@@ -91,10 +91,10 @@ def test_unknown_until_enough_points() -> None:
     for i in range(11):
         monitor.add(float(t[i]), float(y[i]))
         v = monitor.verdict()
-        assert v.state == "unknown" and v.slope is None and v.fit_rmse is None and v.confidence == 0.0
+        assert v.state == SlipState.UNKNOWN and v.slope is None and v.fit_rmse is None and v.confidence == 0.0
         assert v.n_points == i + 1 and "collecting points" in v.detail
     monitor.add(float(t[11]), float(y[11]))
-    assert monitor.verdict().state == "slipping"
+    assert monitor.verdict().state == SlipState.SLIPPING
     assert StreamingStability("time").verdict().x is None
 
 
@@ -200,7 +200,7 @@ def test_clock_jump_is_an_error_and_reset_recovers() -> None:
     assert monitor.verdict() == before
     monitor.reset()
     assert monitor.n_points == 0 and monitor.fit is None and monitor.refits == 0
-    assert monitor.verdict().state == "unknown"
+    assert monitor.verdict().state == SlipState.UNKNOWN
     monitor.add(0.01, 3.0)  # an earlier time is fine after a reset
     assert monitor.n_points == 1
 
@@ -214,7 +214,7 @@ def test_window_bounds_the_points_held() -> None:
     np.testing.assert_allclose(xs, t[-50:])
     final = monitor.verdict()
     # the last 0.5 s are all stable: the onset can only be bounded by the first point held
-    assert final.state == "stable" and final.onset == pytest.approx(t[-50])
+    assert final.state == SlipState.STABLE and final.onset == pytest.approx(t[-50])
     assert "at or before" in final.detail
 
 

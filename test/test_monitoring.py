@@ -95,8 +95,8 @@ def test_settings_shipped_and_refused():
     values = yaml.safe_load(config_path("monitor.yaml").read_text())["monitor"]["ros__parameters"]
     with pytest.raises(ConfigError, match="window_revolutions: must be >= 1"):
         MonitorSettings.from_values(values | {"window_revolutions": 0})
-    with pytest.raises(ConfigError, match="loss_period_factor: must be > 1"):
-        MonitorSettings.from_values(values | {"loss_period_factor": 0.5})
+    with pytest.raises(ConfigError, match="loss_silence_revolutions: must be > 0"):
+        MonitorSettings.from_values(values | {"loss_silence_revolutions": 0.0})
 
 
 @pytest.mark.parametrize("revolutions", [1, 3])
@@ -206,25 +206,32 @@ def test_a_stop_is_not_a_sensor_loss():
     assert "stopped" in status.detail
 
 
-def test_lost_pulses_are_a_fault_held_for_a_while_and_the_slip_stays_exact():
+def test_lost_pulses_are_a_warning_with_counts_and_the_slip_stays_exact():
+    """Three cage pulses lost: counted, a warning held for fault_hold_s, never a fault; the
+    window whose closing pulse was lost is skipped and every other window's slip is exact."""
     monitor = make(fault_hold_s=1.0)
     cage = train(constant(CAGE, 4, 0.0, 4.0), 4, "cage")
     lost = {p.pulse_index for p in cage[20:23]}
     kept = [p for p in cage if p.pulse_index not in lost]
-    seen: list[tuple[float, MonitorState, tuple[str, ...]]] = []
-    feed(
-        monitor,
-        train(constant(INNER, 4, 0.0, 4.0), 4, "spindle"),
-        kept,
-        on_check=lambda s: seen.append((monitor.last_pulse_time() or 0.0, s.state, s.faults)),
-    )
+    seen: list[tuple[float, MonitorState, tuple[str, ...], tuple[str, ...]]] = []
+    slips: list[float] = []
+
+    def on_check(status):
+        seen.append((monitor.last_pulse_time() or 0.0, status.state, status.faults, status.warnings))
+        slips.append(status.slip_rate)
+
+    feed(monitor, train(constant(INNER, 4, 0.0, 4.0), 4, "spindle"), kept, on_check=on_check)
     t_gap = cage[23].time
-    gap_reason = "cage: 3 pulse(s) lost before pulse_index 23 (gap in pulse_index)"
-    during = [(state, faults) for t, state, faults in seen if t_gap <= t < t_gap + 0.9]
-    assert during and all(state is MonitorState.FAULT and faults == (gap_reason,) for state, faults in during)
-    # held for fault_hold_s of rig time, then cleared while pulses keep coming
-    assert all(state is not MonitorState.FAULT for t, state, _ in seen if t > t_gap + 1.2)
-    assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+    reason = "cage: 3 pulse(s) lost before pulse_index 23"
+    during = [(state, faults, warnings) for t, state, faults, warnings in seen if t_gap <= t < t_gap + 0.9]
+    assert during and all(faults == () and warnings == (reason,) for _, faults, warnings in during)
+    assert all(state is not MonitorState.FAULT for _, state, _, _ in seen)
+    assert all(w == () for t, _, _, w in seen if t > t_gap + 1.2)  # the warning expired
+    status = monitor.status()
+    assert status.lost == (0, 3)
+    assert status.windows_skipped == 1  # index 20 closes the window from 16; 23 starts the next
+    finite = [s for s in slips if math.isfinite(s)]
+    assert finite and max(abs(s - expected_slip(INNER, CAGE)) for s in finite) < 1e-8
 
 
 def test_a_clock_jump_back_resets_to_unknown():
@@ -235,14 +242,14 @@ def test_a_clock_jump_back_resets_to_unknown():
     feed(monitor, train(constant(INNER, 4, 0.0, 0.05), 4, "spindle"), train(constant(CAGE, 4, 0.0, 0.05), 4, "cage"))
     status = monitor.status()
     assert status.state is MonitorState.UNKNOWN
-    assert monitor.windows == 0 and monitor.stability.n_points == 0 and status.time is None
+    assert monitor.windows == 0 and monitor.slope.n_points == 0 and status.time is None
     assert any("clock jumped back" in note for note in status.notes)
     # and it measures again afterwards
     feed(monitor, train(constant(INNER, 4, 0.05, 1.0), 4, "spindle", first_index=50), train(constant(CAGE, 4, 0.05, 1.0), 4, "cage", first_index=50))
     assert monitor.windows > 3
     assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
     monitor.clock_jump(1.0, 0.2)
-    assert monitor.windows == 0 and monitor.status().notes == ("reset: the clock jumped back from 1 s to 0.2 s",)
+    assert monitor.windows == 0 and monitor.status().notes == ("reset: the clock jumped back from 1.000000 s to 0.200000 s",)
 
 
 def test_out_of_order_pulses_restart_their_shaft_without_crashing():
@@ -256,11 +263,12 @@ def test_out_of_order_pulses_restart_their_shaft_without_crashing():
         monitor.add_pulse(p.sensor_id, p)
     status = monitor.status()
     assert any("out-of-order" in n and "index 40" in n for n in status.notes)
-    # 41 after 39 looked like a lost pulse: a held fault, gone once the hold has passed
-    assert status.faults == ("spindle: 1 pulse(s) lost before pulse_index 41 (gap in pulse_index)",)
+    # 41 after 39 looked like a lost pulse: a warning (no fault), gone once the hold has passed
+    assert status.faults == () and status.warnings == ("spindle: 1 pulse(s) lost before pulse_index 41",)
     monitor.check(2.0)
+    monitor.check(3.1)
     status = monitor.status()
-    assert status.faults == () and status.state is not MonitorState.FAULT
+    assert status.warnings == () and status.state is not MonitorState.FAULT
     assert status.time is not None and status.time > 1.5  # windows went on after the restart
     assert status.slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
 
@@ -298,12 +306,13 @@ def test_no_slip_point_below_the_minimum_spindle_speed():
     feed(monitor, train(constant(5.0, 4, 0.0, 10.0), 4, "spindle"), train(constant(2.0, 4, 0.0, 10.0), 4, "cage"))
     status = monitor.status()
     assert status.inner_ring_speed == pytest.approx(5.0, rel=1e-9)
-    assert math.isnan(status.slip_rate) and monitor.stability.n_points == 0
+    assert math.isnan(status.slip_rate) and monitor.slope.n_points == 0
 
 
-def test_the_slip_series_restarts_at_the_start_and_end_of_a_speed_change():
-    """Steady at 100 rad/s, a linear ramp to 150 rad/s, steady again: the series held at the end
-    covers only the last steady stretch."""
+def test_speed_changes_are_noticed_and_the_slope_forgets_the_ramp():
+    """Steady at 100 rad/s, a linear ramp to 150 rad/s, steady again: the start and end of the
+    ramp are noticed, the slope's trailing window holds only the last slope_span_s, and the
+    slip of time-aligned windows stays exact through the ramp and after it."""
 
     def angle(t: np.ndarray) -> np.ndarray:  # 100 rad/s to 2 s, +25 rad/s^2 to 4 s, then 150 rad/s
         a = np.where(t < 2.0, 100 * t, 200 + 100 * (t - 2) + 12.5 * (t - 2) ** 2)
@@ -325,8 +334,10 @@ def test_the_slip_series_restarts_at_the_start_and_end_of_a_speed_change():
     )
     assert any("spindle speed changing" in n for n in notes)
     assert any("spindle speed steady at" in n for n in notes)
-    x, _ = monitor.stability.points()
-    # series restarted at the end of the ramp (t = 4 s): it spans at most the last 3 s
-    assert x[-1] - x[0] <= 3.0 + 0.1
-    assert monitor.stability.n_points < monitor.windows
-    assert monitor.status().slip_rate == pytest.approx(expected_slip(150.0, 0.41 * 150.0), abs=1e-6)
+    x, _ = monitor.slope.points()
+    # the trailing window: at most slope_span_s of windows (at least min_slope_points)
+    assert x[-1] - x[0] <= monitor.settings.slope_span_s and x[0] > 4.0
+    assert monitor.status().state is MonitorState.STABLE
+    # the strips' spacing is measured from the pulses (here: equal); its estimate from pulse times
+    # known to about a nanosecond leaves 1e-5 percentage points at most
+    assert monitor.status().slip_rate == pytest.approx(expected_slip(150.0, 0.41 * 150.0), abs=1e-5)

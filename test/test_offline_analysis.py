@@ -385,7 +385,7 @@ def test_monitor_parameters_come_from_the_run_context(tmp_path: Path) -> None:
 
 
 def status_row(time: float, windows: int, inner: float, state: int = 1, slip: float = 1.0) -> StatusRow:
-    return StatusRow(time, "tick", state, time, inner, 0.4 * inner, 0.43 * inner, slip, 0.0, 0.5, windows, "")
+    return StatusRow(time, "tick", state, time, inner, 0.4 * inner, 0.43 * inner, slip, 0.0, 0.99, windows, "")
 
 
 def test_segments_of_a_program_and_stretches_of_a_bench_run() -> None:
@@ -399,7 +399,9 @@ def test_segments_of_a_program_and_stretches_of_a_bench_run() -> None:
     a, b = program.finish()
     assert (a.name, a.ramp_end, a.time_to_stable) == ("a", 1.0, pytest.approx(4.0))
     assert (b.name, b.start_time, b.ramp_end, b.target_speed) == ("b", 10.0, 12.0, 150.0)
-    assert b.time_to_stable == pytest.approx(1.0) and b.inner_ring_speed == pytest.approx(150.0) and b.final_state == 2
+    # stable from 13.0 s, but a verdict reaches back 1 s + one cage revolution (0.105 s at 60 rad/s):
+    # the first whose windows all follow the ramp's end at 12.0 s is the row at 13.2 s
+    assert b.time_to_stable == pytest.approx(1.2) and b.inner_ring_speed == pytest.approx(150.0) and b.final_state == 2
     stretches = SegmentTracker(False, [])
     speeds = [100.0] * 30 + [100.0 + 2.0 * k for k in range(1, 10)] + [120.0] * 50  # 3 s, a ramp, 5 s
     for k, inner in enumerate(speeds):

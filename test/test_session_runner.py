@@ -1,6 +1,6 @@
 """The program runner without ROS, on a fake clock with fake monitor statuses: dwell counted from
 the end of the speed change (STEP ramp and constant acceleration), until-stable (a stable verdict
-from the ramp or the previous speed does not count), the timeout, the dwell verdict, measured
+resting on windows of the ramp or the previous speed does not count), the timeout, the dwell verdict, measured
 against true slip over the same window, the mean bearing force, interruption.
 """
 
@@ -34,8 +34,15 @@ def program(tmp_path: Path) -> TestProgram:
     return load_program(path)
 
 
-def status(t: float, state: StatusState, slip: float = 3.0, cage: float = 40.0, revolutions: int = 1) -> SlipObservation:
-    return SlipObservation(time=t, state=state, slip_rate=slip, inner_ring_speed=94.0, cage_speed=cage, window_revolutions=revolutions)
+def status(t: float, state: StatusState, slip: float = 3.0, cage: float = 40.0, revolutions: int = 1, confidence: float = 0.99) -> SlipObservation:
+    return SlipObservation(
+        time=t, state=state, slip_rate=slip, inner_ring_speed=94.0, cage_speed=cage, window_revolutions=revolutions, confidence=confidence
+    )
+
+
+# The shipped monitor's verdict rests on the windows of the last slope_span_s = 1 s, at least 5 of
+# them: a status stamped t with one-revolution windows of w seconds speaks for t - max(1 + w, 5 w) on.
+W40 = 2.0 * math.pi / 40.0  # window at the default cage speed of 40 rad/s: 0.157 s
 
 
 def run_until(runner: ProgramRunner, t0: float, t1: float, dt: float = 0.01) -> list:
@@ -70,20 +77,22 @@ def test_constant_acceleration_dwell_starts_when_the_target_speed_is_reached(pro
     assert [o.verdict for o in runner.outcomes] == [Verdict.UNKNOWN, Verdict.TIMEOUT, Verdict.TIMEOUT, Verdict.UNKNOWN]
 
 
-def test_until_stable_needs_a_stable_verdict_stamped_after_the_ramp(program: TestProgram) -> None:
+def test_until_stable_needs_a_stable_verdict_on_windows_after_the_ramp(program: TestProgram) -> None:
     runner = ProgramRunner(program)
     runner.start(0.0)
     (plan,) = runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
     runner.observe_status(status(2.0, StatusState.STABLE))  # during the ramp: ignored
-    assert runner.update(2.6) == []
-    runner.observe_status(status(2.7, StatusState.SLIPPING, slip=3.4))
-    runner.observe_status(status(3.3, StatusState.STABLE, slip=3.2))
-    (nxt,) = runner.update(3.31)
+    runner.observe_status(status(3.3, StatusState.STABLE))  # its windows reach back to 2.14 s: ignored
+    assert runner.update(3.3) == []
+    first = plan.ramp_end + 1.0 + W40
+    runner.observe_status(status(first + 0.01, StatusState.STABLE, confidence=0.9))  # held, not shown now
+    runner.observe_status(status(first + 0.05, StatusState.STABLE, slip=3.2))
+    (nxt,) = runner.update(first + 0.06)
     outcome = runner.outcomes[-1]
     assert outcome.name == "n0900" and outcome.verdict is Verdict.STABLE
-    assert outcome.time_to_stable == pytest.approx(3.3 - plan.ramp_end)
-    assert outcome.measured_slip == 3.2 and outcome.end_time == pytest.approx(3.31)
-    assert nxt.segment.name == "n1200" and nxt.start_time == pytest.approx(3.31)
+    assert outcome.time_to_stable == pytest.approx(first + 0.05 - plan.ramp_end)
+    assert outcome.measured_slip == 3.2
+    assert nxt.segment.name == "n1200"
 
 
 def test_stable_verdict_of_the_previous_speed_does_not_end_the_next_segment(program: TestProgram) -> None:
@@ -91,31 +100,31 @@ def test_stable_verdict_of_the_previous_speed_does_not_end_the_next_segment(prog
     runner.start(0.0)
     runner.update(1.0)
     runner.observe_status(status(2.6, StatusState.SLIPPING))
-    runner.observe_status(status(3.0, StatusState.STABLE))
-    (n1200,) = runner.update(3.0)  # ramp 3.0 .. 4.0
-    runner.observe_status(status(3.0, StatusState.STABLE))  # stamped at the segment start: the old speed
-    assert run_until(runner, 3.0, 6.99) == []  # nothing after the ramp: waits until the timeout
-    assert runner.update(7.0) and runner.outcomes[-1].verdict is Verdict.TIMEOUT
+    runner.observe_status(status(3.7, StatusState.STABLE))  # n0900 (ramp end 2.5) is stable
+    (n1200,) = runner.update(3.7)  # ramp 3.7 .. 4.7
+    runner.observe_status(status(3.7, StatusState.STABLE))  # stamped at the segment start: the old speed
+    runner.observe_status(status(5.0, StatusState.STABLE))  # its windows reach back into the ramp
+    assert run_until(runner, 3.7, 7.69) == []  # nothing on windows after the ramp: the timeout
+    assert runner.update(7.7) and runner.outcomes[-1].verdict is Verdict.TIMEOUT
     assert runner.outcomes[-1].time_to_stable is None
 
 
-def test_a_stable_verdict_fitted_on_the_ramp_does_not_count(program: TestProgram) -> None:
-    """The monitor's first fit after a run-up can say "stable" from the ramp's rising slip: the
-    window reaching into the ramp, or no other state reported after the ramp, rules it out."""
+def test_a_stable_verdict_resting_on_the_ramp_does_not_count(program: TestProgram) -> None:
+    """A verdict whose slope still includes windows of the ramp speaks for the ramp, and a stable
+    state held by hysteresis (P(slope >= k) below 0.95) for older points: neither counts."""
     runner = ProgramRunner(program)
     runner.start(0.0)
     (plan,) = runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
-    runner.observe_status(status(2.2, StatusState.UNKNOWN))  # collecting points during the ramp
-    cage = 2.0 * math.pi / 0.1  # a 0.1 s window
-    runner.observe_status(status(2.55, StatusState.STABLE, cage=cage))  # window starts at 2.45: in the ramp
-    runner.observe_status(status(2.7, StatusState.STABLE, cage=cage))  # window after, but no restart seen
-    assert runner.update(2.8) == []
-    runner.observe_status(status(2.8, StatusState.UNKNOWN))  # the series restarted for the new speed
-    runner.observe_status(status(3.9, StatusState.STABLE, slip=3.3, cage=cage))
-    assert runner.update(3.9) and runner.outcomes[-1].time_to_stable == pytest.approx(3.9 - plan.ramp_end)
+    cage = 2.0 * math.pi / 0.1  # 0.1 s windows: a verdict reaches back 1.1 s
+    runner.observe_status(status(2.55, StatusState.STABLE, cage=cage))
+    runner.observe_status(status(3.5, StatusState.STABLE, cage=cage))  # back to 2.4 s: in the ramp
+    runner.observe_status(status(3.62, StatusState.STABLE, cage=cage, confidence=0.6))
+    assert runner.update(3.62) == []
+    runner.observe_status(status(3.65, StatusState.STABLE, slip=3.3, cage=cage))
+    assert runner.update(3.65) and runner.outcomes[-1].time_to_stable == pytest.approx(3.65 - plan.ramp_end)
 
 
-def test_without_a_speed_change_the_first_stable_window_after_the_start_counts(tmp_path: Path) -> None:
+def test_without_a_speed_change_the_first_stable_verdict_on_windows_after_the_start_counts(tmp_path: Path) -> None:
     path = tmp_path / "load_step.yaml"
     path.write_text(
         "name: load_step\nbearing: bearings/h7006c.yaml\nstability_criterion: axial_load\ninitial_speed_rpm: 900\n"
@@ -125,11 +134,11 @@ def test_without_a_speed_change_the_first_stable_window_after_the_start_counts(t
     runner = ProgramRunner(load_program(path))
     plan = runner.start(10.0)
     assert plan.ramp_end == 10.0
-    runner.observe_status(status(10.1, StatusState.STABLE, cage=2.0 * math.pi / 0.2))  # window from 9.9: before
-    runner.observe_status(status(10.3, StatusState.STABLE, cage=2.0 * math.pi / 0.2))
-    runner.update(10.3)
+    runner.observe_status(status(10.1, StatusState.STABLE, cage=2.0 * math.pi / 0.2))  # back to 8.9 s: before
+    runner.observe_status(status(11.3, StatusState.STABLE, cage=2.0 * math.pi / 0.2))  # back to 10.1 s
+    runner.update(11.3)
     assert runner.finished and runner.outcomes[-1].verdict is Verdict.STABLE
-    assert runner.outcomes[-1].time_to_stable == pytest.approx(0.3)
+    assert runner.outcomes[-1].time_to_stable == pytest.approx(1.3)
 
 
 def test_dwell_verdict_is_the_monitors_last_state_in_the_segment(program: TestProgram) -> None:
@@ -150,8 +159,8 @@ def test_measured_and_true_slip_compare_over_the_same_window(program: TestProgra
         runner.observe_truth(t, 3.0 if t < 3.0 else 3.5)
     cage = 2.0 * math.pi / 0.5  # one cage revolution takes 0.5 s
     runner.observe_status(status(2.6, StatusState.UNKNOWN))
-    runner.observe_status(status(3.45, StatusState.STABLE, slip=3.49, cage=cage))
-    runner.update(3.5)
+    runner.observe_status(status(3.45, StatusState.SLIPPING, slip=3.49, cage=cage))
+    runner.update(2.5 + 4.0)  # n0900 times out: its last status decides
     outcome = runner.outcomes[-1]
     # window 2.95 .. 3.45 s: 5 samples at 3.0 %, 45 at 3.5 % (samples 2.95 .. 3.45 inclusive)
     inside = [3.0 if k * 0.01 < 3.0 else 3.5 for k in range(295, 346)]
@@ -190,10 +199,11 @@ def test_a_speed_the_spindle_did_not_reach_is_marked(program: TestProgram) -> No
     runner = ProgramRunner(program)
     runner.start(0.0)
     runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
-    slow = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(600.0), cage_speed=40.0, window_revolutions=1)
+    slow = status(3.7, StatusState.UNKNOWN)
+    slow = SlipObservation(**{**slow.__dict__, "inner_ring_speed": rpm_to_rad_s(600.0)})
     runner.observe_status(slow)
-    runner.observe_status(SlipObservation(**{**slow.__dict__, "time": 3.5, "state": StatusState.STABLE}))
-    runner.update(3.6)
+    runner.observe_status(SlipObservation(**{**slow.__dict__, "time": 3.8, "state": StatusState.STABLE}))  # on windows after the ramp
+    runner.update(3.9)
     outcome = runner.outcomes[-1]
     assert outcome.verdict is Verdict.STABLE
     assert outcome.measured_speed == pytest.approx(rpm_to_rad_s(600.0))

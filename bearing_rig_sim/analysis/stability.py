@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from enum import StrEnum
+from enum import IntEnum
 from typing import Any
 from collections.abc import Callable, Sequence
 
@@ -57,12 +57,24 @@ before 0.6 s.
 """
 
 
-class SlipState(StrEnum):
-    """State of the bearing by the slope criterion; values compare equal to plain strings."""
+class SlipState(IntEnum):
+    """State of the bearing by the slope criterion, and of the monitor: the one state enum of the
+    project. The values are SlipStatus.msg's ``STATE_*`` constants; :attr:`label` is the name
+    shown to people ("stable")."""
 
-    UNKNOWN = "unknown"
-    SLIPPING = "slipping"
-    STABLE = "stable"
+    UNKNOWN = 0
+    SLIPPING = 1
+    STABLE = 2
+    FAULT = 3
+    """Sensor loss or invalid data (the monitor's; the slope criterion never gives it)."""
+
+    @property
+    def label(self) -> str:
+        """Lower-case name: "unknown", "slipping", "stable" or "fault"."""
+        return self.name.lower()
+
+    def __str__(self) -> str:
+        return self.label
 
 
 SlipCurve = Callable[[Any], Any]
@@ -136,7 +148,7 @@ def classify(
     slopes = slope_function(curve, h)(xs)
     if not np.all(np.isfinite(slopes)):
         raise AnalysisError("curve: gives a non-finite slope")
-    return np.where(slopes >= k, SlipState.STABLE.value, SlipState.SLIPPING.value)
+    return np.where(slopes >= k, SlipState.STABLE.label, SlipState.SLIPPING.label)
 
 
 @dataclass(frozen=True)

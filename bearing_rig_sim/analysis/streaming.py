@@ -1,8 +1,16 @@
-"""The slope criterion on points arriving one by one: the monitor's online verdict.
+"""The slope criterion on points arriving one by one.
 
-:class:`StreamingStability` collects (x, slip %) points, x being the time (s) or the axial load
-(N), refits the Gaussian sum on a fixed policy and answers at any moment whether the bearing is
-slipping or stable, with the onset of the stable state and a confidence.
+Two forms, x being the time (s) or the axial load (N):
+
+* :class:`TrailingSlope`, **the monitor's verdict**: the slope of a least-squares line through the
+  slip of a trailing window, decided only when its one-sided 95 % bound is on one side of k (with
+  hysteresis), with change detection on the slip itself; microseconds per point (see its
+  docstring). A global Gaussian does not describe a slip that steps and decays, or a plateau
+  (a 1-term fit to a flat series runs to its width bound and reports R^2 below zero), and its
+  refits cost milliseconds on the pulse path.
+* :class:`StreamingStability`: the paper's own form, the Gaussian sum refitted on a fixed policy
+  over the whole series, with the onset of the stable state; kept for studies and the
+  ``bearing-rig bench analysis`` streaming case. The rest of this docstring describes it.
 
 **Refit policy** (cheap enough for ``add`` at 10-100 Hz):
 
@@ -49,6 +57,8 @@ extrapolation beyond the fitted points is trusted as far as the covariance says.
 from __future__ import annotations
 
 import math
+import statistics
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -316,3 +326,267 @@ class StreamingStability:
             assert self._fit is not None
             self._onset_cache = (key, stable_onset(self._fit, first, latest, self.critical_slope))
         return self._onset_cache[1]
+
+
+# -- the monitor's verdict: a trailing-window slope with a confidence interval ------------------
+T_QUANTILE_95: tuple[float, ...] = (
+    6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812,
+    1.796, 1.782, 1.771, 1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725,
+)
+"""One-sided 95 % quantiles of Student's t for 1 .. 20 degrees of freedom (any statistics
+table); beyond 20 the normal value 1.645 is used, within 5 % of the table's."""
+
+
+def t_quantile_95(dof: int) -> float:
+    """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom."""
+    return T_QUANTILE_95[dof - 1] if dof <= len(T_QUANTILE_95) else 1.645
+
+
+@dataclass(frozen=True)
+class SlopeVerdict:
+    """The verdict of :class:`TrailingSlope` after the latest point.
+
+    Attributes:
+        state: UNKNOWN (no decision yet in this series), SLIPPING or STABLE.
+        slope: slope of the least-squares line over the trailing window, %/unit of x; None with
+            fewer than the minimum points.
+        standard_error: its standard error, same unit; None likewise.
+        critical_slope: k, same unit.
+        confidence: P(slope >= k) under the line fit's normal approximation (Student's t
+            quantiles decide, the normal law gives this number); 0 while the slope is unknown.
+        n_points: points in the trailing window.
+        span: x covered by those points, unit of x.
+        change_at: x of the latest change detected in the series (None if none since reset).
+        detail: one readable line.
+    """
+
+    state: SlipState
+    slope: float | None
+    standard_error: float | None
+    critical_slope: float
+    confidence: float
+    n_points: int
+    span: float
+    change_at: float | None
+    detail: str
+
+
+SCATTER_POINTS = 64
+"""Second differences kept for the scatter of the slip points (1)."""
+
+MIN_SCATTER_POINTS = 8
+"""Second differences needed before their scatter is used (1)."""
+
+
+class TrailingSlope:
+    """The slope criterion on a trailing window of (x, slip %) points, one point at a time.
+
+    **Slope.** A least-squares line through the points of the last ``span`` (unit of x; at least
+    the latest ``min_points`` whatever their span): the paper's Eq. 14 slope of a smoothed slip
+    curve, taken where the verdict is wanted, at the end. Its standard error is ``sigma /
+    sqrt(Sxx)``, with ``sigma`` the scatter of the slip points about the curve, estimated from the
+    second differences of the last :data:`SCATTER_POINTS` points of the series (``y_i - 2 y_(i-1)
+    + y_(i-2)`` has variance ``6 sigma^2`` plus a curvature term negligible between neighbouring
+    windows; the median of their magnitudes, divided by ``0.6745 sqrt 6``, ignores the few that
+    straddle a change), and never below ``resolution`` (percent): until enough points are in,
+    the larger of that and the line's own residual scatter.
+
+    **Decision with hysteresis.** With ``q`` the one-sided 95 % Student's t quantile: the state
+    becomes STABLE when ``slope - q se >= k``, SLIPPING when ``slope + q se < k``, and otherwise
+    stays what it was (UNKNOWN at the start of a series). A verdict thus changes only when the
+    data puts the slope clearly on the other side of k, so noise on a plateau cannot flap it.
+
+    **Changes in the slip itself** (a load step, a lubrication event, anything): each new point
+    is compared with the line's prediction; a point outside ``change_threshold`` prediction
+    standard errors, followed by one more on the same side, marks a change at the first of them.
+    The points before it are dropped, so the slope answers for the slip after the change. The
+    state is kept until the new points decide (hysteresis again). One outlier is not a change.
+
+    Args:
+        critical_slope: k, %/unit of x.
+        span: trailing window, unit of x (> 0).
+        min_points: points needed for a slope (>= 3).
+        resolution: least residual standard deviation believed, percent (> 0).
+        change_threshold: prediction standard errors beyond which a point is a candidate change.
+    """
+
+    def __init__(
+        self,
+        critical_slope: float,
+        span: float,
+        min_points: int = 5,
+        resolution: float = 0.01,
+        change_threshold: float = 4.0,
+    ) -> None:
+        self.critical_slope = finite_number("critical_slope", critical_slope)
+        self.span = finite_number("span", span)
+        if not self.span > 0.0:
+            raise AnalysisError(f"span: must be > 0, got {span!r}")
+        self.min_points = positive_int("min_points", min_points)
+        if self.min_points < 3:
+            raise AnalysisError(f"min_points: must be >= 3, got {min_points!r}")
+        self.resolution = finite_number("resolution", resolution)
+        if not self.resolution > 0.0:
+            raise AnalysisError(f"resolution: must be > 0, got {resolution!r}")
+        self.change_threshold = finite_number("change_threshold", change_threshold)
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every point and the decision (a new series: state UNKNOWN)."""
+        self._x: list[float] = []
+        self._y: list[float] = []
+        self._origin: float | None = None
+        self._state = SlipState.UNKNOWN
+        self._candidate: tuple[int, float] | None = None  # (sign, x) of an outlying point
+        self._change_at: float | None = None
+        self._sigma = self.resolution
+        self._dof = 1
+        self._d2: deque[float] = deque(maxlen=SCATTER_POINTS)
+        self._last2: list[tuple[float, float]] = []
+        self._line: tuple[float, float, float, float, float, int] | None = None  # slope, se, xbar, ybar, sxx, n
+        self._verdict = self._make_verdict()
+
+    @property
+    def n_points(self) -> int:
+        """Points in the trailing window."""
+        return len(self._x)
+
+    def forget_scatter(self) -> None:
+        """Start the scatter estimate afresh (a new operating point: the points' scatter about
+        the curve may differ, and the second differences of a steep, curved stretch such as a
+        run-up measure its curvature, not the scatter); points and decision are kept."""
+        self._d2.clear()
+        self._last2 = []
+
+    def points(self) -> tuple[FloatArray, FloatArray]:
+        """Copies of the points in the trailing window: x (unit of x) and slip (percent)."""
+        origin = self._origin or 0.0
+        return np.asarray(self._x) + origin, np.asarray(self._y, dtype=np.float64)
+
+    @property
+    def state(self) -> SlipState:
+        """The current decision."""
+        return self._state
+
+    def add(self, x: float, slip_pct: float) -> bool:
+        """Add one point (x increasing); returns whether a change in the slip was detected.
+
+        Raises:
+            AnalysisError: a non-finite value or an x not after the previous one (the point is
+                not added).
+        """
+        xv = finite_number("x", x)
+        yv = finite_number("slip_pct", slip_pct)
+        if self._origin is None:
+            self._origin = xv
+        u = xv - self._origin
+        if self._x and not u > self._x[-1]:
+            raise AnalysisError(f"x: must increase, got {xv!r} after {self._x[-1] + self._origin!r}; call reset()")
+        changed = self._test_change(u, yv)
+        if changed:
+            self._last2 = []
+        self._second_difference(u, yv)
+        self._x.append(u)
+        self._y.append(yv)
+        while len(self._x) > self.min_points and u - self._x[0] > self.span:
+            del self._x[0], self._y[0]
+        self._fit()
+        self._decide()
+        self._verdict = self._make_verdict()
+        return changed
+
+    def _test_change(self, u: float, y: float) -> bool:
+        line = self._line
+        if line is None:
+            return False
+        slope, _se, xbar, ybar, sxx, n = line
+        sigma = self._sigma
+        predicted = ybar + slope * (u - xbar)
+        spread = sigma * math.sqrt(1.0 + 1.0 / n + (u - xbar) ** 2 / sxx)
+        z = (y - predicted) / spread
+        if abs(z) <= self.change_threshold:
+            self._candidate = None
+            return False
+        sign = 1 if z > 0 else -1
+        if self._candidate is None or self._candidate[0] != sign:
+            self._candidate = (sign, u)
+            return False
+        start = self._candidate[1]
+        self._candidate = None
+        keep = [i for i, xi in enumerate(self._x) if xi >= start]
+        self._x = [self._x[i] for i in keep]
+        self._y = [self._y[i] for i in keep]
+        self._change_at = start + (self._origin or 0.0)
+        self._line = None
+        return True
+
+    def _second_difference(self, u: float, y: float) -> None:
+        """Record the second difference ending at (u, y), scaled to equal spacing."""
+        last = self._last2
+        if len(last) == 2:
+            (x0, y0), (x1, y1) = last
+            h0, h1 = x1 - x0, u - x1
+            if h0 > 0.0 and h1 > 0.0:
+                # divided second difference times the mean spacing squared / 2: 'y_i - 2 y_(i-1) + y_(i-2)'
+                # for equal spacing; its noise variance is 6 sigma^2 at equal spacing
+                d2 = 2.0 * ((y - y1) / h1 - (y1 - y0) / h0) / (h0 + h1) * (0.5 * (h0 + h1)) ** 2
+                self._d2.append(abs(d2))
+        last.append((u, y))
+        if len(last) > 2:
+            del last[0]
+
+    def _scatter(self, residual_scatter: float) -> tuple[float, int]:
+        """sigma (percent) and its degrees of freedom."""
+        if len(self._d2) >= MIN_SCATTER_POINTS:
+            pooled = statistics.median(self._d2) / (0.6745 * math.sqrt(6.0))
+            return max(pooled, self.resolution), len(self._d2)
+        return max(residual_scatter, self.resolution), max(len(self._x) - 2, 1)
+
+    def _fit(self) -> None:
+        n = len(self._x)
+        if n < self.min_points:
+            self._line = None
+            return
+        # plain sums: a few dozen points, where numpy's call overhead would dominate
+        xs, ys = self._x, self._y
+        xbar, ybar = sum(xs) / n, sum(ys) / n
+        dx = [x - xbar for x in xs]
+        sxx = sum(d * d for d in dx)
+        if not sxx > 0.0:
+            self._line = None
+            return
+        slope = sum(d * (y - ybar) for d, y in zip(dx, ys)) / sxx
+        sse = sum((y - ybar - slope * d) ** 2 for d, y in zip(dx, ys))
+        scatter = math.sqrt(sse / (n - 2)) if n > 2 else 0.0
+        self._sigma, self._dof = self._scatter(scatter)
+        self._line = (slope, self._sigma / math.sqrt(sxx), xbar, ybar, sxx, n)
+
+    def _decide(self) -> None:
+        if self._line is None:
+            return
+        slope, se, *_rest = self._line
+        q = t_quantile_95(self._dof)
+        k = self.critical_slope
+        if slope - q * se >= k:
+            self._state = SlipState.STABLE
+        elif slope + q * se < k:
+            self._state = SlipState.SLIPPING
+
+    def _make_verdict(self) -> SlopeVerdict:
+        k = self.critical_slope
+        n = len(self._x)
+        span = self._x[-1] - self._x[0] if n else 0.0
+        if self._line is None:
+            detail = f"collecting slip points: {n} of the {self.min_points} needed for a slope"
+            if self._state is not SlipState.UNKNOWN:
+                detail += f" (holding {self._state.label} since a change at x = {self._change_at:.6g})"
+            return SlopeVerdict(self._state, None, None, k, 0.0, n, span, self._change_at, detail)
+        slope, se, *_rest = self._line
+        confidence = 0.5 * (1.0 + math.erf((slope - k) / (se * math.sqrt(2.0))))
+        relation = {SlipState.STABLE: "clearly >=", SlipState.SLIPPING: "clearly <"}.get(self._state, "not clearly either side of")
+        detail = f"slope {slope:.3g} +- {se:.2g} over {n} points ({span:.3g}) {relation} k = {k:g}; P(slope >= k) {confidence:.3f}"
+        return SlopeVerdict(self._state, slope, se, k, confidence, n, span, self._change_at, detail)
+
+    def verdict(self) -> SlopeVerdict:
+        """The verdict after the latest point (cached; microseconds)."""
+        return self._verdict

@@ -21,7 +21,7 @@ prints one JSON object per line:
   each step, over and over) is analysed offline as ``bearing-rig analyze`` does, in a fresh
   process: ``analyse_s`` (the monitor run over every pulse, the series and CSV files), of it
   ``monitor_s`` (inside the monitor's own ``add_pulse``, ``check`` and ``status``: its slip
-  windows, Gaussian refits and verdicts), ``report_s`` (plots and markdown), ``target_s`` (60 for an hour, pro rata), ``peak_rss_mb``,
+  windows, trailing slopes and verdicts), ``report_s`` (plots and markdown), ``target_s`` (30 for an hour, pro rata), ``peak_rss_mb``,
   ``baseline_rss_mb``, and the counts (pulses, windows, status rows).
 """
 
@@ -56,8 +56,8 @@ from bearing_rig_sim.synthetic.traffic import (
 TARGET_MSGS_PER_S = 20_000
 """Recorder throughput required by issue 6 (messages/s)."""
 
-TARGET_ANALYSE_S_PER_HOUR = 60.0
-"""Offline analysis of a one-hour bag required by issue 6 (s)."""
+TARGET_ANALYSE_S_PER_HOUR = 30.0
+"""Offline analysis of a one-hour bag required by issue 12 (s; issue 6 asked for 60)."""
 
 PROGRAM_RPM = (900.0, 1200.0, 1500.0, 1800.0, 2100.0, 2400.0, 2700.0)
 """Inner-ring speeds of :func:`program_traffic`: the validation program's (rpm)."""
@@ -144,7 +144,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     status: Any = store.types["bearing_rig_msgs/msg/SlipStatus"](
         header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
         theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
-        confidence=0.9, window_revolutions=1, detail="1-term Gaussian fit of 300 points; slope -0.001 %/s >= k = -0.03 %/s",
+        confidence=0.9, window_revolutions=1, detail="slope -0.001 +- 0.002 over 7 points (0.953) clearly >= k = -0.03; P(slope >= k) 1.000",
     )
     dt = 1e-3
     for step in range(int(round(duration_s / dt))):

@@ -30,7 +30,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Analyse the bag and write the report."""
     from bearing_rig_sim.commands.bag import bag_warnings_as_lines
-    from bearing_rig_sim.monitoring import MonitorSettings, MonitorState
+    from bearing_rig_sim.monitoring import MonitorSettings, SlipState
     from bearing_rig_sim.offline.analysis import analyse_bag
     from bearing_rig_sim.offline.report import state_name, write_report
 
@@ -42,7 +42,7 @@ def run(args: argparse.Namespace) -> int:
         files = write_report(result, out)
     final = result.final_status
     verdict = state_name(int(final.state)) if final is not None else "none"
-    stable = sum(s.final_state == MonitorState.STABLE for s in result.segments)
+    stable = sum(s.final_state == SlipState.STABLE for s in result.segments)
     print(
         f"{args.bag}: {result.windows} slip windows, final verdict {verdict}; "
         f"{len(result.segments)} segment(s), {stable} stable{'' if result.complete else '; INCOMPLETE bag, partial results'}"

@@ -27,6 +27,7 @@ BENCHMARKS: dict[str, str] = {
     "bags": "bearing_rig_sim.benchmarks.bags",
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
     "rig": "bearing_rig_sim.benchmarks.rig",
+    "sweep": "bearing_rig_sim.benchmarks.sweep",
     "shadow": "bearing_rig_sim.benchmarks.shadow",
 }
 """Benchmark name -> module path (``bearing_rig_sim.benchmarks.<name>``)."""

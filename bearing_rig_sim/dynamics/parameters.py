@@ -2,15 +2,23 @@
 
 :class:`BearingParameters` holds the primary data (SI units) and :func:`derive` computes
 everything the kernels need (groove geometry, Hertz constants, masses, inertias, resistance
-coefficients) into a flat float64 vector whose layout is defined in :mod:`.kernels`.
+coefficients, and with ``friction.model: rheology`` the traction table of :mod:`.traction`) into a
+flat float64 vector whose layout is defined in :mod:`.kernels` (the table appended after
+``P_SIZE``). The lubricant comes from ``lubricant.file`` (:class:`.lubrication.Lubricant`).
 
-Resistance models (what makes the cage slip; docs/paper.md section 12), each applied in the kernels:
+Resistance models (what makes the cage slip; docs/model.md), each applied in the kernels; the
+lubrication mode of the lubricant file selects the drag and land laws:
 
-* Ball drag in the oil-air mixture (Harris and Kotzalas, *Advanced Concepts*, ch. 7, sphere drag
-  with C_d = 24/Re + C_d,inf): F = s (3 pi eta_mix Dw v + 1/2 rho_mix C_d (pi Dw^2/4) v|v|),
-  v = ball-centre orbital speed, rho_mix and eta_mix the volume-weighted oil-air mixture.
-* Cage land friction (outer-land guided cage): a Petroff short-journal oil film
-  T_v = s_v 2 pi eta r^3 w omega_c / c plus boundary friction T_b = s_b mu m_c g r (smoothed sign).
+* Ball drag, oil-air or oil bath (Harris and Kotzalas, *Advanced Concepts*, ch. 7, sphere drag
+  with C_d = 24/Re + C_d,inf): F = s (3 pi eta Dw v + 1/2 rho C_d (pi Dw^2/4) v|v|),
+  v = ball-centre orbital speed, rho and eta of the oil-air mixture or of the oil times the fill.
+* Ball drag, grease (Herschel-Bulkley): F = fill (3.5 pi Dw^2 tau_y + 3 pi K Dw^(2-n) v^n) plus
+  the inertial term, the plastic drag of a sphere (Beris et al. 1985) and Stokes drag with the
+  apparent viscosity at v/Dw.
+* Cage land friction (outer-land guided cage): a Petroff short-journal film
+  T_v = s_v 2 pi eta r^3 w omega_c / c (oil) or 2 pi r^2 w fill (tau_y + K (r omega_c/c)^n)
+  (grease), plus boundary friction T_b = s_b mu m_c g r with a horizontal spindle (smoothed sign).
+* Houpert's EHL rolling force at each raceway contact, as a moment on the ball's rolling.
 * Ball-pocket friction: mu_p times the pocket normal force, on the ball's spin.
 * Elastic-hysteresis rolling resistance at each raceway contact (Harris and Kotzalas ch. 7):
   M = (3/16) alpha_h Q b, with b the semi-minor axis of the contact ellipse, on the ball's spin.
@@ -48,10 +56,14 @@ class BearingParameters:
     Materials: densities (kg/m^3), Young's moduli (Pa), Poisson ratios (1).
     Contact: Hunt-Crossley coefficient a_e (s/m) and exponent n (1); full-damping penetration (m).
     Friction: model name, mu_s, v_s (m/s), mu_d, v_d (m/s), EHL mu_max and SRR0, pocket mu.
-    Lubricant: oil and air densities (kg/m^3) and viscosities (Pa s), oil volume fraction (1).
+    Lubricant: oil and air densities (kg/m^3) and viscosities (Pa s), oil volume fraction (1);
+    with a lubricant file, ``lubricant`` (:class:`.lubrication.Lubricant`) and its
+    ``lubricant_temperature`` (degC) set the oil values.
     Resistances: drag coefficient, scale factors (1), land friction coefficient (1),
     hysteresis factor alpha_h (1).
     Integration: time steps of the reduced and stiff models (s).
+    Also: ``ehl_rolling_scale`` (1) on Houpert's force, ``composite_roughness`` (m, RMS; 0 if
+    not given) for the film parameter, ``spindle_axis`` (``horizontal`` or ``vertical``).
     """
 
     name: str

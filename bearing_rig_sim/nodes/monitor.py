@@ -1,23 +1,25 @@
 """The monitor node: cage slip and its stability from the fibre-optic pulse topics (a thin shell
-around :class:`~bearing_rig_sim.monitoring.SlipMonitor`).
+around :class:`~bearing_rig_sim.monitoring.SlipMonitor` and the
+:class:`~bearing_rig_sim.monitoring.StatusSchedule` that offline analysis runs too).
 
-Subscribes only ``/rig/spindle/pulses`` and ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse,
-sensor data), so it runs unchanged on the bench's topics. Publishes:
+Subscribes ``/rig/spindle/pulses`` and ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse,
+sensor data) and, with the ``axial_load`` criterion, ``/rig/axial_load/force`` (the load cell), so
+it runs unchanged on the bench's topics. Publishes:
 
-* ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): ``status_rate_hz``
-  (wall clock) and at once on every change of state;
+* ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): when the
+  schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes);
+  when the pulses stop, at ``status_rate_hz`` of the steady clock;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` (wall) and
-  on every change of level: OK stable, WARN slipping or unknown, ERROR sensor loss or invalid data.
+  on every change of level: OK stable, WARN slipping, unknown or pulses lost lately (with the
+  counts), ERROR sustained sensor loss or invalid data.
 
-The rig clock is the node's clock: ``use_sim_time: true`` in ``config/monitor.yaml`` (the
-simulator's /clock), the system clock on the bench (``-p use_sim_time:=false``). A clock going
-back resets the monitor. Timers run on the steady clock, so a source that stops (and takes
-/clock with it) is still noticed: the rig time used for the sensor-loss check is the later of the
-node's clock and the latest pulse's time plus the wall time since it arrived.
+The rig time is the pulses' stamps, extrapolated by the steady clock while none arrive; with
+``use_sim_time`` a /clock going back resets the monitor.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -25,29 +27,31 @@ from typing import Any
 from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
+from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, DIAGNOSTICS, PULSE_TOPICS, SLIP_STATUS
 from bearing_rig_sim.monitoring import (
     NODE_NAME,
     MonitorSettings,
-    MonitorState,
     MonitorStatus,
     SlipMonitor,
+    SlipState,
+    StatusSchedule,
     shipped_parameters,
 )
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
     PULSE_READER_QOS,
-    RELIABLE_QOS,
-    STATUS_QOS,
     WARN,
     diagnostic_array,
     diagnostic_status,
     from_stamp,
+    qos_profile,
     run_node,
     to_stamp,
 )
@@ -55,8 +59,8 @@ from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, surv
 from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
-LEVELS = {MonitorState.STABLE: OK, MonitorState.SLIPPING: WARN, MonitorState.UNKNOWN: WARN, MonitorState.FAULT: ERROR}
-"""Diagnostics level of each monitor state."""
+LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WARN, SlipState.FAULT: ERROR}
+"""Diagnostics level of each monitor state (recent lost pulses raise OK to WARN)."""
 
 
 class MonitorNode(Node):
@@ -71,9 +75,10 @@ class MonitorNode(Node):
         values = declare_and_read(self, shipped_parameters())
         self.settings = MonitorSettings.from_values(values, f"{NODE_NAME} parameters")
         self.monitor = SlipMonitor(self.settings.kinematics(), self.settings)
+        self.schedule = StatusSchedule(self.monitor)
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
-        self._last_state: MonitorState | None = None
+        self._last_state: SlipState | None = None
         self._last_level: bytes | None = None
         self._received = {"spindle": 0, "cage": 0}
         # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
@@ -81,10 +86,12 @@ class MonitorNode(Node):
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
         self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
-        self._status_pub = self.create_publisher(SlipStatus, "/rig/slip_status", STATUS_QOS)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", lambda m: self._on_pulse("spindle", m), PULSE_READER_QOS)
-        self.create_subscription(FibreOpticPulse, "/rig/cage/pulses", lambda m: self._on_pulse("cage", m), PULSE_READER_QOS)
+        self._status_pub = self.create_publisher(SlipStatus, SLIP_STATUS.name, qos_profile(SLIP_STATUS))
+        self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
+        for shaft, topic in PULSE_TOPICS.items():
+            self.create_subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
+        if self.settings.criterion == "axial_load":
+            self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
@@ -112,14 +119,16 @@ class MonitorNode(Node):
             )
             self._last_pulse_wall = time.monotonic()
             self._received[shaft] += 1
-            if self.monitor.add_pulse(shaft, pulse):
-                # A slip window just closed: publish its status now rather than at the next
-                # timer tick, so the status follows the pulse within the processing time.
-                self._publish(self.monitor.status())
+            for scheduled in self.schedule.on_pulse(shaft, pulse):
+                self._publish(scheduled.status)
         except Exception as exc:
             if not self.context.ok():
                 raise
             self.get_logger().error(f"{shaft} pulse not processed: {exc}", throttle_duration_sec=1.0)
+
+    @survives_shutdown
+    def _on_load(self, msg: WrenchStamped) -> None:
+        self.monitor.add_load(from_stamp(msg.header.stamp), float(msg.wrench.force.z))
 
     def _clock_now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
@@ -143,10 +152,10 @@ class MonitorNode(Node):
             self.monitor.clock_jump(self._last_clock, clock_now)
             self._last_pulse_wall = None
         self._last_clock = clock_now
+        if self._last_pulse_wall is not None and time.monotonic() - self._last_pulse_wall < 2.0 / self.settings.status_rate_hz:
+            return  # the pulses drive the schedule
         now = self._rig_now(clock_now)
-        if now is not None:
-            self.monitor.check(now)
-        self._publish(self.monitor.status())
+        self._publish(self.schedule.idle(now).status if now is not None else self.monitor.status())
 
     @survives_shutdown
     def _on_diagnostics_timer(self) -> None:
@@ -155,10 +164,10 @@ class MonitorNode(Node):
     # -- outputs -------------------------------------------------------------------------------
     def _publish(self, status: MonitorStatus) -> None:
         if status.state != self._last_state:
-            self.get_logger().info(f"state {status.state.name.lower()}: {status.detail}")
+            self.get_logger().info(f"state {status.state.label}: {status.detail}")
         self._last_state = status.state
         self._status_pub.publish(self._status_message(status))
-        if LEVELS[status.state] != self._last_level:
+        if _level(status) != self._last_level:
             self._publish_diagnostics(status)
 
     def _status_message(self, status: MonitorStatus) -> SlipStatus:
@@ -169,24 +178,37 @@ class MonitorNode(Node):
         return msg
 
     def _publish_diagnostics(self, status: MonitorStatus) -> None:
-        level = LEVELS[status.state]
+        level = _level(status)
         self._last_level = level
         values = {
-            "state": status.state.name.lower(),
+            "state": status.state.label,
             "slip_rate_pct": f"{status.slip_rate:.6g}",
             "inner_ring_speed_rad_s": f"{status.inner_ring_speed:.6g}",
             "cage_speed_rad_s": f"{status.cage_speed:.6g}",
-            "fitted_slope_pct_per_s": f"{status.fitted_slope:.4g}",
-            "critical_slope_pct_per_s": f"{status.critical_slope:g}",
+            f"fitted_slope_pct_per_{_X_UNIT[status.criterion]}": f"{status.fitted_slope:.4g}",
+            f"critical_slope_pct_per_{_X_UNIT[status.criterion]}": f"{status.critical_slope:g}",
             "confidence": f"{status.confidence:.3f}",
             "windows": status.windows,
             "spindle_pulses_received": self._received["spindle"],
             "cage_pulses_received": self._received["cage"],
+            "spindle_pulses_lost": status.lost[0],
+            "cage_pulses_lost": status.lost[1],
+            "cage_windows_skipped": status.windows_skipped,
             "faults": " | ".join(status.faults),
+            "warnings": " | ".join(status.warnings),
         }
-        message = f"{status.state.name.lower()}: {status.detail}"
+        message = f"{status.state.label}: {status.detail}"
         array = diagnostic_array(to_stamp(max(self._clock_now(), 0.0)), [diagnostic_status(f"{NODE_NAME}: cage slip", level, message, values)])
         self._diag_pub.publish(array)
+
+
+_X_UNIT = {"time": "s", "axial_load": "n"}
+
+
+def _level(status: MonitorStatus) -> bytes:
+    """Diagnostics level: the state's, raised to WARN while lost pulses are recent."""
+    level = LEVELS[status.state]
+    return WARN if level == OK and status.warnings else level
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -5,18 +5,14 @@
     result = analyse_bag("bags/20250612T093015Z-validation", csv_dir="reports/run")
     print(result.final_status.state, [s.final_state for s in result.segments])
 
-The two fibre-optic pulse topics are read in log-time order and fed, in lockstep, into the same
-:class:`~bearing_rig_sim.monitoring.SlipMonitor` the monitor node wraps, so the slip windows and
-verdicts offline are the monitor's. Nothing depends on a wall clock: two runs over one bag give
+The two fibre-optic pulse topics are read in log-time order and fed through the same
+:class:`~bearing_rig_sim.monitoring.StatusSchedule` and
+:class:`~bearing_rig_sim.monitoring.SlipMonitor` the monitor node runs, so the slip windows,
+verdicts and the moments of the statuses offline are the node's (one status row per status the
+node would publish, plus a last one after the last pulse). With the ``axial_load`` criterion the
+load cell's force is fed too. The criterion is the run's test program's ``stability_criterion``
+when the bag records the program. Nothing depends on a wall clock: two runs over one bag give
 bit-identical results.
-
-**The clock.** The monitor node takes the pulse stamps as its time base; it calls
-:meth:`SlipMonitor.check` (where the Gaussian refits run) and publishes a status
-``status_rate_hz`` times a second, and publishes one more as each slip window closes. Offline,
-before each pulse ``check`` runs at every tick ``t0 + k / status_rate_hz`` up to the pulse's time
-(``t0``: the first pulse), each followed by a status row, and each closed window emits a row at
-once. A pulse further back than ``clock_jump_tolerance_s`` restarts the ticks (the monitor
-resets itself on it). After the last pulse one final ``check`` and row close the series.
 
 **What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
 of the five fields the monitor needs (little-endian CDR; other encodings through the reader's
@@ -49,18 +45,25 @@ import functools
 import math
 import struct
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 from collections.abc import Callable
 
 
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
-from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, shipped_parameters
+from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.reader import BagReader, open_bag
-from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary, SegmentTracker, program_segment_names, write_segments_csv
+from bearing_rig_sim.offline.segments import (
+    SEGMENTS_CSV,
+    SegmentSummary,
+    SegmentTracker,
+    program_criterion,
+    program_segment_names,
+    write_segments_csv,
+)
 from bearing_rig_sim.offline.series import (
     STATUS_CSV,
     WINDOWS_CSV,
@@ -262,9 +265,13 @@ class OfflineAnalysis:
         source = "given"
         if settings is None:
             settings, source = self._run_settings()
+        criterion = program_criterion(bag.run_metadata)
+        if source != "given" and criterion and criterion != settings.criterion:
+            settings = replace(settings, criterion=criterion)
+            source += f", criterion {criterion!r} from the run's test program"
         self.settings = settings
         self.monitor = SlipMonitor(settings.kinematics(), settings)
-        self.period = 1.0 / settings.status_rate_hz
+        self.schedule = StatusSchedule(self.monitor)
         topics = bag.topics
         self.result = OfflineResult(
             path=bag.path,
@@ -283,12 +290,11 @@ class OfflineAnalysis:
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0
         self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
-        self._origin: float | None = None
-        self._tick = 0
-        self._clock = -math.inf
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
-        self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata))
+        self._segments = SegmentTracker(
+            self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings
+        )
         self._sinks: list[CsvWriter] = []
         self._csv_dir = csv_dir
         if csv_dir is not None:
@@ -342,9 +348,11 @@ class OfflineAnalysis:
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
             handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
+            if name == LOAD_CELL and self.settings.criterion == "axial_load":
+                handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
-                handlers[topic](log_time_ns, data)
+                handlers[topic](log_time_ns, cast(bytes, data))  # raw=True: the CDR bytes
             self._finish()
         finally:
             for sink in self._sinks:
@@ -372,38 +380,34 @@ class OfflineAnalysis:
             return
         shaft = self._shaft_of[topic]
         self.result.pulses[shaft] += 1
-        t = pulse.time
-        if math.isfinite(t):
-            self._advance(t)
-        if self.monitor.add_pulse(shaft, pulse):
-            latest = self.monitor.latest_window
-            assert latest is not None
-            window = SlipWindowRow(latest.start_time, latest.end_time, latest.inner_ring_speed, latest.cage_speed, latest.slip_rate)
-            self.result.windows += 1
-            if self._sinks:
-                self._windows_csv.write(window)
-            if self._on_window is not None:
-                self._on_window(window)
-            self._emit(self._clock, "window", self.monitor.status())
+        for scheduled in self.schedule.on_pulse(shaft, pulse):
+            if scheduled.reason == "window":
+                latest = self.monitor.latest_window
+                assert latest is not None
+                window = SlipWindowRow(latest.start_time, latest.end_time, latest.inner_ring_speed, latest.cage_speed, latest.slip_rate)
+                self.result.windows += 1
+                if self._sinks:
+                    self._windows_csv.write(window)
+                if self._on_window is not None:
+                    self._on_window(window)
+            self._emit(scheduled.time, scheduled.reason, scheduled.status)
+        clock = self.schedule.clock
+        if math.isfinite(clock):
+            if not math.isfinite(self.result.first_time):
+                self.result.first_time = clock
+            self.result.last_time = clock
 
-    def _advance(self, t: float) -> None:
-        """Run the checks of every tick up to ``t``; restart the ticks on a clock jump back."""
-        if self._origin is None or t < self._clock - self.settings.clock_jump_tolerance_s:
-            self._origin, self._tick, self._clock = t, 0, t
-        while (tick := self._origin + self._tick * self.period) <= t:
-            self.monitor.check(tick)
-            self._emit(tick, "tick", self.monitor.status())
-            self._tick += 1
-        self._clock = max(self._clock, t)
-        if not math.isfinite(self.result.first_time):
-            self.result.first_time = t
-        self.result.last_time = self._clock
+    def _on_load_cell(self, log_time_ns: int, data: bytes) -> None:
+        """The load cell's force, for the axial-load criterion (and the rows)."""
+        message, stamp = self._decoded(LOAD_CELL, log_time_ns, data)
+        if message is not None:
+            self.monitor.add_load(stamp, float(message.wrench.force.z))
 
     def _finish(self) -> None:
-        if self._origin is not None:
-            self.monitor.check(self._clock)
-            self._emit(self._clock, "end", self.monitor.status())
-            self.result.final_status = self.monitor.status()
+        final = self.schedule.finish()
+        if final is not None:
+            self._emit(final.time, final.reason, final.status)
+            self.result.final_status = final.status
         self.result.segments = self._segments.finish()
 
     # -- context topics ------------------------------------------------------------------------
@@ -418,7 +422,8 @@ class OfflineAnalysis:
         if message is None:
             return None, _NAN
         stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-        reference = self._clock if self._origin is not None else log_time_ns * 1e-9
+        clock = self.schedule.clock
+        reference = clock if math.isfinite(clock) else log_time_ns * 1e-9
         return message, stamp if abs(stamp - reference) <= PLAUSIBLE_STAMP_S else reference
 
     def _on_recorded_status(self, log_time_ns: int, data: bytes) -> None:
@@ -432,7 +437,7 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
-        self._segments.recorded(stamp, state)
+        self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
         command, start = self._decoded(COMMAND, log_time_ns, data)
@@ -495,6 +500,7 @@ class OfflineAnalysis:
             reason=reason,
             state=int(status.state),
             window_end=_NAN if status.time is None else status.time,
+            window_start=_NAN if status.window_start is None else status.window_start,
             inner_ring_speed=status.inner_ring_speed,
             cage_speed=status.cage_speed,
             theoretical_cage_speed=status.theoretical_cage_speed,

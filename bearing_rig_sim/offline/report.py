@@ -25,8 +25,8 @@ from collections.abc import Sequence
 
 
 import bearing_rig_sim
+from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
-from bearing_rig_sim.monitoring import MonitorState
 from bearing_rig_sim.offline.analysis import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
@@ -35,7 +35,7 @@ REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")
 
 _RPM = 1.0 / RPM_TO_RAD_S
-_STATE_NAMES = {int(s): s.name.lower() for s in MonitorState}
+_STATE_NAMES = {int(s): s.name.lower() for s in SlipState}
 _RUN_KEYS = ("run_id", "started_utc", "program_file", "command_line", "project_version", "realtime", "ros_domain_id")
 _TOPIC_USE = {
     **{topic: "slip windows and verdicts (offline monitor)" for topic in PULSE_TOPICS.values()},
@@ -131,8 +131,8 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
     import matplotlib.pyplot as plt
 
     paths = []
-    thin = {"linewidth": 0.8}
-    figures = (
+    thin: dict[str, Any] = {"linewidth": 0.8}
+    figures: tuple[tuple[str, str, str, list[tuple[str, str, float, dict[str, Any]]], str], ...] = (
         (
             "speeds.png",
             "Speeds",
@@ -290,14 +290,15 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     lines.append(f"* state changes: {max(len(result.transitions) - 1, 0)} offline, {max(len(result.recorded_transitions) - 1, 0)} recorded")
     if result.transitions_dropped:
         lines.append(f"* {result.transitions_dropped} further state changes were counted but not kept for the status plot")
-    stable = sum(s.final_state == MonitorState.STABLE for s in result.segments)
+    stable = sum(s.final_state == SlipState.STABLE for s in result.segments)
     source = "program segments (from /rig/spindle/command)" if result.segment_source == "program" else "constant-speed stretches (no spindle command in the bag)"
     lines += [f"* {len(result.segments)} {source}: {stable} end stable; {_agreement(result.segments)}", ""]
     lines += ["## Segments", ""]
     if result.segments:
         lines += [
             "Means are taken from the ramp's end to the segment's end; verdicts are the last state in the segment; "
-            "time to stable counts from the ramp's end to the end of the first stable window.",
+            "time to stable counts from the ramp's end to the first stable status (P(slope >= k) >= 0.95) whose "
+            "slip windows all follow the ramp's end, the rule the live session summary uses.",
             "",
             *_segment_table(result),
             "",

@@ -11,8 +11,9 @@
   least :data:`STRETCH_MIN_DURATION_S`; the ramp end is the stretch's start.
 
 A segment's means are taken over the rows from its ramp end on; its verdicts are the last state
-in it; its time to stable runs from the ramp end to the end of the first stable window (the
-window must end after the ramp: a stable verdict from before belongs to the previous speed).
+in it; its time to stable follows the one rule the live session summary also uses
+(:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`), for the offline statuses and the
+recorded ones alike.
 
 Units: s, rad/s, N; slip in percent.
 """
@@ -23,8 +24,10 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import ConfigError, parse_yaml
-from bearing_rig_sim.monitoring import MonitorState
+from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
+from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
 
 SEGMENTS_CSV = "segments.csv"
@@ -51,8 +54,7 @@ class SegmentSummary:
         slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
             status / simulator truth, %.
         final_state / final_recorded_state: state at the segment's end (recorded: -1 if none).
-        time_to_stable / recorded_time_to_stable: first stable verdict whose window ends at or
-            after the ramp end, minus the ramp end, s (None without one).
+        time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one).
         rows: status rows after the ramp end (1).
     """
 
@@ -76,15 +78,16 @@ class SegmentSummary:
 class _Segment:
     """Accumulates one segment's figures from the status rows after its ramp end."""
 
-    def __init__(self, name: str, start: float, ramp_end: float, target: float) -> None:
+    def __init__(self, name: str, start: float, ramp_end: float, target: float, settings: MonitorSettings) -> None:
         self.name, self.start, self.ramp_end, self.target = name, start, ramp_end, target
         self.end = start
         self.sums: dict[str, list[float]] = {}
         self.rows = 0
-        self.final_state = int(MonitorState.UNKNOWN)
+        self.final_state = int(SlipState.UNKNOWN)
         self.final_recorded = -1
-        self.stable_at: float | None = None
-        self.recorded_stable_at: float | None = None
+        self.settings = settings
+        self.stable = TimeToStable(ramp_end)
+        self.recorded_stable = TimeToStable(ramp_end)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):
@@ -100,17 +103,20 @@ class _Segment:
         self.end = row.time
         self.final_state = row.state
         self.final_recorded = row.recorded_state
-        if row.state == MonitorState.STABLE and self.stable_at is None and row.window_end >= self.ramp_end:
-            self.stable_at = row.window_end
+        if math.isfinite(row.window_end):
+            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence)
         if row.time < self.ramp_end:
             return
         self.rows += 1
         for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
             self._add(key, getattr(row, key))
 
-    def add_recorded(self, stamp: float, state: int) -> None:
-        if state == MonitorState.STABLE and self.recorded_stable_at is None and stamp >= self.ramp_end:
-            self.recorded_stable_at = stamp
+    def evidence(self, stamp: float, cage_speed: float) -> float:
+        st = self.settings
+        return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points)
+
+    def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
+        self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence)
 
     def summary(self) -> SegmentSummary:
         return SegmentSummary(
@@ -126,8 +132,8 @@ class _Segment:
             truth_slip_rate=self.mean("truth_slip_rate"),
             final_state=self.final_state,
             final_recorded_state=self.final_recorded,
-            time_to_stable=None if self.stable_at is None else self.stable_at - self.ramp_end,
-            recorded_time_to_stable=None if self.recorded_stable_at is None else self.recorded_stable_at - self.ramp_end,
+            time_to_stable=self.stable.time_to_stable,
+            recorded_time_to_stable=self.recorded_stable.time_to_stable,
             rows=self.rows,
         )
 
@@ -142,6 +148,15 @@ def program_segment_names(run_metadata: dict[str, str]) -> list[str]:
         return []
 
 
+def program_criterion(run_metadata: dict[str, str]) -> str:
+    """The run's test program's ``stability_criterion`` ("" when absent or unreadable)."""
+    try:
+        doc = parse_yaml(run_metadata.get("program", "") or "", "run context: program")
+        return str(doc.get("stability_criterion", "") or "")
+    except (ConfigError, AttributeError):
+        return ""
+
+
 def write_segments_csv(path: Path, segments: list[SegmentSummary]) -> Path:
     """The segment table as CSV (speeds in rpm); returns ``path``."""
     sink = CsvWriter(path, csv_columns(SegmentSummary))
@@ -153,8 +168,6 @@ def write_segments_csv(path: Path, segments: list[SegmentSummary]) -> Path:
     return path
 
 
-
-
 class SegmentTracker:
     """Segments of a run from its status rows (see the module documentation).
 
@@ -163,9 +176,10 @@ class SegmentTracker:
         names: the test program's segment names (used when their count matches).
     """
 
-    def __init__(self, by_program: bool, names: list[str]) -> None:
+    def __init__(self, by_program: bool, names: list[str], settings: MonitorSettings | None = None) -> None:
         self.by_program = by_program
         self.names = names
+        self.settings = settings if settings is not None else MonitorSettings.from_yaml()
         self.segments: list[SegmentSummary] = []
         self._open: _Segment | None = None
         self._previous_target = _NAN
@@ -185,7 +199,7 @@ class SegmentTracker:
         self._previous_target = target
         index = len(self.segments) + (self._open is not None)
         self._close()
-        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target)
+        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings)
 
     def row(self, row: StatusRow) -> None:
         """One status row, in time order."""
@@ -198,17 +212,18 @@ class SegmentTracker:
                 mean = self._stretch_sum / self._stretch_windows if self._stretch_windows else _NAN
                 if self._open is None or abs(inner - mean) > STRETCH_TOLERANCE * mean:
                     self._close()
-                    self._open = _Segment("", row.time, row.time, _NAN)
+                    self._open = _Segment("", row.time, row.time, _NAN, self.settings)
                     self._stretch_sum, self._stretch_windows = 0.0, 0
                 self._stretch_sum += inner
                 self._stretch_windows += 1
         if self._open is not None:
             self._open.add_row(row)
 
-    def recorded(self, stamp: float, state: int) -> None:
-        """A recorded slip status (its stamp, s, and state)."""
+    def recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
+        """A recorded slip status: its stamp (window end, s), cage speed (rad/s), state and
+        confidence."""
         if self._open is not None:
-            self._open.add_recorded(stamp, state)
+            self._open.add_recorded(stamp, cage_speed, state, confidence)
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

@@ -55,6 +55,8 @@ class StatusRow:
     truth_inner_ring_speed: float = _NAN
     truth_cage_speed: float = _NAN
     truth_slip_rate: float = _NAN
+    window_start: float = _NAN
+    """Start of the latest slip window (its first cage pulse), s."""
     recorded_state: int = -1
     recorded_slip_rate: float = _NAN
     axial_load_setpoint: float = _NAN

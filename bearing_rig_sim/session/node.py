@@ -259,6 +259,7 @@ class SessionNode(Node):
                     inner_ring_speed=msg.inner_ring_speed,
                     cage_speed=msg.cage_speed,
                     window_revolutions=msg.window_revolutions,
+                    confidence=msg.confidence,
                 )
             )
         elif name == TRUTH.name:

@@ -14,14 +14,10 @@ Rules (simulation time throughout, s):
 * ``dwell_s``: the segment ends at ``ramp end + dwell``. Its verdict is the monitor's last state
   within the segment (stable, slipping, fault; unknown when no status came).
 * ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
-  new operating point: its slip window (``window_revolutions`` cage revolutions ending at its
-  stamp) lies entirely after the ramp end, and, when the segment changes the speed, the monitor
-  has reported some other state (unknown, slipping) in a status stamped after the ramp end
-  before it. The monitor restarts its slip series for a new speed and needs a dozen windows
-  before a verdict, so this second rule keeps a verdict fitted on the ramp's own points (slip
-  rising during a run-up has a slope above the critical one: "stable") or carried over from the
-  previous speed from ending the segment; a speed change too small for the monitor to restart
-  then ends in "timeout" rather than in a false "stable". Verdict "stable", time to stable =
+  new operating point, by the rule offline analysis also uses
+  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): P(slope >= k) at least 0.95 on
+  slip windows that all started after the ramp end (the monitor's ``slope_span_s`` and
+  ``min_slope_points`` say how far back its verdict reaches). Verdict "stable", time to stable =
   that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".
 * Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
@@ -44,10 +40,13 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from enum import Enum, IntEnum
+from enum import Enum
 
+from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.load_control import settle_band
+from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
+from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
 
 __all__ = [
@@ -79,13 +78,8 @@ def speed_tolerance(target_speed: float) -> float:
     return max(SPEED_TOLERANCE_FRACTION * target_speed, SPEED_TOLERANCE_RAD_S)
 
 
-class StatusState(IntEnum):
-    """The ``STATE_*`` constants of SlipStatus.msg."""
-
-    UNKNOWN = 0
-    SLIPPING = 1
-    STABLE = 2
-    FAULT = 3
+StatusState = SlipState
+"""The ``STATE_*`` constants of SlipStatus.msg: the project's one state enum."""
 
 
 class Verdict(str, Enum):
@@ -128,6 +122,8 @@ class SlipObservation:
     """rad/s."""
     window_revolutions: int
     """Whole cage revolutions in the slip window."""
+    confidence: float = 0.0
+    """P(slope >= k) of the monitor's verdict (1)."""
 
     @property
     def window_duration(self) -> float:
@@ -209,8 +205,8 @@ class _SegmentData:
     force_sum_all: float = 0.0
     force_count_all: int = 0
     statuses: int = field(default=0)
-    unsettled_after_ramp: bool = False
-    """A status other than stable, stamped after the ramp end, has come."""
+    rule: TimeToStable | None = None
+    """The "stable after the ramp" rule, shared with offline analysis."""
     disturbances: list[str] = field(default_factory=list)
     setpoint_seen: float | None = None
     """When the load controller's state first showed the segment's set-point, s of sim time."""
@@ -229,8 +225,10 @@ class ProgramRunner:
         if runner.finished: ...                 # runner.outcomes holds one row per segment
     """
 
-    def __init__(self, program: TestProgram) -> None:
+    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None) -> None:
         self.program = program
+        self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
+        """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
         self.outcomes: list[SegmentOutcome] = []
         self._data: _SegmentData | None = None
         self._truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_HISTORY)
@@ -272,7 +270,7 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        self._data = _SegmentData(plan)
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -355,15 +353,10 @@ class ProgramRunner:
             return
         data.last_status = status
         data.statuses += 1
-        plan = data.plan
-        if status.time < plan.ramp_end or data.stable is not None:
-            return
-        if status.state is not StatusState.STABLE:
-            data.unsettled_after_ramp = True
-            return
-        window_after_ramp = status.time - status.window_duration >= plan.ramp_end
-        changes_speed = plan.profile.target_speed != plan.profile.start_speed
-        if window_after_ramp and (data.unsettled_after_ramp or not changes_speed):
+        assert data.rule is not None
+        st = self.monitor_settings
+        evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points)
+        if data.rule.observe(status.time, evidence, int(status.state), status.confidence):
             data.stable = status
 
     def observe_truth(self, time: float, slip_rate: float) -> None:

@@ -105,6 +105,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     overrides = node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime:
         overrides.setdefault("simulator", {})["realtime"] = "false"
+    # the monitor judges slip against what the program's stability_criterion names
+    overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion
     for name, values in overrides.items():
         commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
     start = datetime.now(UTC)

@@ -15,7 +15,8 @@ import csv
 import math
 import multiprocessing
 import os
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from pathlib import Path
 from collections.abc import Callable, Iterable, Sequence
@@ -24,11 +25,11 @@ import numpy as np
 import yaml
 from scipy.optimize import least_squares
 
-from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import check_number, rad_s_to_rpm, rpm_to_rad_s
-from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
+from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.sweep.points import solver_for
 
 DEFAULT_FITTED: tuple[str, ...] = ("yield_stress", "consistency")
 """Parameters fitted by default: the Herschel-Bulkley yield stress and consistency of the grease
@@ -58,12 +59,6 @@ PHYSICAL_RANGES: dict[str, PhysicalRange] = {
     "eyring_stress": PhysicalRange("Pa", 2e6, 1e7, "Eyring stress of mineral and ester base oils (Johnson and Tevaarwerk 1977)"),
 }
 """Physical quantities :func:`calibrate` may fit, with their plausible ranges."""
-
-SETTLE_S = 0.15
-"""Simulated settling time before averaging, s: the traction and pocket dynamics settle in a
-few milliseconds; the margin covers light-load points where the cage takes longer."""
-AVERAGE_S = 0.05
-"""Averaging window of the steady cage speed, s."""
 
 
 class CalibrationError(RigError):
@@ -159,15 +154,12 @@ def read_bench_csv(path: str | Path) -> list[BenchPoint]:
 
 
 def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load: float) -> SteadyState:
-    """Run the default engine from the rolling start to a steady state; average the speeds."""
-    engine = BearingDynamics(params)
-    engine.initialise(inner_ring_speed, axial_load)
-    engine.advance(SETTLE_S)
-    avg = engine.advance(AVERAGE_S)
-    kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
-    slip = float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
-    h_in, h_out = engine.minimum_films()
-    return SteadyState(avg.inner_ring_speed, axial_load, avg.cage_speed, slip, engine.friction_torque(), engine.power_loss(), h_in, h_out)
+    """The default engine's steady state reached from the rolling start, by the direct solver
+    (which integrates where Newton cannot settle it; :mod:`bearing_rig_sim.dynamics.steady`)."""
+    point = solver_for(params).solve(inner_ring_speed, axial_load)
+    return SteadyState(
+        point.inner_ring_speed, axial_load, point.cage_speed, point.slip_pct, point.torque, point.power, point.film_min_inner, point.film_min_outer
+    )
 
 
 def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyState:
@@ -178,7 +170,7 @@ def steady_states(
     params: BearingParameters,
     points: Iterable[tuple[float, float]],
     workers: int | None = None,
-    pool: ProcessPoolExecutor | None = None,
+    pool: Executor | None = None,
     progress: Callable[[int, int], None] | None = None,
 ) -> list[SteadyState]:
     """Steady states of many (inner-ring speed rad/s, axial load N) points, on ``pool`` or on
@@ -203,8 +195,16 @@ def _collect(results: Iterable[SteadyState], total: int, progress: Callable[[int
     return out
 
 
-def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A pool of forked workers (they inherit the compiled kernels)."""
+def process_pool(workers: int) -> AbstractContextManager[Executor]:
+    """Where points run in parallel: on the Dask cluster named by ``DASK_SCHEDULER_ADDRESS``
+    when it is set (:func:`bearing_rig_sim.sweep.runner.cluster_executor`), else on ``workers``
+    forked processes (they inherit the compiled kernels and start at once)."""
+    import dask
+
+    if dask.config.get("scheduler-address", None):
+        from bearing_rig_sim.sweep.runner import cluster_executor  # Dask's client only when used
+
+        return cluster_executor(workers)
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"))
 
 
@@ -288,7 +288,7 @@ def calibrate(
     speeds_loads = [(pt.inner_ring_speed, pt.axial_load) for pt in points]
     workers = workers or os.cpu_count() or 1
 
-    def model(x: np.ndarray, pool: ProcessPoolExecutor | None) -> list[SteadyState]:
+    def model(x: np.ndarray, pool: Executor | None) -> list[SteadyState]:
         nonlocal evaluations
         evaluations += 1
         trial = with_values(base, {k: float(math.exp(v)) for k, v in zip(fitted, x)})

@@ -83,8 +83,9 @@ class Outputs:
 
 def inputs_key(params: BearingParameters) -> str:
     """Hash of every input of the experiments: bearing parameters, grids, code version and the
-    engine's kernel source."""
-    kernels = (Path(__file__).parent.parent / "dynamics" / "kernels.py").read_bytes()
+    engine's kernel and steady-solver source."""
+    dynamics = Path(__file__).parent.parent / "dynamics"
+    kernels = b"".join((dynamics / name).read_bytes() for name in ("kernels.py", "steady.py"))
     fields = {k: v for k, v in dataclasses.asdict(params).items() if k != "source"}
     doc = {
         "params": fields,

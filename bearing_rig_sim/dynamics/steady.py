@@ -1,0 +1,404 @@
+"""Direct steady-state solver of the default (reduced) engine at constant speed and axial load.
+
+Under a pure axial load every ball runs the same way, so a steady state is four numbers:
+ball orbit speed omega_m and spin omega_a (rad/s), cage speed Omega (rad/s) and the pocket
+offset u = r_m (theta - phi) (m), the same for every ball and pocket. Instead of integrating
+the equations of motion until they settle, :class:`SteadySolver` solves for these four numbers
+by Newton's method on a residual built from the engine's own step:
+
+    g(x) = (step_h(x) - x) / h
+
+where ``step_h`` is one linearly implicit step (:func:`.kernels.step_reduced`) of length h from
+the symmetric state x. That step is x + (I - h J~)^-1 h f(x) with f the model's right-hand
+side, so g(x) = 0 exactly where f(x) = 0: the solution is the engine's equilibrium under the
+engine's own force laws, whatever they are, and no law is restated here. The Jacobian of g is
+formed by finite differences (four more steps). At the solution that Jacobian is
+(I - h J~)^-1 J, and its eigenvalues tell whether integration with step h would settle there
+(all real parts negative) or leave: stability as the reference integrator sees it (an unstable
+mode growing faster than 1/h looks stable to both).
+
+The four unknowns are the reduced model's dynamic states (ball centres and the inner ring's
+axial position are quasi-static: the step solves them itself). A dynamic state added to the
+reduced model later must be added to x here; ``test/test_dynamics_steady.py`` compares the
+solver with the integration over the paper's grid and would show the omission.
+
+Time integration stays the reference. The solver falls back to it (:data:`METHOD_INTEGRATION`
+or :data:`METHOD_INTEGRATION_NEWTON`) when Newton does not converge from the starting guess
+or converges to an unstable equilibrium: it then integrates from the same start, trying Newton
+on the settling state every few milliseconds, and averages the integration where Newton never
+converges. :meth:`SteadySolver.integrate` is the reference itself.
+
+The model can hold two stable steady states at one operating point (rolling with creep, and
+gross skid); which one is found depends on where the solution starts: from the engine's
+rolling start (:meth:`BearingDynamics.initialise`: kinematic speeds, balls touching their
+pockets; :data:`ORIGIN_ROLLING_START`) or from a neighbouring point's solution
+(:data:`ORIGIN_CONTINUATION`), as a live load sweep would. Each result says which.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.engine import BearingDynamics, DynamicsInputError
+from bearing_rig_sim.dynamics.parameters import BearingParameters
+
+SKID_SLIP_PCT = 20.0
+"""Slip (%) above which a steady state is gross skid rather than rolling with creep (the
+threshold the reproduction of the paper's load sweep uses)."""
+
+ORIGIN_ROLLING_START = "rolling_start"
+"""The solution started from the engine's rolling start at this point."""
+ORIGIN_CONTINUATION = "continuation"
+"""The solution started from a neighbouring point's steady state."""
+
+METHOD_NEWTON = "newton"
+"""Newton on the step residual converged to a stable equilibrium from the start."""
+METHOD_INTEGRATION_NEWTON = "integration+newton"
+"""Newton failed from the start; integration settled and Newton polished the settled state."""
+METHOD_INTEGRATION = "integration"
+"""Integration only (no stable equilibrium found by Newton): time averages over a window."""
+
+STATE_ROLLING = "rolling"
+STATE_SKID = "skid"
+
+BASIN_S = 0.002
+"""Integration from the rolling start before Newton, s: whether the rolling start ends in
+rolling or in gross skid is decided within about a millisecond (the skid's slip passes 10 %
+in 0.5 ms at the paper's grid points that skid); Newton then skips the slow tail."""
+SETTLE_S = 0.15
+"""Integration: settling time before averaging, s. The traction and pocket dynamics settle in a
+few milliseconds; the margin covers light-load points where the cage takes longer."""
+FALLBACK_CHUNK_S = 0.005
+"""Integration fallback: Newton is tried again after each chunk of this length, s."""
+AVERAGE_S = 0.05
+"""Integration: averaging window of the steady cage speed, s."""
+
+_CONVERGED, _UNSTABLE, _NOT_CONVERGED = 0, 1, 2
+_STEP_TOL = 1e-11
+"""Newton converges when every speed update is below this fraction of the inner-ring speed
+(and the pocket-offset update below this fraction of the pocket clearance)."""
+_MAX_ITER = 40
+_STABILITY_MARGIN = 1e-6
+"""Eigenvalues of the step-residual Jacobian with real part above this (1/s, relative to the
+largest magnitude) count as unstable."""
+
+
+@njit(cache=True)
+def _load_state(x: np.ndarray, omega_i: float, rm: float, base_ball: np.ndarray, base_ring: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray) -> None:
+    """Write the symmetric state x = (omega_m, omega_a, Omega, u) into the engine arrays."""
+    z = ball.shape[0]
+    ball[:, :] = base_ball
+    ring[:] = base_ring
+    ring[kn.R_OMEGA] = omega_i
+    for j in range(z):
+        theta = 2.0 * math.pi * j / z
+        ball[j, kn.B_THETA] = theta
+        ball[j, kn.B_OMEGA] = x[0]
+        ball[j, kn.B_SPIN] = x[1]
+        cage[j, kn.C_PHI] = theta - x[3] / rm
+        cage[j, kn.C_OMEGA] = x[2]
+
+
+@njit(cache=True)
+def _residual(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float, arrays: tuple, g: np.ndarray) -> None:
+    """g = (step_h(x) - x) / h, averaged over balls and pockets (they are identical).
+
+    ``arrays`` = (base_ball, base_ring, ball, cage, ring, out, stats, work): the ball positions
+    and ring state to start each step from (the warm start of the normal-contact solution),
+    then the engine-shaped arrays the step works in (see :mod:`.kernels`).
+    """
+    base_ball, base_ring, ball, cage, ring, out, stats, work = arrays
+    rm = p[kn.P_RM]
+    _load_state(x, omega_i, rm, base_ball, base_ring, ball, cage, ring)
+    kn.step_reduced(p, ball, cage, ring, out, stats, work, 1, h, load, 0.0, 0)
+    z = ball.shape[0]
+    wm = 0.0
+    wa = 0.0
+    wc = 0.0
+    u = 0.0
+    for j in range(z):
+        theta = 2.0 * math.pi * j / z
+        wm += ball[j, kn.B_OMEGA]
+        wa += ball[j, kn.B_SPIN]
+        wc += cage[j, kn.C_OMEGA]
+        u += rm * ((ball[j, kn.B_THETA] - theta) - (cage[j, kn.C_PHI] - theta))
+    g[0] = (wm / z - x[0]) / h
+    g[1] = (wa / z - x[1]) / h
+    g[2] = (wc / z - x[2]) / h
+    g[3] = (u / z - x[3]) / h
+
+
+@njit(cache=True)
+def _keep_warm_start(arrays: tuple) -> None:
+    """The normal-contact solution of the last residual step becomes the next warm start."""
+    base_ball, base_ring, ball, ring = arrays[0], arrays[1], arrays[2], arrays[4]
+    base_ball[:, kn.B_R] = ball[:, kn.B_R]
+    base_ball[:, kn.B_Z] = ball[:, kn.B_Z]
+    base_ring[kn.R_DELTA] = ring[kn.R_DELTA]
+
+
+@njit(cache=True)
+def _newton(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float, arrays: tuple, max_iter: int) -> tuple[int, int, float]:
+    """Damped Newton on the step residual from ``x`` (updated in place); ``arrays`` as for
+    :func:`_residual`, its base ball positions and ring state updated to each accepted iterate.
+
+    Returns (status, iterations, largest real part of the Jacobian's eigenvalues, 1/s).
+    """
+    speed_scale = max(abs(omega_i), 1.0)
+    clear = max(p[kn.P_POCKET_CLEAR], 1e-9)
+    scale = np.array([speed_scale, speed_scale, speed_scale, clear])
+    # residual norm: the increments of one step, relative to the unknowns' scales
+    rscale = h / scale
+    trust = np.array([0.2, 0.2, 0.2, 1.0]) * scale
+    g = np.zeros(4)
+    gt = np.zeros(4)
+    jac = np.zeros((4, 4))
+    xt = np.zeros(4)
+    _residual(p, x, omega_i, load, h, arrays, g)
+    _keep_warm_start(arrays)
+    norm = np.max(np.abs(g * rscale))
+    converged = False
+    it = 0
+    while it < max_iter and not converged:
+        it += 1
+        for k in range(4):
+            e = 1e-7 * scale[k]
+            xt[:] = x
+            xt[k] += e
+            _residual(p, xt, omega_i, load, h, arrays, gt)
+            jac[:, k] = (gt - g) / e
+        if not np.all(np.isfinite(jac)):
+            return _NOT_CONVERGED, it, 0.0
+        dx = -np.linalg.solve(jac, g)
+        if not np.all(np.isfinite(dx)):
+            return _NOT_CONVERGED, it, 0.0
+        # a trust region: speeds move by at most 20 % of the inner-ring speed per iteration,
+        # the pocket offset by at most the clearance
+        limit = np.max(np.abs(dx) / trust)
+        if limit > 1.0:
+            dx /= limit
+        lam = 1.0
+        accepted = False
+        new_norm = norm
+        for _ in range(12):
+            xt[:] = x + lam * dx
+            _residual(p, xt, omega_i, load, h, arrays, gt)
+            new_norm = np.max(np.abs(gt * rscale))
+            if new_norm <= (1.0 - 1e-4 * lam) * norm:
+                accepted = True
+                break
+            lam *= 0.5
+        converged = np.max(np.abs(dx) / scale) < _STEP_TOL
+        if not accepted and not converged:
+            return _NOT_CONVERGED, it, 0.0
+        if accepted:
+            x[:] = xt
+            g[:] = gt
+            norm = new_norm
+            _keep_warm_start(arrays)
+    if not converged:
+        return _NOT_CONVERGED, it, 0.0
+    eig = np.linalg.eigvals(jac.astype(np.complex128))
+    worst = np.max(eig.real)
+    size = np.max(np.abs(eig))
+    status = _UNSTABLE if worst > _STABILITY_MARGIN * size else _CONVERGED
+    return status, it, worst
+
+
+@dataclass(frozen=True)
+class SteadyPoint:
+    """A steady operating point of the engine (SI; slip in percent at the nominal angle).
+
+    Attributes:
+        inner_ring_speed: rad/s.
+        axial_load: N.
+        cage_speed: rad/s.
+        ball_orbit_speed: rad/s.
+        ball_spin_speed: rad/s (about the rolling axis, absolute).
+        pocket_offset: m, ball centre ahead of its pocket centre at the pitch radius.
+        slip_pct: cage slip S_c, % (digest Eq. 11-12, nominal contact angle).
+        torque: friction torque on the inner ring, N m (power loss over inner-ring speed).
+        power: power loss of the bearing, W (:meth:`BearingDynamics.power_loss`).
+        film_min_inner / film_min_outer: minimum film thickness of the inner and outer contacts,
+            m (:meth:`BearingDynamics.minimum_films`; NaN without a lubricant file).
+        state: :data:`STATE_ROLLING` or :data:`STATE_SKID`.
+        origin: :data:`ORIGIN_ROLLING_START` or :data:`ORIGIN_CONTINUATION`.
+        method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON` or
+            :data:`METHOD_INTEGRATION`.
+        iterations: Newton iterations of the last Newton run (0 if none converged).
+        stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
+            False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
+    """
+
+    inner_ring_speed: float
+    axial_load: float
+    cage_speed: float
+    ball_orbit_speed: float
+    ball_spin_speed: float
+    pocket_offset: float
+    slip_pct: float
+    torque: float
+    power: float
+    film_min_inner: float
+    film_min_outer: float
+    state: str
+    origin: str
+    method: str
+    iterations: int
+    stable: bool
+
+    @property
+    def vector(self) -> np.ndarray:
+        """(omega_m, omega_a, Omega, u): the solver's unknowns, to continue from."""
+        return np.array([self.ball_orbit_speed, self.ball_spin_speed, self.cage_speed, self.pocket_offset])
+
+
+class SteadySolver:
+    """Steady states of one bearing's default engine; reuse it for many points.
+
+    Args:
+        params: bearing data.
+        step: the step h of the residual, s (default: the engine's reduced time step; the
+            solution does not depend on it, only the conditioning does).
+    """
+
+    def __init__(self, params: BearingParameters, *, step: float | None = None) -> None:
+        self.params = params
+        self.engine = BearingDynamics(params)
+        self.step = float(step) if step is not None else self.engine.time_step
+        self.basin_time = BASIN_S
+        self.kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
+        z = params.ball_count
+        self._ball = np.zeros((z, kn.NB))
+        self._cage = np.zeros((z, kn.NC))
+        self._ring = np.zeros(kn.NR)
+        self._out = np.zeros((z, kn.NO))
+        self._stats = np.zeros(kn.NS)
+        self._work = np.zeros((z, kn.NW))
+
+    # -- public --------------------------------------------------------------------------------
+    def solve(self, inner_ring_speed: float, axial_load: float, start: SteadyPoint | None = None) -> SteadyPoint:
+        """The steady state at ``inner_ring_speed`` (rad/s, > 0) and ``axial_load`` (N).
+
+        Args:
+            start: a neighbouring point's solution to continue from; ``None`` starts from the
+                engine's rolling start at this point.
+
+        Raises:
+            DynamicsInputError: a non-finite or out-of-range input.
+        """
+        omega, axial_load = self._inputs(inner_ring_speed, axial_load)
+        engine = self.engine
+        if start is None:
+            origin = ORIGIN_ROLLING_START
+            engine.initialise(omega, axial_load)
+            # which state the rolling start ends in is decided in its first milliseconds
+            engine.advance(self.basin_time)
+            x0 = self._vector_of_engine()
+        else:
+            origin = ORIGIN_CONTINUATION
+            # the neighbour's speeds scaled to this inner-ring speed; the engine's current ball
+            # positions are only the warm start of the normal-contact solution
+            x0 = start.vector * np.array([omega / start.inner_ring_speed] * 3 + [1.0])
+        x = x0.copy()
+        status, iterations = self._newton(x, omega, axial_load)
+        if status == _CONVERGED:
+            return self._point(x, omega, axial_load, origin, METHOD_NEWTON, iterations)
+        # fall back to the reference: integrate from the same start, trying Newton on the way
+        if start is None:
+            engine.initialise(omega, axial_load)
+        else:
+            self._load_engine(x0, omega)
+        settled = 0.0
+        while settled < SETTLE_S - 1e-12:
+            engine.advance(FALLBACK_CHUNK_S, axial_load=axial_load)
+            settled += FALLBACK_CHUNK_S
+            x = self._vector_of_engine()
+            status, iterations = self._newton(x, omega, axial_load)
+            if status == _CONVERGED:
+                return self._point(x, omega, axial_load, origin, METHOD_INTEGRATION_NEWTON, iterations)
+        return self._averaged(omega, axial_load, origin)
+
+    def integrate(self, inner_ring_speed: float, axial_load: float) -> SteadyPoint:
+        """The reference: integrate from the rolling start for :data:`SETTLE_S`, then average
+        the cage speed over :data:`AVERAGE_S`."""
+        omega, axial_load = self._inputs(inner_ring_speed, axial_load)
+        self.engine.initialise(omega, axial_load)
+        self.engine.advance(SETTLE_S)
+        return self._averaged(omega, axial_load, ORIGIN_ROLLING_START)
+
+    def _averaged(self, omega: float, axial_load: float, origin: str) -> SteadyPoint:
+        avg = self.engine.advance(AVERAGE_S, axial_load=axial_load)
+        x = self._vector_of_engine()
+        x[2] = avg.cage_speed
+        return self._point(x, omega, axial_load, origin, METHOD_INTEGRATION, 0, stable=False)
+
+    @staticmethod
+    def _inputs(inner_ring_speed: float, axial_load: float) -> tuple[float, float]:
+        omega = float(inner_ring_speed)
+        if not math.isfinite(omega) or omega <= 0.0:
+            raise DynamicsInputError(f"inner_ring_speed must be finite and > 0, got {inner_ring_speed!r}")
+        return omega, float(axial_load)
+
+    def sweep_load(self, inner_ring_speed: float, loads: list[float]) -> list[SteadyPoint]:
+        """Continuation along ``loads`` (N) at one speed, as a live load sweep: the first point
+        from the rolling start, each next one from the previous solution."""
+        points: list[SteadyPoint] = []
+        for load in loads:
+            points.append(self.solve(inner_ring_speed, load, points[-1] if points else None))
+        return points
+
+    # -- internals -----------------------------------------------------------------------------
+    def _vector_of_engine(self) -> np.ndarray:
+        e = self.engine
+        rm = float(e.vector[kn.P_RM])
+        u = rm * float(np.mean(e.ball[:, kn.B_THETA] - e.cage[:, kn.C_PHI]))
+        return np.array([float(np.mean(e.ball[:, kn.B_OMEGA])), float(np.mean(e.ball[:, kn.B_SPIN])), e.cage_speed, u])
+
+    def _load_engine(self, x: np.ndarray, omega: float) -> None:
+        e = self.engine
+        _load_state(x, omega, float(e.vector[kn.P_RM]), e.ball.copy(), e.ring.copy(), e.ball, e.cage, e.ring)
+
+    def _newton(self, x: np.ndarray, omega: float, load: float) -> tuple[int, int]:
+        e = self.engine
+        base_ball = e.ball.copy()
+        base_ring = e.ring.copy()
+        try:
+            arrays = (base_ball, base_ring, self._ball, self._cage, self._ring, self._out, self._stats, self._work)
+            status, iterations, _ = _newton(e.vector, x, omega, load, self.step, arrays, _MAX_ITER)
+        except np.linalg.LinAlgError:  # a singular Jacobian: no Newton step from here
+            return _NOT_CONVERGED, 0
+        return int(status), int(iterations)
+
+    def _point(self, x: np.ndarray, omega: float, load: float, origin: str, method: str, iterations: int, stable: bool = True) -> SteadyPoint:
+        e = self.engine
+        # the engine's own diagnostics (power loss, films) at the solution: one step from it
+        self._load_engine(x, omega)
+        e.advance(e.time_step, axial_load=load)
+        power = e.power_loss()
+        film_inner, film_outer = e.minimum_films()
+        slip = float(self.kinematics.slip_rate(float(x[2]), omega))
+        return SteadyPoint(
+            inner_ring_speed=omega,
+            axial_load=float(load),
+            cage_speed=float(x[2]),
+            ball_orbit_speed=float(x[0]),
+            ball_spin_speed=float(x[1]),
+            pocket_offset=float(x[3]),
+            slip_pct=slip,
+            torque=power / omega,
+            power=power,
+            film_min_inner=film_inner,
+            film_min_outer=film_outer,
+            state=STATE_SKID if slip > SKID_SLIP_PCT else STATE_ROLLING,
+            origin=origin,
+            method=method,
+            iterations=iterations,
+            stable=stable,
+        )

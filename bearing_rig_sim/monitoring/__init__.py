@@ -1,0 +1,32 @@
+"""The monitor's core without ROS: settings, whole-revolution windows with lost-pulse accounting,
+the monitor and verdict, and the check/report schedule that the node and offline analysis share.
+
+* :mod:`~bearing_rig_sim.monitoring.settings`: :class:`MonitorSettings` (``config/monitor.yaml``);
+* :mod:`~bearing_rig_sim.monitoring.windows`: :class:`SlipWindows`, the bench counter's books;
+* :mod:`~bearing_rig_sim.monitoring.monitor`: :class:`SlipMonitor`, :class:`MonitorStatus`;
+* :mod:`~bearing_rig_sim.monitoring.schedule`: :class:`StatusSchedule`, :class:`TimeToStable`.
+"""
+
+from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.monitoring.monitor import MonitorState, MonitorStatus, MonitorWindow, SlipMonitor
+from bearing_rig_sim.monitoring.schedule import ScheduledStatus, StatusSchedule, TimeToStable
+from bearing_rig_sim.monitoring.settings import NODE_NAME, SHIPPED_FILE, MonitorSettings, shipped_parameters
+from bearing_rig_sim.monitoring.windows import LossRules, SlipWindow, SlipWindows
+
+__all__ = [
+    "NODE_NAME",
+    "SHIPPED_FILE",
+    "LossRules",
+    "MonitorSettings",
+    "MonitorState",
+    "MonitorStatus",
+    "MonitorWindow",
+    "ScheduledStatus",
+    "SlipMonitor",
+    "SlipState",
+    "SlipWindow",
+    "SlipWindows",
+    "StatusSchedule",
+    "TimeToStable",
+    "shipped_parameters",
+]

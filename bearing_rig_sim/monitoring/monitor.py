@@ -1,0 +1,350 @@
+"""The slip monitor without ROS: cage slip and its stability from the fibre-optic pulses alone.
+
+:class:`SlipMonitor` reads only what the bench's sensors give (per pulse: time, strip id, strip
+count, pulse index; and, for the load criterion, the load cell's force) and the bearing's
+kinematics, so it runs unchanged on the real bench's topics.
+
+* **Windows** come from :class:`~bearing_rig_sim.monitoring.windows.SlipWindows`: whole cage
+  revolutions counted by pulse index, the spindle's angle interpolated at both ends, lost pulses
+  accounted for (an isolated loss is a warning, a sustained one a fault).
+* **Slip** of each window: Eq. 11 of the paper (docs/paper.md), percent.
+* **Verdict**: the paper's slope criterion on the slip series, against time (k2) or against the
+  measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
+  slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,
+  and a change in the slip itself (whatever caused it) restarts the slope's window.
+* **Speed changes**: at the start and the end of one (a window's mean spindle speed more than
+  ``restart_speed_change_fraction`` from the previous window's, or back within it) the slip's
+  scatter is estimated afresh; the verdict is kept, its trailing window forgets the ramp within
+  ``slope_span_s``. Below ``min_inner_ring_speed_rad_s`` (and at a stop) the series restarts:
+  state unknown until new points decide.
+
+**Bad data is reported, never raised**: a malformed pulse is a fault held ``fault_hold_s``; an
+out-of-order pulse restarts its shaft's counting (a note); a clock jump back resets everything.
+
+Units: s, rad/s, N; slip and slopes in percent, percent per second or per newton.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections import deque
+from dataclasses import dataclass
+
+from bearing_rig_sim.analysis.inputs import AnalysisError
+from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.analysis.streaming import TrailingSlope
+from bearing_rig_sim.monitoring.settings import MonitorSettings
+from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows
+from bearing_rig_sim.rig.fibre_optic import Pulse
+
+MonitorState = SlipState
+"""The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""
+
+LOAD_HISTORY = 4096
+"""Load-cell samples kept for the windows' mean load (4 s at the load cell's 1 kHz)."""
+
+
+@dataclass(frozen=True)
+class MonitorStatus:
+    """The monitor's status (the fields of SlipStatus.msg, SI units, slip in percent).
+
+    ``time`` is the end of the latest window (None before the first); speeds, slip and slope
+    are NaN when not known; ``faults`` lists the active faults' reasons, ``warnings`` the recent
+    losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
+    the pulses lost per shaft since the start and ``windows_skipped`` the cage windows skipped.
+    ``confidence`` is P(slope >= k) (0 while no slope is known).
+    """
+
+    state: SlipState
+    time: float | None
+    inner_ring_speed: float
+    cage_speed: float
+    theoretical_cage_speed: float
+    slip_rate: float
+    fitted_slope: float
+    critical_slope: float
+    criterion: str
+    confidence: float
+    window_revolutions: int
+    detail: str
+    faults: tuple[str, ...] = ()
+    notes: tuple[str, ...] = ()
+    windows: int = 0
+    warnings: tuple[str, ...] = ()
+    lost: tuple[int, int] = (0, 0)
+    windows_skipped: int = 0
+    window_start: float | None = None
+
+    def message_fields(self) -> dict[str, object]:
+        """The SlipStatus.msg fields of this status (all but the header), for any message class
+        of that type (rclpy's or a bag typestore's)."""
+        return {
+            "inner_ring_speed": self.inner_ring_speed,
+            "cage_speed": self.cage_speed,
+            "theoretical_cage_speed": self.theoretical_cage_speed,
+            "slip_rate": self.slip_rate,
+            "fitted_slope": self.fitted_slope,
+            "critical_slope": self.critical_slope,
+            "state": int(self.state),
+            "criterion": self.criterion,
+            "confidence": self.confidence,
+            "window_revolutions": self.window_revolutions,
+            "detail": self.detail,
+        }
+
+
+@dataclass(frozen=True)
+class MonitorWindow:
+    """A completed window and its slip (NaN below the minimum speed) and mean load (NaN if no
+    load-cell sample fell in it), N."""
+
+    window: SlipWindow
+    slip_rate: float
+    axial_load: float
+
+    @property
+    def start_time(self) -> float:
+        return self.window.start_time
+
+    @property
+    def end_time(self) -> float:
+        return self.window.end_time
+
+    @property
+    def inner_ring_speed(self) -> float:
+        return self.window.inner_ring_speed
+
+    @property
+    def cage_speed(self) -> float:
+        return self.window.cage_speed
+
+
+class SlipMonitor:
+    """Online cage slip and its stability from the two pulse streams (module docstring).
+
+    Args:
+        kinematics: the bearing's geometry.
+        settings: the monitor's parameters.
+    """
+
+    def __init__(self, kinematics: BearingKinematics, settings: MonitorSettings) -> None:
+        self.kinematics = kinematics
+        self.settings = settings
+        self.criterion = settings.criterion
+        self._ratio = kinematics.epicyclic_ratio()
+        span = settings.slope_span_s if self.criterion == "time" else settings.slope_span_n
+        self.slope = TrailingSlope(
+            critical_slope=settings.critical_slope,
+            span=span,
+            min_points=settings.min_slope_points,
+            resolution=settings.slip_resolution_pct,
+            change_threshold=settings.change_threshold,
+        )
+        self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s)
+        self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
+        self._loads: deque[tuple[float, float]] = deque(maxlen=LOAD_HISTORY)
+        self.reset()
+
+    # -- state ---------------------------------------------------------------------------------
+    def reset(self, reason: str = "") -> None:
+        """Forget every pulse, window, slope and fault (state unknown); ``reason`` becomes a note."""
+        self.counter.reset()
+        self.slope.reset()
+        self._latest: MonitorWindow | None = None
+        self._invalid: dict[str, tuple[float | None, str]] = {}
+        self._warnings: dict[str, tuple[float | None, str]] = {}
+        self._steady: bool | None = None
+        self._previous_inner: float | None = None
+        self._last_x: float | None = None
+        self._bin: tuple[float, float, int] = (0.0, 0.0, 0)  # load sum, slip sum, windows
+        self._now: float | None = None
+        self.windows = 0
+        """Windows completed since the last reset (1)."""
+        self._notes.clear()
+        self._loads.clear()
+        if reason:
+            self._notes.append((None, reason))
+
+    @property
+    def latest_window(self) -> MonitorWindow | None:
+        """The latest completed window (None before the first)."""
+        return self._latest
+
+    def last_pulse_time(self) -> float | None:
+        """Time of the latest pulse of either shaft, s (None before any)."""
+        return self.counter.last_pulse_time()
+
+    # -- input ---------------------------------------------------------------------------------
+    def clock_jump(self, previous: float, now: float) -> None:
+        """The rig clock went back from ``previous`` to ``now`` (s): reset everything."""
+        self.reset(f"reset: the clock jumped back from {previous:.6f} s to {now:.6f} s")
+
+    def add_load(self, time: float, force: float) -> None:
+        """A load-cell sample: axial force ``force`` (N) at rig time ``time`` (s); non-finite
+        samples are ignored."""
+        if math.isfinite(time) and math.isfinite(force):
+            self._loads.append((time, force))
+
+    def add_pulse(self, shaft: str, pulse: Pulse) -> bool:
+        """Take one pulse of ``shaft`` (``"spindle"`` or ``"cage"``); never raises on bad data.
+
+        Returns:
+            Whether a slip window was completed (the status may have changed).
+        """
+        done = self.counter.add_pulse(shaft, pulse)
+        self._take_events()
+        t = pulse.time
+        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+            self._now = float(t) if self._now is None else max(self._now, float(t))
+        for window in done:
+            self._add_window(window)
+        return bool(done)
+
+    def _take_events(self) -> None:
+        for kind, when, text in self.counter.events:
+            if kind == "reset":
+                self.slope.reset()
+                self._latest, self._steady, self._previous_inner, self._last_x = None, None, None, None
+                self._bin = (0.0, 0.0, 0)
+                self.windows = 0
+                self._notes.append((when, text))
+            elif kind == "invalid":
+                self._invalid[text.split(":", 1)[0]] = (when if when is not None else self._now, text)
+            elif kind == "gap":
+                self._warnings[text.split(":", 1)[0]] = (when, text)
+            else:
+                self._notes.append((when, text))
+        self.counter.events.clear()
+
+    def _restart_series(self, time: float, why: str) -> None:
+        if self.slope.n_points or self.slope.state is not SlipState.UNKNOWN:
+            self._notes.append((time, f"slip series restarted at {time:.6f} s: {why}"))
+        self.slope.reset()
+        self._last_x = None
+        self._bin = (0.0, 0.0, 0)
+
+    def _mean_load(self, t0: float, t1: float) -> float:
+        loads = self._loads
+        if not loads:
+            return math.nan
+        times = [t for t, _ in loads]
+        i, j = bisect.bisect_left(times, t0), bisect.bisect_right(times, t1)
+        if j > i:
+            return sum(f for _, f in list(loads)[i:j]) / (j - i)
+        return loads[-1][1] if times[-1] <= t1 and t1 - times[-1] < t1 - t0 else math.nan
+
+    def _add_window(self, window: SlipWindow) -> None:
+        st = self.settings
+        inner, t1 = window.inner_ring_speed, window.end_time
+        self.windows += 1
+        load = self._mean_load(window.start_time, t1) if self.criterion == "axial_load" else math.nan
+        if not inner >= st.min_inner_ring_speed_rad_s:
+            if self._previous_inner is not None:
+                self._restart_series(t1, f"spindle below {st.min_inner_ring_speed_rad_s:g} rad/s")
+            self._previous_inner, self._steady = None, None
+            self._latest = MonitorWindow(window, math.nan, load)
+            return
+        previous = self._previous_inner
+        steady = None if previous is None else abs(inner - previous) <= st.restart_speed_change_fraction * previous
+        if steady is not None and self._steady is not None and steady != self._steady and st.restart_speed_change_fraction > 0.0:
+            change = f"steady at {inner:.6g} rad/s" if steady else f"changing, {previous:.6g} -> {inner:.6g} rad/s"
+            self.slope.forget_scatter()
+            self._notes.append((t1, f"spindle speed {change}: slip scatter estimated afresh"))
+        self._steady = steady
+        self._previous_inner = inner
+        slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
+        self._latest = MonitorWindow(window, slip, load)
+        if self.criterion == "time":
+            self._add_point(t1, t1, slip)
+        elif math.isfinite(load):
+            self._add_to_load_bin(t1, load, slip)
+
+    def _add_to_load_bin(self, t1: float, load: float, slip: float) -> None:
+        """Against load, the slip points are bins of load: the windows whose mean load stays
+        within ``load_step_n / 2`` of their bin's mean are averaged, and a bin becomes a point
+        (mean load, mean slip) when the load leaves it, if its load is above the last point's."""
+        total_load, total_slip, count = self._bin
+        if count and abs(load - total_load / count) > 0.5 * self.settings.load_step_n:
+            x, y = total_load / count, total_slip / count
+            if self._last_x is None or x > self._last_x:
+                self._add_point(t1, x, y)
+            total_load, total_slip, count = 0.0, 0.0, 0
+        self._bin = (total_load + load, total_slip + slip, count + 1)
+
+    def _add_point(self, t1: float, x: float, slip: float) -> None:
+        try:
+            if self.slope.add(x, slip):
+                self._notes.append((t1, "a change in the slip: slope window restarted"))
+            self._last_x = x
+        except AnalysisError as exc:  # cannot happen with ordered points; never crash
+            self._restart_series(t1, str(exc))
+
+    # -- time-based checks ---------------------------------------------------------------------
+    def check(self, now: float) -> None:
+        """Sensor-loss checks and the expiry of held faults and warnings at rig time ``now`` (s)."""
+        if not math.isfinite(now):
+            return
+        self.counter.check(now)
+        hold = self.settings.fault_hold_s
+        for held in (self._invalid, self._warnings):
+            for key, (when, reason) in list(held.items()):
+                if when is None:
+                    held[key] = (now, reason)
+                elif now - when > hold:
+                    del held[key]
+        kept = [(now if when is None else when, text) for when, text in self._notes]
+        self._notes.clear()
+        self._notes.extend((when, text) for when, text in kept if now - when <= hold)
+        if self.counter.stopped and (self.slope.n_points or self.slope.state is not SlipState.UNKNOWN):
+            self._restart_series(now, "the rig stopped")
+            self._previous_inner, self._steady = None, None
+
+    # -- output --------------------------------------------------------------------------------
+    def faults(self) -> tuple[str, ...]:
+        """Reasons of the active faults (sustained loss first, then malformed pulses)."""
+        loss = self.counter.faults()
+        return tuple(loss[n] for n in SHAFTS if n in loss) + tuple(r for _, r in self._invalid.values())
+
+    def status(self) -> MonitorStatus:
+        """The current status (never raises)."""
+        verdict = self.slope.verdict()
+        faults = self.faults()
+        notes = tuple(text for _, text in self._notes)
+        warnings = tuple(text for _, text in self._warnings.values())
+        latest = self._latest
+        if faults:
+            state, detail = SlipState.FAULT, "; ".join(faults)
+        elif self.counter.stopped:
+            state, detail = SlipState.UNKNOWN, self.counter.stopped
+        else:
+            state = verdict.state
+            detail = verdict.detail if latest is not None else "waiting for whole cage revolutions"
+        if warnings:
+            detail = f"{detail}; warning: {'; '.join(warnings)}"
+        if notes:
+            detail = f"{detail}; note: {notes[-1]}"
+        inner = latest.inner_ring_speed if latest is not None else math.nan
+        books = self.counter.books
+        return MonitorStatus(
+            state=state,
+            time=latest.end_time if latest is not None else None,
+            inner_ring_speed=inner,
+            cage_speed=latest.cage_speed if latest is not None else math.nan,
+            theoretical_cage_speed=self._ratio * inner,
+            slip_rate=latest.slip_rate if latest is not None else math.nan,
+            fitted_slope=verdict.slope if verdict.slope is not None else math.nan,
+            critical_slope=verdict.critical_slope,
+            criterion=self.criterion,
+            confidence=verdict.confidence if state in (SlipState.STABLE, SlipState.SLIPPING, SlipState.UNKNOWN) else 0.0,
+            window_revolutions=self.settings.window_revolutions,
+            detail=detail,
+            faults=faults,
+            notes=notes,
+            windows=self.windows,
+            warnings=warnings,
+            lost=(books["spindle"].lost, books["cage"].lost),
+            windows_skipped=books["cage"].windows_skipped,
+            window_start=latest.start_time if latest is not None else None,
+        )

@@ -1,0 +1,129 @@
+"""When the monitor checks and reports, and when a segment counts as stable: one policy for the
+monitor node, offline analysis (``bearing-rig analyze``) and the live session summary.
+
+**Schedule** (:class:`StatusSchedule`), on the rig clock of the pulses, so that the node and a
+replayed bag give the same statuses: before each pulse, :meth:`SlipMonitor.check` runs at every
+tick ``t0 + k / status_rate_hz`` up to the pulse's time (``t0``: the first pulse), each followed
+by a status; each closed slip window gives one more status at once. A pulse further back than
+``clock_jump_tolerance_s`` restarts the ticks (the monitor resets itself on it). When the pulses
+stop, the node calls :meth:`StatusSchedule.idle` with its own estimate of the rig time, so a
+silent sensor is still reported; offline the ticks catch up at the next pulse, and
+:meth:`StatusSchedule.finish` closes the series.
+
+**Time to stable** (:class:`TimeToStable`): a segment is stable at the first status that is
+STABLE *on evidence from after the ramp's end*: its confidence P(slope >= k) is at least
+:data:`STABLE_CONFIDENCE` (so the present points, not a state held by hysteresis, say stable)
+and every slip window its slope rests on started at or after the ramp's end
+(:func:`evidence_start`). The time to stable is that status's stamp (its window's end) minus the
+ramp's end. The live session summary and ``analyze`` both use it, on the fields a SlipStatus
+carries, so they agree.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim.monitoring.monitor import MonitorStatus, SlipMonitor
+from bearing_rig_sim.rig.fibre_optic import Pulse
+
+
+@dataclass(frozen=True)
+class ScheduledStatus:
+    """A status the schedule emits: rig time (s), why ("tick", "window", "idle", "end")."""
+
+    time: float
+    reason: str
+    status: MonitorStatus
+
+
+class StatusSchedule:
+    """Feeds pulses to a :class:`SlipMonitor` and says when to check and report (module
+    docstring)."""
+
+    def __init__(self, monitor: SlipMonitor) -> None:
+        self.monitor = monitor
+        self.period = 1.0 / monitor.settings.status_rate_hz
+        self._origin: float | None = None
+        self._tick = 0
+        self.clock = -math.inf
+        """Latest rig time seen (s)."""
+
+    def on_pulse(self, shaft: str, pulse: Pulse) -> list[ScheduledStatus]:
+        """The statuses due up to and at this pulse, in order."""
+        out: list[ScheduledStatus] = []
+        t = pulse.time
+        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+            self._advance(float(t), out)
+        if self.monitor.add_pulse(shaft, pulse):
+            out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
+        return out
+
+    def _advance(self, t: float, out: list[ScheduledStatus]) -> None:
+        tolerance = self.monitor.settings.clock_jump_tolerance_s
+        if self._origin is None or t < self.clock - tolerance:
+            self._origin, self._tick, self.clock = t, 0, t
+        while (tick := self._origin + self._tick * self.period) <= t:
+            self.monitor.check(tick)
+            out.append(ScheduledStatus(tick, "tick", self.monitor.status()))
+            self._tick += 1
+        self.clock = max(self.clock, t)
+
+    def idle(self, now: float) -> ScheduledStatus:
+        """No pulse for a while: check at the rig time ``now`` (s) and report."""
+        self.monitor.check(now)
+        return ScheduledStatus(now, "idle", self.monitor.status())
+
+    def finish(self) -> ScheduledStatus | None:
+        """The last check and status after the last pulse (None if no pulse came)."""
+        if self._origin is None:
+            return None
+        self.monitor.check(self.clock)
+        return ScheduledStatus(self.clock, "end", self.monitor.status())
+
+
+STABLE_CONFIDENCE = 0.95
+"""A stable status counts for the time to stable when P(slope >= k) is at least this (1): the
+one-sided 95 % bound the verdict itself uses."""
+
+
+def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int) -> float:
+    """The earliest time the verdict of a status stamped ``stamp`` (s) can rest on, s.
+
+    Its slope is fitted to the slip windows that ended in the last ``slope_span_s`` (at least the
+    last ``min_slope_points`` of them), each ``window_revolutions`` cage revolutions long at
+    ``cage_speed`` (rad/s). -inf when the cage speed is unknown.
+    """
+    if not (math.isfinite(cage_speed) and cage_speed > 0.0 and window_revolutions > 0):
+        return -math.inf
+    window = window_revolutions * 2.0 * math.pi / cage_speed
+    return stamp - max(slope_span_s + window, min_slope_points * window)
+
+
+class TimeToStable:
+    """The one "stable after the ramp" rule (module docstring).
+
+    Args:
+        ramp_end: end of the segment's ramp, rig s.
+    """
+
+    def __init__(self, ramp_end: float) -> None:
+        self.ramp_end = ramp_end
+        self.stable_at: float | None = None
+        """Stamp of the status that made the segment stable, s (None before)."""
+
+    def observe(self, stamp: float, evidence_from: float, state: int, confidence: float) -> bool:
+        """A status stamped ``stamp`` whose verdict rests on data from ``evidence_from`` on (s,
+        :func:`evidence_start`); returns whether this status made the segment stable."""
+        if self.stable_at is not None or state != SlipState.STABLE or not confidence >= STABLE_CONFIDENCE:
+            return False
+        if evidence_from >= self.ramp_end:
+            self.stable_at = stamp
+            return True
+        return False
+
+    @property
+    def time_to_stable(self) -> float | None:
+        """Stable stamp - ramp end, s (None without one)."""
+        return None if self.stable_at is None else self.stable_at - self.ramp_end

@@ -1,0 +1,456 @@
+"""Whole-revolution slip windows and lost-pulse accounting from two pulse streams (no ROS).
+
+:class:`SlipWindows` does what the bench's counter does with the fibre-optic pulses of the
+spindle and the cage (per pulse: time, strip id, strip count, pulse index), and nothing more:
+it turns them into slip windows and keeps the books of what was lost. The monitor judges the
+windows; the shadow-mode comparison can reuse the same class.
+
+**Counting by index, not by pulses received.** ``pulse_index`` counts every strip passage,
+received or not, so a gap in it tells exactly how many pulses were lost, and the strip of each
+index is fixed (``(strip_id - pulse_index) mod strip_count`` is constant for a shaft; a pulse
+that breaks it is malformed). A cage window runs from a passage of one strip to the passage of
+the same strip ``window_revolutions`` revolutions later (index difference ``window_revolutions
+* strip_count``), so the mean cage speed ``2 pi R / (t1 - t0)`` is exact whatever the strips'
+spacing. If that closing passage is lost, the window is skipped (counted in
+:attr:`LossBooks.windows_skipped`) and the next window starts at the next cage pulse received.
+
+**Time-aligned spindle speed.** The spindle's angle is known at each of its pulses (its index,
+corrected for the strip's own spacing error, below) and interpolated linearly between them at
+the cage window's two ends; the mean inner-ring speed is the difference over the same interval,
+so a changing speed gives no apparent slip from windows that do not line up. A window waits for
+the first spindle pulse at or after its end (a gap in the spindle's pulses widens the
+interpolation bracket and costs nothing else).
+
+**Strip spacing errors** of the spindle do not bias the interpolated angle: each strip's offset
+from its nominal position (a fraction of a revolution) is measured from the pulses themselves,
+over whole revolutions with every pulse received whose period differs from the one before by
+less than :data:`STEADY_PERIOD_CHANGE` (at a steady speed a time fraction is an angle fraction),
+averaged over :data:`SPACING_AVERAGE_REVOLUTIONS`, and added to the strip's nominal angle.
+Until then the nominal positions are used.
+
+**Losses** (:class:`LossBooks`, per shaft): pulses lost, isolated gaps, windows skipped. An
+isolated loss is a warning. It is a fault only when sustained, by one of two rules stated in
+revolutions of the shaft, so they hold at any speed:
+
+* more than ``max_lost_fraction`` of the pulses expected over the last ``loss_horizon_revolutions``
+  revolutions were lost (expected pulses are counted by index);
+* no pulse for longer than ``loss_silence_revolutions`` revolutions at the shaft's last pulse
+  rate (and at least ``loss_min_timeout_s``), found at two consecutive checks, so that a checker
+  that was itself held up is not mistaken for the sensor.
+
+**A stop is not a fault.** When both shafts have been silent for :data:`STOP_SILENCE_PERIODS` of
+their last pulse periods and each one's last period was longer than the one before by more than
+:data:`STOP_PERIOD_GROWTH` (both were slowing down), the rig has stopped. A shaft that falls
+silent at a steady or rising speed is lost.
+
+Units: s, rad/s; revolutions and pulses are counts.
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from collections import deque
+from dataclasses import dataclass, field
+
+from bearing_rig_sim.rig.fibre_optic import TWO_PI, Pulse
+
+SHAFTS = ("spindle", "cage")
+
+MAX_PENDING_WINDOWS = 1000
+"""Most cage windows kept waiting for spindle pulses; older ones are dropped (1)."""
+
+STOP_PERIOD_GROWTH = 0.01
+"""A pulse period longer than the shaft's previous one by more than this fraction means the
+shaft was slowing down (1). A microsecond of timing jitter changes a 5.5 ms pulse period (2700 rpm,
+4 strips) by less than 0.1 %."""
+
+STOP_SILENCE_PERIODS = 4.0
+"""Both shafts slowing down and silent for this many of their last pulse periods (and at least
+``loss_min_timeout_s``): the rig has stopped (1). No fault hangs on it, so it may be decided
+sooner than a sensor loss."""
+
+STEADY_PERIOD_CHANGE = 0.002
+"""A spindle revolution whose period is within this fraction of the previous one's is steady
+enough to measure the strips' spacing from (1): at 20 rad/s^2 and 900 rpm a revolution's period
+changes by 1.4 %, so ramps are excluded; jitter of microseconds changes a 67 ms period by
+about 0.003 %."""
+
+SPACING_AVERAGE_REVOLUTIONS = 32
+"""Revolutions over which each strip's spacing error is averaged (exponential weight 1/32)."""
+
+
+@dataclass(frozen=True)
+class LossRules:
+    """When lost pulses make a fault (see the module docstring); every count in revolutions. The
+    values come from ``config/monitor.yaml`` (:meth:`MonitorSettings.loss_rules`).
+
+    Attributes:
+        loss_horizon_revolutions: revolutions over which the lost fraction is taken (> 0).
+        max_lost_fraction: more than this fraction of the expected pulses lost is a fault (0-1).
+        loss_silence_revolutions: no pulse for this many revolutions at the last pulse rate is
+            a fault (> 0).
+        loss_min_timeout_s: ... but never sooner than this, s (> 0).
+        silent_shaft_revolutions: a shaft silent since the start is lost once the other has
+            turned this many revolutions.
+    """
+
+    loss_horizon_revolutions: float
+    max_lost_fraction: float
+    loss_silence_revolutions: float
+    loss_min_timeout_s: float
+    silent_shaft_revolutions: float
+
+
+@dataclass(frozen=True)
+class SlipWindow:
+    """One completed window of whole cage revolutions.
+
+    Attributes:
+        start_time, end_time: its two cage pulses (same strip), s.
+        cage_speed: mean cage speed, rad/s.
+        inner_ring_speed: mean spindle speed over the same interval, rad/s.
+    """
+
+    start_time: float
+    end_time: float
+    cage_speed: float
+    inner_ring_speed: float
+
+
+@dataclass
+class LossBooks:
+    """Lost-pulse accounting of one shaft since the last reset (counts).
+
+    Attributes:
+        received: pulses taken.
+        lost: pulses missing from ``pulse_index``.
+        gaps: gaps in ``pulse_index`` (one gap may lose several pulses).
+        windows_skipped: cage windows whose closing pulse was lost (cage only).
+        last_gap: (rig time, pulses lost) of the latest gap; None before any.
+    """
+
+    received: int = 0
+    lost: int = 0
+    gaps: int = 0
+    windows_skipped: int = 0
+    last_gap: tuple[float, int] | None = None
+
+
+@dataclass
+class _Shaft:
+    """What is kept of one shaft's pulses since its last restart."""
+
+    name: str
+    strip_count: int | None = None
+    offset: int | None = None
+    last_time: float | None = None
+    last_index: int | None = None
+    last_period: float | None = None
+    previous_period: float | None = None
+    pulses: int = 0
+    times: list[float] = field(default_factory=list)
+    angles: list[float] = field(default_factory=list)  # revolutions, spacing-corrected
+    window_start: tuple[int, float] | None = None
+    recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
+    recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
+    steady_period: float | None = None  # period of the last whole revolution measured, s
+
+    def revolutions(self) -> float:
+        """Revolutions counted since the shaft's restart (pulses received / strips)."""
+        return self.pulses / self.strip_count if self.strip_count else 0.0
+
+    def slowing(self) -> bool:
+        """Whether the last pulse period was longer than the one before (STOP_PERIOD_GROWTH)."""
+        if self.last_period is None or self.previous_period is None:
+            return False
+        return self.last_period > self.previous_period * (1.0 + STOP_PERIOD_GROWTH)
+
+
+class SlipWindows:
+    """Whole-revolution windows and loss accounting (see the module docstring).
+
+    Args:
+        window_revolutions: whole cage revolutions per window (>= 1).
+        rules: when losses are a fault.
+        clock_jump_tolerance_s: a pulse further back than this before its shaft's previous one
+            is a clock jump (everything restarts); less far back, an out-of-order pulse (that
+            shaft restarts), s.
+    """
+
+    def __init__(self, window_revolutions: int, rules: LossRules, clock_jump_tolerance_s: float) -> None:
+        self.window_revolutions = window_revolutions
+        self.rules = rules
+        self.clock_jump_tolerance_s = clock_jump_tolerance_s
+        self.books = {name: LossBooks() for name in SHAFTS}
+        self.events: list[tuple[str, float | None, str]] = []
+        """(kind, rig time, text) since the caller last cleared it; kind is "invalid" (a
+        malformed pulse, discarded), "gap" (lost pulses), "note" (an out-of-order pulse or a
+        restart) or "reset" (a clock jump: the caller resets what it derived)."""
+        self._spacing: dict[int, float] = {}
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget every pulse and window (the books and the strips' spacing are kept)."""
+        self._shafts = {name: _Shaft(name) for name in SHAFTS}
+        self._pending: deque[tuple[float, float]] = deque()
+        self._suspect: set[str] = set()
+        self.silent: dict[str, str] = {}
+        """Shafts found silent at two consecutive checks, with the reason."""
+        self.stopped = ""
+        """Why the rig is taken to have stopped ("" while it is not)."""
+
+    # -- queries -------------------------------------------------------------------------------
+    def last_pulse_time(self) -> float | None:
+        """Time of the latest pulse of either shaft, s (None before any)."""
+        times = [s.last_time for s in self._shafts.values() if s.last_time is not None]
+        return max(times) if times else None
+
+    def lost_fraction(self, shaft: str) -> float:
+        """Lost pulses over the last ``loss_horizon_revolutions`` of ``shaft`` as a fraction of
+        the pulses expected there (by index); 0 before any pulse."""
+        s = self._shafts[shaft]
+        if s.strip_count is None or s.last_index is None:
+            return 0.0
+        horizon = self.rules.loss_horizon_revolutions * s.strip_count
+        while s.recent_gaps and s.recent_gaps[0][0] <= s.last_index - horizon:
+            s.recent_gaps.popleft()
+        return sum(lost for _, lost in s.recent_gaps) / horizon
+
+    def faults(self) -> dict[str, str]:
+        """Active sustained-loss faults by shaft (silence, or too large a lost fraction)."""
+        out = dict(self.silent)
+        for name in SHAFTS:
+            if name in out:
+                continue
+            fraction = self.lost_fraction(name)
+            if fraction > self.rules.max_lost_fraction:
+                out[name] = (
+                    f"{name}: {100.0 * fraction:.3g} % of the pulses of the last "
+                    f"{self.rules.loss_horizon_revolutions:g} revolutions lost (limit "
+                    f"{100.0 * self.rules.max_lost_fraction:g} %): sustained loss"
+                )
+        return out
+
+    def spacing(self) -> dict[int, float]:
+        """The spindle strips' measured spacing errors, fractions of a revolution by strip."""
+        return dict(self._spacing)
+
+    # -- input ---------------------------------------------------------------------------------
+    def add_pulse(self, shaft: str, pulse: Pulse) -> list[SlipWindow]:
+        """Take one pulse of ``shaft`` (``"spindle"`` or ``"cage"``); the windows it completes.
+
+        Never raises on bad data: what happened goes to :attr:`events`.
+        """
+        if shaft not in self._shafts:
+            self.events.append(("note", None, f"pulse of unknown shaft {shaft!r} ignored"))
+            return []
+        problem = _malformed(pulse)
+        if problem:
+            self.events.append(("invalid", None, f"{shaft}: invalid pulse discarded ({problem})"))
+            return []
+        s = self._shafts[shaft]
+        t, index = float(pulse.time), int(pulse.pulse_index)
+        last_time, last_index = s.last_time, s.last_index
+        if last_time is not None and last_index is not None:
+            if t < last_time - self.clock_jump_tolerance_s:
+                self.reset()
+                self.events.append(("reset", t, f"reset: {shaft} pulse at {t:.6f} s after one at {last_time:.6f} s (clock jumped back)"))
+                s = self._shafts[shaft]
+            elif t <= last_time or index <= last_index:
+                self.events.append(
+                    (
+                        "note",
+                        t,
+                        f"{shaft}: out-of-order pulse (index {index} at {t:.6f} s after index {s.last_index} at "
+                        f"{s.last_time:.6f} s) discarded; {shaft} counting restarted",
+                    )
+                )
+                self._restart_shaft(shaft)
+                return []
+            elif pulse.strip_count != s.strip_count:
+                self.events.append(("note", t, f"{shaft}: strip_count changed from {s.strip_count} to {pulse.strip_count}; counting restarted"))
+                self._restart_shaft(shaft)
+                s = self._shafts[shaft]
+            elif (pulse.strip_id - index) % pulse.strip_count != s.offset:
+                self.events.append(
+                    (
+                        "invalid",
+                        t,
+                        f"{shaft}: strip {pulse.strip_id} at pulse_index {index} does not match the earlier strips "
+                        "(strip ids inconsistent with the indices); counting restarted",
+                    )
+                )
+                self._restart_shaft(shaft)
+                s = self._shafts[shaft]
+        books = self.books[shaft]
+        books.received += 1
+        if s.last_index is not None and s.last_time is not None:
+            step = index - s.last_index
+            if step > 1:
+                books.lost += step - 1
+                books.gaps += 1
+                books.last_gap = (t, step - 1)
+                s.recent_gaps.append((index, step - 1))
+                self.events.append(("gap", t, f"{shaft}: {step - 1} pulse(s) lost before pulse_index {index}"))
+            s.previous_period = s.last_period
+            s.last_period = (t - s.last_time) / step
+        else:
+            s.strip_count = pulse.strip_count
+            s.offset = (pulse.strip_id - index) % pulse.strip_count
+        s.last_time, s.last_index = t, index
+        s.pulses += 1
+        self.silent.pop(shaft, None)
+        self._suspect.discard(shaft)
+        self.stopped = ""
+        if shaft == "spindle":
+            self._add_spindle_pulse(s, t, index)
+            return self._process_pending()
+        return self._add_cage_pulse(s, t, index)
+
+    def _restart_shaft(self, shaft: str) -> None:
+        self._shafts[shaft] = _Shaft(shaft)
+        self.silent.pop(shaft, None)
+        self._suspect.discard(shaft)
+
+    def _add_spindle_pulse(self, s: _Shaft, t: float, index: int) -> None:
+        assert s.strip_count is not None and s.offset is not None
+        n = s.strip_count
+        strip = (index + s.offset) % n
+        s.recent.append((index, t))
+        if len(s.recent) > n + 1:
+            s.recent.popleft()
+        if strip == 0 and n > 1:
+            self._measure_spacing(s, n)
+        s.times.append(t)
+        s.angles.append(index / n + self._spacing.get(strip, 0.0))
+
+    def _measure_spacing(self, s: _Shaft, n: int) -> None:
+        """Update the strips' spacing errors from the revolution that ends at this strip-0 pulse.
+
+        Over one whole revolution with every pulse received, pulse m's time fraction of the
+        revolution minus its nominal fraction is e(strip m) - e(0); with the errors' mean taken
+        as zero (only differences matter), each strip's error follows.
+        """
+        first_index, first_time = s.recent[0]
+        last_index, last_time = s.recent[-1]
+        if len(s.recent) != n + 1 or last_index - first_index != n:
+            s.steady_period = None
+            return
+        period = last_time - first_time
+        previous, s.steady_period = s.steady_period, period
+        if previous is None or abs(period - previous) > STEADY_PERIOD_CHANGE * previous:
+            return
+        d = [(time - first_time) / period - (index - first_index) / n for index, time in list(s.recent)[1:]]
+        mean = sum(d) / n
+        assert s.offset is not None
+        for (index, _), dm in zip(list(s.recent)[1:], d):
+            strip = (index + s.offset) % n
+            sample = dm - mean
+            old = self._spacing.get(strip)
+            self._spacing[strip] = sample if old is None else old + (sample - old) / SPACING_AVERAGE_REVOLUTIONS
+
+    def _add_cage_pulse(self, cage: _Shaft, t: float, index: int) -> list[SlipWindow]:
+        assert cage.strip_count is not None
+        span = self.window_revolutions * cage.strip_count
+        if cage.window_start is None:
+            cage.window_start = (index, t)
+            return []
+        start_index, start_time = cage.window_start
+        if index - start_index < span:
+            return []
+        if index - start_index == span:
+            self._pending.append((start_time, t))
+            if len(self._pending) > MAX_PENDING_WINDOWS:
+                self._pending.popleft()
+        else:  # the passage closing the window was lost: skip it, start afresh here
+            self.books["cage"].windows_skipped += 1
+        cage.window_start = (index, t)
+        return self._process_pending()
+
+    # -- windows -------------------------------------------------------------------------------
+    def _spindle_angle(self, spindle: _Shaft, t: float) -> float:
+        """Spindle revolutions at ``t`` (index units / strips, spacing-corrected), interpolated."""
+        k = bisect.bisect_right(spindle.times, t) - 1
+        if k >= len(spindle.times) - 1:
+            return spindle.angles[-1]
+        t0, t1 = spindle.times[k], spindle.times[k + 1]
+        a0, a1 = spindle.angles[k], spindle.angles[k + 1]
+        return a0 + (t - t0) / (t1 - t0) * (a1 - a0)
+
+    def _process_pending(self) -> list[SlipWindow]:
+        spindle = self._shafts["spindle"]
+        done: list[SlipWindow] = []
+        while self._pending and spindle.times and spindle.times[-1] >= self._pending[0][1]:
+            t0, t1 = self._pending.popleft()
+            if spindle.times[0] > t0:
+                continue  # the spindle's pulses start after the window: cannot be measured
+            duration = t1 - t0
+            inner = TWO_PI * (self._spindle_angle(spindle, t1) - self._spindle_angle(spindle, t0)) / duration
+            cage = TWO_PI * self.window_revolutions / duration
+            done.append(SlipWindow(t0, t1, cage, inner))
+        self._prune_spindle()
+        return done
+
+    def _prune_spindle(self) -> None:
+        spindle, cage = self._shafts["spindle"], self._shafts["cage"]
+        starts = [t0 for t0, _ in self._pending]
+        if cage.window_start is not None:
+            starts.append(cage.window_start[1])
+        keep_from = min(starts) if starts else math.inf
+        k = bisect.bisect_right(spindle.times, keep_from) - 1
+        k = min(k, len(spindle.times) - 1)
+        if k > 0:
+            del spindle.times[:k]
+            del spindle.angles[:k]
+
+    # -- time-based checks ---------------------------------------------------------------------
+    def check(self, now: float) -> None:
+        """Silence checks at rig time ``now`` (s): updates :attr:`silent` and :attr:`stopped`.
+
+        A shaft is silent when found so at this check and at the previous one. ``now`` may run
+        ahead of the pulses (extrapolated by a wall clock when the source has stopped).
+        """
+        if not math.isfinite(now):
+            return
+        rules = self.rules
+        quiet: dict[str, str] = {}
+        for name in SHAFTS:
+            s = self._shafts[name]
+            other = self._shafts["cage" if name == "spindle" else "spindle"]
+            if s.last_time is None:
+                turned = other.revolutions()
+                if turned >= rules.silent_shaft_revolutions:
+                    quiet[name] = f"{name}: no pulse since the start while the {other.name} turned {turned:.3g} revolutions"
+                continue
+            limit = rules.loss_min_timeout_s
+            if s.last_period is not None and s.strip_count:
+                limit = max(limit, rules.loss_silence_revolutions * s.strip_count * s.last_period)
+            silence = now - s.last_time
+            if silence > limit:
+                quiet[name] = f"{name}: no pulse for {silence:.3g} s (limit {limit:.3g} s, {rules.loss_silence_revolutions:g} revolutions)"
+        confirmed = {name: reason for name, reason in quiet.items() if name in self._suspect}
+        self._suspect = set(quiet)
+        spindle, cage = self._shafts["spindle"], self._shafts["cage"]
+        if all(s.slowing() and s.last_time is not None and s.last_period is not None and now - s.last_time > max(rules.loss_min_timeout_s, STOP_SILENCE_PERIODS * s.last_period) for s in (spindle, cage)):
+            self.stopped = "spindle and cage stopped (their pulse periods grew before the pulses ceased)"
+            self.silent = {}
+        else:
+            self.stopped = ""
+            self.silent = {name: f"{reason}: sensor loss" for name, reason in confirmed.items()}
+
+
+def _malformed(pulse: Pulse) -> str:
+    """Why a pulse cannot be used ("" if it can)."""
+    t = pulse.time
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        return f"time {t!r} is not a finite number"
+    for name in ("strip_id", "strip_count", "pulse_index"):
+        value = getattr(pulse, name)
+        if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+            return f"{name} {value!r} is not an integer >= 0"
+    if pulse.strip_count < 1:
+        return "strip_count is 0"
+    if pulse.strip_id >= pulse.strip_count:
+        return f"strip_id {pulse.strip_id} is not below strip_count {pulse.strip_count}"
+    return ""

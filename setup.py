@@ -45,6 +45,7 @@ setup(
     data_files=[
         ("share/ament_index/resource_index/packages", [f"resource/{PACKAGE_NAME}"]),
         (f"share/{PACKAGE_NAME}", ["package.xml"]),
+        (f"share/{PACKAGE_NAME}/launch", ["launch/rig.launch.py"]),
         *config_data_files(),
     ],
     install_requires=["setuptools"],

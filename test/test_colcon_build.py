@@ -21,7 +21,7 @@ import pytest
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 VENV = Path(sys.prefix)
-SOURCES = ("setup.py", "setup.cfg", "package.xml", "resource", "bearing_rig_sim", "config", "msg_defs")
+SOURCES = ("setup.py", "setup.cfg", "package.xml", "resource", "bearing_rig_sim", "config", "launch", "msg_defs")
 IGNORE = shutil.ignore_patterns("__pycache__", "*.pyc", "*.nbi", "*.nbc", "*.egg-info")
 
 
@@ -145,3 +145,18 @@ def test_console_script_runs_from_the_workspace(workspace: Path) -> None:
     from bearing_rig_sim import __version__
 
     assert result.stdout.strip() == f"bearing-rig {__version__}"
+
+
+@pytest.mark.slow
+def test_launch_file_is_installed_and_byte_compiles(workspace: Path) -> None:
+    """``ros2 launch bearing_rig_sim rig.launch.py`` finds it in share/ (launch itself is not on
+    PyPI, so it is not run here: it must at least compile, with the node executables it names
+    installed beside)."""
+    installed = workspace / "install" / "bearing_rig_sim" / "share" / "bearing_rig_sim" / "launch" / "rig.launch.py"
+    assert installed.is_file()
+    assert installed.read_bytes() == (REPO_ROOT / "launch" / "rig.launch.py").read_bytes()
+    compile(installed.read_text(encoding="utf-8"), str(installed), "exec")
+    for name in ("simulator", "load_controller", "monitor"):
+        executable = workspace / "install" / "bearing_rig_sim" / "lib" / "bearing_rig_sim" / name
+        assert executable.is_file() and os.access(executable, os.X_OK), name
+        assert f'"{name}"' in installed.read_text(encoding="utf-8")

@@ -54,6 +54,28 @@ def test_batched_ticks_step_the_same_chain_as_single_ticks(config: LoadingChainC
     assert a.time == pytest.approx(0.3) and b.time == pytest.approx(0.3)
 
 
+def test_follow_steps_one_force_sample_per_millisecond_however_the_clock_is_read(config: LoadingChainConfig) -> None:
+    """The node wakes every 10 ms of wall time and reads whatever /clock came last: follow gives a
+    result (a force message) for each multiple of the 1 ms sample period passed, stepped from the
+    previous one, so the forces are those of a clock read every millisecond."""
+    chunked, every_ms = AxialLoadOperation.from_config(config, sample_period_s=0.001), AxialLoadOperation.from_config(config)
+    assert [r.time for r in chunked.follow(0.0)] == [0.0]  # the first reading starts the count
+    every_ms.advance_to(0.0)
+    for op in (chunked, every_ms):
+        assert op.request_setpoint(400.0, SetpointSource.TOPIC).accepted
+    samples = chunked.follow(0.0105)
+    assert [round(r.time, 9) for r in samples] == [round(0.001 * k, 9) for k in range(1, 11)]
+    assert all(r.stepped == pytest.approx(0.001) for r in samples)
+    assert chunked.follow(0.0105) == [] and chunked.follow(0.0109) == []  # the next sample not reached
+    samples += chunked.follow(0.0371)
+    assert [round(r.time, 9) for r in samples] == [round(0.001 * k, 9) for k in range(1, 38)]
+    reference = drive(every_ms, 0.0, 0.037, 0.001)
+    assert [r.state.bearing_force for r in samples] == pytest.approx([r.state.bearing_force for r in reference], rel=1e-12)
+    assert [round(r.time, 9) for r in samples if r.state_due] == [0.01, 0.02, 0.03]  # 100 Hz of sim time
+    back = chunked.follow(0.002)
+    assert len(back) == 1 and back[0].stepped == 0.0 and "went back" in back[0].clock_note
+
+
 def test_clock_going_back_restarts_the_count_and_a_jump_is_capped(config: LoadingChainConfig) -> None:
     op = AxialLoadOperation.from_config(config, max_clock_gap_s=0.5)
     drive(op, 0.0, 1.0, 0.01)

@@ -44,7 +44,7 @@ class Harness:
 
     def __init__(self, ros_graph: Any, *ros_args: str) -> None:
         self.graph = ros_graph
-        self.process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--ros-args", *ros_args)
+        self.process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", *ros_args)
         self.node = ros_graph.node("load_controller_test")
         self.executor = ros_graph.executor([self.node])
         self.time = 0.0
@@ -156,7 +156,7 @@ def test_load_step_settles_within_the_stated_time(ros_graph: Any) -> None:
     assert states[-1].bearing_force == pytest.approx(target, rel=0.02)
 
 
-BAD_VALUES = [(math.nan, "finite"), (-5.0, ">= 0"), (5000.0, "<= 1000")]
+BAD_VALUES = [(math.nan, "finite"), (-5.0, ">= 0"), (5000.0, "<= 1000"), (20_000.0, "<= 1000")]
 
 
 def test_bad_setpoints_are_refused_by_every_route_and_the_node_answers(ros_graph: Any) -> None:
@@ -180,8 +180,12 @@ def test_bad_setpoints_are_refused_by_every_route_and_the_node_answers(ros_graph
 
         mark = rig.mark()
         result = rig.set_by_parameter(value)
-        assert not result.successful and reason in result.reason
-        rig.wait_diagnostic(mark, DiagnosticStatus.WARN, "by parameter refused", reason)
+        assert not result.successful
+        if 0.0 <= value <= 10_000.0:  # inside the parameter's declared range: the chain refuses it
+            assert reason in result.reason
+            rig.wait_diagnostic(mark, DiagnosticStatus.WARN, "by parameter refused", reason)
+        else:  # outside the declared range (config/load_controller's descriptor): ROS refuses it
+            assert "out of range" in result.reason and "Max: 10000.0" in result.reason, result.reason
         assert rig.set_by_service(100.0).accepted
     result = rig.set_by_parameter("a lot")
     assert not result.successful and "must be a number" in result.reason
@@ -231,15 +235,16 @@ def test_interlock_trip_refused_reset_then_reset(ros_graph: Any, tmp_path: Path)
     [
         (["-p", "use_sim_time:=false"], "use_sim_time must be true"),
         (["-p", "rig_file:=/nonexistent/rig.yaml"], "/nonexistent/rig.yaml"),
-        (["-p", "state_rate_hz:=0.0"], "state_rate_hz must be a finite number > 0"),
-        (["-p", "state_rate_hz:=fast"], "parameter refused: Trying to set parameter 'state_rate_hz' to 'fast'"),
+        (["-p", "state_rate_hz:=0.0"], "state_rate_hz: must be > 0"),
+        (["-p", "state_rate_hz:=5000.0"], "range: > 0 and <= 1000"),
+        (["-p", "state_rate_hz:=fast"], "state_rate_hz: must be a number, got 'fast'"),
         (["--params-file", "{tmp}/broken.yaml"], "ROS arguments refused: failed to initialize rcl: Couldn't parse params file"),
     ],
 )
 def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, tmp_path: Path, ros_args: list[str], expected: str) -> None:
     (tmp_path / "broken.yaml").write_text("load_controller:\n  ros__parameters:\n    state_rate_hz: [1,\n")
     ros_args = [arg.replace("{tmp}", str(tmp_path)) for arg in ros_args]
-    process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--ros-args", *ros_args)
+    process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", *ros_args)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 2, err[-2000:]
     assert "load_controller: error:" in err and expected in err and "Traceback" not in err

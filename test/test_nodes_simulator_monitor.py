@@ -45,7 +45,7 @@ def rig_strips() -> tuple[int, int]:
 
 
 def start(ros_graph: Any, module: str, *params: str, flags: tuple[str, ...] = ()) -> subprocess.Popen[str]:
-    args = ["-m", f"bearing_rig_sim.nodes.{module}", *flags]
+    args = ["-m", f"bearing_rig_sim.nodes.{module}", "--autostart", *flags]
     if params:
         args.append("--ros-args")
         for p in params:

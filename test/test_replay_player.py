@@ -300,7 +300,7 @@ def test_monitor_on_a_replay_reaches_the_recorded_verdict(ros_graph, tmp_path: P
     node.create_subscription(SlipStatus, "/rig/slip_status", lambda m: statuses.append((time.monotonic(), m.state)), qos)
     node.create_subscription(FibreOpticPulse, CAGE, lambda _m: last_pulse.append(time.monotonic()), qos_profile_sensor_data)
     executor = ros_graph.executor([node])
-    monitor = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.monitor import main; sys.exit(main())")
+    monitor = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.monitor import main; sys.exit(main(['monitor', '--autostart']))")
     assert ros_graph.spin_until(lambda: bool(statuses), timeout=30.0, executor=executor), "the monitor node did not come up"
     replay = ros_graph.spawn_python(
         "-m", "bearing_rig_sim.cli", "replay", str(bag), "--topics", "/rig/spindle/pulses", "/rig/cage/pulses", "--wait-for-subscribers", "--delay", "20"

@@ -128,6 +128,55 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
         assert context["ros_domain_id"] == str(ros_graph.domain_id) and context["realtime"] == "false"
     assert (bag / "logs" / "simulator.log").is_file()
 
+    # the session managed the nodes' lifecycles: bring-up in order, shut-down in reverse order
+    nodes = ("simulator", "load_controller", "monitor")
+    expected = [f"lifecycle: {n} configure: unconfigured -> inactive" for n in nodes]
+    expected += [f"lifecycle: {n} activate: inactive -> active" for n in nodes]
+    expected += [f"lifecycle: {n} deactivate: active -> inactive" for n in reversed(nodes)]
+    expected += [f"lifecycle: {n} cleanup: inactive -> unconfigured" for n in reversed(nodes)]
+    assert [line for line in out.splitlines() if line.startswith("lifecycle: ")] == expected
+    logged = (bag / "logs" / "session.log").read_text(encoding="utf-8")
+    assert [line.split(" ", 1)[1] for line in logged.splitlines() if " lifecycle: " in line] == expected
+    assert lifecycle_diagnostics(bag) == [
+        (f"lifecycle_manager: {line.split()[1]}", line.split()[2].rstrip(":")) for line in expected
+    ]
+
+
+def lifecycle_diagnostics(bag: Path) -> list[tuple[str, str]]:
+    """(status name, transition) of the lifecycle statuses on /diagnostics in the bag, in order."""
+    found = []
+    with AnyReader([bag], default_typestore=rig_typestore()) as reader:
+        connections = [c for c in reader.connections if c.topic == "/diagnostics"]
+        for connection, _time, raw in reader.messages(connections=connections):
+            for status in reader.deserialize(raw, connection.msgtype).status:
+                if status.name.startswith("lifecycle_manager: "):
+                    values = {kv.key: kv.value for kv in status.values}
+                    found.append((status.name, values["transition"]))
+    return found
+
+
+def test_a_node_failing_to_configure_is_named_and_the_bag_finalised(ros_graph: Any, tmp_path: Path) -> None:
+    params = tmp_path / "params.yaml"
+    params.write_text("monitor:\n  ros__parameters:\n    bearing_file: bearings/missing.yaml\n", encoding="utf-8")
+    session = start_session(ros_graph, tmp_path, "--params-file", str(params))
+    out, err = session.communicate(timeout=120)
+    assert session.returncode == 1, f"{out[-3000:]}\n{err[-3000:]}"
+    assert "the monitor node failed to configure: " in err and "missing.yaml" in err, err[-3000:]
+    assert "summary (failed)" in out
+    lines = [line for line in out.splitlines() if line.startswith("lifecycle: ")]
+    assert lines[:2] == [
+        "lifecycle: simulator configure: unconfigured -> inactive",
+        "lifecycle: load_controller configure: unconfigured -> inactive",
+    ]
+    assert lines[2].startswith("lifecycle: monitor configure FAILED, stays unconfigured: ") and "missing.yaml" in lines[2]
+    assert lines[3:] == [
+        "lifecycle: load_controller cleanup: inactive -> unconfigured",
+        "lifecycle: simulator cleanup: inactive -> unconfigured",
+    ]
+    bag = the_bag(tmp_path)
+    check_bag_decodes(bag)  # finalised: both readers read it whole
+    assert ("lifecycle_manager: monitor", "configure") in lifecycle_diagnostics(bag)
+
 
 def read_until(session: subprocess.Popen[str], prefix: str, seconds: float = 90.0) -> list[str]:
     """The session's output lines up to the first starting with ``prefix`` (progress prints at
@@ -262,6 +311,23 @@ def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> N
     gaps = [(a, b) for a, b in zip(clock_ns, clock_ns[1:]) if round((b - a) / 1_000_000) != 1]
     assert not gaps, f"/clock: {len(gaps)} gaps, first {gaps[:5]}"
     assert clock_ns[-1] - clock_ns[0] >= 20 * 1_000_000_000
+
+
+def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:
+    """What launch/rig.launch.py does: nodes brought up elsewhere, the program run by
+    ``bearing-rig run --attach --no-record`` on the environment's domain."""
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    rows = summary_rows(out)
+    assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
+    assert "not recorded (--no-record)" in out
+    assert not any(line.startswith("lifecycle: ") for line in out.splitlines())
+    (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
+    assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()
 
 
 def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_graph: Any, tmp_path: Path) -> None:

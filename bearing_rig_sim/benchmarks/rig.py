@@ -23,7 +23,12 @@ time from a probe in the benchmark's own process. Rows (one JSON object each):
   ``p50_ms``, ``p99_ms``, ``max_ms`` over all windows; ``on_change_*`` over those whose state
   differs from the previous status's. Target: p99 <= 5 ms.
 * ``case: "cpu"``, one row per process (``node``): user + system CPU time over the window from
-  ``/proc/<pid>/stat`` (the probe's from ``os.times``), as ``cpu_pct`` of one core.
+  ``/proc/<pid>/stat`` (the probe's from ``os.times``), as ``cpu_pct`` of one core; and
+  ``node: "nodes_total"``, the three nodes together, against ``target_pct`` 100 (the rig within
+  one core at 1 kHz).
+
+The nodes start with ``--autostart`` (each configures and activates itself, as the session's
+lifecycle manager would have them), so the window measures the running rig only.
 """
 
 from __future__ import annotations
@@ -208,7 +213,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
     logs = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-rig-"))
     env, lease = session_environment(os.environ)
     apply_transport_profile(env, logs)
-    children = [NodeProcess(name, node_command(spec), logs / f"{name}.log") for name, spec in NODES.items()]
+    children = [NodeProcess(name, node_command(spec) + ["--autostart"], logs / f"{name}.log") for name, spec in NODES.items()]
     context = rclpy.Context()
     probe = None
     series = _Series()
@@ -251,9 +256,19 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
         lease.release()
     duration = mono_end - mono_start
     yield from _rows(args, series, wall_start, wall_end, duration)
+    total: float | None = 0.0
     for name in NODES:
-        used = None if cpu_start[name] is None or cpu_end[name] is None else cpu_end[name] - cpu_start[name]
+        start, end = cpu_start[name], cpu_end[name]
+        used = None if start is None or end is None else end - start
+        total = None if used is None or total is None else total + used
         yield {"bench": "rig", "case": "cpu", "node": name, "cpu_pct": None if used is None else round(100.0 * used / duration, 1)}
+    yield {
+        "bench": "rig",
+        "case": "cpu",
+        "node": "nodes_total",
+        "cpu_pct": None if total is None else round(100.0 * total / duration, 1),
+        "target_pct": 100.0,
+    }
     own = (own_end.user + own_end.system) - (own_start.user + own_start.system)
     yield {"bench": "rig", "case": "cpu", "node": "bench_probe", "cpu_pct": round(100.0 * own / duration, 1)}
 

@@ -1,4 +1,4 @@
-"""``bearing-rig replay BAG [--rate R] [--loop] [--topics T ...] [--start S] [--duration D]``:
+"""``bearing-rig replay BAG [--rate R] [--loop] [--topics T ...] [--start S] [--duration D] [--foxglove [PORT]]``:
 republish a recorded bag into the ROS 2 graph with its original timing, and ``/clock``.
 
 Nodes on ``use_sim_time`` (the monitor's default) follow the bag's clock. Replay only the sensor
@@ -14,8 +14,9 @@ import time
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.interfaces import CLOCK
+from bearing_rig_sim.commands.run import add_foxglove_argument
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import CLOCK
 
 
 def register(subparsers: Any) -> None:
@@ -35,6 +36,7 @@ def register(subparsers: Any) -> None:
         help="start as soon as every replayed topic (except /clock) has a subscriber, waiting at most --delay seconds",
     )
     p.add_argument("--quiet", action="store_true", help="no summary line")
+    add_foxglove_argument(p)
     p.set_defaults(func=run)
 
 
@@ -56,7 +58,15 @@ def run(args: argparse.Namespace) -> int:
     )
     with bag_warnings_as_lines(), open_bag(args.bag) as bag:
         topics = check_topics(bag, options.topics)
-        sink = RosReplaySink(bag.topics)
+        sink: Any = RosReplaySink(bag.topics)
+        view = None
+        if args.foxglove is not None:
+            from bearing_rig_sim.bags import msg_definition_text
+            from bearing_rig_sim.live.foxglove import FoxgloveLiveView, LiveReplaySink
+
+            view = FoxgloveLiveView(args.foxglove, msg_definition_text)
+            sink = LiveReplaySink(sink, view, {name: info.msgtype for name, info in bag.topics.items() if name in topics or name == CLOCK.name})
+            print(f"Foxglove live view: {view.url} (layout to import: config/foxglove/rig.json)", flush=True)
         try:
             if args.wait_for_subscribers:
                 alone = sink.wait_for_subscribers([t for t in topics if t != CLOCK.name], args.delay)
@@ -69,7 +79,9 @@ def run(args: argparse.Namespace) -> int:
             print("bearing-rig: replay interrupted", file=sys.stderr)
             return 130
         finally:
-            sink.close()
+            (sink.inner if view is not None else sink).close()
+            if view is not None:
+                view.close()
     if not args.quiet:
         skipped = f"; skipped (type not installed): {', '.join(stats.skipped_topics)}" if stats.skipped_topics else ""
         print(f"{args.bag}: {stats.summary()}{skipped}")

@@ -1,4 +1,4 @@
-"""``bearing-rig run [PROGRAM] [--no-realtime] [--bag-dir DIR] [--quiet]``: a rig session.
+"""``bearing-rig run [PROGRAM] [--no-realtime] [--bag-dir DIR] [--quiet] [--params-file FILE] [--foxglove [PORT]]``.
 
 Starts the simulator, load controller and monitor as separate processes on a private ROS domain,
 runs the test program on the simulation clock, records every rig topic to
@@ -19,6 +19,23 @@ from bearing_rig_sim.config import check_number, config_path
 MAX_STARTUP_TIMEOUT_S = 3600.0
 """Longest ``--startup-timeout`` accepted, s: an hour covers the slowest first start (kernel
 compilation on a loaded machine); NaN or infinity would never time out."""
+
+FOXGLOVE_PORT = 8765
+"""Default port of ``--foxglove``: the Foxglove app's default."""
+
+
+def add_foxglove_argument(parser: argparse.ArgumentParser) -> None:
+    """``--foxglove [PORT]``: serve the topics live to the Foxglove app (run and replay)."""
+    parser.add_argument(
+        "--foxglove",
+        type=int,
+        nargs="?",
+        const=FOXGLOVE_PORT,
+        default=None,
+        metavar="PORT",
+        help=f"serve the rig's topics live to the Foxglove app on ws://localhost:PORT (default {FOXGLOVE_PORT}); "
+        "layout: config/foxglove/rig.json",
+    )
 
 DEFAULT_PROGRAM = ("programs", "validation.yaml")
 """The default program, under ``config/``: the validation program (paper Table 3 conditions)."""
@@ -49,6 +66,20 @@ def register(subparsers: Any) -> None:
         metavar="SECONDS",
         help="longest wait for the nodes to come up (default: 60 s; the simulator's first start compiles its kernels)",
     )
+    parser.add_argument(
+        "--params-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="ROS 2 parameter file given to every node (a block per node name), over config/<node>.yaml",
+    )
+    parser.add_argument(
+        "--attach",
+        action="store_true",
+        help="run the program on nodes already running and managed elsewhere (launch/rig.launch.py): start no processes",
+    )
+    parser.add_argument("--no-record", action="store_true", help="record no bag (where ros2 bag record records)")
+    add_foxglove_argument(parser)
     parser.set_defaults(func=run)
 
 
@@ -63,6 +94,10 @@ def run(args: argparse.Namespace) -> int:
         bag_dir=args.bag_dir,
         quiet=args.quiet,
         startup_timeout_s=check_number(args.startup_timeout, "bearing-rig run", "--startup-timeout", gt=0.0, le=MAX_STARTUP_TIMEOUT_S),
+        params_file=args.params_file,
+        foxglove_port=args.foxglove,
+        attach=args.attach,
+        record=not args.no_record,
         command_line=["bearing-rig", *sys.argv[1:]],
     )
     return run_session(options)

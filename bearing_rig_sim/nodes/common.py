@@ -104,11 +104,10 @@ def default_params_file(node_name: str) -> Path:
 
 
 def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[str]:
-    """Command-line arguments for ``rclpy.init``: the given ones, plus the shipped parameter
-    file when the user gave none (``--params-file`` or ``-p`` after ``--ros-args``)."""
+    """Command-line arguments for ``rclpy.init``: the given ones, with the shipped parameter file
+    put first after ``--ros-args``, so parameter files and ``-p`` given by the user override it
+    (a partial user file changes only what it names)."""
     args = list(sys.argv if argv is None else argv)
-    if "--params-file" in args:
-        return args
     path = default_params_file(node_name)
     if not path.exists():
         return args
@@ -116,6 +115,17 @@ def ros_args_with_defaults(node_name: str, argv: Sequence[str] | None) -> list[s
         i = args.index("--ros-args")
         return args[: i + 1] + ["--params-file", str(path)] + args[i + 1 :]
     return args + ["--ros-args", "--params-file", str(path)]
+
+
+AUTOSTART_FLAG = "--autostart"
+"""Command-line flag of every node's console script: configure and activate at once (what a
+lifecycle manager would do), exit status 2 with the reason if configure fails."""
+
+
+def split_autostart(argv: Sequence[str]) -> tuple[list[str], bool]:
+    """``argv`` without :data:`AUTOSTART_FLAG`, and whether it was there."""
+    args = list(argv)
+    return [a for a in args if a != AUTOSTART_FLAG], AUTOSTART_FLAG in args
 
 
 def _rcl_message(exc: Exception) -> str:
@@ -126,9 +136,20 @@ def _rcl_message(exc: Exception) -> str:
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Initialise rclpy (with the node's shipped parameter file), spin the node made by
     ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
-    Returns the process exit status."""
+
+    A lifecycle node starts unconfigured, driven by the standard ``lifecycle_msgs`` services;
+    with ``--autostart`` it configures and activates itself first.
+
+    Returns:
+        The process exit status: 0, or 2 when ``--autostart`` could not configure or activate.
+
+    Raises:
+        RigError: malformed ROS arguments; the node could not be made (a parameter given at
+            start out of its range or of the wrong type).
+    """
+    args, autostart = split_autostart(sys.argv if argv is None else argv)
     try:
-        rclpy.init(args=ros_args_with_defaults(node_name, argv))
+        rclpy.init(args=ros_args_with_defaults(node_name, args))
     except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
         raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
@@ -138,6 +159,11 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             node = factory()
         except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
             raise RigError(f"parameter refused: {exc}") from None
+        if autostart and hasattr(node, "trigger_configure"):
+            failed = _autostart(node)
+            if failed:
+                print(f"{node_name}: error: {failed}", file=sys.stderr)
+                return 2
         executor.add_node(node)
         executor.spin()
     except (KeyboardInterrupt, ExternalShutdownException):
@@ -154,6 +180,17 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             node.destroy_node()
         rclpy.try_shutdown()
     return 0
+
+
+def _autostart(node: Node) -> str:
+    """Configure then activate a lifecycle node; why it failed, or "" when it is active."""
+    from rclpy.lifecycle import TransitionCallbackReturn
+
+    if node.trigger_configure() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+        return getattr(node, "configure_error", "") or "configure failed"
+    if node.trigger_activate() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+        return "activate failed"
+    return ""
 
 
 CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {

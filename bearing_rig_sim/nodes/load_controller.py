@@ -7,13 +7,15 @@ parameters from ``config/load_controller.yaml``.
 
 Interfaces (README, interface table):
 
-* follows ``/clock`` (rosgraph_msgs/Clock) through the node's own sim-time clock
-  (``use_sim_time`` must be true): a jump handler on that clock steps the chain at each advance
-  by the sim time elapsed, in sub-steps of at most 1 ms. rclpy's time source keeps only the
-  latest tick (best effort, depth 1), so ticks that came while the node was busy are taken
-  together and the node keeps up with a simulator faster than real time; and ``/clock`` is
-  dispatched once per tick, not twice (the time source's and a subscription of our own);
-* subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable);
+* follows ``/clock`` (rosgraph_msgs/Clock; ``use_sim_time`` must be true): a timer on the steady
+  clock wakes every ``step_period_s`` (10 ms), takes the latest ``/clock`` from a queue no
+  callback drains, and steps the chain to it in force samples of ``1 / force_rate_hz`` of sim time
+  (:meth:`~bearing_rig_sim.load_control.AxialLoadOperation.follow`), publishing the forces of
+  each sample with its stamp. The node wakes 100 times a second instead of once per ``/clock``
+  message (rclpy's own time source would dispatch each of the 1000), and keeps up with a
+  simulator faster than real time (each wake-up takes whatever sim time passed);
+* subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable), taken by the step
+  timer before it steps, so a set-point is in force for every sample published after it came;
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
@@ -22,8 +24,8 @@ Interfaces (README, interface table):
   reason; it mirrors the set-point in force whichever way it was given;
 * publishes, stamped with the simulation time of the clock tick:
   ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z = the force that reaches the
-  bearing, N, reliable, every clock advance: the simulator's input), ``/rig/axial_load/force``
-  (WrenchStamped, the load cell's reading, N, sensor data, every clock advance),
+  bearing, N, reliable, ``force_rate_hz`` of sim time: the simulator's input),
+  ``/rig/axial_load/force`` (WrenchStamped, the load cell's reading, N, sensor data, the same),
   ``/rig/axial_load/state`` (bearing_rig_msgs/AxialLoadState, reliable, ``state_rate_hz`` of sim
   time) and ``/diagnostics`` (every ``diagnostics_period_s`` of sim time and at once on a change:
   OK; WARN after a refused set-point, until the next accepted one; ERROR with the interlock's
@@ -35,32 +37,45 @@ interlock (load limit, rate limit, clutch slip) latches a fault: brake de-energi
 ``/diagnostics``. **Only the reset_fault service clears it**, and only once its cause is gone:
 the load cell reads at or below the load limit, the clutch holds again, and the set-point is
 below the clutch's holding force. Set-points given meanwhile are stored and take effect after
-the reset. The clutch is engaged at start (``engage_clutch_on_start``).
+the reset. The clutch is engaged at configure (``engage_clutch_on_start``).
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the chain, the
+publishers, the services and the timer are made at configure; stepping and publishing run only
+while active. The services answer in every configured state (a set-point given while inactive
+takes effect at activation); set-points on the topic are taken by the step, so one given while
+inactive waits in the reader's queue and takes effect at activation. An interlock fault does not deactivate the node: the brake is de-energised, and the
+node goes on publishing the (falling) force, the ERROR and the state, as the bench's controller
+does; only reset_fault clears it.
 """
 
 from __future__ import annotations
 
-import math
 import sys
-from pathlib import Path
 from collections.abc import Sequence
+from typing import Any
 
 from bearing_rig_msgs.msg import AxialLoadState
 from bearing_rig_msgs.srv import SetAxialLoad
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
-from rclpy.clock import JumpThreshold
-from rclpy.duration import Duration
+from rcl_interfaces.msg import SetParametersResult
+from rclpy.clock import Clock as RosClock
+from rclpy.clock import ClockType, ROSClock
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.time import Time as RosTime
+from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.interfaces import AXIAL_LOAD_CLUTCH, AXIAL_LOAD_FORCE, AXIAL_LOAD_RESET_FAULT, AXIAL_LOAD_SET, AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS
+from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, Reply, SetpointSource
+from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
+from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
 from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
@@ -73,99 +88,143 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
+from bearing_rig_sim.nodes.parameters import spec_for
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
-NODE_NAME = "load_controller"
 SETPOINT_PARAMETER = "axial_load_setpoint_n"
 DIAGNOSTIC_NAME = "load_controller: axial load"
+CLOCK_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
+"""The /clock reader's QoS: every tick of a step period kept (100 ms of a 1 kHz clock), so that
+the clock guard sees the stamps in a row it needs to confirm a restarted clock."""
 
 _LEVELS = {HealthLevel.OK: OK, HealthLevel.WARN: WARN, HealthLevel.ERROR: ERROR}
 
 
-class LoadControllerNode(Node):
+class LoadControllerNode(ManagedNode):
     """The load controller (see the module documentation).
 
     Raises:
-        ConfigError: the rig file (parameter ``rig_file``) is missing or invalid.
-        RigError: a rate or period parameter out of range.
+        RigError: a parameter given at start out of its range.
     """
 
-    def __init__(self, **kwargs: object) -> None:
-        super().__init__(NODE_NAME, **kwargs)  # type: ignore[arg-type]
-        read_only = ParameterDescriptor(read_only=True)
-        rig_file = str(self.declare_parameter("rig_file", "", read_only).value)
-        engage = bool(self.declare_parameter("engage_clutch_on_start", True, read_only).value)
-        state_rate = float(self.declare_parameter("state_rate_hz", 100.0, read_only).value)
-        diagnostics_period = float(self.declare_parameter("diagnostics_period_s", 1.0, read_only).value)
-        max_gap = float(self.declare_parameter("max_clock_gap_s", 5.0, read_only).value)
-        if not (math.isfinite(state_rate) and state_rate > 0.0):
-            raise RigError(f"{NODE_NAME}: state_rate_hz must be a finite number > 0 Hz, got {state_rate!r}")
-        rig_path = Path(rig_file) if rig_file else config_path("rig.yaml")
-        config = LoadingChainConfig.from_yaml(rig_path)
-        self.operation = AxialLoadOperation.from_config(
-            config,
-            state_period_s=1.0 / state_rate,
-            diagnostics_period_s=diagnostics_period,
-            max_clock_gap_s=max_gap,
-            engage=engage,
-        )
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__(NODE_NAME, **kwargs)
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
         self._mirroring = False
+        self.operation: AxialLoadOperation | None = None
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        # The clock is read by the step timer from a queue of its own (see the module
+        # documentation): rclpy's time source would wake the executor for every tick.
+        if self.get_parameter("use_sim_time").value:
+            self._time_source.detach_node()
+        self._clock_tap: Node | None = None
+        self.clock_guard = ClockGuard(name=f"{NODE_NAME}: /clock")
+        """Negative and far-jumping /clock stamps are refused (see :mod:`bearing_rig_sim.clock_guard`)."""
+
+    def configure(self) -> None:
+        """Validate the parameters; build the chain, publishers, services and the step timer."""
+        settings = LoadControllerSettings.from_values(parameter_values(self, {**self._defaults, "use_sim_time": True}), f"{NODE_NAME} parameters")
+        self.settings = settings
+        config = LoadingChainConfig.from_yaml(settings.rig_file)
+        operation = AxialLoadOperation.from_settings(config, settings)
+        reply = operation.request_setpoint(settings.axial_load_setpoint_n, SetpointSource.PARAMETER)
+        if not reply.accepted:
+            raise RigError(f"{NODE_NAME}: {reply.message}")
+        self.operation = operation
 
         # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
-        # walks on every wake-up (about 1000 a second here); an incompatible QoS goes unlogged.
+        # walks on every wake-up; an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
-        self._force_pub = self.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_STREAM_QOS, event_callbacks=quiet)
-        self._load_cell_pub = self.create_publisher(WrenchStamped, "/rig/axial_load/force", SENSOR_QOS, event_callbacks=quiet)
-        self._state_pub = self.create_publisher(AxialLoadState, "/rig/axial_load/state", RELIABLE_QOS, event_callbacks=quiet)
-        self._diagnostics_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS, event_callbacks=quiet)
-
-        descriptor = ParameterDescriptor(
-            description="axial-load set-point, N (finite, >= 0, <= max_setpoint_n of the rig file)",
-            dynamic_typing=True,
+        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, RELIABLE_STREAM_QOS, event_callbacks=quiet)
+        self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
+        self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._rig_services = [
+            self.create_service(SetAxialLoad, AXIAL_LOAD_SET.name, self._on_set_service),
+            self.create_service(Trigger, AXIAL_LOAD_RESET_FAULT.name, self._on_reset_fault),
+            self.create_service(SetBool, AXIAL_LOAD_CLUTCH.name, self._on_clutch),
+        ]
+        self._clock_tap = Node(f"{NODE_NAME}_inputs", context=self.context)
+        self._clock_sub = self._clock_tap.create_subscription(
+            Clock, CLOCK.name, _unused, CLOCK_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
         )
-        initial = self.declare_parameter(SETPOINT_PARAMETER, 0.0, descriptor).value
-        self.add_on_set_parameters_callback(self._on_set_parameters)
-        self._apply(self.operation.request_setpoint(_as_number(initial), SetpointSource.PARAMETER))
-        self._mirror_setpoint()
-
-        if not self.get_parameter("use_sim_time").value:
-            raise RigError(f"{NODE_NAME}: steps the loading chain on the simulation clock: use_sim_time must be true")
-        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
+        # The set-points too are taken by the step, before it steps: one that came since the
+        # last step is in force for every sample this step publishes (a callback of its own
+        # could run after the step and leave a lagging node's samples on the old set-point).
+        self._setpoint_sub = self._clock_tap.create_subscription(
+            Float64, AXIAL_LOAD_SETPOINT.name, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
+        )
+        self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
         self._bearing_msg = WrenchStamped()
         self._bearing_msg.header.frame_id = "bearing"
         self._load_cell_msg = WrenchStamped()
         self._load_cell_msg.header.frame_id = "load_cell"
-        self._jump_handle = self.get_clock().create_jump_callback(
-            JumpThreshold(min_forward=Duration(nanoseconds=1), min_backward=Duration(nanoseconds=-1)),
-            post_callback=self._on_clock,
-        )
-        self.create_subscription(
-            Float64, "/rig/axial_load/setpoint", self._on_setpoint, RELIABLE_QOS,
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-        )
-        self.create_service(SetAxialLoad, "/rig/axial_load/set", self._on_set_service)
-        self.create_service(Trigger, "/rig/axial_load/reset_fault", self._on_reset_fault)
-        self.create_service(SetBool, "/rig/axial_load/clutch", self._on_clutch)
+        self._mirror_setpoint()
         self.get_logger().info(
-            f"loading chain from {rig_path}; clutch {'engaged' if engage else 'released'}; "
-            f"set-point {self.operation.setpoint:g} N; stepping on /clock"
+            f"loading chain from {settings.rig_file}; clutch {'engaged' if settings.engage_clutch_on_start else 'released'}; "
+            f"set-point {operation.setpoint:g} N; stepping on /clock every {settings.step_period_s * 1e3:g} ms"
         )
 
+    def activate(self) -> None:
+        """Report the health at once on activation."""
+        if self.operation is not None:
+            self.operation.mark_reported(None)
+
+    def cleanup(self) -> None:
+        """Drop the chain, the services and the clock reader."""
+        for service in getattr(self, "_rig_services", []):
+            self.destroy_service(service)
+        self._rig_services = []
+        if self._clock_tap is not None:
+            self._clock_tap.destroy_node()
+            self._clock_tap = None
+        self.operation = None
+
     # -- clock ------------------------------------------------------------------------------------
-    def _on_clock(self, _jump: object = None) -> None:
-        """The sim-time clock moved (forward or back): step the chain to it and publish."""
-        stamp = self.get_clock().now().to_msg()
-        result = self.operation.advance_to(stamp.sec + stamp.nanosec * 1e-9)
-        if result.clock_note:
-            self.get_logger().warning(result.clock_note)
-        if result.tripped:
-            self.get_logger().error(f"interlock tripped: {result.tripped}; brake de-energised, call reset_fault once clear")
-        self._publish_forces(stamp, result.state)
-        if result.state_due:
-            self._state_pub.publish(self._state_message(stamp, result.state))
-        if result.diagnostics_due:
-            self._publish_diagnostics()
+    def _latest_clock(self) -> Time | None:
+        """The latest /clock stamp queued since the last call that the clock guard accepts
+        (None when none came): negative and far-jumping stamps are refused and logged."""
+        latest = None
+        handle = self._clock_sub.handle
+        guard = self.clock_guard
+        with handle:
+            while (taken := handle.take_message(Clock, False)) is not None:
+                stamp = taken[0].clock
+                verdict = guard.check(stamp.sec * 1_000_000_000 + stamp.nanosec)
+                if verdict.note:
+                    self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
+                if verdict.accepted:
+                    latest = stamp
+        return latest
+
+    @survives_shutdown
+    def _on_step(self) -> None:
+        """Apply the set-points that came, step the chain to the latest /clock in force samples
+        and publish them."""
+        handle = self._setpoint_sub.handle
+        with handle:
+            while (taken := handle.take_message(Float64, False)) is not None:
+                self._on_setpoint(taken[0])
+        operation = self.operation
+        stamp = self._latest_clock()
+        if operation is None or stamp is None:
+            return
+        clock = self.get_clock()
+        if isinstance(clock, ROSClock):  # the node's clock follows the /clock it steps on
+            clock.set_ros_time_override(RosTime.from_msg(stamp))
+        for result in operation.follow(stamp.sec + stamp.nanosec * 1e-9):
+            sample = to_stamp(result.time)
+            if result.clock_note:
+                self.get_logger().warning(result.clock_note)
+            if result.tripped:
+                self.get_logger().error(f"interlock tripped: {result.tripped}; brake de-energised, call reset_fault once clear")
+            self._publish_forces(sample, result.state)
+            if result.state_due:
+                self._state_pub.publish(self._state_message(sample, result.state))
+            if result.diagnostics_due:
+                self._publish_diagnostics()
 
     def _publish_forces(self, stamp: object, state: LoadChainState) -> None:
         bearing, cell = self._bearing_msg, self._load_cell_msg
@@ -193,6 +252,8 @@ class LoadControllerNode(Node):
         return msg
 
     def _publish_diagnostics(self) -> None:
+        if self.operation is None:
+            return
         health = self.operation.health()
         state = self.operation.chain.state()
         now = self.operation.time or 0.0
@@ -215,12 +276,14 @@ class LoadControllerNode(Node):
             self.get_logger().info(reply.message)
         else:
             self.get_logger().warning(reply.message)
-        if self.operation.health_changed():
+        if self.active and self.operation is not None and self.operation.health_changed():
             self._publish_diagnostics()
         return reply
 
     def _mirror_setpoint(self) -> None:
         """Keep the parameter equal to the set-point in force."""
+        if self.operation is None:
+            return
         current = self.get_parameter(SETPOINT_PARAMETER).value
         if current == self.operation.setpoint and isinstance(current, float):
             return
@@ -231,10 +294,12 @@ class LoadControllerNode(Node):
             self._mirroring = False
 
     def _on_setpoint(self, msg: Float64) -> None:
+        assert self.operation is not None  # taken by the step, which runs from activate to deactivate
         if self._apply(self.operation.request_setpoint(msg.data, SetpointSource.TOPIC)).accepted:
             self._mirror_setpoint()
 
     def _on_set_service(self, request: SetAxialLoad.Request, response: SetAxialLoad.Response) -> SetAxialLoad.Response:
+        assert self.operation is not None  # the service lives from configure to cleanup
         reply = self._apply(self.operation.request_setpoint(request.axial_load, SetpointSource.SERVICE))
         if reply.accepted:
             self._mirror_setpoint()
@@ -243,12 +308,14 @@ class LoadControllerNode(Node):
         return response
 
     def _on_reset_fault(self, _request: Trigger.Request, response: Trigger.Response) -> Trigger.Response:
+        assert self.operation is not None
         reply = self._apply(self.operation.reset_fault())
         response.success = reply.accepted
         response.message = reply.message
         return response
 
     def _on_clutch(self, request: SetBool.Request, response: SetBool.Response) -> SetBool.Response:
+        assert self.operation is not None
         reply = self._apply(self.operation.set_clutch(bool(request.data)))
         response.success = reply.accepted
         response.message = reply.message
@@ -260,10 +327,19 @@ class LoadControllerNode(Node):
         for parameter in parameters:
             if parameter.name != SETPOINT_PARAMETER or self._mirroring:
                 continue
+            if self.operation is None:  # not configured: validated at configure
+                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(_as_number(parameter.value))
+                if reason:
+                    return SetParametersResult(successful=False, reason=reason)
+                continue
             reply = self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
             if not reply.accepted:
                 return SetParametersResult(successful=False, reason=reply.message)
         return SetParametersResult(successful=True)
+
+
+def _unused(_msg: object) -> None:  # pragma: no cover - the readers' node is never spun
+    """Callback of the /clock and set-point readers; their queues are taken by the step timer."""
 
 
 def _as_number(value: object) -> object:
@@ -275,7 +351,8 @@ def _as_number(value: object) -> object:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Console script ``load_controller`` / ``bearing-rig-load-controller``."""
+    """Console script ``load_controller`` / ``bearing-rig-load-controller``: the node starts
+    unconfigured (``lifecycle_msgs`` services); ``--autostart`` configures and activates it."""
     try:
         return run_node(NODE_NAME, LoadControllerNode, argv)
     except RigError as exc:

@@ -15,6 +15,11 @@ it runs unchanged on the bench's topics. Publishes:
 
 The rig time is the pulses' stamps, extrapolated by the steady clock while none arrive; with
 ``use_sim_time`` a /clock going back resets the monitor.
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the slip monitor,
+publishers, subscriptions and timers are made at configure; pulses are taken and statuses
+published only while active. A sensor loss or invalid data is a FAULT state on the status and an
+ERROR on /diagnostics with the node staying active (it recovers when the pulses return).
 """
 
 from __future__ import annotations
@@ -29,15 +34,16 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.node import Node
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
+from bearing_rig_sim.interfaces import DIAGNOSTICS, SLIP_STATUS
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, DIAGNOSTICS, PULSE_TOPICS, SLIP_STATUS
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS
 from bearing_rig_sim.monitoring import (
     NODE_NAME,
     MonitorSettings,
     MonitorStatus,
+    PulseMerger,
     SlipMonitor,
     SlipState,
     StatusSchedule,
@@ -55,7 +61,7 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
@@ -63,7 +69,7 @@ LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WAR
 """Diagnostics level of each monitor state (recent lost pulses raise OK to WARN)."""
 
 
-class MonitorNode(Node):
+class MonitorNode(ManagedNode):
     """The monitor node (see the module docstring).
 
     Raises:
@@ -72,10 +78,16 @@ class MonitorNode(Node):
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        values = declare_and_read(self, shipped_parameters())
-        self.settings = MonitorSettings.from_values(values, f"{NODE_NAME} parameters")
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
+        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
+
+    def configure(self) -> None:
+        """Validate the parameters; build the slip monitor, publishers, subscriptions, timers."""
+        self.settings = MonitorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.monitor = SlipMonitor(self.settings.kinematics(), self.settings)
         self.schedule = StatusSchedule(self.monitor)
+        self.merger = PulseMerger()
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
         self._last_state: SlipState | None = None
@@ -84,26 +96,26 @@ class MonitorNode(Node):
         # Time base: the pulse stamps (rig time), extrapolated by the steady clock between
         # pulses. With use_sim_time the node's /clock also counts, and a jump back resets.
         self._sim_time = bool(self.get_parameter("use_sim_time").value)
-        self.clock_guard = guard_sim_clock(self)  # negative and far-jumping /clock stamps refused
 
-        self._status_pub = self.create_publisher(SlipStatus, SLIP_STATUS.name, qos_profile(SLIP_STATUS))
-        self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
+        self._status_pub = self.publisher(SlipStatus, SLIP_STATUS.name, qos_profile(SLIP_STATUS))
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         for shaft, topic in PULSE_TOPICS.items():
-            self.create_subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
+            self.subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
         if self.settings.criterion == "axial_load":
-            self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
+            self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
-        self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
+        self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
+        self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
         kin = self.monitor.kinematics
         self.get_logger().info(
             f"monitoring cage slip over {self.settings.window_revolutions} cage revolution(s) per window "
             f"(epicyclic ratio {kin.epicyclic_ratio():.6g} at {math.degrees(kin.contact_angle):g} deg)"
         )
 
-    def close(self) -> None:
-        """Before ``destroy_node``: let the executor release the node's handles."""
-        release_executor(self)
+    def activate(self) -> None:
+        """Report the state at once on activation (the first status, then the timers)."""
+        self._last_state = None
+        self._last_level = None
 
     # -- inputs --------------------------------------------------------------------------------
     @survives_shutdown
@@ -119,12 +131,17 @@ class MonitorNode(Node):
             )
             self._last_pulse_wall = time.monotonic()
             self._received[shaft] += 1
-            for scheduled in self.schedule.on_pulse(shaft, pulse):
-                self._publish(scheduled.status)
+            self._feed(self.merger.push(shaft, pulse, time.monotonic()))
         except Exception as exc:
             if not self.context.ok():
                 raise
             self.get_logger().error(f"{shaft} pulse not processed: {exc}", throttle_duration_sec=1.0)
+
+    def _feed(self, pulses: list[tuple[str, Pulse]]) -> None:
+        """Pulses back in time order (:class:`PulseMerger`) through the shared schedule."""
+        for shaft, pulse in pulses:
+            for scheduled in self.schedule.on_pulse(shaft, pulse):
+                self._publish(scheduled.status)
 
     @survives_shutdown
     def _on_load(self, msg: WrenchStamped) -> None:
@@ -152,6 +169,7 @@ class MonitorNode(Node):
             self.monitor.clock_jump(self._last_clock, clock_now)
             self._last_pulse_wall = None
         self._last_clock = clock_now
+        self._feed(self.merger.expire(time.monotonic()))
         if self._last_pulse_wall is not None and time.monotonic() - self._last_pulse_wall < 2.0 / self.settings.status_rate_hz:
             return  # the pulses drive the schedule
         now = self._rig_now(clock_now)

@@ -1,13 +1,30 @@
-"""What the simulator and monitor node shells share beyond nodes/common.py.
+"""What the node shells share beyond nodes/common.py: the managed-node base and parameters.
 
-* :func:`declare_and_read`: ROS parameters declared from the shipped parameter file. Each key of
-  ``config/<node>.yaml`` is declared with the file's value as default (so a partial user file or a
-  ``-p`` override changes only what it names) and with dynamic typing (so ``-p rate:=2`` is not
-  refused for being an integer where the file has ``2.0``); the node's ROS-free settings class
-  then validates the values as one mapping, with messages naming the key and the allowed range.
+* :class:`ManagedNode`: an ``rclpy`` lifecycle node with the rig's contract, the one every node
+  of the rig follows (README, "Managed nodes"):
+
+  - **unconfigured** (after start): parameters declared, nothing else; nothing published;
+  - **configure**: the parameters are validated by the node's ROS-free settings class and the
+    core (engine, loading chain, monitor) is built, with its publishers, subscriptions and
+    timers (timers stopped). A bad parameter or file fails the transition: the reason is logged
+    as one ``configure failed: ...`` line, the node stays unconfigured and can be configured
+    again;
+  - **activate**: the timers start and inputs are taken: the streams flow;
+  - **deactivate**: timers stopped, inputs ignored, publishers disabled: an inactive node
+    publishes nothing (``/diagnostics`` included);
+  - **cleanup** / **shutdown**: the core and every entity made at configure are destroyed.
+
+  Faults of the rig (an interlock, a sensor loss, a halted engine, an overrun storm) do not
+  change the lifecycle state: the node stays active and reports them on ``/diagnostics`` (and
+  its status topic), as the bench's own instruments would; deciding to stop is the lifecycle
+  manager's (``bearing-rig run``). An exception inside a transition is logged and fails it.
+
+* :func:`declare_described`: each parameter of the shipped ``config/<node>.yaml`` declared with
+  the file's value as default and a descriptor from :mod:`bearing_rig_sim.nodes.parameters`
+  (description, unit, range, read-only), with dynamic typing (``-p rate:=2`` is not refused for
+  being an integer where the file has ``2.0``).
 * :func:`survives_shutdown`: a callback that publishes can be running when Ctrl-C or SIGTERM
-  shuts the context down; its "context is invalid" error is swallowed then (and only then), so
-  the executor's spin ends normally.
+  shuts the context down; its "context is invalid" error is swallowed then (and only then).
 * :func:`release_executor`: called from a node's ``close()``. When a callback raised out of
   ``spin``, the executor's wait-set iterator stays suspended holding every entity's handle, and
   ``Node.destroy_node`` then busy-waits for ever for those handles (rclpy in Jazzy). Shutting the
@@ -20,8 +37,15 @@ import functools
 from typing import Any, TypeVar
 from collections.abc import Callable, Mapping
 
-from rcl_interfaces.msg import ParameterDescriptor
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidParameterValueException
+from rclpy.lifecycle import LifecycleNode, LifecyclePublisher, LifecycleState, TransitionCallbackReturn
 from rclpy.node import Node
+from rclpy.subscription import Subscription
+from rclpy.timer import Timer
+
+from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.nodes.parameters import ParameterSpec, spec_for
 
 IMPLICIT = ("use_sim_time",)
 """Parameters every rclpy node declares by itself."""
@@ -29,16 +53,57 @@ IMPLICIT = ("use_sim_time",)
 F = TypeVar("F", bound=Callable[..., Any])
 
 
+def descriptor_of(spec: ParameterSpec) -> ParameterDescriptor:
+    """The ROS descriptor of a parameter: description with the unit, range, read-only."""
+    description = f"{spec.description} [{spec.unit}]" if spec.unit and spec.unit != "1" else spec.description
+    descriptor = ParameterDescriptor(
+        name=spec.name,
+        description=description,
+        additional_constraints=spec.constraints(),
+        read_only=spec.read_only,
+        dynamic_typing=True,
+    )
+    if spec.numeric:
+        assert spec.low is not None and spec.high is not None
+        if spec.integer:
+            descriptor.integer_range = [IntegerRange(from_value=int(spec.low), to_value=int(spec.high), step=0)]
+        else:
+            descriptor.floating_point_range = [FloatingPointRange(from_value=float(spec.low), to_value=float(spec.high), step=0.0)]
+    return descriptor
+
+
+def declare_described(node: Node, node_name: str, defaults: Mapping[str, Any]) -> None:
+    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) with its descriptor.
+
+    Raises:
+        RigError: a value given at start (``-p``, parameter file) is out of the parameter's
+            range (one line naming the parameter and the range); a parameter has no spec.
+    """
+    for name, default in defaults.items():
+        if name in IMPLICIT:
+            continue
+        spec = spec_for(node_name, name)
+        try:
+            node.declare_parameter(name, default, descriptor_of(spec))
+        except InvalidParameterValueException as exc:
+            raise RigError(f"{node_name}: parameter {name} refused: {spec.constraints()} ({' '.join(str(exc).split())})") from None
+
+
 def declare_and_read(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
-    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) and return the
-    values in force (defaults overridden by parameter files and ``-p``)."""
+    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) with dynamic typing
+    and return the values in force: for a plain node whose parameters have no spec in
+    :mod:`bearing_rig_sim.nodes.parameters` yet (the shadow node)."""
     values: dict[str, Any] = {}
     for name, default in defaults.items():
         if name in IMPLICIT:
             continue
-        descriptor = ParameterDescriptor(dynamic_typing=True)
-        values[name] = node.declare_parameter(name, default, descriptor).value
+        values[name] = node.declare_parameter(name, default, ParameterDescriptor(dynamic_typing=True)).value
     return values
+
+
+def parameter_values(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
+    """The values in force of the parameters named in ``defaults`` (and ``use_sim_time``)."""
+    return {name: node.get_parameter(name).value for name in defaults if node.has_parameter(name)}
 
 
 def survives_shutdown(method: F) -> F:
@@ -54,7 +119,7 @@ def survives_shutdown(method: F) -> F:
                 raise
             return None
 
-    return wrapper  # type: ignore[return-value]
+    return wrapper  # type: ignore[return-value]  # functools.wraps loses the TypeVar's signature
 
 
 def release_executor(node: Node) -> None:
@@ -63,3 +128,150 @@ def release_executor(node: Node) -> None:
     executor = node.executor
     if executor is not None:
         executor.shutdown(timeout_sec=0.0)
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception's message on one line."""
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+class ManagedNode(LifecycleNode):
+    """A lifecycle node following the rig's contract (see the module docstring).
+
+    Subclasses implement :meth:`configure` (build the core with :meth:`publisher`,
+    :meth:`subscription` and :meth:`timer`), and may extend :meth:`activate`,
+    :meth:`deactivate` and :meth:`cleanup`.
+    """
+
+    def __init__(self, node_name: str, **node_options: Any) -> None:
+        super().__init__(node_name, **node_options)
+        self.active = False
+        """True between activate and deactivate: inputs are taken, timers run."""
+        self.configure_error = ""
+        """Why the last configure failed ("" when it did not)."""
+        self._publishers_made: list[LifecyclePublisher] = []
+        self._subscriptions_made: list[Subscription] = []
+        self._timers_made: list[Timer] = []
+
+    # -- what subclasses implement ----------------------------------------------------------------
+    def configure(self) -> None:
+        """Validate the parameters and build the core and its entities.
+
+        Raises:
+            RigError: a parameter or a file it names is malformed (fails the transition).
+        """
+        raise NotImplementedError
+
+    def activate(self) -> None:
+        """Start the streams (the timers made at configure are started by the base)."""
+
+    def deactivate(self) -> None:
+        """Stop the streams (the timers are stopped by the base)."""
+
+    def cleanup(self) -> None:
+        """Drop the core (the entities made at configure are destroyed by the base)."""
+
+    # -- entities made at configure ----------------------------------------------------------------
+    def publisher(self, msg_type: Any, topic: str, qos: Any, **kwargs: Any) -> LifecyclePublisher:
+        """A lifecycle publisher (publishes only while active), destroyed at cleanup."""
+        pub: LifecyclePublisher = self.create_lifecycle_publisher(msg_type, topic, qos, **kwargs)
+        self._publishers_made.append(pub)
+        return pub
+
+    def subscription(self, msg_type: Any, topic: str, callback: Callable[[Any], None], qos: Any, **kwargs: Any) -> Subscription:
+        """A subscription whose callback runs only while active, destroyed at cleanup."""
+
+        def gated(msg: Any) -> None:
+            if self.active:
+                callback(msg)
+
+        sub = self.create_subscription(msg_type, topic, gated, qos, **kwargs)
+        self._subscriptions_made.append(sub)
+        return sub
+
+    def timer(self, period_s: float, callback: Callable[[], None], **kwargs: Any) -> Timer:
+        """A timer, stopped until activate and again at deactivate, destroyed at cleanup."""
+        made = self.create_timer(period_s, callback, **kwargs)
+        made.cancel()
+        self._timers_made.append(made)
+        return made
+
+    def _destroy_entities(self) -> None:
+        for made in self._timers_made:
+            made.cancel()
+            self.destroy_timer(made)
+        for sub in self._subscriptions_made:
+            self.destroy_subscription(sub)
+        for pub in self._publishers_made:
+            self.destroy_lifecycle_publisher(pub)
+        self._timers_made, self._subscriptions_made, self._publishers_made = [], [], []
+
+    # -- transitions ---------------------------------------------------------------------------------
+    def on_configure(self, state: LifecycleState) -> TransitionCallbackReturn:
+        try:
+            self.configure()
+        except Exception as exc:
+            self.configure_error = one_line(exc)
+            self.get_logger().error(f"configure failed: {self.configure_error}")
+            self._destroy_entities()
+            self._safe_cleanup()
+            return TransitionCallbackReturn.FAILURE
+        self.configure_error = ""
+        self.get_logger().info("configured")
+        return super().on_configure(state)
+
+    def on_activate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        result = super().on_activate(state)  # enables the lifecycle publishers
+        if result != TransitionCallbackReturn.SUCCESS:
+            return result
+        try:
+            self.active = True
+            self.activate()
+            for made in self._timers_made:
+                made.reset()
+        except Exception as exc:
+            self.active = False
+            self.get_logger().error(f"activate failed: {one_line(exc)}")
+            return TransitionCallbackReturn.FAILURE
+        self.get_logger().info("active")
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_deactivate(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        for made in self._timers_made:
+            made.cancel()
+        try:
+            self.deactivate()
+        except Exception as exc:
+            self.get_logger().error(f"deactivate: {one_line(exc)}")
+        self.get_logger().info("inactive")
+        return super().on_deactivate(state)
+
+    def on_cleanup(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self._destroy_entities()
+        self._safe_cleanup()
+        self.get_logger().info("cleaned up")
+        return super().on_cleanup(state)
+
+    def on_shutdown(self, state: LifecycleState) -> TransitionCallbackReturn:
+        if self.active:
+            self.on_deactivate(state)
+        self._destroy_entities()
+        self._safe_cleanup()
+        return TransitionCallbackReturn.SUCCESS
+
+    def on_error(self, state: LifecycleState) -> TransitionCallbackReturn:
+        self.active = False
+        self._destroy_entities()
+        self._safe_cleanup()
+        return TransitionCallbackReturn.SUCCESS
+
+    def _safe_cleanup(self) -> None:
+        try:
+            self.cleanup()
+        except Exception as exc:
+            self.get_logger().error(f"cleanup: {one_line(exc)}")
+
+    def close(self) -> None:
+        """Before ``destroy_node``: let the executor release the node's handles."""
+        release_executor(self)

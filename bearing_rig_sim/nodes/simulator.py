@@ -16,13 +16,21 @@ Publishes (interface table, docs/interfaces.md):
   on every change of level (see :mod:`bearing_rig_sim.health`).
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
-and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable). Bad input
-is refused with a logged reason and an ERROR on /diagnostics; the node goes on.
+and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z in N, reliable; 1 kHz, so
+its queue is taken by the loop, not dispatched message by message). Bad input is refused with a
+logged reason and an ERROR on /diagnostics; the node goes on.
 
 One timer on the steady clock drives the loop (no threads): in real time it runs the chunks the
 wall clock asks for (:class:`~bearing_rig_sim.simulation.pacing.RealTimePacer`), otherwise a
 batch of ``max_batch_chunks`` per call, as fast as possible. ``simulator --no-realtime`` sets
 the parameter ``realtime`` to false.
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
+drive, sensors), publishers, subscriptions and timers are made at configure; the simulated time
+runs only while active (it stands still while inactive and goes on from there at the next
+activation, anchored to the wall clock anew). A halted engine, refused inputs and overruns are
+reported on /diagnostics (ERROR, WARN) with the node staying active; ``simulator --autostart``
+configures and activates at once.
 """
 
 from __future__ import annotations
@@ -35,11 +43,14 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
+from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SpindleCommand as SpindleCommandMsg
+from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SPEEDS, SPINDLE_COMMAND, SPINDLE_PULSES, TRUTH
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
@@ -52,7 +63,7 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
 from bearing_rig_sim.health import Health, HealthLevel
@@ -66,8 +77,11 @@ NO_REALTIME_FLAG = "--no-realtime"
 
 MAX_UINT32 = 2**32 - 1
 
+FORCE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+"""The force reader: reliable like the load controller's publisher, deep enough for 1 s at 1 kHz."""
 
-class SimulatorNode(Node):
+
+class SimulatorNode(ManagedNode):
     """The simulator node (see the module docstring).
 
     Raises:
@@ -76,8 +90,12 @@ class SimulatorNode(Node):
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        values = declare_and_read(self, shipped_parameters())
-        s = SimulatorSettings.from_values(values, f"{NODE_NAME} parameters")
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
+
+    def configure(self) -> None:
+        """Validate the parameters; build the twin, the pacer, publishers, subscriptions, timers."""
+        s = SimulatorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.settings = s
         self.twin = RigTwin.from_files(
             s.bearing_file,
@@ -108,22 +126,29 @@ class SimulatorNode(Node):
         self._chunks = 0
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
+        self._anchor = True
 
-        self._clock_pub = self.create_publisher(ClockMsg, "/clock", RELIABLE_STREAM_QOS)
+        self._clock_pub = self.publisher(ClockMsg, CLOCK.name, RELIABLE_STREAM_QOS)
         self._pulse_pubs = {
-            "spindle": self.create_publisher(FibreOpticPulse, "/rig/spindle/pulses", RELIABLE_STREAM_QOS),
-            "cage": self.create_publisher(FibreOpticPulse, "/rig/cage/pulses", RELIABLE_STREAM_QOS),
+            "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, RELIABLE_STREAM_QOS),
+            "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, RELIABLE_STREAM_QOS),
         }
-        self._speeds_pub = self.create_publisher(JointState, "/rig/speeds", RELIABLE_STREAM_QOS)
-        self._truth_pub = self.create_publisher(SimulatorTruth, "/rig/truth", RELIABLE_STREAM_QOS)
-        self._diag_pub = self.create_publisher(DiagnosticArray, "/diagnostics", RELIABLE_QOS)
-        self.create_subscription(SpindleCommandMsg, "/rig/spindle/command", self._on_command, STATUS_QOS)
-        self.create_subscription(WrenchStamped, "/rig/bearing/axial_force", self._on_force, RELIABLE_QOS)
+        self._speeds_pub = self.publisher(JointState, SPEEDS.name, RELIABLE_STREAM_QOS)
+        self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, RELIABLE_STREAM_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
+        # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
+        # instead of one per message), from a reader on a node no executor spins.
+        self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
+        self._force_sub = self._force_tap.create_subscription(
+            WrenchStamped, BEARING_AXIAL_FORCE.name, _unused, FORCE_QOS,
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+        )
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
-        self._loop_timer = self.create_timer(period, self._on_loop, clock=steady)
-        self._diag_timer = self.create_timer(1.0 / s.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
+        self.timer(period, self._on_loop, clock=steady)
+        self.timer(1.0 / s.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
         self._speeds_msg = JointState(name=["inner_ring", "cage"])
         self._clock_msg = ClockMsg()
         mode = f"real time x{s.rate:g}" if s.realtime else "as fast as possible"
@@ -132,17 +157,32 @@ class SimulatorNode(Node):
             f"spindle {s.initial_speed_rad_s:g} rad/s, axial load {self.twin.axial_load:g} N"
         )
 
-    def close(self) -> None:
-        """Before ``destroy_node``: let the executor release the node's handles."""
-        release_executor(self)
+    def activate(self) -> None:
+        """The simulated time goes on from where it stands, anchored to the wall clock anew."""
+        self._anchor = True
+        self._last_level = None
+
+    def deactivate(self) -> None:
+        """Apply the forces that came while active; later ones are applied at the next activation
+        (the latest is the load in force)."""
+        self._take_forces()
+
+    def cleanup(self) -> None:
+        """Destroy the force reader's node."""
+        tap = getattr(self, "_force_tap", None)
+        if tap is not None:
+            tap.destroy_node()
+            self._force_tap = None
 
     # -- the loop ------------------------------------------------------------------------------
     @survives_shutdown
     def _on_loop(self) -> None:
         if self.health.halted:
             return
-        if not self.pacer.started:
+        if self._anchor:
             self.pacer.start(self.twin.time)
+            self._anchor = False
+        self._take_forces()
         for _ in range(self.pacer.due_chunks(self.twin.time)):
             try:
                 out = self.twin.tick(with_truth=(self._chunks + 1) % self._truth_every == 0)
@@ -224,12 +264,15 @@ class SimulatorNode(Node):
             f"(rig clock {self.twin.time:.6g} s)"
         )
 
-    @survives_shutdown
-    def _on_force(self, msg: WrenchStamped) -> None:
-        try:
-            self.twin.set_axial_load(msg.wrench.force.z)
-        except Exception as exc:
-            self._refuse("axial force", str(exc))
+    def _take_forces(self) -> None:
+        """Apply the axial forces queued since the last call, in order of arrival."""
+        handle = self._force_sub.handle
+        with handle:
+            while (taken := handle.take_message(WrenchStamped, False)) is not None:
+                try:
+                    self.twin.set_axial_load(taken[0].wrench.force.z)
+                except Exception as exc:
+                    self._refuse("axial force", str(exc))
 
     def _refuse(self, kind: str, reason: str) -> None:
         self.get_logger().error(f"{kind} refused: {reason}", throttle_duration_sec=1.0)
@@ -273,6 +316,10 @@ class SimulatorNode(Node):
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)
         self._diag_pub.publish(diagnostic_array(to_stamp(max(twin.time, 0.0)), [status]))
+
+
+def _unused(_msg: object) -> None:  # pragma: no cover - the force reader's node is never spun
+    """Callback of the force reader; its queue is taken by the loop."""
 
 
 def pulse_message(pulse: Pulse) -> FibreOpticPulse:

@@ -9,14 +9,21 @@
    the session's Fast DDS transport profile (deeper shared-memory buffers, unless the user gave
    a profile; :mod:`.processes`), each node 5 steps nicer than the session process (the recorder
    comes first), their output in ``<bag dir>/<run id>/logs/<node>.log``;
-3. waits, up to ``startup_timeout_s``, for each to come up: the simulator's first ``/clock`` and
-   its command subscription, the load controller's first state and its set-point subscription,
-   the monitor's status publisher and pulse subscription; otherwise stops with the name of the
-   process that did not, and the tail of its output;
-4. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
+3. is their lifecycle manager (:mod:`.lifecycle`, :mod:`.manager`): once every node's
+   ``change_state`` service is up, configures all of them in order, then activates all in order;
+   each transition is an event line (also in ``logs/session.log``) and a ``/diagnostics`` status
+   (``lifecycle_manager: <node>``, recorded). A node that fails a transition is named with its
+   reason (its ``configure failed: ...`` line) and the session ends (exit status 1);
+4. waits, up to ``startup_timeout_s`` in all, for each to come up: the simulator's first
+   ``/clock`` and its command subscription, the load controller's first state and its set-point
+   subscription, the monitor's status publisher and pulse subscription; otherwise stops with the
+   name of the process that did not, and the tail of its output;
+5. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
    clock while recording every rig topic and printing progress;
-5. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node dies: stops the runner, stops the
-   nodes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag, prints the summary so far.
+6. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node fails or dies: stops the runner,
+   deactivates the active nodes and cleans up the configured ones (reverse order, the nodes
+   still running), stops the processes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag,
+   prints the summary so far.
 
 Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died.
 Everything ROS in the session process runs in one ``SingleThreadedExecutor``.
@@ -34,15 +41,18 @@ from datetime import datetime, UTC
 from enum import Enum
 from pathlib import Path
 from types import FrameType
-from typing import TextIO
+from typing import Any, TextIO
 from collections.abc import Sequence
 
 from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
+from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import make_run_id, node_parameters, run_context
+from bearing_rig_sim.session.lifecycle import TransitionRecord, bring_up, shut_down
 from bearing_rig_sim.session.processes import (
     NODES,
+    DomainLease,
     NodeProcess,
     apply_transport_profile,
     node_command,
@@ -82,6 +92,20 @@ class SessionOptions:
     """Longest wait for the nodes to come up, s of wall time."""
     command_line: Sequence[str] = field(default_factory=tuple)
     """The command line, for the run context."""
+    params_file: Path | None = None
+    """A ROS 2 parameter file given to every node (blocks per node name), over the shipped ones."""
+    attach: bool = False
+    """Run the program on nodes already running and managed elsewhere (``launch/rig.launch.py``):
+    no processes started, no lifecycle transitions, the environment's ROS domain as it is."""
+    record: bool = True
+    """Record the bag; False (``--no-record``, where ``ros2 bag record`` records): only the
+    session log and summary."""
+    foxglove_port: int | None = None
+    """Serve the recorded topics live to the Foxglove app on this port of 127.0.0.1 (0: any
+    free port); None: no live view."""
+    transition_timeout_s: float = 10.0
+    """Longest wait for a node to answer a deactivate or cleanup, wall s (bring-up transitions
+    have ``startup_timeout_s``: a first configure compiles the engine's kernels)."""
 
 
 class _Phase(Enum):
@@ -100,19 +124,26 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     program = load_program(options.program)  # checked against the shipped rig, as the nodes use it
-    commands = {name: node_command(spec) for name, spec in NODES.items()}
+    commands = {} if options.attach else {name: node_command(spec) for name, spec in NODES.items()}
     simulator_defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
-    overrides = node_parameters(program, simulator_defaults)  # the program's bearing, in every node
-    if not options.realtime:
+    overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
+    if not options.realtime and not options.attach:
         overrides.setdefault("simulator", {})["realtime"] = "false"
     # the monitor judges slip against what the program's stability_criterion names
     overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion
     for name, values in overrides.items():
         commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
+    if options.params_file is not None:
+        params = Path(options.params_file)
+        if not params.is_file():
+            raise RigError(f"--params-file: no such file: {params}")
+        for name in commands:
+            commands[name] = commands[name] + ["--ros-args", "--params-file", str(params.resolve())]
     start = datetime.now(UTC)
     run_id = make_run_id(program.name, start)
     bag_path = _fresh_path(Path(options.bag_dir) / run_id)
-    env, lease = session_environment(os.environ)
+    env, lease = (dict(os.environ), DomainLease(int(os.environ.get("ROS_DOMAIN_ID") or 0), None)) if options.attach else session_environment(os.environ)
+    env.setdefault("ROS_DOMAIN_ID", str(lease.domain_id))
     context = run_context(
         program,
         run_id=run_id,
@@ -125,12 +156,49 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         },
     )
     try:
-        writer = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE)
-        apply_transport_profile(env, writer.path / "logs")
-        session = _Session(options, program, writer, env, commands, out, err)
-        return session.run()
+        writer: Any = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE) if options.record else _NoBag(bag_path)
+        if not options.attach:
+            apply_transport_profile(env, writer.path / "logs")
+        view = None
+        if options.foxglove_port is not None:
+            from bearing_rig_sim.live.foxglove import FoxgloveLiveView
+            from bearing_rig_sim.bags.typestore import msg_definition_text
+
+            view = FoxgloveLiveView(options.foxglove_port, msg_definition_text)
+        try:
+            session = _Session(options, program, writer, env, commands, out, err, view)
+            return session.run()
+        finally:
+            if view is not None:
+                view.close()
     finally:
         lease.release()
+
+
+class _NoBag:
+    """The writer of a session that records nothing (``--no-record``): its folder holds the logs."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = Path(path)
+        (self.path / "logs").mkdir(parents=True, exist_ok=True)
+
+    def add_topic(self, name: str, msgtype: str, qos: str) -> None:
+        """Nothing to set up."""
+
+    def write(self, topic: str, log_time_ns: int, data: bytes) -> None:
+        """Nothing kept."""
+
+    def close(self) -> None:
+        """Nothing to finalise."""
+
+
+def _failure_line(output: str, transition: str) -> str:
+    """The node's own ``<transition> failed: ...`` reason from its output ("" when absent)."""
+    marker = f"{transition} failed: "
+    for line in reversed(output.splitlines()):
+        if marker in line:
+            return line[line.index(marker) + len(marker) :].strip()
+    return ""
 
 
 def _fresh_path(path: Path) -> Path:
@@ -149,11 +217,12 @@ class _Session:
         self,
         options: SessionOptions,
         program: TestProgram,
-        writer: BagWriter,
+        writer: Any,
         env: dict[str, str],
         commands: dict[str, list[str]],
         out: TextIO,
         err: TextIO,
+        view: Any = None,
     ) -> None:
         self.options = options
         self.program = program
@@ -163,16 +232,26 @@ class _Session:
         self.err = err
         self.printer = ProgressPrinter(out, quiet=options.quiet)
         self.runner = ProgramRunner(program)
-        self.recorder = SessionRecorder(writer)
+        self.view = view
+        if view is not None:
+            from bearing_rig_sim.live.foxglove import TeeWriter
+
+            self.recorder = SessionRecorder(TeeWriter(writer, view))
+        else:
+            self.recorder = SessionRecorder(writer)
         self.rtf = RealTimeFactor()
         logs = writer.path / "logs"
-        self.children = [NodeProcess(name, commands[name], logs / f"{name}.log") for name in NODES]
+        self.children = [NodeProcess(name, commands[name], logs / f"{name}.log") for name in NODES if name in commands]
         self.phase = _Phase.STARTING
         self.status: int | None = None
         self.failure = ""
         self.signal_received: int | None = None
-        self.node = None
+        self.node: Any = None
+        self.manager: Any = None
+        self.bringing_up = False
         self.deadline = 0.0
+        logs.mkdir(parents=True, exist_ok=True)
+        self.session_log = open(logs / "session.log", "a", encoding="utf-8")
 
     # -- main -------------------------------------------------------------------------------------
     def run(self) -> int:
@@ -180,6 +259,7 @@ class _Session:
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.signals import SignalHandlerOptions
 
+        from bearing_rig_sim.session.manager import LifecycleManager
         from bearing_rig_sim.session.node import DRAIN_PERIOD_S, SessionNode
 
         segments = len(self.program.segments)
@@ -188,6 +268,8 @@ class _Session:
             f"{'real time' if self.options.realtime else 'no real time'}), ROS_DOMAIN_ID {self.env['ROS_DOMAIN_ID']}, "
             f"bag {self.writer.path}"
         )
+        if self.view is not None:
+            self._event(f"Foxglove live view: {self.view.url} (layout to import: config/foxglove/rig.json)")
         previous_handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
         context = rclpy.Context()
         executor = None
@@ -199,6 +281,9 @@ class _Session:
             with own_ros_environment(self.env):
                 rclpy.init(args=[], context=context, domain_id=int(self.env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
                 self.node = SessionNode(self.recorder, self.runner, context=context, on_event=self._event)
+                node = self.node
+                if not self.options.attach:
+                    self.manager = LifecycleManager(node, list(NODES), self._on_transition, lambda: node.sim_time)
             executor = SingleThreadedExecutor(context=context)
             executor.add_node(self.node)
             self.node.create_timer(DRAIN_PERIOD_S, self._tick)
@@ -211,6 +296,10 @@ class _Session:
         except KeyboardInterrupt:  # a second Ctrl-C while stopping
             self._end(EXIT_INTERRUPTED, "stopped by a second SIGINT")
         finally:
+            try:
+                self._deactivate_nodes(executor)
+            except KeyboardInterrupt:  # a second Ctrl-C: stop the processes at once
+                self.failure = self.failure or "stopped by a second SIGINT"
             self._shut_down(context, executor)
             for sig, handler in previous_handlers.items():
                 signal.signal(sig, handler)
@@ -247,9 +336,13 @@ class _Session:
         for child in self.children:
             if child.poll() is not None and not child.stop_requested:
                 when = "during start-up" if self.phase is _Phase.STARTING else "during the run"
+                if self.manager is not None:
+                    self.manager.drop(child.name)
                 self._end(EXIT_FAILED, f"the {child.name} node stopped {when}: {child.describe_exit()}")
                 return
         if self.phase is _Phase.STARTING:
+            if not self._bring_up():
+                return
             missing = self.node.missing()
             if not missing:
                 self.phase = _Phase.RUNNING
@@ -278,6 +371,68 @@ class _Session:
             else:
                 self._end(EXIT_OK)
 
+    def _bring_up(self) -> bool:
+        """Drive the lifecycle bring-up; True once every node is active."""
+        manager = self.manager
+        if manager is None:  # attached to nodes managed elsewhere
+            return True
+        manager.poll()
+        if not self.bringing_up:
+            missing = manager.services_missing()
+            if not missing:
+                self.bringing_up = True
+                manager.run(bring_up(list(NODES)), self.options.startup_timeout_s)  # configure compiles the kernels on a first run
+                manager.poll()
+            elif time.monotonic() > self.deadline:
+                name = missing[0]
+                child = next(c for c in self.children if c.name == name)
+                self._end(
+                    EXIT_FAILED,
+                    f"the {name} node did not come up within {self.options.startup_timeout_s:g} s (no /{name}/change_state "
+                    f"service); the end of its output ({child.log_path}):\n{child.output_tail()}",
+                )
+            return False
+        failed = manager.failed
+        if failed is not None:
+            child = next(c for c in self.children if c.name == failed.step.node)
+            self._end(
+                EXIT_FAILED,
+                f"the {failed.step.node} node failed to {failed.step.transition}: {failed.detail}; "
+                f"the end of its output ({child.log_path}):\n{child.output_tail()}",
+            )
+            return False
+        return not manager.busy
+
+    def _on_transition(self, record: TransitionRecord) -> None:
+        """A transition answered: the node's own reason for a failure, an event line."""
+        if not record.success:
+            child = next((c for c in self.children if c.name == record.step.node), None)
+            reason = _failure_line(child.output_tail(40), record.step.transition) if child is not None else ""
+            if reason:
+                record = TransitionRecord(record.step, False, reason)
+                if self.manager is not None:
+                    self.manager.failed = record
+        self._event(record.line())
+
+    def _deactivate_nodes(self, executor: Any) -> None:
+        """Deactivate and clean up the nodes still running (see the module documentation)."""
+        manager, node = self.manager, self.node
+        if manager is None or node is None or executor is None:
+            return
+        gone = [c.name for c in self.children if c.poll() is not None]
+        for name in gone:
+            manager.drop(name)
+        steps = shut_down(list(NODES), manager.states, gone)
+        if not steps:
+            return
+        manager.run(steps, self.options.transition_timeout_s)
+        manager.poll()
+        deadline = time.monotonic() + self.options.transition_timeout_s * (len(steps) + 1)
+        while manager.busy and time.monotonic() < deadline:
+            executor.spin_once(timeout_sec=0.02)
+            manager.poll()
+            node.drain()
+
     def _start_segment(self, plan: SegmentPlan) -> None:
         assert self.node is not None
         self.node.send(plan)
@@ -294,6 +449,9 @@ class _Session:
         self._event(f"segment {outcome.index + 1}/{self.runner.segment_count} {outcome.name}: {outcome.verdict.value}{stable}{slip}")
 
     def _event(self, line: str) -> None:
+        if not self.session_log.closed:
+            self.session_log.write(f"{datetime.now(UTC):%Y-%m-%dT%H:%M:%S.%fZ} {line}\n")
+            self.session_log.flush()
         if not self.options.quiet:
             self.printer.message(line)
 
@@ -355,6 +513,7 @@ class _Session:
 
     def _report(self) -> int:
         self.printer.done()
+        self.session_log.close()
         status = EXIT_FAILED if self.status is None else self.status
         if status == EXIT_FAILED:
             self.err.write(f"bearing-rig run: {self.failure}\n")
@@ -372,6 +531,10 @@ class _Session:
         self.out.write(format_summary(self.runner.outcomes) + "\n")
         counts = self.recorder.counts
         total = sum(counts.values())
+        if not self.options.record:
+            self.out.write(f"\nnot recorded (--no-record); session log in {self.writer.path / 'logs'}\n")
+            self.out.flush()
+            return status
         self.out.write(
             f"\nbag: {self.writer.path} ({total} messages; /clock {counts.get('/clock', 0)}, /rig/speeds "
             f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "

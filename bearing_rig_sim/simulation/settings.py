@@ -10,11 +10,11 @@ File parameters (bearing, calibration, rig) are relative to ``config/`` unless a
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import NodeSettingsFile, Section, config_path
 from bearing_rig_sim.dynamics.engine import MODELS
 from bearing_rig_sim.rig.spindle import SpindleConfig
 
@@ -34,7 +34,7 @@ def resolve_config_file(value: str) -> Path | None:
 
 
 @dataclass(frozen=True)
-class SimulatorSettings:
+class SimulatorSettings(NodeSettingsFile):
     """The simulator node's validated parameters (SI units; the unit is in each name).
 
     Attributes:
@@ -65,6 +65,9 @@ class SimulatorSettings:
         diagnostics_rate_hz: rate of /diagnostics (besides every change), wall Hz.
         fault_hold_s: a refused command or force keeps /diagnostics at ERROR this long, wall s.
     """
+
+    NODE_NAME: ClassVar[str] = NODE_NAME
+    SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     bearing_file: Path
     calibration_file: Path | None
@@ -97,7 +100,7 @@ class SimulatorSettings:
             ConfigError: naming the source, the key and the allowed range.
         """
         from_rig = ("max_spindle_speed_rad_s", "max_spindle_acceleration_rad_s2")
-        names = [f for f in cls.__dataclass_fields__ if f not in from_rig]
+        names = [f.name for f in fields(cls) if f.name not in from_rig]
         s.reject_unknown([*names, "use_sim_time"])
         files = {}
         for key in ("bearing_file", "calibration_file", "rig_file"):
@@ -137,20 +140,6 @@ class SimulatorSettings:
             fault_hold_s=s.number("fault_hold_s", ge=0.0),
         )
 
-    @classmethod
-    def from_values(cls, values: dict[str, Any], source: str = "simulator parameters") -> SimulatorSettings:
-        """Validate a flat mapping of parameter values (the node's ROS parameters)."""
-        return cls.from_section(Section(dict(values), source))
-
-    @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> SimulatorSettings:
-        """Read ``simulator: ros__parameters:`` of a parameter file (default: the shipped one).
-
-        Raises:
-            ConfigError: naming the file and the key.
-        """
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
-
 
 def shipped_parameters() -> dict[str, Any]:
     """The raw values of the shipped ``config/simulator.yaml`` (the node's declared defaults).
@@ -158,7 +147,4 @@ def shipped_parameters() -> dict[str, Any]:
     Raises:
         ConfigError: the shipped file is missing or malformed.
     """
-    section = ros_parameters(load_yaml(config_path(SHIPPED_FILE)), NODE_NAME)
-    SimulatorSettings.from_section(section)  # the defaults themselves must be valid
-    return dict(section.data)
-
+    return SimulatorSettings.shipped_parameters()

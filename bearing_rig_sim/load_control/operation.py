@@ -11,7 +11,10 @@ Policies (the node's documentation repeats them):
 * **Stepping.** :meth:`AxialLoadOperation.advance_to` steps the chain by the sim time elapsed
   since the last call, in sub-steps of at most ``max_substep_s`` (1 ms), so the chain keeps up
   however many clock ticks arrive at once when the simulator runs faster than real time. The
-  first clock reading only starts the count. A clock that goes back (a simulator restart, a
+  first clock reading only starts the count. :meth:`AxialLoadOperation.follow` does the same in
+  samples: one step (and one result, i.e. one force message) per ``sample_period_s`` of sim
+  time on the grid of its multiples, however late and in whatever chunks the clock is read, so
+  the node can wake up once per chunk of wall time and still publish the forces at their rate. A clock that goes back (a simulator restart, a
   replay that loops) restarts the count without stepping; a forward gap longer than
   ``max_clock_gap_s`` (a paused process, a clock jump) is stepped as ``max_clock_gap_s`` only.
 * **Set-points.** A request that is not a finite number, is negative or is above the chain's
@@ -47,9 +50,14 @@ import math
 from dataclasses import dataclass
 from enum import Enum
 
+from typing import TYPE_CHECKING
+
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.loading import ClutchState, LoadChainState, LoadingChain, LoadingChainConfig, SetpointError
+
+if TYPE_CHECKING:
+    from bearing_rig_sim.load_control.settings import LoadControllerSettings
 
 __all__ = [
     "AdvanceResult",
@@ -110,7 +118,11 @@ class AxialLoadOperation:
         state_period_s: sim time between two state messages, s (> 0).
         diagnostics_period_s: sim time between two periodic diagnostics, s (> 0).
         max_clock_gap_s: longest clock advance stepped at once, s (> 0).
+        sample_period_s: sim time between two force samples of :meth:`follow`, s (> 0).
         engage: engage the clutch at start.
+
+    The values come from :class:`~bearing_rig_sim.load_control.settings.LoadControllerSettings`
+    (``config/load_controller.yaml``); there are no defaults here.
 
     Raises:
         RigError: a period or gap that is not a finite number > 0.
@@ -120,15 +132,17 @@ class AxialLoadOperation:
         self,
         chain: LoadingChain,
         *,
-        state_period_s: float = 0.01,
-        diagnostics_period_s: float = 1.0,
-        max_clock_gap_s: float = 5.0,
-        engage: bool = True,
+        state_period_s: float,
+        diagnostics_period_s: float,
+        max_clock_gap_s: float,
+        sample_period_s: float,
+        engage: bool,
     ) -> None:
         for name, value in (
             ("state_period_s", state_period_s),
             ("diagnostics_period_s", diagnostics_period_s),
             ("max_clock_gap_s", max_clock_gap_s),
+            ("sample_period_s", sample_period_s),
         ):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value <= 0.0:
                 raise RigError(f"load controller: {name} must be a finite number > 0 s, got {value!r}")
@@ -136,6 +150,7 @@ class AxialLoadOperation:
         self.state_period = float(state_period_s)
         self.diagnostics_period = float(diagnostics_period_s)
         self.max_clock_gap = float(max_clock_gap_s)
+        self.sample_period_ns = max(1, round(float(sample_period_s) * 1e9))
         self._time: float | None = None
         self._next_state = 0.0
         self._next_diagnostics = 0.0
@@ -151,8 +166,32 @@ class AxialLoadOperation:
 
     @classmethod
     def from_config(cls, config: LoadingChainConfig, **options: float | bool) -> AxialLoadOperation:
-        """An operation of a new chain built from ``config`` (options as in the constructor)."""
-        return cls(LoadingChain(config), **options)  # type: ignore[arg-type]
+        """An operation of a new chain built from ``config``, run as the shipped
+        ``config/load_controller.yaml`` says, with ``options`` (constructor keywords) overriding."""
+        from bearing_rig_sim.load_control.settings import LoadControllerSettings
+
+        settings = LoadControllerSettings.from_yaml()
+        values: dict[str, float | bool] = {
+            "state_period_s": 1.0 / settings.state_rate_hz,
+            "diagnostics_period_s": settings.diagnostics_period_s,
+            "max_clock_gap_s": settings.max_clock_gap_s,
+            "sample_period_s": 1.0 / settings.force_rate_hz,
+            "engage": settings.engage_clutch_on_start,
+        }
+        values.update(options)
+        return cls(LoadingChain(config), **values)  # type: ignore[arg-type]  # keywords checked by the constructor
+
+    @classmethod
+    def from_settings(cls, config: LoadingChainConfig, settings: LoadControllerSettings) -> AxialLoadOperation:
+        """An operation of a new chain built from ``config``, run as ``settings`` say."""
+        return cls(
+            LoadingChain(config),
+            state_period_s=1.0 / settings.state_rate_hz,
+            diagnostics_period_s=settings.diagnostics_period_s,
+            max_clock_gap_s=settings.max_clock_gap_s,
+            sample_period_s=1.0 / settings.force_rate_hz,
+            engage=settings.engage_clutch_on_start,
+        )
 
     # -- requests ---------------------------------------------------------------------------------
     @property
@@ -241,6 +280,7 @@ class AxialLoadOperation:
         previous = self._time
         note = ""
         stepped = 0.0
+        state: LoadChainState | None = None
         if previous is None:
             self._schedule_from(sim_time)
         elif sim_time < previous:
@@ -251,9 +291,10 @@ class AxialLoadOperation:
             if stepped > self.max_clock_gap:
                 note = f"clock advanced {stepped:.3f} s at once: stepping {self.max_clock_gap:g} s (max_clock_gap_s)"
                 stepped = self.max_clock_gap
-            self.chain.step(stepped)
+            state = self.chain.step(stepped)  # the state after the step
         self._time = float(sim_time)
-        state = self.chain.state()
+        if state is None:
+            state = self.chain.state()
         self._watch_force(float(sim_time), state)
         state_due = sim_time >= self._next_state - 1e-9
         if state_due:
@@ -265,6 +306,32 @@ class AxialLoadOperation:
             self._reported = health
         tripped = state.fault_reason if state.fault and not was_faulted else ""
         return AdvanceResult(float(sim_time), stepped, state, state_due, diagnostics_due, tripped, note)
+
+    def follow(self, sim_time: float) -> list[AdvanceResult]:
+        """Step the chain to ``sim_time`` (s) in samples (see the module documentation).
+
+        Returns one result per multiple of ``sample_period_s`` passed since the last reading (in
+        order; each stepped from the previous one), or the single result of
+        :meth:`advance_to` for the first reading, a clock that went back or a gap longer than
+        ``max_clock_gap_s``. Empty when the clock has not reached the next sample.
+
+        Raises:
+            RigError: ``sim_time`` is not a finite number >= 0.
+        """
+        previous = self._time
+        if (
+            previous is None
+            or isinstance(sim_time, bool)
+            or not isinstance(sim_time, (int, float))
+            or not math.isfinite(sim_time)
+            or sim_time < previous
+            or sim_time - previous > self.max_clock_gap
+        ):
+            return [self.advance_to(sim_time)]
+        period = self.sample_period_ns
+        first = round(previous * 1e9) // period + 1
+        last = round(sim_time * 1e9) // period
+        return [self.advance_to(k * period * 1e-9) for k in range(first, last + 1)]
 
     def _settle_bound(self, start_n: float, target_n: float) -> float:
         # a band wider than half the set-point (small set-points) is stated as half of it
@@ -323,8 +390,9 @@ class AxialLoadOperation:
             return Health(HealthLevel.OK, ("set-point 0 N: brake de-energised",))
         return Health(HealthLevel.OK, (f"controlling the axial load; set-point {chain.setpoint:g} N",))
 
-    def mark_reported(self, health: Health) -> None:
-        """Note that ``health`` was published (diagnostics are due again when it changes)."""
+    def mark_reported(self, health: Health | None) -> None:
+        """Note that ``health`` was published (diagnostics are due again when it changes;
+        None: nothing was, so they are due at once)."""
         self._reported = health
 
     def health_changed(self) -> bool:

@@ -1,0 +1,30 @@
+"""The load controller's core (no ROS): the operation of the axial loading chain
+(:mod:`.operation`) and the node's validated settings (:mod:`.settings`)."""
+
+from bearing_rig_sim.load_control.operation import (
+    AdvanceResult,
+    AxialLoadOperation,
+    Health,
+    HealthLevel,
+    Reply,
+    SetpointSource,
+    closed_loop_time_constant,
+    settle_band,
+    settle_time_bound,
+)
+from bearing_rig_sim.load_control.settings import NODE_NAME, LoadControllerSettings, shipped_parameters
+
+__all__ = [
+    "NODE_NAME",
+    "AdvanceResult",
+    "AxialLoadOperation",
+    "Health",
+    "HealthLevel",
+    "LoadControllerSettings",
+    "Reply",
+    "SetpointSource",
+    "closed_loop_time_constant",
+    "settle_band",
+    "settle_time_bound",
+    "shipped_parameters",
+]

@@ -1,0 +1,169 @@
+"""What every ROS parameter of the rig's nodes is: its meaning, unit, range and whether it may
+change while the node runs (no ROS; :mod:`bearing_rig_sim.nodes.shell` turns these into
+``rcl_interfaces/ParameterDescriptor`` values, so ``ros2 param describe`` tells a user what to set).
+
+The values themselves (defaults) live only in the shipped parameter files
+``config/<node>.yaml``; the validation that counts is the node's settings class, run in
+``on_configure``. The ranges here are the plausible ones for the rig: inside what the settings
+classes accept (a test checks each bound against them), so a value the ROS layer lets through is
+never refused later for being out of range.
+
+Read-only: everything a node reads in ``on_configure`` (files, models, rates, periods): a live
+change would leave the running node inconsistent with its parameters, and ``ros2 param set``
+refuses it with "read-only". They are set at start (parameter file, ``-p``). Only the load
+controller's set-point is live.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+__all__ = ["NODE_PARAMETERS", "ParameterSpec", "spec_for"]
+
+
+@dataclass(frozen=True)
+class ParameterSpec:
+    """One parameter of a node.
+
+    Attributes:
+        name: parameter name (the unit is in the name where it has one).
+        description: what it is, in the rig's words.
+        unit: SI unit, ``"1"`` for a pure number, ``""`` for text, files and flags.
+        low, high: plausible range, inclusive (numbers only; None for text and flags).
+        integer: an integer parameter (``IntegerRange``), else a floating-point one.
+        read_only: refused by ``set_parameters`` once declared (read at configure).
+        low_exclusive: the lower bound itself is refused (by the settings class, at configure);
+            ROS ranges are inclusive, so the descriptor's text says ``> low``.
+    """
+
+    name: str
+    description: str
+    unit: str = ""
+    low: float | None = None
+    high: float | None = None
+    integer: bool = False
+    read_only: bool = True
+    low_exclusive: bool = False
+
+    @property
+    def numeric(self) -> bool:
+        return self.low is not None and self.high is not None
+
+    def constraints(self) -> str:
+        """The descriptor's ``additional_constraints`` text: unit, range, when it applies."""
+        parts = []
+        if self.unit:
+            parts.append(f"unit: {self.unit}")
+        if self.numeric:
+            assert self.low is not None and self.high is not None
+            low = "> " if self.low_exclusive else ">= "
+            parts.append(f"range: {low}{self.low:g} and <= {self.high:g}")
+        parts.append("read-only: set at start (parameter file or -p), read at configure" if self.read_only else "may be set live")
+        return "; ".join(parts)
+
+    def check(self, value: object) -> str:
+        """Why ``value`` is out of this parameter's range ("" when it is in range or not a number)."""
+        if not self.numeric or isinstance(value, bool) or not isinstance(value, (int, float)):
+            return ""
+        assert self.low is not None and self.high is not None
+        v = float(value)
+        if not math.isfinite(v):
+            return f"{self.name}: must be a finite number, got {value!r}"
+        if v < self.low or v > self.high or (self.low_exclusive and v == self.low):
+            low = ">" if self.low_exclusive else ">="
+            return f"{self.name}: must be {low} {self.low:g} and <= {self.high:g} {self.unit}".rstrip() + f", got {value!r}"
+        return ""
+
+
+def _files(*specs: tuple[str, str]) -> list[ParameterSpec]:
+    return [ParameterSpec(name, text) for name, text in specs]
+
+
+SIMULATOR = [
+    *_files(
+        ("bearing_file", "bearing data file (absolute, or relative to the package's config/)"),
+        ("calibration_file", "calibration laid over the bearing data ('' = none; relative to config/)"),
+        ("rig_file", "rig data file: sensors (strip counts, jitter, drop probability) and loading chain"),
+        ("model", "engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)"),
+    ),
+    ParameterSpec("chunk_s", "simulated time per engine call and per /clock message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
+    ParameterSpec("realtime", "lock the simulated time to the wall clock (false: as fast as possible)"),
+    ParameterSpec("rate", "simulated seconds per wall second when in real time", "1", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("loop_period_s", "period of the loop timer in real time (wall clock)", "s", 1e-4, 0.1),
+    ParameterSpec("max_batch_chunks", "most chunks computed per loop call", "1", 1, 10_000, integer=True),
+    ParameterSpec("overrun_margin_s", "lag behind the wall clock counted as an overrun", "s", 0.0, 10.0, low_exclusive=True),
+    ParameterSpec("resync_lag_s", "lag behind the wall clock beyond which the debt is dropped", "s", 0.0, 60.0, low_exclusive=True),
+    ParameterSpec("rtf_window_s", "sliding window of the reported real-time factor (wall clock)", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("initial_speed_rad_s", "spindle speed at start", "rad/s", 0.0, 1000.0),
+    ParameterSpec("initial_axial_load_n", "axial load until the loading chain's first force message", "N", 0.0, 10_000.0),
+    ParameterSpec("max_command_lead_s", "how far ahead of the rig clock a command's stamp may be", "s", 0.0, 3600.0),
+    ParameterSpec("counter_timeout_s", "the pulse counters show 0 after this long without a pulse", "s", 0.0, 60.0, low_exclusive=True),
+    ParameterSpec("speeds_rate_hz", "rate of /rig/speeds in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("truth_rate_hz", "rate of /rig/truth in simulated time", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("fault_hold_s", "a refused command or force keeps /diagnostics at ERROR this long (wall clock)", "s", 0.0, 600.0),
+]
+
+LOAD_CONTROLLER = [
+    ParameterSpec("rig_file", "rig data file with the loading chain ('' = the shipped config/rig.yaml)"),
+    ParameterSpec(
+        "axial_load_setpoint_n",
+        "axial-load set-point; also settable by topic and service; mirrors the one in force",
+        "N",
+        0.0,
+        10_000.0,
+        read_only=False,
+    ),
+    ParameterSpec("engage_clutch_on_start", "close the magnet clutch when the node is configured"),
+    ParameterSpec("state_rate_hz", "rate of /rig/axial_load/state in simulated time", "Hz", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_period_s", "simulated time between two periodic /diagnostics", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("max_clock_gap_s", "longest clock advance stepped at once (a larger jump is stepped as this much)", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("force_rate_hz", "rate of the force messages (one chain step each) in simulated time", "Hz", 0.0, 10_000.0, low_exclusive=True),
+    ParameterSpec("step_period_s", "wall time between two wake-ups stepping the chain to the /clock time", "s", 0.001, 0.1),
+]
+
+MONITOR = [
+    ParameterSpec("bearing_file", "bearing data file: geometry for the epicyclic cage speed (relative to config/)"),
+    ParameterSpec("contact_angle_deg", "contact angle of the slip formula (negative: the bearing file's nominal)", "deg", -1.0, 89.0),
+    ParameterSpec("window_revolutions", "whole cage revolutions per slip window", "1", 1, 1000, integer=True),
+    ParameterSpec("criterion", "abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)"),
+    ParameterSpec("critical_slope_pct_per_s", "critical slope k2 of the stability criterion (slip against time)", "%/s", -10.0, 0.0),
+    ParameterSpec("critical_slope_pct_per_n", "critical slope k1 of the stability criterion (slip against axial load)", "%/N", -1.0, 0.0),
+    ParameterSpec("slope_span_s", "trailing window of the slope against time", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("slope_span_n", "trailing window of the slope against axial load", "N", 0.0, 10_000.0, low_exclusive=True),
+    ParameterSpec("load_step_n", "with the load criterion: width of the load bins, one slip point each", "N", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("min_slope_points", "points needed for a slope", "1", 3, 100_000, integer=True),
+    ParameterSpec("slip_resolution_pct", "least scatter of the slip believed", "%", 0.0, 10.0, low_exclusive=True),
+    ParameterSpec("change_threshold", "prediction standard errors that make a change in the slip", "1", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("min_inner_ring_speed_rad_s", "no slip point below this spindle speed", "rad/s", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("restart_speed_change_fraction", "window-to-window speed change that restarts the slip series (0: never)", "1", 0.0, 1.0),
+    ParameterSpec("loss_horizon_revolutions", "revolutions over which lost pulses are counted", "1", 0.0, 1e5, low_exclusive=True),
+    ParameterSpec("max_lost_fraction", "fraction of pulses lost over the horizon that is a sustained loss", "1", 0.0, 1.0),
+    ParameterSpec("loss_silence_revolutions", "a shaft silent for this many of its revolutions is lost", "1", 0.0, 1e4, low_exclusive=True),
+    ParameterSpec("loss_min_timeout_s", "sensor loss never sooner than this without a pulse", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("silent_shaft_revolutions", "a shaft silent from the start is lost once the other turned this many revolutions", "1", 0.0, 1e4, low_exclusive=True),
+    ParameterSpec("fault_hold_s", "a malformed pulse stays a fault, a loss a warning, this long (rig time)", "s", 0.0, 600.0),
+    ParameterSpec("clock_jump_tolerance_s", "a pulse this far before its predecessor is a clock jump (reset all)", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("status_rate_hz", "status checks and messages per second of rig time, plus one per slip window", "Hz", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+]
+
+NODE_PARAMETERS: dict[str, dict[str, ParameterSpec]] = {
+    "simulator": {p.name: p for p in SIMULATOR},
+    "load_controller": {p.name: p for p in LOAD_CONTROLLER},
+    "monitor": {p.name: p for p in MONITOR},
+}
+"""Every parameter of every node (besides rclpy's own ``use_sim_time``), by node name."""
+
+
+def spec_for(node: str, name: str) -> ParameterSpec:
+    """The spec of ``node``'s parameter ``name``.
+
+    Raises:
+        KeyError: naming the parameter that has no spec (every declared one must have one).
+    """
+    try:
+        return NODE_PARAMETERS[node][name]
+    except KeyError:
+        raise KeyError(f"{node}: parameter {name!r} has no description in bearing_rig_sim/nodes/parameters.py") from None

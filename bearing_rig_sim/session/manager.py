@@ -1,0 +1,115 @@
+"""The lifecycle manager's ROS side: ``lifecycle_msgs`` service calls to the nodes, one at a time,
+and a ``/diagnostics`` status per transition (a thin shell around :mod:`.lifecycle`).
+
+Nothing here blocks: :meth:`LifecycleManager.poll` is called from the session's timer, sends the
+next transition when the previous one has answered, and reports each answer. A transition not
+answered within its time limit fails (the node is named, with "no answer within N s").
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+from collections.abc import Callable, Sequence
+
+from diagnostic_msgs.msg import DiagnosticArray
+from lifecycle_msgs.msg import Transition
+from lifecycle_msgs.srv import ChangeState
+from rclpy.node import Node
+
+from bearing_rig_sim.interfaces import DIAGNOSTICS
+from bearing_rig_sim.nodes.common import OK, ERROR, RELIABLE_QOS, diagnostic_array, diagnostic_status, to_stamp
+from bearing_rig_sim.session.lifecycle import GOAL, TRANSITION_IDS, Step, TransitionRecord
+
+__all__ = ["DIAGNOSTIC_PREFIX", "LifecycleManager"]
+
+DIAGNOSTIC_PREFIX = "lifecycle_manager: "
+"""``/diagnostics`` status name of a node's lifecycle: the prefix and the node's name."""
+
+
+class LifecycleManager:
+    """Asks the nodes for transitions through their ``<name>/change_state`` services.
+
+    Args:
+        node: the session's node (clients and the diagnostics publisher are made on it).
+        names: the managed nodes, in bring-up order.
+        on_record: called with each transition's record (done or failed).
+        sim_time: the session's simulation time now, s (stamps of the diagnostics).
+    """
+
+    def __init__(
+        self,
+        node: Node,
+        names: Sequence[str],
+        on_record: Callable[[TransitionRecord], None],
+        sim_time: Callable[[], float],
+    ) -> None:
+        self.names = list(names)
+        self.states = {name: "unconfigured" for name in names}
+        """Each node's primary state as the manager knows it."""
+        self.records: list[TransitionRecord] = []
+        self.failed: TransitionRecord | None = None
+        """The transition that failed (the queue is dropped then), else None."""
+        self._clients = {name: node.create_client(ChangeState, f"/{name}/change_state") for name in names}
+        self._diagnostics = node.create_publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self._on_record = on_record
+        self._sim_time = sim_time
+        self._queue: list[Step] = []
+        self._pending: tuple[Step, Any, float] | None = None
+        self._limit = 10.0
+
+    def services_missing(self) -> list[str]:
+        """Nodes whose ``change_state`` service is not available yet."""
+        return [name for name, client in self._clients.items() if not client.service_is_ready()]
+
+    def run(self, steps: Sequence[Step], limit_s: float) -> None:
+        """Queue ``steps`` (after any queued), each given ``limit_s`` wall s to answer."""
+        self._queue.extend(steps)
+        self._limit = limit_s
+        self.failed = None
+
+    @property
+    def busy(self) -> bool:
+        """Transitions queued or waiting for an answer."""
+        return bool(self._queue) or self._pending is not None
+
+    def poll(self) -> None:
+        """Take the pending answer (if any) and send the next transition."""
+        if self._pending is not None:
+            step, future, deadline = self._pending
+            if future.done():
+                self._pending = None
+                result = future.result()
+                success = bool(result is not None and result.success)
+                self._record(TransitionRecord(step, success, "" if success else "the node refused the transition"))
+            elif time.monotonic() > deadline:
+                self._pending = None
+                self._record(TransitionRecord(step, False, f"no answer within {self._limit:g} s"))
+        if self._pending is None and self._queue:
+            step = self._queue.pop(0)
+            request = ChangeState.Request(transition=Transition(id=TRANSITION_IDS[step.transition], label=""))
+            self._pending = (step, self._clients[step.node].call_async(request), time.monotonic() + self._limit)
+
+    def drop(self, name: str) -> None:
+        """Forget a node whose process ended: no more transitions for it."""
+        self.states[name] = "gone"
+        self._queue = [s for s in self._queue if s.node != name]
+        if self._pending is not None and self._pending[0].node == name:
+            self._pending = None
+
+    def _record(self, record: TransitionRecord) -> None:
+        self.records.append(record)
+        self.states[record.step.node] = record.state
+        if not record.success:
+            self.failed = record
+            self._queue.clear()
+        step = record.step
+        level = OK if record.success else ERROR
+        message = (
+            f"{step.transition}: {GOAL[step.transition]}" if record.success else f"{step.transition} failed: {record.detail or 'refused'}"
+        )
+        status = diagnostic_status(
+            DIAGNOSTIC_PREFIX + step.node, level, message, {"state": record.state, "transition": step.transition}, hardware_id="bearing_rig_session"
+        )
+        self._diagnostics.publish(diagnostic_array(to_stamp(max(self._sim_time(), 0.0)), [status]))
+        self._on_record(record)

@@ -1,0 +1,95 @@
+"""The rig on a full ROS 2 Jazzy install: ``ros2 launch bearing_rig_sim rig.launch.py``.
+
+Starts the simulator, the load controller and the monitor as managed (lifecycle) nodes and brings
+them up as ``bearing-rig run`` does: configure each in turn (simulator, load controller, monitor),
+then activate each in turn, every step on the previous one's transition event. Then, with a
+``program``, runs it from ``bearing-rig run PROGRAM --attach --no-record`` (the program runner,
+live progress and summary, on these nodes), and with ``record:=true`` records the rig's topics with
+``ros2 bag record`` (MCAP storage) into ``bag_dir``.
+
+Arguments:
+  program:=FILE       test program (YAML); empty (default): the nodes only
+  record:=true|false  record with ros2 bag record (default false)
+  bag_dir:=DIR        where ros2 bag record writes (default bags/launch)
+  realtime:=true|false  simulator locked to the wall clock (default true)
+
+The nodes read their shipped parameter files (config/<node>.yaml) by themselves; override single
+parameters in the usual launch ways (a wrapping launch file, ``--ros-args`` in ``ros2 run``).
+
+launch and launch_ros are not on PyPI: this file runs on a full ROS 2 install only; the project's
+own venv runs ``bearing-rig run`` instead (README).
+"""
+
+from __future__ import annotations
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, EmitEvent, ExecuteProcess, RegisterEventHandler
+from launch.conditions import IfCondition
+from launch.events import matches_action
+from launch.substitutions import LaunchConfiguration, PythonExpression
+from launch_ros.actions import LifecycleNode
+from launch_ros.event_handlers import OnStateTransition
+from launch_ros.events.lifecycle import ChangeState
+from lifecycle_msgs.msg import Transition
+
+NODES = ("simulator", "load_controller", "monitor")
+"""Bring-up order: the source of /clock first."""
+
+RECORDED = (
+    "/clock /rig/spindle/command /rig/spindle/pulses /rig/cage/pulses /rig/speeds /rig/truth "
+    "/rig/axial_load/setpoint /rig/axial_load/state /rig/axial_load/force /rig/bearing/axial_force "
+    "/rig/slip_status /diagnostics"
+)
+
+
+def _change(node: LifecycleNode, transition: int) -> EmitEvent:
+    return EmitEvent(event=ChangeState(lifecycle_node_matcher=matches_action(node), transition_id=transition))
+
+
+def _on(node: LifecycleNode, goal: str, action: EmitEvent) -> RegisterEventHandler:
+    return RegisterEventHandler(OnStateTransition(target_lifecycle_node=node, goal_state=goal, entities=[action]))
+
+
+def generate_launch_description() -> LaunchDescription:
+    program = LaunchConfiguration("program")
+    record = LaunchConfiguration("record")
+    nodes = [
+        LifecycleNode(
+            package="bearing_rig_sim",
+            executable=name,
+            name=name,
+            namespace="",
+            output="screen",
+            parameters=[{"realtime": LaunchConfiguration("realtime")}] if name == "simulator" else [],
+        )
+        for name in NODES
+    ]
+    steps: list[RegisterEventHandler | EmitEvent] = [_change(nodes[0], Transition.TRANSITION_CONFIGURE)]
+    # configure each in turn, then activate each in turn
+    for previous, following in zip(nodes, nodes[1:]):
+        steps.append(_on(previous, "inactive", _change(following, Transition.TRANSITION_CONFIGURE)))
+    steps.append(_on(nodes[-1], "inactive", _change(nodes[0], Transition.TRANSITION_ACTIVATE)))
+    for previous, following in zip(nodes, nodes[1:]):
+        steps.append(_on(previous, "active", _change(following, Transition.TRANSITION_ACTIVATE)))
+    runner = ExecuteProcess(
+        cmd=["bearing-rig", "run", program, "--attach", "--no-record"],
+        output="screen",
+        condition=IfCondition(PythonExpression(["'", program, "' != ''"])),
+    )
+    recorder = ExecuteProcess(
+        cmd=["ros2", "bag", "record", "-s", "mcap", "-o", LaunchConfiguration("bag_dir"), *RECORDED.split()],
+        output="screen",
+        condition=IfCondition(record),
+    )
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument("program", default_value="", description="test program YAML; empty: the nodes only"),
+            DeclareLaunchArgument("record", default_value="false", description="record the rig's topics with ros2 bag record"),
+            DeclareLaunchArgument("bag_dir", default_value="bags/launch", description="output of ros2 bag record"),
+            DeclareLaunchArgument("realtime", default_value="true", description="simulator locked to the wall clock"),
+            *nodes,
+            *steps,
+            _on(nodes[-1], "active", recorder),
+            _on(nodes[-1], "active", runner),
+        ]
+    )

@@ -71,7 +71,9 @@ def test_shadow_flags_a_bench_with_other_drag_and_recalibrates(bench_bag: Path, 
     bench_value = yaml.safe_load(shipped.read_text())["parameters"][key]["value"]
     cal = scaled_calibration(shipped, key, 1.0 / 1.3, tmp_path / "low.yaml")
     out = tmp_path / "out"
-    assert main(["shadow", "--bag", str(bench_bag), "--out", str(out), "--calibration", str(cal), "--recalibrate", key]) == 1
+    saved = tmp_path / "recalibrated.yaml"
+    argv = ["shadow", "--bag", str(bench_bag), "--out", str(out), "--calibration", str(cal), "--recalibrate", key, "--save-calibration", str(saved)]
+    assert main(argv) == 1
     printed = capsys.readouterr().out
     assert "slip higher than predicted" in printed and f"re-calibrated {key}" in printed
     rows = read_rows(out / RESIDUALS_CSV)
@@ -82,6 +84,12 @@ def test_shadow_flags_a_bench_with_other_drag_and_recalibrates(bench_bag: Path, 
     value = float(line.split(": ", 1)[1].split(" ")[0])
     assert value == pytest.approx(bench_value, rel=0.03)  # the bench's calibrated consistency
     assert yaml.safe_load(shipped.read_text())["parameters"][key]["value"] == bench_value
+    # written only where asked, and loadable as a calibration
+    assert yaml.safe_load(cal.read_text())["parameters"][key]["value"] == pytest.approx(bench_value / 1.3)
+    assert yaml.safe_load(saved.read_text())["parameters"][key]["value"] == pytest.approx(value, rel=1e-5)
+    from bearing_rig_sim.dynamics import BearingParameters
+
+    assert BearingParameters.from_yaml(None, saved).lubricant is not None
 
 
 def test_shadow_bag_without_the_load_cell_is_a_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

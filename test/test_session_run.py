@@ -328,3 +328,26 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     assert not any(line.startswith("lifecycle: ") for line in out.splitlines())
     (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
     assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()
+
+
+def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_graph: Any, tmp_path: Path) -> None:
+    """The audit's case: a set-point from another node during a segment (30 N against the
+    program's 100 N) gave "stable" and exit 0. Now the segment is marked and the run exits 3."""
+    from std_msgs.msg import Float64
+
+    from bearing_rig_sim.nodes.common import RELIABLE_QOS
+
+    session = start_session(ros_graph, tmp_path)
+    seen = read_until(session, "segment 2/3 n0900:")
+    node = ros_graph.node("meddler")
+    setpoint = node.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
+    # the load controller and the session's recorder
+    assert ros_graph.spin_until(lambda: setpoint.get_subscription_count() >= 2, timeout=30.0, nodes=[node])
+    setpoint.publish(Float64(data=30.0))
+    rest, err = session.communicate(timeout=150)
+    out = "".join(seen) + rest
+    assert session.returncode == 3, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    assert "summary (conditions not met)" in out and "conditions not met in" in err
+    rows = {row[1]: row for row in summary_rows(out)}
+    assert "disturbed" in rows["n0900"][CONDITIONS], out[-3000:]
+    assert "conditions not met in segment 2 n0900:" in out

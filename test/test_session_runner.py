@@ -243,7 +243,8 @@ def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
     runner.observe_axial_setpoint(0.7, 100.0)  # the program's own
     runner.update(1.0)
     assert runner.outcomes[-1].conditions_met
-    runner.observe_axial_setpoint(1.6, 30.0)  # n0900 (starts at 1.0): someone called the service
+    runner.observe_axial_setpoint(1.2, 100.0)  # n0900 (starts at 1.0): its set-point in force
+    runner.observe_axial_setpoint(1.6, 30.0)  # then someone called the service
     runner.observe_disturbance(1.7, "a message on /rig/spindle/command not sent by this session")
     runner.observe_disturbance(1.8, "a message on /rig/spindle/command not sent by this session")  # once
     runner.interrupt(2.0)

@@ -24,8 +24,9 @@ in the benchmark's process takes the cage pulses and ``/twin/residual`` with the
 times (the middleware's ``received_timestamp``). Per rate: ``windows_received`` against
 ``windows_expected`` (the offline run over the same bag), ``latency_p50_ms`` / ``latency_p99_ms``
 / ``latency_max_ms`` from the reception of a window's closing cage pulse to that of its residual
-(the engine's half-revolution wait included), ``drain_ms`` from the last pulse to the last
-residual; the node keeps up at that rate when every window arrives and the latency does not grow.
+(the engine's half-revolution wait included; windows given up without a prediction, such as the
+last one of the bag, which the engine never passes, are not counted), ``drain_ms`` from the last
+pulse to the last residual; the node keeps up at that rate when every window arrives and the latency does not grow.
 
 Taken on a quiet machine for the records; the machine's load changes every figure.
 """
@@ -34,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import bisect
+import math
 import os
 import statistics
 import sys
@@ -199,13 +201,15 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
         stop_all([shadow, replay])
         context.try_shutdown()
         lease.release()
+    from rclpy.serialization import deserialize_message
+
     arrivals = sorted((stamp, at) for at, raw in pulses if (stamp := header_stamp_ns(raw)) is not None)
     stamps = [s for s, _ in arrivals]
     latencies = []
     for at, raw in residuals:
         stamp = header_stamp_ns(raw)
-        if stamp is None:
-            continue
+        if stamp is None or math.isnan(deserialize_message(raw, ShadowResidual).predicted_slip):
+            continue  # a window given up (no prediction) is not a residual that came late
         k = bisect.bisect_left(stamps, stamp - 2000)
         if k < len(stamps) and abs(stamps[k] - stamp) <= 2000:
             latencies.append((at - arrivals[k][1]) * 1e-6)

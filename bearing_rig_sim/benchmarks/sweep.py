@@ -103,13 +103,15 @@ def _cluster_rows(loads: list[float], method: str, repeats: int) -> Iterator[dic
         "grid": {"inner_ring_speed_rpm": list(SPEEDS_RPM), "axial_load_n": loads},
     }
     spec = spec_from_section(Section(doc, "<bench sweep>"))
+    warm_doc = {"sweep": {"name": "bench-warm-up"}, "grid": {"inner_ring_speed_rpm": [1000.0, 9000.0], "axial_load_n": [100.0]}}
+    warm = spec_from_section(Section(warm_doc, "<bench sweep warm-up>"))
     chosen = INTEGRATE if method == "integrate" else SOLVE
     walls: dict[int, float] = {}
     for workers in (1, 2):
         client, cluster = open_client(None, workers)
         try:
             with tempfile.TemporaryDirectory() as tmp:
-                run_sweep(spec, Path(tmp) / "warm", client=client, method=chosen, progress=False)  # warm-up
+                run_sweep(warm, Path(tmp) / "warm", client=client, method=chosen, progress=False)  # workers up, kernels loaded
                 runs = []
                 for i in range(max(1, repeats)):
                     outcome = run_sweep(spec, Path(tmp) / f"run{i}", client=client, method=chosen, progress=False)

@@ -34,6 +34,13 @@ def register(subparsers: Any) -> None:
         metavar="PARAMETER",
         help="track a calibration parameter online (default: the parameter file's recalibrate_parameter); never written to the calibration file",
     )
+    p.add_argument(
+        "--save-calibration",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="with --bag --recalibrate: write a copy of the calibration with the estimate to FILE (never over the calibration itself)",
+    )
     p.add_argument("ros_args", nargs=argparse.REMAINDER, help="live: after --, arguments for the node (-- --ros-args -p name:=value)")
     p.set_defaults(func=run)
 
@@ -69,6 +76,8 @@ def run(args: argparse.Namespace) -> int:
         e = result.estimate
         outside = "" if e.in_range or e.range is None else f"; OUTSIDE its plausible range {e.range[0]:g}-{e.range[1]:g}"
         print(f"re-calibrated {e.name}: {e.value:.6g} +- {e.std:.3g} (calibrated {e.calibrated:.6g}{outside}); not written")
+    if args.save_calibration is not None:
+        _save_calibration(args.save_calibration, settings.calibration_file, result.estimate)
     print(f"report: {out / 'report.md'}; rows: {out / 'residuals.csv'}")
     return 1 if c["anomalous"] else 0
 
@@ -87,3 +96,31 @@ def _live(args: argparse.Namespace, settings: Any) -> int:
     if extra:
         argv += (["--ros-args"] if "--ros-args" not in argv else []) + extra
     return main(argv)
+
+
+def _save_calibration(dest: Path, source: Path | None, estimate: Any) -> None:
+    """Write ``source`` with the estimate's value to ``dest`` (a new file, never ``source``).
+
+    Raises:
+        RigError: no estimate, the destination is the calibration itself or exists, or the
+            estimate lies outside the parameter's stated range.
+    """
+    import yaml
+
+    from bearing_rig_sim.errors import RigError
+
+    if estimate is None or source is None:
+        raise RigError("--save-calibration needs --recalibrate and a calibration file")
+    if dest.exists():
+        raise RigError(f"--save-calibration: {dest} exists already, not overwriting")
+    if not estimate.in_range:
+        raise RigError(f"--save-calibration: {estimate.name} = {estimate.value:.6g} lies outside its stated range {estimate.range}; not written")
+    doc = yaml.safe_load(source.read_text(encoding="utf-8"))
+    entry = doc["parameters"][estimate.name]
+    if isinstance(entry, dict):
+        entry["value"] = float(f"{estimate.value:.6g}")
+        entry["source"] = f"online re-calibration by shadow mode (+- {estimate.std:.3g}, {estimate.updates} steady windows); was {estimate.calibrated:.6g}"
+    else:
+        doc["parameters"][estimate.name] = float(f"{estimate.value:.6g}")
+    dest.write_text(yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
+    print(f"calibration with {estimate.name} = {estimate.value:.6g} written to {dest}")

@@ -9,7 +9,7 @@ the monitor and verdict, and the check/report schedule that the node and offline
 
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorState, MonitorStatus, MonitorWindow, SlipMonitor
-from bearing_rig_sim.monitoring.schedule import ScheduledStatus, StatusSchedule, TimeToStable
+from bearing_rig_sim.monitoring.schedule import PulseMerger, ScheduledStatus, StatusSchedule, TimeToStable
 from bearing_rig_sim.monitoring.settings import NODE_NAME, SHIPPED_FILE, MonitorSettings, shipped_parameters
 from bearing_rig_sim.monitoring.windows import LossRules, SlipWindow, SlipWindows
 
@@ -21,6 +21,7 @@ __all__ = [
     "MonitorState",
     "MonitorStatus",
     "MonitorWindow",
+    "PulseMerger",
     "ScheduledStatus",
     "SlipMonitor",
     "SlipState",

@@ -22,6 +22,7 @@ carries, so they agree.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.stability import SlipState
@@ -127,3 +128,57 @@ class TimeToStable:
     def time_to_stable(self) -> float | None:
         """Stable stamp - ramp end, s (None without one)."""
         return None if self.stable_at is None else self.stable_at - self.ramp_end
+
+
+class PulseMerger:
+    """Puts the two pulse topics back in time order before the schedule (the node's use).
+
+    A subscriber gets each topic from its own queue; after a hold-up the backlogs come one
+    message per topic in turn, so the sparser cage pulses run ahead in time of the spindle's (0.7 s
+    was seen), and a check on that clock finds the spindle silent. A bag is already in log-time
+    order and needs none of this. Rule: a pulse goes on once it is no later than the other
+    shaft's latest pulse plus twice that shaft's last pulse interval (the other's next pulse is
+    due by then), or the other shaft has not been heard of for ``max_wait_s`` of the steady
+    clock (silent, which the schedule's checks then judge); pulses go on in time order.
+
+    Args:
+        max_wait_s: longest hold while the other shaft is silent, wall s.
+    """
+
+    def __init__(self, max_wait_s: float = 0.2) -> None:
+        self.max_wait_s = max_wait_s
+        self._held: dict[str, deque[Pulse]] = {"spindle": deque(), "cage": deque()}
+        self._latest: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
+        self._interval: dict[str, float] = {"spindle": math.inf, "cage": math.inf}
+        self._heard: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
+
+    def push(self, shaft: str, pulse: Pulse, wall_now: float) -> list[tuple[str, Pulse]]:
+        """Take one received pulse; the pulses (of either shaft) that may go on now, in order."""
+        t = pulse.time
+        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+            return [(shaft, pulse)]  # the monitor reports what is wrong with it
+        if t > self._latest[shaft]:
+            if math.isfinite(self._latest[shaft]):
+                self._interval[shaft] = t - self._latest[shaft]
+            self._latest[shaft] = t
+        self._heard[shaft] = wall_now
+        self._held[shaft].append(pulse)
+        return self._release(wall_now)
+
+    def expire(self, wall_now: float) -> list[tuple[str, Pulse]]:
+        """The held pulses that may go on because the other shaft has been silent too long."""
+        return self._release(wall_now)
+
+    def _release(self, wall_now: float) -> list[tuple[str, Pulse]]:
+        out: list[tuple[str, Pulse]] = []
+        while True:
+            heads = [(q[0].time, name) for name, q in self._held.items() if q]
+            if not heads:
+                return out
+            t, name = min(heads)
+            other = "cage" if name == "spindle" else "spindle"
+            due = self._latest[other] + 2.0 * self._interval[other]
+            silent = wall_now - self._heard[other] > self.max_wait_s
+            if not (self._held[other] or t <= due or silent):
+                return out
+            out.append((name, self._held[name].popleft()))

@@ -40,10 +40,17 @@ RELIABLE_QOS = QoSProfile(
 RELIABLE_STREAM_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=5000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
 )
-"""The publishers of the 1 kHz reliable streams (``/clock``, the force on the bearing): reliable
-like :data:`RELIABLE_QOS` (and compatible with its readers), but a reliable writer drops a sample
-its readers have not acknowledged once ``depth`` newer ones are written. At depth 10 a recorder
-held up for 10 ms (a busy host) lost stretches of ``/clock``; 5000 covers 5 s of it."""
+"""The publishers of the simulator's streams (``/clock``, pulses, speeds, truth) and of the force
+on the bearing. Reliable, so that a reader that asks for it (the session's recorder) gets every
+sample: a sample lost in transport (a shared-memory port full while the reader's process was held
+up on a busy host) is sent again. Readers asking for best effort (the interface table's sensor
+data, the monitor) are served as before. A reliable writer drops a sample its reliable readers have
+not acknowledged once ``depth`` newer ones are written: at depth 10 a recorder held up for 10 ms
+lost stretches of ``/clock``; 5000 covers seconds of it."""
+
+RELIABLY_RECORDED = ("/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force")
+"""Topics published with :data:`RELIABLE_STREAM_QOS`, which the session's recorder reads
+reliably whatever the interface table offers readers."""
 
 PULSE_READER_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE

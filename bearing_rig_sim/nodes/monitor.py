@@ -43,6 +43,7 @@ from bearing_rig_sim.monitoring import (
     NODE_NAME,
     MonitorSettings,
     MonitorStatus,
+    PulseMerger,
     SlipMonitor,
     SlipState,
     StatusSchedule,
@@ -86,6 +87,7 @@ class MonitorNode(ManagedNode):
         self.settings = MonitorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.monitor = SlipMonitor(self.settings.kinematics(), self.settings)
         self.schedule = StatusSchedule(self.monitor)
+        self.merger = PulseMerger()
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
         self._last_state: SlipState | None = None
@@ -129,12 +131,17 @@ class MonitorNode(ManagedNode):
             )
             self._last_pulse_wall = time.monotonic()
             self._received[shaft] += 1
-            for scheduled in self.schedule.on_pulse(shaft, pulse):
-                self._publish(scheduled.status)
+            self._feed(self.merger.push(shaft, pulse, time.monotonic()))
         except Exception as exc:
             if not self.context.ok():
                 raise
             self.get_logger().error(f"{shaft} pulse not processed: {exc}", throttle_duration_sec=1.0)
+
+    def _feed(self, pulses: list[tuple[str, Pulse]]) -> None:
+        """Pulses back in time order (:class:`PulseMerger`) through the shared schedule."""
+        for shaft, pulse in pulses:
+            for scheduled in self.schedule.on_pulse(shaft, pulse):
+                self._publish(scheduled.status)
 
     @survives_shutdown
     def _on_load(self, msg: WrenchStamped) -> None:
@@ -162,6 +169,7 @@ class MonitorNode(ManagedNode):
             self.monitor.clock_jump(self._last_clock, clock_now)
             self._last_pulse_wall = None
         self._last_clock = clock_now
+        self._feed(self.merger.expire(time.monotonic()))
         if self._last_pulse_wall is not None and time.monotonic() - self._last_pulse_wall < 2.0 / self.settings.status_rate_hz:
             return  # the pulses drive the schedule
         now = self._rig_now(clock_now)

@@ -56,7 +56,6 @@ from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
     RELIABLE_QOS,
     RELIABLE_STREAM_QOS,
-    SENSOR_QOS,
     STATUS_QOS,
     diagnostic_array,
     diagnostic_status,
@@ -131,11 +130,11 @@ class SimulatorNode(ManagedNode):
 
         self._clock_pub = self.publisher(ClockMsg, CLOCK.name, RELIABLE_STREAM_QOS)
         self._pulse_pubs = {
-            "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, SENSOR_QOS),
-            "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, SENSOR_QOS),
+            "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, RELIABLE_STREAM_QOS),
+            "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, RELIABLE_STREAM_QOS),
         }
-        self._speeds_pub = self.publisher(JointState, SPEEDS.name, SENSOR_QOS)
-        self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, SENSOR_QOS)
+        self._speeds_pub = self.publisher(JointState, SPEEDS.name, RELIABLE_STREAM_QOS)
+        self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, RELIABLE_STREAM_QOS)
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
         self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call

@@ -31,7 +31,7 @@ from std_msgs.msg import Float64
 
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, RELIABLY_RECORDED, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 
@@ -43,8 +43,11 @@ DRAIN_PERIOD_S = 0.02
 MAX_CLOCK_EVENTS = 10
 """Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
-RECORDER_DEPTH = 5000
-"""Reader queue depth of each recorded topic: 5 s of a 1 kHz topic in real time, 1 s at 5x."""
+RECORDER_DEPTH = 50000
+"""Reader queue depth of each recorded topic: 50 s of a 1 kHz topic in real time, some 15 s at
+the 3x of a session without real time. The reader's history drops its oldest sample once this many
+wait (reliable or not): at 5000 a session held up for two seconds on a busy host lost stretches of
+/clock."""
 
 MESSAGE_TYPES: dict[str, type] = {
     "rosgraph_msgs/msg/Clock": Clock,
@@ -69,8 +72,10 @@ EVENT_WIDTH = 100
 
 
 def reader_qos(topic: RecordedTopic) -> QoSProfile:
-    """The recorder's subscription QoS: compatible with the publisher's offered profile, deep."""
-    best_effort = topic.qos == "sensor_data"
+    """The recorder's subscription QoS: compatible with the publisher's offered profile, deep;
+    reliable for the streams the rig's nodes publish reliably (:data:`RELIABLY_RECORDED`), so
+    that none of their samples is lost on a busy host."""
+    best_effort = topic.qos == "sensor_data" and topic.name not in RELIABLY_RECORDED
     return QoSProfile(
         history=HistoryPolicy.KEEP_LAST,
         depth=RECORDER_DEPTH,

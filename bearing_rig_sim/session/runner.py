@@ -380,8 +380,8 @@ class ProgramRunner:
         """The load controller's set-point in force (N) at ``time`` (s of sim time), from its
         state. The segment's own set-point starts the load's settling time (the simulator may run
         ahead of the session, so the set-point can arrive well after the segment's start in sim
-        time); any other, once the segment's was seen, or one that is neither the segment's nor
-        the previous segment's, was set from outside."""
+        time, the previous one, or the load controller's initial 0 N, still in force); any other
+        once the segment's was seen was set from outside."""
         data = self._data
         if data is None or time < data.plan.start_time:
             return
@@ -390,9 +390,7 @@ class ProgramRunner:
             if data.setpoint_seen is None:
                 data.setpoint_seen = time
             return
-        index = data.plan.index
-        previous = self.program.segments[index - 1].axial_load if index > 0 else None
-        if data.setpoint_seen is not None or (previous is not None and setpoint != previous):
+        if data.setpoint_seen is not None:  # before it, an earlier set-point is still in force
             self.observe_disturbance(time, f"the load controller's set-point was {setpoint:g} N, not the program's {own:g} N")
 
     def observe_disturbance(self, time: float, what: str) -> None:

@@ -1,10 +1,16 @@
 """Measured slip windows for the shadow twin: the monitor's own windows and fault handling.
 
 The one place the shadow twin touches the monitor. :class:`MeasuredWindows` wraps the monitor's
-ROS-free core (:class:`~bearing_rig_sim.monitoring.SlipMonitor`), so that the windows compared
-with the prediction are the monitor's whole-cage-revolution windows, with the monitor's rules for
-lost pulses, malformed and out-of-order pulses, clock jumps, sensor loss and a stopped rig. Only
-the windows, the active faults and the stop are used; the monitor's verdict is not.
+whole-revolution windows and loss books (:class:`~bearing_rig_sim.monitoring.SlipWindows`), with
+the monitor's parameters (``config/monitor.yaml``: loss rules, clock-jump tolerance, fault hold),
+so that the windows compared with the prediction are the monitor's, and the monitor's rules decide
+what is a fault:
+
+* an isolated lost pulse costs nothing (a window whose closing cage pulse was lost is skipped by
+  the counter; a spindle gap only widens the interpolation): no fault;
+* sustained loss or silence (the counter's rules, stated in revolutions) is a fault while it lasts;
+* a malformed pulse is a fault held ``fault_hold_s`` of bench time, as the monitor holds it;
+* a clock jump back restarts the counting; a stopped rig is reported, not a fault.
 
 Units: s, rad/s.
 """
@@ -15,7 +21,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 
-from bearing_rig_sim.monitoring import MonitorSettings, SlipMonitor
+from bearing_rig_sim.monitoring import MonitorSettings, SlipWindows
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 
@@ -47,7 +53,8 @@ class MeasuredWindows:
     def __init__(self, window_revolutions: int, monitor_settings: MonitorSettings | None = None) -> None:
         base = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
         self.settings = dataclasses.replace(base, window_revolutions=window_revolutions)
-        self._monitor = SlipMonitor(self.settings.kinematics(), self.settings)
+        self._counter = SlipWindows(window_revolutions, self.settings.loss_rules(), self.settings.clock_jump_tolerance_s)
+        self._invalid: dict[str, tuple[float | None, str]] = {}
 
     @property
     def clock_jump_tolerance_s(self) -> float:
@@ -56,23 +63,30 @@ class MeasuredWindows:
 
     def add_pulse(self, shaft: str, pulse: Pulse) -> list[MeasuredWindow]:
         """Take one pulse of ``"spindle"`` or ``"cage"``; the windows it completes (never raises)."""
-        if not self._monitor.add_pulse(shaft, pulse):
-            return []
-        w = self._monitor.latest_window
-        if w is None:  # pragma: no cover - add_pulse returned True
-            return []
-        return [MeasuredWindow(w.start_time, w.end_time, w.cage_speed, w.inner_ring_speed)]
+        done = self._counter.add_pulse(shaft, pulse)
+        for kind, when, text in self._counter.events:
+            if kind == "invalid":
+                self._invalid[text.split(":", 1)[0]] = (when, text)
+            elif kind == "reset":
+                self._invalid.clear()
+        self._counter.events.clear()
+        return [MeasuredWindow(w.start_time, w.end_time, w.cage_speed, w.inner_ring_speed) for w in done]
 
     def check(self, now: float) -> None:
-        """Sensor-loss and stop checks at bench time ``now`` (s)."""
-        if math.isfinite(now):
-            self._monitor.check(now)
+        """Sensor-loss and stop checks at bench time ``now`` (s); held faults expire."""
+        if not math.isfinite(now):
+            return
+        self._counter.check(now)
+        for key, (when, reason) in list(self._invalid.items()):
+            if when is None:
+                self._invalid[key] = (now, reason)
+            elif now - when > self.settings.fault_hold_s:
+                del self._invalid[key]
 
     def faults(self) -> tuple[str, ...]:
-        """The input faults active now (lost or malformed pulses, sensor loss)."""
-        return self._monitor.faults()
+        """The input faults active now (sustained loss or silence, malformed pulses)."""
+        return tuple(self._counter.faults().values()) + tuple(text for _, text in self._invalid.values())
 
     def stopped(self) -> str:
         """Why the rig is taken to have stopped ("" while it is not)."""
-        status = self._monitor.status()
-        return status.detail if status.state == 0 and "stopped" in status.detail else ""
+        return self._counter.stopped

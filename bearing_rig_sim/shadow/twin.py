@@ -12,8 +12,8 @@ as a bag delivers them:
   residual and its band (:mod:`.residual`), and whether the anomaly rule flags it.
 
 A window is *compared* only when nothing in the inputs spoils it; otherwise its ``note`` says why
-and it cannot build up an anomaly: an input fault the monitor reports (lost or malformed pulses,
-sensor loss), a load-cell dropout (no sample for ``load_timeout_s``) overlapping it, the engine
+and it cannot build up an anomaly: an input fault the monitor's counter reports (sustained loss
+or silence, malformed pulses; an isolated lost pulse is no fault), a load-cell dropout (no sample for ``load_timeout_s``) overlapping it, the engine
 (re)started less than ``settle_s`` before it, a spindle below ``min_inner_ring_speed_rad_s``.
 Nothing is dropped: every window gives a row.
 

@@ -506,11 +506,11 @@ class _Session:
                 self.writer.close()
             finally:
                 if executor is not None:
-                    executor.shutdown(timeout_sec=1.0)  # type: ignore[attr-defined]
+                    executor.shutdown(timeout_sec=1.0)  # type: ignore[attr-defined]  # rclpy objects carry no type information
                 if node is not None:
                     node.close()
                     node.destroy_node()
-                context.try_shutdown()  # type: ignore[attr-defined]
+                context.try_shutdown()  # type: ignore[attr-defined]  # rclpy objects carry no type information
 
     def _report(self) -> int:
         self.printer.done()

@@ -231,7 +231,7 @@ def stable_onset(
         if stable[i + 1]:
             begin = at
         else:
-            intervals.append((float(begin), at))  # type: ignore[arg-type]
+            intervals.append((float(begin), at))  # type: ignore[arg-type]  # begin is set before at in this branch
             begin = None
     if begin is not None:
         intervals.append((float(begin), x1))

@@ -110,7 +110,7 @@ def storage_file_index(name: str) -> int:
 
 
 def _qos_dicts(profiles: list[Qos]) -> list[dict[str, Any]]:
-    return dump_qos_v9(list(profiles))  # type: ignore[return-value]
+    return dump_qos_v9(list(profiles))  # type: ignore[return-value]  # rosbags types the dump as its own str alias
 
 
 def qos_yaml(profiles: list[Qos]) -> str:

@@ -73,10 +73,10 @@ class QosSpec:
         (system default, best available, unknown)."""
         try:
             return cls(
-                reliability=qos.reliability.name.lower(),  # type: ignore[arg-type]
-                durability=qos.durability.name.lower(),  # type: ignore[arg-type]
+                reliability=qos.reliability.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
+                durability=qos.durability.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
                 depth=int(qos.depth),
-                history=qos.history.name.lower(),  # type: ignore[arg-type]
+                history=qos.history.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
             )
         except BagError:
             return None

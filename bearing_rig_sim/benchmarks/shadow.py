@@ -100,7 +100,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                         tick += CHECK_PERIOD_S
                     t0 = time.perf_counter()
                     if kind == "force":
-                        twin.add_force(t, float(payload))  # type: ignore[arg-type]
+                        twin.add_force(t, float(payload))  # type: ignore[arg-type]  # a decoded float64 field
                         rows = []
                     else:
                         assert isinstance(payload, Pulse)

@@ -213,7 +213,7 @@ class AxialLoadOperation:
         """
         origin = SetpointSource(source).value
         try:
-            self.chain.set_setpoint(force_n)  # type: ignore[arg-type]
+            self.chain.set_setpoint(force_n)  # type: ignore[arg-type]  # any object: the chain validates and refuses it
         except SetpointError as exc:
             self._refusal = f"set-point by {origin} refused: {exc}"
             return Reply(False, self._refusal)

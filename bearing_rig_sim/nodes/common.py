@@ -186,9 +186,9 @@ def _autostart(node: Node) -> str:
     """Configure then activate a lifecycle node; why it failed, or "" when it is active."""
     from rclpy.lifecycle import TransitionCallbackReturn
 
-    if node.trigger_configure() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+    if node.trigger_configure() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]  # rclpy's lifecycle node has no type information
         return getattr(node, "configure_error", "") or "configure failed"
-    if node.trigger_activate() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]
+    if node.trigger_activate() != TransitionCallbackReturn.SUCCESS:  # type: ignore[attr-defined]  # rclpy's lifecycle node has no type information
         return "activate failed"
     return ""
 

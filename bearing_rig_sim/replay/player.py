@@ -348,7 +348,7 @@ class RosReplaySink:
         self.node = Node(node_name, context=self.context)
         self._publishers: dict[str, Any] = {}
         declared = dict(topics)
-        declared.setdefault(CLOCK_TOPIC, None)  # type: ignore[arg-type]
+        declared.setdefault(CLOCK_TOPIC, None)  # type: ignore[arg-type]  # None: the clock topic has no recorded QoS
         for name, info in declared.items():
             msgtype = CLOCK_TYPE if info is None else info.msgtype
             cls = message_class(msgtype)
@@ -391,7 +391,7 @@ class RosReplaySink:
                 publisher.wait_for_all_acked(Duration(nanoseconds=int(max(deadline - time.monotonic(), 0.0) * 1e9)))
             time.sleep(max(deadline - time.monotonic(), 0.0))
             self.node.destroy_node()
-            self.node = None  # type: ignore[assignment]
+            self.node = None  # type: ignore[assignment]  # closed: the sink is not used again
         self.context.try_shutdown()
 
     def __enter__(self) -> RosReplaySink:

@@ -61,7 +61,7 @@ class ParameterRecord:
     def __post_init__(self) -> None:
         hints = typing.get_type_hints(type(self))
         source = type(self).__name__
-        for field in dataclasses.fields(self):  # type: ignore[arg-type]
+        for field in dataclasses.fields(self):  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
             value = getattr(self, field.name)
             kind = hints[field.name]
             if isinstance(kind, type) and issubclass(kind, ParameterRecord):
@@ -90,7 +90,7 @@ class ParameterRecord:
             ConfigError: naming the file, the dotted key and the allowed range.
         """
         hints = typing.get_type_hints(cls)
-        fields = dataclasses.fields(cls)  # type: ignore[arg-type]
+        fields = dataclasses.fields(cls)  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
         section.reject_unknown([f.name for f in fields])
         values: dict[str, Any] = {}
         for field in fields:

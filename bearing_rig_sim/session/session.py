@@ -129,8 +129,9 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime and not options.attach:
         overrides.setdefault("simulator", {})["realtime"] = "false"
-    # the monitor judges slip against what the program's stability_criterion names
-    overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion
+    if not options.attach:  # attached: the nodes' parameters are whoever started them's
+        # the monitor judges slip against what the program's stability_criterion names
+        overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion
     for name, values in overrides.items():
         commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
     if options.params_file is not None:
@@ -505,11 +506,11 @@ class _Session:
                 self.writer.close()
             finally:
                 if executor is not None:
-                    executor.shutdown(timeout_sec=1.0)  # type: ignore[attr-defined]
+                    executor.shutdown(timeout_sec=1.0)  # type: ignore[attr-defined]  # rclpy objects carry no type information
                 if node is not None:
                     node.close()
                     node.destroy_node()
-                context.try_shutdown()  # type: ignore[attr-defined]
+                context.try_shutdown()  # type: ignore[attr-defined]  # rclpy objects carry no type information
 
     def _report(self) -> int:
         self.printer.done()

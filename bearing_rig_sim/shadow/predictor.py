@@ -154,7 +154,7 @@ class MeasuredDrive:
         k = max(0, min(k, len(times) - 2))
         t0, t1 = times[k], times[k + 1]
         f = (t - t0) / (t1 - t0)
-        return tuple(  # type: ignore[return-value]
+        return tuple(  # type: ignore[return-value]  # a fixed-length tuple built from a generator
             a[k] + f * (a[k + 1] - a[k]) for a in (self._cage, self._inner, self._load)
         )
 

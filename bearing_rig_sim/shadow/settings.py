@@ -150,7 +150,7 @@ class ShadowSettings:
 
     def replace(self, **changes: object) -> ShadowSettings:
         """A copy with some values changed (not re-validated: for tests and the command line)."""
-        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]
+        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]  # keys checked against the dataclass fields above
 
 
 def calibration_rms(path: Path | None) -> float | None:

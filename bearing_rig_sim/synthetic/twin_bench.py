@@ -125,7 +125,7 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
                 vec = types["geometry_msgs/msg/Vector3"]
                 msg = types["geometry_msgs/msg/WrenchStamped"](
                     header=header,
-                    wrench=types["geometry_msgs/msg/Wrench"](force=vec(x=0.0, y=0.0, z=float(payload)), torque=vec(x=0.0, y=0.0, z=0.0)),  # type: ignore[arg-type]
+                    wrench=types["geometry_msgs/msg/Wrench"](force=vec(x=0.0, y=0.0, z=float(payload)), torque=vec(x=0.0, y=0.0, z=0.0)),  # type: ignore[arg-type]  # rosbags' message constructors are loosely typed
                 )
                 writer.write_message(AXIAL_LOAD_FORCE.name, int(round(t * 1e9)), msg)
             else:

@@ -19,26 +19,13 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 
-from bearing_rig_sim.monitoring import MonitorSettings, SlipWindows
+from bearing_rig_sim.monitoring import MonitorSettings, SlipWindow, SlipWindows
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
 
-@dataclass(frozen=True)
-class MeasuredWindow:
-    """One window of whole cage revolutions as the monitor measured it.
-
-    Attributes:
-        start_time, end_time: its two cage pulses (same strip), s.
-        cage_speed: mean cage speed, rad/s.
-        inner_ring_speed: mean spindle speed over the same interval, rad/s.
-    """
-
-    start_time: float
-    end_time: float
-    cage_speed: float
-    inner_ring_speed: float
+MeasuredWindow = SlipWindow
+"""One window of whole cage revolutions as the monitor measured it (the monitor's own type)."""
 
 
 class MeasuredWindows:
@@ -70,7 +57,7 @@ class MeasuredWindows:
             elif kind == "reset":
                 self._invalid.clear()
         self._counter.events.clear()
-        return [MeasuredWindow(w.start_time, w.end_time, w.cage_speed, w.inner_ring_speed) for w in done]
+        return list(done)
 
     def check(self, now: float) -> None:
         """Sensor-loss and stop checks at bench time ``now`` (s); held faults expire."""

@@ -206,6 +206,16 @@ def test_monitor_finds_stable_slip_close_to_the_truth(ros_graph):
     probe = Probe(ros_graph)
     probe.wait(lambda: any(s.state == SlipStatus.STATE_STABLE for s in probe.status), "a stable verdict")
     stable = next(s for s in probe.status if s.state == SlipStatus.STATE_STABLE)
+    # The truth comes on its own topic: wait for one stamped at or after the verdict's window.
+    probe.wait(
+        lambda: any(from_stamp(t.header.stamp) >= from_stamp(stable.header.stamp) for t in probe.truth),
+        "a truth sample after the stable verdict",
+    )
+    # The truth comes on its own topic: wait for one stamped at or after the verdict's window.
+    probe.wait(
+        lambda: any(from_stamp(t.header.stamp) >= from_stamp(stable.header.stamp) for t in probe.truth),
+        "a truth sample after the stable verdict",
+    )
     truth = min(probe.truth, key=lambda t: abs(from_stamp(t.header.stamp) - from_stamp(stable.header.stamp)))
     assert stable.slip_rate == pytest.approx(truth.slip_rate, abs=0.1)
     assert stable.inner_ring_speed == pytest.approx(speed, rel=1e-3)

@@ -306,6 +306,11 @@ class BearingDynamics:
             films.append(film.minimum)
         return films[0], films[1]
 
+    def angles(self) -> tuple[float, float, float]:
+        """Time (s), inner-ring angle (rad) and the strip-carrying cage segment's angle (rad): what
+        the fibre-optic sensors see, without the copies of :meth:`observe`."""
+        return float(self.ring[kn.R_TIME]), float(self.ring[kn.R_ANGLE]), float(self.cage[self.strip_segment, kn.C_PHI])
+
     def observe(self) -> Observation:
         """The current state as an :class:`Observation` (copies)."""
         o = self.out

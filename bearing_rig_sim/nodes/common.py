@@ -2,8 +2,8 @@
 
 The QoS profiles are the ones of the interface table (README, docs/interfaces.md). Nodes are
 thin shells: each wires publishers, subscriptions, timers and parameters around a ROS-free core
-and starts through :func:`run_node`, which uses a ``SingleThreadedExecutor`` (the
-``MultiThreadedExecutor`` of Jazzy's rclpy drops to a few hertz with several nodes).
+and starts through :func:`run_node`, which spins it on rclpy's ``EventsExecutor`` (see
+:func:`node_executor`).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from rclpy._rclpy_pybind11 import RCLError
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
-from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
@@ -40,17 +40,13 @@ RELIABLE_QOS = QoSProfile(
 RELIABLE_STREAM_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=5000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
 )
-"""The publishers of the simulator's streams (``/clock``, pulses, speeds, truth) and of the force
-on the bearing. Reliable, so that a reader that asks for it (the session's recorder) gets every
+"""The contract's ``reliable_stream`` profile: the publishers of the simulator's streams
+(``/clock``, pulses, speeds, truth) and of the force on the bearing. Reliable, so that a reader that asks for it (the session's recorder) gets every
 sample: a sample lost in transport (a shared-memory port full while the reader's process was held
 up on a busy host) is sent again. Readers asking for best effort (the interface table's sensor
 data, the monitor) are served as before. A reliable writer drops a sample its reliable readers have
 not acknowledged once ``depth`` newer ones are written: at depth 10 a recorder held up for 10 ms
 lost stretches of ``/clock``; 5000 covers seconds of it."""
-
-RELIABLY_RECORDED = ("/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force")
-"""Topics published with :data:`RELIABLE_STREAM_QOS`, which the session's recorder reads
-reliably whatever the interface table offers readers."""
 
 PULSE_READER_QOS = QoSProfile(
     history=HistoryPolicy.KEEP_LAST, depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
@@ -133,9 +129,53 @@ def _rcl_message(exc: Exception) -> str:
     return re.sub(r", at [^,]*\.c:\d+", "", " ".join(str(exc).split()))
 
 
+EXECUTOR_ENV = "BEARING_RIG_EXECUTOR"
+"""Environment variable naming the executor of the nodes: ``events`` (default) or ``single``."""
+
+SPIN_SLICE_S = 0.5
+"""Longest wait of one ``spin_once`` of the node loop, s: how soon a shutdown is seen when idle."""
+
+
+def node_executor(kind: str | None = None) -> Executor:
+    """The executor a node of the rig spins on.
+
+    ``events`` (the default): rclpy's ``EventsExecutor`` (``rclpy.experimental``, in Jazzy since
+    rclpy 7.1.4), which dispatches in C++ the events the middleware reports. The
+    ``SingleThreadedExecutor`` rebuilds a wait set in Python over every timer, subscription,
+    service and QoS event handler of the node at each wake-up; a lifecycle node has some twenty of
+    them and wakes hundreds of times a second, so that walk costs more than the work it dispatches
+    (``bearing-rig bench rig``: the monitor took 16 % of a core on it, 7 % on the events
+    executor). ``single``: the ``SingleThreadedExecutor`` (``BEARING_RIG_EXECUTOR=single``), for
+    comparison or should the events executor misbehave on some middleware.
+
+    Raises:
+        RigError: an unknown kind.
+    """
+    import os
+
+    chosen = (kind if kind is not None else os.environ.get(EXECUTOR_ENV, "events")).strip().lower()
+    if chosen == "single":
+        return SingleThreadedExecutor()
+    if chosen != "events":
+        raise RigError(f"{EXECUTOR_ENV}={chosen!r}: expected 'events' or 'single'")
+    from rclpy.experimental import EventsExecutor
+
+    return EventsExecutor()
+
+
+def spin_until_shutdown(executor: Executor) -> None:
+    """Spin ``executor`` until the context shuts down (Ctrl-C, SIGTERM, ``rclpy.shutdown``).
+
+    One ``spin_once`` at a time: the events executor's own ``spin()`` in rclpy 7.1.6 neither runs
+    timers nor returns on a signal, its ``spin_once`` does both.
+    """
+    while rclpy.ok():
+        executor.spin_once(timeout_sec=SPIN_SLICE_S)
+
+
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
     """Initialise rclpy (with the node's shipped parameter file), spin the node made by
-    ``factory`` on a ``SingleThreadedExecutor`` until Ctrl-C or shutdown, then clean up.
+    ``factory`` on :func:`node_executor` until Ctrl-C or shutdown, then clean up.
 
     A lifecycle node starts unconfigured, driven by the standard ``lifecycle_msgs`` services;
     with ``--autostart`` it configures and activates itself first.
@@ -145,7 +185,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
 
     Raises:
         RigError: malformed ROS arguments; the node could not be made (a parameter given at
-            start out of its range or of the wrong type).
+            start out of its range or of the wrong type); an unknown executor kind.
     """
     args, autostart = split_autostart(sys.argv if argv is None else argv)
     try:
@@ -153,7 +193,11 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
     except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
         raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
-    executor = SingleThreadedExecutor()
+    try:
+        executor = node_executor()
+    except RigError:
+        rclpy.try_shutdown()
+        raise
     try:
         try:
             node = factory()
@@ -165,7 +209,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
                 print(f"{node_name}: error: {failed}", file=sys.stderr)
                 return 2
         executor.add_node(node)
-        executor.spin()
+        spin_until_shutdown(executor)
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -195,6 +239,7 @@ def _autostart(node: Node) -> str:
 
 CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {
     "reliable": RELIABLE_QOS,
+    "reliable_stream": RELIABLE_STREAM_QOS,
     "sensor_data": SENSOR_QOS,
     "transient_local": STATUS_QOS,
 }

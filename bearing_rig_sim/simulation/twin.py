@@ -208,7 +208,7 @@ class RigTwin:
         self.step_count = 0
         """Engine integration steps since the start (1)."""
         self._acceleration = 0.0
-        self._observation = engine.observe()
+        self._angles = engine.angles()
 
     @classmethod
     def from_files(
@@ -307,7 +307,7 @@ class RigTwin:
         """
         h = self.chunk if h is None else self._check_chunk(h)
         engine = self.engine
-        before = self._observation
+        _, inner_before, cage_before = self._angles
         t0 = engine.time
         steps = int(round(h / engine.time_step))
         t_end = t0 + steps * engine.time_step
@@ -321,11 +321,9 @@ class RigTwin:
             engine.advance(remaining, axial_load=self._load)
         self.step_count += steps
         self._acceleration = accel
-        after = engine.observe()
-        self._observation = after
-        t1 = after.time
-        spindle = self.spindle_sensor.update(t0, before.inner_ring_angle, t1, after.inner_ring_angle)
-        cage = self.cage_sensor.update(t0, before.cage_angle, t1, after.cage_angle)
+        self._angles = t1, inner_after, cage_after = engine.angles()
+        spindle = self.spindle_sensor.update(t0, inner_before, t1, inner_after)
+        cage = self.cage_sensor.update(t0, cage_before, t1, cage_after)
         for pulse in spindle:
             self.spindle_counter.add(pulse)
         for pulse in cage:
@@ -334,7 +332,7 @@ class RigTwin:
             self._last_index["spindle"] = spindle[-1].pulse_index
         if cage:
             self._last_index["cage"] = cage[-1].pulse_index
-        truth = self._truth(after) if with_truth else None
+        truth = self._truth(engine.observe()) if with_truth else None
         return TickOutput(t0, t1, spindle, cage, self.measured(t1), truth)
 
     def measured(self, now: float | None = None) -> MeasuredSpeeds:
@@ -352,7 +350,7 @@ class RigTwin:
 
     def truth(self) -> TruthSummary:
         """The ground truth now (see :class:`TruthSummary`)."""
-        return self._truth(self._observation)
+        return self._truth(self.engine.observe())
 
     def _truth(self, obs: Observation) -> TruthSummary:
         inner = obs.inner_ring_speed

@@ -24,15 +24,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-QosName = Literal["reliable", "sensor_data", "transient_local"]
-"""The contract's three QoS profiles (see :data:`QOS_DESCRIPTIONS`)."""
+QosName = Literal["reliable", "reliable_stream", "sensor_data", "transient_local"]
+"""The contract's four QoS profiles (see :data:`QOS_DESCRIPTIONS`)."""
 
 QOS_DESCRIPTIONS: dict[str, str] = {
     "reliable": "reliable, volatile, depth 10",
+    "reliable_stream": "reliable stream (reliable, depth 5000)",
     "sensor_data": "sensor data (best effort, depth 100)",
     "transient_local": "reliable, transient local, depth 10",
 }
-"""What each profile is, as the interface table says it."""
+"""What each profile is, as the interface table says it.
+
+``reliable_stream`` is the twin's high-rate streams: published reliably with a deep history, so
+that a reader asking for reliability (the session's recorder) gets every sample even when its
+process is held up for seconds, while readers asking for best effort (the monitor, the live view,
+any sensor-data subscriber) are served as sensor data. The physical bench's counter may publish
+the same topics as plain sensor data; every reader of the rig reads them best effort or records
+whatever comes."""
 
 
 @dataclass(frozen=True)
@@ -83,7 +91,7 @@ class Service:
     server: str
 
 
-CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", "reliable", "1 kHz (sim)", "s", "simulator, replay")
+CLOCK = Topic("/clock", "rosgraph_msgs/msg/Clock", "reliable_stream", "1 kHz (sim)", "s", "simulator, replay")
 SPINDLE_COMMAND = Topic(
     "/rig/spindle/command",
     "bearing_rig_msgs/msg/SpindleCommand",
@@ -95,7 +103,7 @@ SPINDLE_COMMAND = Topic(
 SPINDLE_PULSES = Topic(
     "/rig/spindle/pulses",
     "bearing_rig_msgs/msg/FibreOpticPulse",
-    "sensor_data",
+    "reliable_stream",
     "strips x rev/s",
     "s",
     "simulator (bench: pulse counter)",
@@ -103,7 +111,7 @@ SPINDLE_PULSES = Topic(
 CAGE_PULSES = Topic(
     "/rig/cage/pulses",
     "bearing_rig_msgs/msg/FibreOpticPulse",
-    "sensor_data",
+    "reliable_stream",
     "strips x rev/s",
     "s",
     "simulator (bench: pulse counter)",
@@ -111,13 +119,13 @@ CAGE_PULSES = Topic(
 SPEEDS = Topic(
     "/rig/speeds",
     "sensor_msgs/msg/JointState",
-    "sensor_data",
+    "reliable_stream",
     "1 kHz",
     "rad/s (velocity), rad (position)",
     "simulator (bench: pulse counter)",
     note="names `inner_ring`, `cage`",
 )
-TRUTH = Topic("/rig/truth", "bearing_rig_msgs/msg/SimulatorTruth", "sensor_data", "100 Hz", "see msg", "simulator only")
+TRUTH = Topic("/rig/truth", "bearing_rig_msgs/msg/SimulatorTruth", "reliable_stream", "100 Hz", "see msg", "simulator only")
 AXIAL_LOAD_SETPOINT = Topic(
     "/rig/axial_load/setpoint",
     "std_msgs/msg/Float64",
@@ -142,7 +150,7 @@ AXIAL_LOAD_FORCE = Topic(
 BEARING_AXIAL_FORCE = Topic(
     "/rig/bearing/axial_force",
     "geometry_msgs/msg/WrenchStamped",
-    "reliable",
+    "reliable_stream",
     "each `/clock` advance (up to 1 kHz)",
     "N",
     "load controller -> simulator",

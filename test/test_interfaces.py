@@ -47,7 +47,28 @@ def test_unknown_topic_is_named_in_the_error() -> None:
     with pytest.raises(KeyError, match="/rig/nothing"):
         interfaces.topic("/rig/nothing")
     assert interfaces.contract_qos("/rig/nothing") is None
-    assert interfaces.contract_qos("/rig/cage/pulses") == "sensor_data"
+    assert interfaces.contract_qos("/rig/cage/pulses") == "reliable_stream"
+    assert interfaces.contract_qos("/rig/axial_load/force") == "sensor_data"
+
+
+def test_every_qos_name_means_the_same_to_the_nodes_and_to_the_bags() -> None:
+    """The contract's profile names resolve to one and the same profile for a live publisher
+    (nodes.common) and for the QoS stored in a bag (bags.qos), and the table describes it."""
+    from rclpy.qos import DurabilityPolicy, ReliabilityPolicy
+
+    from bearing_rig_sim.bags.qos import QOS_PROFILES
+    from bearing_rig_sim.nodes.common import CONTRACT_QOS_PROFILES
+
+    assert set(CONTRACT_QOS_PROFILES) == set(QOS_PROFILES) == set(interfaces.QOS_DESCRIPTIONS)
+    for name, live in CONTRACT_QOS_PROFILES.items():
+        stored = QOS_PROFILES[name]
+        assert (live.reliability == ReliabilityPolicy.RELIABLE) == (stored.reliability == "reliable"), name
+        assert (live.durability == DurabilityPolicy.TRANSIENT_LOCAL) == (stored.durability == "transient_local"), name
+        assert live.depth == stored.depth, name
+        assert f"depth {stored.depth}" in interfaces.QOS_DESCRIPTIONS[name], name
+    # The twin's high-rate streams are the ones a recorder must get whole (issue: no pulse lost in a bag).
+    streams = {t.name for t in interfaces.TOPICS if t.qos == "reliable_stream"}
+    assert streams == {"/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force"}
 
 
 def test_write_tables_replaces_a_stale_table(tmp_path: Path) -> None:

@@ -50,9 +50,10 @@ def fake() -> tuple[FakeWriter, SessionRecorder]:
 def test_every_topic_of_the_interface_table_is_declared_with_its_qos(fake: tuple[FakeWriter, SessionRecorder]) -> None:
     writer, _ = fake
     assert set(writer.topics) == {t.name for t in RECORDED_TOPICS}
-    assert writer.topics["/rig/speeds"] == ("sensor_msgs/msg/JointState", "sensor_data")
+    assert writer.topics["/rig/speeds"] == ("sensor_msgs/msg/JointState", "reliable_stream")
+    assert writer.topics["/rig/axial_load/force"][1] == "sensor_data"
     assert writer.topics["/rig/slip_status"][1] == "transient_local"
-    assert writer.topics["/clock"][1] == "reliable"
+    assert writer.topics["/clock"][1] == "reliable_stream"
 
 
 def test_header_stamp_is_read_in_either_byte_order() -> None:

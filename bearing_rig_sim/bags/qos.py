@@ -1,11 +1,13 @@
 """Quality-of-service profiles a recorded topic was offered with.
 
 A bag stores, per topic, the QoS its publisher offered (rosbag2 ``offered_qos_profiles``), so that
-a replay can offer the same again. The three named profiles are the ones of the interface contract
-(``docs/interfaces.md``):
+a replay can offer the same again. The named profiles are the ones of the interface contract
+(``docs/interfaces.md``, :data:`bearing_rig_sim.interfaces.QOS_DESCRIPTIONS`):
 
-* ``"reliable"``: reliable, volatile, keep last 10 (commands, states, ``/clock``, diagnostics);
-* ``"sensor_data"``: best effort, volatile, keep last 100 (pulses, speeds, truth, load cell);
+* ``"reliable"``: reliable, volatile, keep last 10 (commands, states, diagnostics);
+* ``"reliable_stream"``: reliable, volatile, keep last 5000 (the twin's streams: ``/clock``,
+  pulses, speeds, truth, the force on the bearing);
+* ``"sensor_data"``: best effort, volatile, keep last 100 (load cell);
 * ``"transient_local"``: reliable, transient local, keep last 10 (latched: spindle command, slip
   status).
 
@@ -84,6 +86,7 @@ class QosSpec:
 
 QOS_PROFILES: dict[str, QosSpec] = {
     "reliable": QosSpec("reliable", "volatile", 10),
+    "reliable_stream": QosSpec("reliable", "volatile", 5000),
     "sensor_data": QosSpec("best_effort", "volatile", 100),
     "transient_local": QosSpec("reliable", "transient_local", 10),
 }
@@ -91,8 +94,7 @@ QOS_PROFILES: dict[str, QosSpec] = {
 
 
 def qos_spec(qos: str | QosSpec) -> QosSpec:
-    """Resolve a profile name (``"reliable"``, ``"sensor_data"``, ``"transient_local"``) or pass a
-    :class:`QosSpec` through.
+    """Resolve a profile name (a key of :data:`QOS_PROFILES`) or pass a :class:`QosSpec` through.
 
     Raises:
         BagError: unknown profile name.

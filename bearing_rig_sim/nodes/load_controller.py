@@ -77,10 +77,10 @@ from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
 from bearing_rig_sim.nodes.common import (
+    qos_profile,
     ERROR,
     OK,
     RELIABLE_QOS,
-    RELIABLE_STREAM_QOS,
     SENSOR_QOS,
     WARN,
     diagnostic_array,
@@ -137,7 +137,7 @@ class LoadControllerNode(ManagedNode):
         # No QoS-event handlers on our own endpoints: each is a waitable that rclpy's executor
         # walks on every wake-up; an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
-        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, RELIABLE_STREAM_QOS, event_callbacks=quiet)
+        self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, qos_profile(BEARING_AXIAL_FORCE), event_callbacks=quiet)
         self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
         self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
         self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)

@@ -31,7 +31,7 @@ from std_msgs.msg import Float64
 
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, RELIABLY_RECORDED, STATUS_QOS, from_stamp, to_stamp
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 
@@ -73,9 +73,9 @@ EVENT_WIDTH = 100
 
 def reader_qos(topic: RecordedTopic) -> QoSProfile:
     """The recorder's subscription QoS: compatible with the publisher's offered profile, deep;
-    reliable for the streams the rig's nodes publish reliably (:data:`RELIABLY_RECORDED`), so
-    that none of their samples is lost on a busy host."""
-    best_effort = topic.qos == "sensor_data" and topic.name not in RELIABLY_RECORDED
+    reliable for every topic but plain sensor data, so that none of the samples of the
+    contract's reliable streams is lost on a busy host."""
+    best_effort = topic.qos == "sensor_data"
     return QoSProfile(
         history=HistoryPolicy.KEEP_LAST,
         depth=RECORDER_DEPTH,

@@ -60,13 +60,8 @@ SPEEDS_TOPIC = SPEEDS.name
 SPINDLE_PULSES_TOPIC = SPINDLE_PULSES.name
 CAGE_PULSES_TOPIC = CAGE_PULSES.name
 TRUTH_TOPIC = TRUTH.name
-RIG_TRAFFIC_TOPICS: dict[str, tuple[str, str]] = {
-    SPEEDS_TOPIC: ("sensor_msgs/msg/JointState", "sensor_data"),
-    SPINDLE_PULSES_TOPIC: ("bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data"),
-    CAGE_PULSES_TOPIC: ("bearing_rig_msgs/msg/FibreOpticPulse", "sensor_data"),
-    TRUTH_TOPIC: ("bearing_rig_msgs/msg/SimulatorTruth", "sensor_data"),
-}
-"""Topics of :func:`rig_traffic`: name -> (type, QoS profile), as in ``docs/interfaces.md``."""
+RIG_TRAFFIC_TOPICS: dict[str, tuple[str, str]] = {t.name: (t.msgtype, t.qos) for t in (SPEEDS, SPINDLE_PULSES, CAGE_PULSES, TRUTH)}
+"""Topics of :func:`rig_traffic`: name -> (type, QoS profile), from the interface contract."""
 
 FAST_CDR_PADDING = 8
 """Trailing bytes Fast-CDR adds to a JointState with names, positions, velocities and no effort."""

@@ -337,12 +337,16 @@ def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_grap
 
     from bearing_rig_sim.nodes.common import RELIABLE_QOS
 
-    session = start_session(ros_graph, tmp_path)
-    seen = read_until(session, "segment 2/3 n0900:")
+    # n0900 held for 5 s of sim time rather than until stable: the set-point lands inside it
+    # however fast the run goes.
+    program = SHORT_PROGRAM.replace("until_stable: true, timeout_s: 8.0}", "dwell_s: 5.0}", 1)
+    session = start_session(ros_graph, tmp_path, program_text=program)
     node = ros_graph.node("meddler")
     setpoint = node.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
-    # the load controller and the session's recorder
-    assert ros_graph.spin_until(lambda: setpoint.get_subscription_count() >= 2, timeout=30.0, nodes=[node])
+    # Matched with the load controller and the session's recorder before the segment starts, so
+    # that the set-point goes out the moment it does.
+    assert ros_graph.spin_until(lambda: setpoint.get_subscription_count() >= 2, timeout=60.0, nodes=[node])
+    seen = read_until(session, "segment 2/3 n0900:")
     setpoint.publish(Float64(data=30.0))
     rest, err = session.communicate(timeout=150)
     out = "".join(seen) + rest

@@ -43,9 +43,12 @@ MIN_AXIAL_LOAD = 1.0
 has no defined contact angle and the quasi-static normal problem becomes singular."""
 
 
-SPEED_TOLERANCE = (0.01, 1.0)
+SPEED_TOLERANCE = (0.01, 0.2)
 """Relative (1) and absolute (rad/s) margin of the run-time speed bounds (see
-:meth:`BearingDynamics.check_state`): rim vibration and round-off, far below a divergence."""
+:meth:`BearingDynamics.check_state`). Legitimate runs at the shipped step (spin-ups at 80 and
+1000 rad/s^2 to 3000-10 000 rpm and stops to rest, 10-1000 N) went at most 0.10 rad/s below
+zero (ball orbit at rest under 1000 N) and 0.05 rad/s above the inner ring's peak; a diverging
+step leaves the bounds by orders of magnitude within a few steps."""
 
 
 class DynamicsInputError(RigError):

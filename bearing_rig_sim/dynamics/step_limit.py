@@ -20,14 +20,14 @@ centrifugal force), so the limit follows the bearing, its lubricant and the rig.
   and cage). Linearised, the step is A-stable: tractions, pocket, rim and land are implicit. It
   fails through the traction's saturation: beyond the rising part of mu(s) the tangent slope is
   nearly zero, the step is explicit there, and the saturated traction of both raceways changes
-  the ball's spin (inertia I_b = 0.4 m r^2, lever r) by r^2 mu_max (Q_i + Q_o) h / I_b of sliding
+  the ball's spin (inertia I_b = 0.4 m r^2, lever r) by r^2 mu (Q_i + Q_o) h / I_b of sliding
   speed in one step. Once that sweep exceeds the width of the traction curve's rising part the
   step jumps from one saturated side to the other and locks into a cycle: the slip it then
   reports is an artefact (up to 100 % and beyond). The allowed sweep is
   :data:`CRITICAL_SLIDING_SWEEP` (measured; docs/model.md, Integration); the limit is
   h < S_c I_b / (r^2 (c_i^2 mu_i Q_i + c_o^2 mu_o Q_o)), c = cos(alpha - beta) the lever factor
-  of each contact on the spin, mu the plateau of the traction law at the contact's load and
-  entrainment speed.
+  of each contact on the spin, mu the traction law's coefficient at the sliding speed S_c and the
+  contact's load and entrainment speed.
 
 A step above the limit is refused at engine construction (:class:`StepLimitError`, one line
 naming the file key, the value, the limit and the mechanism).
@@ -43,20 +43,19 @@ import numpy as np
 
 from bearing_rig_sim.config import config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.traction import SRR_MAX, table_lookup
 from bearing_rig_sim.errors import RigError
 
 STIFF_SAFETY = 0.5
 """Fraction of the stiff model's linear stability limit allowed (see the module docstring)."""
 
-CRITICAL_SLIDING_SWEEP = 1.8
+CRITICAL_SLIDING_SWEEP = 2.0
 """S_c, m/s: the sliding-speed sweep per step of the saturated traction allowed in the reduced
-model. Set from runs of the shipped H7006C with its calibration from a pure-rolling start
-(docs/model.md, Integration): the sweep at the measured critical step varied from 1.4 to 4 m/s
-between operating points (the scaling holds within a factor of about 2.5, not exactly); with
-the loads of the envelope's largest axial load, S_c = 1.8 m/s puts the limit (4.1e-5 s) at or
-below 2/3 of every critical step measured over the envelope (6e-5 s the smallest, at
-10 000 rpm/500 N)."""
+model. Measured, not derived: runs of the shipped H7006C from a pure-rolling start
+(docs/model.md, Integration) found the critical step at 9 operating points from 900 rpm/100 N to
+10 000 rpm/1000 N; with S_c = 2.0 m/s the limit over the envelope (5.1e-5 s, set at 1000 N) lies
+below every one of them (the smallest, 6-7e-5 s at 10 000 rpm/500 N), and above the shipped step
+with either shipped lubricant. Point by point the scaling holds within a factor of about 2.5,
+not exactly: the bound is conservative (by 2 for oil-air and the ehl_traction law)."""
 
 SPEED_FRACTIONS = (0.25, 0.5, 1.0)
 """Spindle speeds (fractions of the envelope's top speed) at which the limits are evaluated,
@@ -132,17 +131,14 @@ def contact_state(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.nda
     )
 
 
-def traction_plateau(p: np.ndarray, contact: int, entrainment: float, load: float) -> float:
-    """The largest traction coefficient of a raceway contact (0 inner, 1 outer) at its
-    entrainment speed (m/s) and load (N): the rheology table at the largest slide-to-roll ratio
-    it holds, the paper law's larger coefficient, or the EHL curve's maximum."""
-    code = p[kn.P_FRIC_MODEL]
-    if code == 2.0:
-        ue = max(entrainment, 1e-3)
-        return float(table_lookup(p, int(p[kn.P_TABLE]), contact, SRR_MAX, ue, load)[0])
-    if code == 1.0:
-        return float(p[kn.P_EHL_MU])
-    return float(max(p[kn.P_MU_S], p[kn.P_MU_D]))
+def sweep_traction(p: np.ndarray, contact: int, entrainment: float, load: float) -> float:
+    """Traction coefficient of a raceway contact (0 inner, 1 outer) at the sliding speed of the
+    allowed sweep, :data:`CRITICAL_SLIDING_SWEEP`, either way (the larger), at its entrainment
+    speed (m/s) and load (N), from the engine's own traction law."""
+    s = CRITICAL_SLIDING_SWEEP
+    forward = kn.contact_traction(p, contact, s, entrainment, load)[0]
+    backward = kn.contact_traction(p, contact, -s, entrainment, load)[0]
+    return float(max(abs(forward), abs(backward)))
 
 
 def symplectic_euler_limit(omega: float, zeta: float) -> float:
@@ -155,8 +151,8 @@ def reduced_limit(p: np.ndarray, c: ContactState) -> float:
     """Traction-saturation limit of the reduced model's step at one operating point, s
     (no safety fraction; see the module docstring)."""
     r, ib = p[kn.P_RBALL], p[kn.P_IBALL]
-    mu_i = traction_plateau(p, 0, c.inner_entrainment, c.inner_load)
-    mu_o = traction_plateau(p, 1, c.outer_entrainment, c.outer_load)
+    mu_i = sweep_traction(p, 0, c.inner_entrainment, c.inner_load)
+    mu_o = sweep_traction(p, 1, c.outer_entrainment, c.outer_load)
     torque_per_r = c.inner_lever**2 * mu_i * c.inner_load + c.outer_lever**2 * mu_o * c.outer_load
     if torque_per_r <= 0.0:
         return math.inf

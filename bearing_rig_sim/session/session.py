@@ -341,6 +341,9 @@ class _Session:
                     self.manager.drop(child.name)
                 self._end(EXIT_FAILED, f"the {child.name} node stopped {when}: {child.describe_exit()}")
                 return
+        if self.node.simulator_stopped:
+            self._end(EXIT_FAILED, f"the simulator stopped the simulation: {self.node.simulator_stopped}")
+            return
         if self.phase is _Phase.STARTING:
             if not self._bring_up():
                 return

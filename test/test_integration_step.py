@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -196,3 +197,48 @@ def test_each_impossible_state_is_named(params: BearingParameters, column: int, 
         engine.check_state()
     engine.cage[3, column] = engine.cage[2, column]
     engine.check_state()  # the state as integrated passes
+
+
+DIVERGING_SIMULATOR = """
+import sys
+import bearing_rig_sim.dynamics.engine as engine
+made = engine.BearingDynamics.__init__
+def bypass(self, *args, **kwargs):  # the issue's 1 ms step, past the construction check
+    kwargs.update(time_step=1e-3, check_step=False)
+    made(self, *args, **kwargs)
+engine.BearingDynamics.__init__ = bypass
+from bearing_rig_sim.nodes.simulator import main
+sys.exit(main(["simulator", "--autostart", "--no-realtime"]))
+"""
+
+
+@pytest.mark.ros
+def test_the_simulator_node_reports_a_divergence_and_stops_publishing(ros_graph: Any) -> None:
+    """The node with the check bypassed: spinning up, the engine diverges; /diagnostics says
+    ERROR "simulation stopped: dynamics diverged ..." with the reason in ``simulation_stopped``
+    (what a session ends on), and no truth message ever carried a cage outside the bounds."""
+    pytest.importorskip("rclpy")
+    from bearing_rig_msgs.msg import SimulatorTruth, SpindleCommand as SpindleCommandMsg
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+
+    from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS
+
+    ros_graph.spawn_python("-c", DIVERGING_SIMULATOR)
+    node = ros_graph.node("probe")
+    executor = ros_graph.executor([node])
+    truths: list[SimulatorTruth] = []
+    stopped: list[DiagnosticStatus] = []
+    node.create_subscription(SimulatorTruth, "/rig/truth", truths.append, SENSOR_QOS)
+    node.create_subscription(
+        DiagnosticArray, "/diagnostics",
+        lambda msg: stopped.extend(s for s in msg.status if stopped_reason((kv.key, kv.value) for kv in s.values)), RELIABLE_QOS,
+    )
+    command = node.create_publisher(SpindleCommandMsg, "/rig/spindle/command", STATUS_QOS)
+    assert ros_graph.spin_until(lambda: command.get_subscription_count() > 0, 60.0, executor=executor), "the simulator did not come up"
+    command.publish(SpindleCommandMsg(target_speed=900 * RPM, profile=SpindleCommandMsg.PROFILE_STEP, ramp_time=0.5))
+    assert ros_graph.spin_until(lambda: bool(stopped), 60.0, executor=executor), "no divergence reported"
+    status = stopped[0]
+    assert status.level == DiagnosticStatus.ERROR
+    assert status.message.startswith("simulation stopped: dynamics diverged at t = ")
+    assert "time step 0.001 s, stability limit" in stopped_reason((kv.key, kv.value) for kv in status.values)
+    assert all(-0.2 <= t.cage_speed <= 1.01 * t.inner_ring_speed + 0.2 for t in truths)

@@ -242,3 +242,37 @@ def test_the_simulator_node_reports_a_divergence_and_stops_publishing(ros_graph:
     assert status.message.startswith("simulation stopped: dynamics diverged at t = ")
     assert "time step 0.001 s, stability limit" in stopped_reason((kv.key, kv.value) for kv in status.values)
     assert all(-0.2 <= t.cage_speed <= 1.01 * t.inner_ring_speed + 0.2 for t in truths)
+
+
+DIVERGING_PROGRAM = """
+name: diverging
+description: load up, then a spin-up on which the bypassed 1 ms step diverges
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, dwell_s: 5.0}
+"""
+
+
+@pytest.mark.ros
+@pytest.mark.slow
+def test_a_session_ends_with_exit_1_naming_the_divergence(ros_graph: Any, tmp_path: Path) -> None:
+    """``bearing-rig run --attach`` on the diverging simulator (and the shipped load controller
+    and monitor): the session ends, exit status 1, naming the divergence, instead of waiting for
+    a clock that no longer moves."""
+    import subprocess
+    import sys
+
+    ros_graph.spawn_python("-c", DIVERGING_SIMULATOR)
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    program = tmp_path / "program.yaml"
+    program.write_text(DIVERGING_PROGRAM, encoding="utf-8")
+    session = subprocess.Popen(
+        [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), "--attach", "--no-record"],
+        env=ros_graph.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    assert "the simulator stopped the simulation: dynamics diverged at t = " in out + err

@@ -276,3 +276,16 @@ def test_a_session_ends_with_exit_1_naming_the_divergence(ros_graph: Any, tmp_pa
     out, err = session.communicate(timeout=150)
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     assert "the simulator stopped the simulation: dynamics diverged at t = " in out + err
+
+
+def test_a_restored_snapshot_taken_while_slowing_down_is_not_a_divergence(params: BearingParameters) -> None:
+    """A state taken while the ring slows down (cage lagging above the ring) and restored into
+    a fresh engine (as the shadow predictor does) keeps its own speeds as the bound."""
+    engine = BearingDynamics(params)
+    engine.initialise(900 * RPM, 10.0)
+    engine.advance(0.1)
+    engine.set_inner_ring_speed(0.2 * engine.cage_speed)  # the drive stops short: cage above ring
+    snap = engine.snapshot()
+    fresh = BearingDynamics(params)
+    fresh.restore(snap)
+    fresh.advance(fresh.time_step)

@@ -345,7 +345,9 @@ class BearingDynamics:
         self.cage[:] = snap.cage
         self.ring[:] = snap.ring
         self.axial_load = snap.axial_load
-        self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]))
+        # A snapshot was taken of an accepted state: its speeds are within the bounds it had.
+        carried = max(float(np.max(snap.cage[:, kn.C_OMEGA])), float(np.max(snap.ball[:, kn.B_OMEGA])))
+        self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]), carried)
 
     @property
     def time(self) -> float:

@@ -25,7 +25,8 @@
    still running), stops the processes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag,
    prints the summary so far.
 
-Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died.
+Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died,
+or the simulator's engine diverged (its diagnostics' ``simulation_stopped``).
 Everything ROS in the session process runs in one ``SingleThreadedExecutor``.
 """
 

@@ -52,12 +52,12 @@ CRITICAL_SLIDING_SWEEP = 2.0
 """S_c, m/s: the sliding-speed sweep per step of the saturated traction allowed in the reduced
 model. Measured, not derived: runs of the shipped H7006C from a pure-rolling start
 (docs/model.md, Integration) found the critical step at 12 operating points from 900 rpm/100 N to
-10 000 rpm/1000 N; with S_c = 2.0 m/s the limit over the envelope (5.1e-5 s, set at 1000 N) lies
+10 000 rpm/1000 N; with S_c = 2.0 m/s the limit over the envelope (5.0e-5 s, set at 1000 N) lies
 below every one of them (the smallest, 6-7e-5 s at 10 000 rpm/500 N), and above the shipped step
 with either shipped lubricant. Point by point the scaling holds within a factor of about 2.5,
 not exactly: the bound is conservative (by 2 for oil-air and the ehl_traction law)."""
 
-SPEED_FRACTIONS = (0.25, 0.5, 1.0)
+SPEED_FRACTIONS = (0.05, 0.1, 0.15, 0.25, 0.5, 0.75, 1.0)
 """Spindle speeds (fractions of the envelope's top speed) at which the limits are evaluated,
 all at the envelope's largest axial load; the smallest limit counts."""
 

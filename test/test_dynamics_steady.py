@@ -137,7 +137,7 @@ def test_a_speed_that_is_not_positive_is_refused(solver: SteadySolver, speed: fl
 @pytest.mark.parametrize(
     "variant",
     [
-        pytest.param(lambda: BearingParameters.calibrated().replace(friction_model="ehl_traction"), id="ehl-traction-law"),
+        pytest.param(lambda: BearingParameters.calibrated().replace(friction_model="ehl_traction", reduced_time_step=2e-5), id="ehl-traction-law"),
         pytest.param(BearingParameters.from_yaml, id="uncalibrated-resistances"),
     ],
 )

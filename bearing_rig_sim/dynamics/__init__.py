@@ -9,11 +9,13 @@ from bearing_rig_sim.dynamics.engine import (
     MIN_AXIAL_LOAD,
     BearingDynamics,
     ChunkAverage,
+    DynamicsDivergedError,
     DynamicsInputError,
     Observation,
     Snapshot,
 )
 from bearing_rig_sim.dynamics.parameters import BearingParameters, DerivedGeometry, derive
+from bearing_rig_sim.dynamics.step_limit import OperatingEnvelope, StepLimit, StepLimitError
 
 __all__ = [
     "MIN_AXIAL_LOAD",
@@ -21,8 +23,12 @@ __all__ = [
     "BearingParameters",
     "ChunkAverage",
     "DerivedGeometry",
+    "DynamicsDivergedError",
     "DynamicsInputError",
     "Observation",
+    "OperatingEnvelope",
     "Snapshot",
+    "StepLimit",
+    "StepLimitError",
     "derive",
 ]

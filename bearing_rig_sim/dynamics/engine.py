@@ -15,6 +15,7 @@ Cage speed and slip are outputs of the integration, never inputs.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -24,6 +25,16 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import film_thickness
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
+from bearing_rig_sim.dynamics.step_limit import (
+    SPEED_FRACTIONS,
+    STIFF_SAFETY,
+    OperatingEnvelope,
+    StepLimit,
+    StepLimitError,
+    contact_state,
+    reduced_limit,
+    stiff_limit,
+)
 from bearing_rig_sim.errors import RigError
 
 MODELS = ("reduced", "stiff")
@@ -32,8 +43,26 @@ MIN_AXIAL_LOAD = 1.0
 has no defined contact angle and the quasi-static normal problem becomes singular."""
 
 
+SPEED_TOLERANCE = (0.01, 0.2)
+"""Relative (1) and absolute (rad/s) margin of the run-time speed bounds (see
+:meth:`BearingDynamics.check_state`). Legitimate runs at the shipped step (spin-ups at 80 and
+1000 rad/s^2 to 3000-10 000 rpm and stops to rest, 10-1000 N) went at most 0.10 rad/s below
+zero (ball orbit at rest under 1000 N) and 0.05 rad/s above the inner ring's peak; a diverging
+step leaves the bounds by orders of magnitude within a few steps."""
+
+
 class DynamicsInputError(RigError):
     """An input of the dynamics engine is not finite or out of its range."""
+
+
+class DynamicsDivergedError(RigError):
+    """The integration produced a state no bearing can be in (non-finite, a body turning
+    backwards or faster than the inner ring ever turned): a numerical fault, not a result."""
+
+
+@functools.lru_cache(maxsize=1)
+def _shipped_envelope() -> OperatingEnvelope:
+    return OperatingEnvelope.from_rig_file()
 
 
 @dataclass(frozen=True)
@@ -107,6 +136,13 @@ class BearingDynamics:
         model: ``"reduced"`` (default, real time) or ``"stiff"`` (reference).
         time_step: integration step, s; defaults to the model's step in the bearing file.
         strip_segment: index of the cage segment carrying the reflective strip (sensor).
+        envelope: the rig's top speed and largest axial load, for the step's stability limit
+            (default: the shipped ``config/rig.yaml``).
+        check_step: refuse a step above the model's stability limit (:mod:`.step_limit`);
+            False only to study a diverging integration.
+
+    Raises:
+        StepLimitError: the step exceeds the model's stability limit over the envelope.
     """
 
     def __init__(
@@ -116,6 +152,8 @@ class BearingDynamics:
         model: str = "reduced",
         time_step: float | None = None,
         strip_segment: int = 0,
+        envelope: OperatingEnvelope | None = None,
+        check_step: bool = True,
     ) -> None:
         if model not in MODELS:
             raise DynamicsInputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
@@ -137,7 +175,43 @@ class BearingDynamics:
         self.record_every = 0
         self.axial_load = 0.0
         self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
+        self._peak_speed = 0.0
+        self.envelope = envelope if envelope is not None else _shipped_envelope()
+        self.step_limit = self._stability_limit(self.envelope)
+        """The model's largest stable step over the envelope (:class:`.step_limit.StepLimit`)."""
+        if check_step and self.time_step > self.step_limit.limit:
+            key = f"integration.{model}_time_step_s" if time_step is None else "time_step"
+            raise StepLimitError(
+                f"{params.source}: {key} = {self.time_step:g} s exceeds the stability limit "
+                f"{self.step_limit.limit:.3g} s of the {model} model ({self.step_limit.mechanism})"
+            )
         self.initialise(0.0, 100.0)
+
+    def _stability_limit(self, envelope: OperatingEnvelope) -> StepLimit:
+        """The smallest stability limit over the envelope's speeds at its largest load."""
+        load = max(envelope.max_axial_load, MIN_AXIAL_LOAD)
+        best, why = math.inf, "no operating point solved"
+        for fraction in SPEED_FRACTIONS:
+            omega = fraction * envelope.max_inner_ring_speed
+            try:
+                self.initialise(omega, load)
+            except DynamicsInputError:
+                continue
+            state = contact_state(self.vector, self.ball, self.ring, self.work[:, : kn.NG])
+            rpm = omega * 30.0 / math.pi
+            if self.model == "reduced":
+                limit = reduced_limit(self.vector, state)
+                mechanism = (
+                    f"traction saturation of the ball spin at {rpm:.0f} rpm, {load:g} N: "
+                    f"Q = {state.inner_load:.0f}/{state.outer_load:.0f} N"
+                )
+            else:
+                linear, mode = stiff_limit(self.vector, state)
+                limit = STIFF_SAFETY * linear
+                mechanism = f"{STIFF_SAFETY:g} x the explicit limit of the {mode}, {rpm:.0f} rpm, {load:g} N"
+            if limit < best:
+                best, why = limit, mechanism
+        return StepLimit(self.model, best, why)
 
     # -- set-up --------------------------------------------------------------------------------
     def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0) -> None:
@@ -158,6 +232,7 @@ class BearingDynamics:
         self.ring[kn.R_DELTA] = approach / max(math.sin(p.contact_angle), 0.05)
         self.ring[kn.R_OMEGA] = omega
         self.ring[kn.R_TIME] = time
+        self._peak_speed = omega
         theta = 2.0 * math.pi * np.arange(z) / z
         self.ball[:] = 0.0
         self.ball[:, kn.B_THETA] = theta
@@ -190,6 +265,7 @@ class BearingDynamics:
     def set_inner_ring_speed(self, omega: float) -> None:
         """Impose the inner-ring speed (rad/s) from now on (a drive speed jump)."""
         self.ring[kn.R_OMEGA] = _finite("inner_ring_speed", omega, 0.0)
+        self._peak_speed = max(self._peak_speed, self.ring[kn.R_OMEGA])
 
     # -- integration ---------------------------------------------------------------------------
     def advance(self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0) -> ChunkAverage:
@@ -216,12 +292,39 @@ class BearingDynamics:
             self._step(
                 self.vector, self.ball, self.cage, self.ring, self.out, self.stats, self.work, n, self.time_step, self.axial_load, accel, 0
             )
-        if not np.all(np.isfinite(self.ball)) or not np.all(np.isfinite(self.cage)):
-            raise RigError("dynamics diverged (non-finite state); reduce the time step")
+        self.check_state()
         t = self.stats[kn.S_TIME]
         if t <= 0.0:
             return ChunkAverage(0.0, self.cage_speed, self.inner_ring_speed)
         return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t)
+
+    def check_state(self) -> None:
+        """Raise if the state is one no bearing can be in (a numerical fault).
+
+        The inner ring is the only driven body; balls and cage are carried by friction, so none
+        can turn backwards or faster than the fastest the inner ring has turned since the
+        start (:data:`SPEED_TOLERANCE` margin). A finite state outside those bounds, like a
+        non-finite one, means the integration diverged.
+
+        Raises:
+            DynamicsDivergedError: naming the quantity, its value, the bounds and the time.
+        """
+        t = self.time
+        if not (np.all(np.isfinite(self.ball)) and np.all(np.isfinite(self.cage)) and np.all(np.isfinite(self.ring))):
+            raise DynamicsDivergedError(f"dynamics diverged at t = {t:.6g} s: non-finite state ({self._step_hint()})")
+        self._peak_speed = max(self._peak_speed, float(self.ring[kn.R_OMEGA]))
+        rel, absolute = SPEED_TOLERANCE
+        lo, hi = -absolute, self._peak_speed * (1.0 + rel) + absolute
+        for name, speeds in (("cage speed", self.cage[:, kn.C_OMEGA]), ("ball orbit speed", self.ball[:, kn.B_OMEGA])):
+            worst = float(speeds[np.argmax(np.abs(speeds - 0.5 * (lo + hi)))])
+            if not lo <= worst <= hi:
+                raise DynamicsDivergedError(
+                    f"dynamics diverged at t = {t:.6g} s: {name} {worst:.6g} rad/s outside [0, {self._peak_speed:.6g}] rad/s "
+                    f"(the inner ring's fastest so far) ({self._step_hint()})"
+                )
+
+    def _step_hint(self) -> str:
+        return f"time step {self.time_step:g} s, stability limit {self.step_limit.limit:.3g} s"
 
     def mean_speeds(self, duration: float, *, axial_load: float | None = None, settle: float = 0.0) -> ChunkAverage:
         """Run ``settle`` seconds, then average cage and inner speeds over ``duration`` seconds."""
@@ -242,6 +345,9 @@ class BearingDynamics:
         self.cage[:] = snap.cage
         self.ring[:] = snap.ring
         self.axial_load = snap.axial_load
+        # A snapshot was taken of an accepted state: its speeds are within the bounds it had.
+        carried = max(float(np.max(snap.cage[:, kn.C_OMEGA])), float(np.max(snap.ball[:, kn.B_OMEGA])))
+        self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]), carried)
 
     @property
     def time(self) -> float:

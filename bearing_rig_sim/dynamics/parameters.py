@@ -201,8 +201,14 @@ class BearingParameters:
             cage_land_friction=res.number("cage_land_friction_coefficient", ge=0.0, le=1.0),
             cage_land_boundary_torque_scale=res.number("cage_land_boundary_torque_scale", ge=0.0),
             rolling_hysteresis_factor=res.number("rolling_hysteresis_factor", ge=0.0, le=0.5),
-            reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=1e-3),
-            stiff_time_step=integ.number("stiff_time_step_s", gt=0.0, le=1e-5),
+            # Plausible ranges only; the engine checks each step against its model's stability
+            # limit over the rig's envelope (dynamics/step_limit.py). Reduced: the traction
+            # saturation limit S_c I_b / (r^2 mu Q) is 1e-5..1e-4 s for spindle-size balls
+            # (4.1e-5 s for H7006C at 1000 N); 1e-3 s cycled to 100 % slip. Stiff: the Hertz
+            # contact mode of a ball of a few mm under tens to hundreds of newtons has periods
+            # of 10-30 us, so the explicit limit is a few microseconds (4.8e-6 s for H7006C).
+            reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=2e-4),
+            stiff_time_step=integ.number("stiff_time_step_s", gt=0.0, le=5e-6),
             dynamic_load_rating=doc.section("bearing").number("dynamic_load_rating_n", gt=0.0, default=13000.0),
             lubricant=lubricant,
             lubricant_temperature=temperature,

@@ -69,7 +69,7 @@ from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, paramete
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
 from bearing_rig_sim.health import Health, HealthLevel
-from bearing_rig_sim.simulation.health import SimulatorHealth
+from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
 from bearing_rig_sim.simulation.twin import RigTwin, TickOutput
@@ -334,6 +334,7 @@ class SimulatorNode(ManagedNode):
             "spindle_pulses": self._pulses["spindle"],
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,
+            STOPPED_KEY: self.health.halted,
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)
         self._diag_pub.publish(diagnostic_array(to_stamp(max(twin.time, 0.0)), [status]))

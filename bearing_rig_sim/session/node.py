@@ -34,6 +34,7 @@ from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CA
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
+from bearing_rig_sim.simulation.health import stopped_reason
 
 __all__ = ["DRAIN_PERIOD_S", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
 
@@ -140,6 +141,8 @@ class SessionNode(Node):
             for topic in recorder.topics.values()
         ]
         self._diagnostic_levels: dict[str, int] = {}
+        self.simulator_stopped = ""
+        """Why the simulator stopped for good (its diagnostics' ``simulation_stopped``), or ""."""
         self._pending: list[tuple[str, bytes]] = []
         self.sim_time_ns = 0
         """Stamp of the last ``/clock`` taken, ns."""
@@ -282,6 +285,7 @@ class SessionNode(Node):
         """An event line when a component's diagnostic level changes to or from WARN/ERROR."""
         for status in msg.status:
             level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
+            self.simulator_stopped = self.simulator_stopped or stopped_reason((kv.key, kv.value) for kv in status.values)
             previous = self._diagnostic_levels.get(status.name, 0)
             self._diagnostic_levels[status.name] = level
             if level != previous and (level > 0 or previous > 0):

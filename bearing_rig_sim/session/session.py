@@ -25,7 +25,8 @@
    still running), stops the processes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag,
    prints the summary so far.
 
-Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died.
+Exit status: 0 the program ran to its end; 130 interrupted; 1 a node failed to come up or died,
+or the simulator's engine diverged (its diagnostics' ``simulation_stopped``).
 Everything ROS in the session process runs in one ``SingleThreadedExecutor``.
 """
 
@@ -341,6 +342,9 @@ class _Session:
                     self.manager.drop(child.name)
                 self._end(EXIT_FAILED, f"the {child.name} node stopped {when}: {child.describe_exit()}")
                 return
+        if self.node.simulator_stopped:
+            self._end(EXIT_FAILED, f"the simulator stopped the simulation: {self.node.simulator_stopped}")
+            return
         if self.phase is _Phase.STARTING:
             if not self._bring_up():
                 return

@@ -13,9 +13,20 @@ Times are the wall clock's (s), given by the caller.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 from bearing_rig_sim.health import Health, HealthLevel
 
-__all__ = ["Health", "HealthLevel", "SimulatorHealth"]
+__all__ = ["STOPPED_KEY", "Health", "HealthLevel", "SimulatorHealth", "stopped_reason"]
+
+STOPPED_KEY = "simulation_stopped"
+"""Key of the simulator's diagnostic values that says why the simulation stopped for good
+(a diverged engine); empty while it runs. A session ends on it (exit status 1)."""
+
+
+def stopped_reason(values: Iterable[tuple[str, str]]) -> str:
+    """Why the simulation stopped, from a diagnostic status's (key, value) pairs; "" if it runs."""
+    return next((value for key, value in values if key == STOPPED_KEY and value), "")
 
 
 class SimulatorHealth:

@@ -34,7 +34,7 @@ import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import config_path
-from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Observation
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
@@ -231,10 +231,12 @@ class RigTwin:
 
         Raises:
             ConfigError: a file is missing or malformed (naming the file and key).
+            StepLimitError: the bearing file's step exceeds the model's stability limit over
+                the rig file's envelope (top spindle speed, largest axial load).
         """
         bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
         params = BearingParameters.from_yaml(bearing, calibration_file)
-        engine = BearingDynamics(params, model=model)
+        engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file))
         sensors = FibreOpticConfig.from_yaml(rig_file)
         return cls(engine, sensors, BearingKinematics.from_config(bearing), **options)
 
@@ -303,7 +305,10 @@ class RigTwin:
 
         Raises:
             TwinError: ``h`` not a whole number of engine steps.
-            RigError: the engine diverged (non-finite state); the twin cannot continue.
+            DynamicsDivergedError: the engine's state left what a bearing can do (non-finite,
+                a body turning backwards or faster than the inner ring has turned); nothing of
+                the chunk is returned and the twin cannot continue (the node halts and reports
+                it on /diagnostics; a session then ends with exit status 1).
         """
         h = self.chunk if h is None else self._check_chunk(h)
         engine = self.engine

@@ -26,7 +26,7 @@ import yaml
 from scipy.optimize import least_squares
 
 from bearing_rig_sim.config import check_number, rad_s_to_rpm, rpm_to_rad_s
-from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics import BearingParameters, DynamicsDivergedError
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.sweep.points import solver_for
@@ -246,13 +246,13 @@ def current_value(params: BearingParameters, name: str) -> float:
     return float(getattr(params, name))
 
 
-def check_in_range(values: dict[str, float]) -> None:
+def check_in_range(values: dict[str, float], what: str = "best fit") -> None:
     """Raise :class:`CalibrationError` naming the first value outside its physical range."""
     for name, value in values.items():
         rng = PHYSICAL_RANGES.get(name)
         if rng is not None and not rng.low <= value <= rng.high:
             raise CalibrationError(
-                f"best fit of {name} = {value:.4g} {rng.unit} is outside its physical range [{rng.low:g}, {rng.high:g}] {rng.unit} "
+                f"{what} of {name} = {value:.4g} {rng.unit} is outside its physical range [{rng.low:g}, {rng.high:g}] {rng.unit} "
                 f"({rng.reason}); nothing written: the model lacks a mechanism the data contain"
             )
 
@@ -272,7 +272,8 @@ def calibrate(
 
     Raises:
         CalibrationError: more than :data:`MAX_FITTED` parameters, or a best fit outside the
-            parameter's :data:`PHYSICAL_RANGES` (the message names it).
+            parameter's :data:`PHYSICAL_RANGES` (the message names it), or a trial on which the
+            engine diverged (naming the parameter out of its range, else the fault).
     """
     if len(points) < len(fitted):
         raise CalibrationError(f"{len(points)} data rows cannot determine {len(fitted)} parameters")
@@ -291,8 +292,15 @@ def calibrate(
     def model(x: np.ndarray, pool: Executor | None) -> list[SteadyState]:
         nonlocal evaluations
         evaluations += 1
-        trial = with_values(base, {k: float(math.exp(v)) for k, v in zip(fitted, x)})
-        return steady_states(trial, speeds_loads, 1, pool)
+        values = {k: float(math.exp(v)) for k, v in zip(fitted, x)}
+        trial = with_values(base, values)
+        try:
+            return steady_states(trial, speeds_loads, 1, pool)
+        except DynamicsDivergedError as exc:
+            # No slip to fit there: name the parameter that left its range, else the fault.
+            check_in_range(values, "the fit's trial value")
+            shown = ", ".join(f"{k} = {v:.4g}" for k, v in values.items())
+            raise CalibrationError(f"the engine diverged at the fit's trial {shown}: {exc}") from None
 
     with process_pool(min(workers, len(points))) if workers > 1 else _no_pool() as pool:
         # Slip is reported to 0.01 %: a relative step of 1e-4 in the log-parameters is ample.

@@ -285,8 +285,8 @@ def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> N
     """Every pulse the simulator emitted is in the bag: its own pulse_index counts every pulse
     since it started (pulse_drop_probability is 0 in config/rig.yaml), so the bag's indices must
     start at 0 (the spindle is at rest until the program starts) and run without a gap to the
-    last; and /clock has every 1 ms chunk from the first the recorder received (the simulator
-    starts before the session's recorder has matched it, at rest)."""
+    last; and /clock has every 1 ms chunk from the first (the session activates the nodes once
+    its recorder has matched their streams: before, the first 2-3 s of /clock were missing)."""
     from bearing_rig_sim.bags import open_bag as open_rig_bag
 
     session = start_session(ros_graph, tmp_path, program_text=NO_GAP_PROGRAM)
@@ -311,6 +311,7 @@ def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> N
     gaps = [(a, b) for a, b in zip(clock_ns, clock_ns[1:]) if round((b - a) / 1_000_000) != 1]
     assert not gaps, f"/clock: {len(gaps)} gaps, first {gaps[:5]}"
     assert clock_ns[-1] - clock_ns[0] >= 20 * 1_000_000_000
+    assert round(clock_ns[0] / 1_000_000) == 1, f"/clock in the bag starts at {clock_ns[0] * 1e-9:.3f} s, not at the first 1 ms chunk"
 
 
 def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:

@@ -30,7 +30,20 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
 from bearing_rig_sim.clock_guard import ClockGuard
-from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
+from bearing_rig_sim.interfaces import (
+    AXIAL_LOAD_FORCE,
+    AXIAL_LOAD_SETPOINT,
+    AXIAL_LOAD_STATE,
+    BEARING_AXIAL_FORCE,
+    CAGE_PULSES,
+    CLOCK,
+    DIAGNOSTICS,
+    SLIP_STATUS,
+    SPEEDS,
+    SPINDLE_COMMAND,
+    SPINDLE_PULSES,
+    TRUTH,
+)
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -70,6 +83,11 @@ _LEVEL_NAMES = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 
 EVENT_WIDTH = 100
 """Longest diagnostic message shown in an event line (the bag keeps it whole)."""
+
+
+BRING_UP_STREAMS = (CLOCK, SPINDLE_PULSES, CAGE_PULSES, SPEEDS, TRUTH, BEARING_AXIAL_FORCE, AXIAL_LOAD_FORCE, AXIAL_LOAD_STATE, SLIP_STATUS)
+"""The topics the managed nodes publish from their activation on, which the recorder must have
+matched before the session activates them (see :meth:`SessionNode.unmatched_streams`)."""
 
 
 def reader_qos(topic: RecordedTopic) -> QoSProfile:
@@ -177,6 +195,14 @@ class SessionNode(Node):
         self._setpoint.publish(setpoint)
 
     # -- readiness --------------------------------------------------------------------------------
+    def unmatched_streams(self) -> list[str]:
+        """The managed nodes' streams (:data:`BRING_UP_STREAMS`) whose publisher the recorder's
+        reader has not matched yet. Their publishers exist from configure on; the nodes publish
+        only once active, so a session that activates them after this is empty records every
+        sample from the first."""
+        counts = {topic.name: sub.get_publisher_count() for topic, _type, sub in self._recorded}
+        return [t.name for t in BRING_UP_STREAMS if counts.get(t.name, 1) == 0]
+
     def subscribers_besides_recorder(self, topic: str) -> int:
         """Subscriptions to ``topic`` other than the recorder's."""
         return sum(1 for info in self.get_subscriptions_info_by_topic(topic) if info.node_name != self.tap.get_name())

@@ -10,7 +10,8 @@
    a profile; :mod:`.processes`), each node 5 steps nicer than the session process (the recorder
    comes first), their output in ``<bag dir>/<run id>/logs/<node>.log``;
 3. is their lifecycle manager (:mod:`.lifecycle`, :mod:`.manager`): once every node's
-   ``change_state`` service is up, configures all of them in order, then activates all in order;
+   ``change_state`` service is up, configures all of them in order, waits until the recorder has
+   matched the streams they will publish (at most ``MATCH_WAIT_S``), then activates all in order;
    each transition is an event line (also in ``logs/session.log``) and a ``/diagnostics`` status
    (``lifecycle_manager: <node>``, recorded). A node that fails a transition is named with its
    reason (its ``configure failed: ...`` line) and the session ends (exit status 1);
@@ -75,6 +76,11 @@ outside (the summary marks which); stopped by a signal."""
 CHUNK_SIZE = 256 * 1024
 """Uncompressed bytes per bag chunk: about 0.5 s of the rig's traffic, the most a killed session
 loses, and a chunk compressed in some 15 ms, a short hold-up of the session's loop."""
+
+
+MATCH_WAIT_S = 10.0
+"""Longest wait, after every node is configured, for the recorder to match their streams before
+they are activated (wall s)."""
 
 
 @dataclass(frozen=True)
@@ -251,6 +257,9 @@ class _Session:
         self.node: Any = None
         self.manager: Any = None
         self.bringing_up = False
+        self._activations: list[Any] = []
+        """The activations of the bring-up, held back until the recorder has matched the streams."""
+        self._match_deadline: float | None = None
         self.deadline = 0.0
         logs.mkdir(parents=True, exist_ok=True)
         self.session_log = open(logs / "session.log", "a", encoding="utf-8")
@@ -386,7 +395,9 @@ class _Session:
             missing = manager.services_missing()
             if not missing:
                 self.bringing_up = True
-                manager.run(bring_up(list(NODES)), self.options.startup_timeout_s)  # configure compiles the kernels on a first run
+                steps = bring_up(list(NODES))
+                self._activations = [s for s in steps if s.transition == "activate"]
+                manager.run([s for s in steps if s.transition != "activate"], self.options.startup_timeout_s)  # configure compiles the kernels on a first run
                 manager.poll()
             elif time.monotonic() > self.deadline:
                 name = missing[0]
@@ -406,7 +417,23 @@ class _Session:
                 f"the end of its output ({child.log_path}):\n{child.output_tail()}",
             )
             return False
-        return not manager.busy
+        if manager.busy:
+            return False
+        if self._activations:
+            # Every node configured: activate once the recorder has matched their streams (or,
+            # failing that, after MATCH_WAIT_S with an event line naming what it has not).
+            unmatched = self.node.unmatched_streams() if self.options.record else []
+            if unmatched and self._match_deadline is None:
+                self._match_deadline = time.monotonic() + MATCH_WAIT_S
+            if unmatched and time.monotonic() < (self._match_deadline or 0.0):
+                return False
+            if unmatched:
+                self._event(f"recorder: not matched after {MATCH_WAIT_S:g} s with {', '.join(unmatched)}; their first samples may be missing")
+            manager.run(self._activations, self.options.startup_timeout_s)
+            self._activations = []
+            manager.poll()
+            return False
+        return True
 
     def _on_transition(self, record: TransitionRecord) -> None:
         """A transition answered: the node's own reason for a failure, an event line."""

@@ -266,3 +266,16 @@ def test_negative_and_far_future_clock_stamps_are_refused_and_the_node_lives_on(
     assert samples[-1][1] == pytest.approx(200.0, rel=0.02)
     assert max(rig.forces) == round(rig.time / TICK)  # no force stamped after the good clock
     assert min(rig.forces) > 0 and rig.time == pytest.approx(good + 0.2)
+
+
+def test_clock_stamps_are_read_from_the_serialized_message() -> None:
+    """The step reads /clock serialized: the stamp must be the one rclpy serialized."""
+    from rclpy.serialization import serialize_message
+    from rosgraph_msgs.msg import Clock
+
+    from bearing_rig_sim.nodes.load_controller import clock_stamp
+
+    for sec, nanosec in ((0, 1_000_000), (1_795_400_000, 999_999_999), (-5, 7), (2**31 - 1, 2**32 - 1)):
+        msg = Clock()
+        msg.clock.sec, msg.clock.nanosec = sec, nanosec
+        assert clock_stamp(serialize_message(msg)) == (sec, nanosec)

@@ -309,12 +309,17 @@ class BearingDynamics:
         Raises:
             DynamicsDivergedError: naming the quantity, its value, the bounds and the time.
         """
-        t = self.time
-        if not (np.all(np.isfinite(self.ball)) and np.all(np.isfinite(self.cage)) and np.all(np.isfinite(self.ring))):
-            raise DynamicsDivergedError(f"dynamics diverged at t = {t:.6g} s: non-finite state ({self._step_hint()})")
-        self._peak_speed = max(self._peak_speed, float(self.ring[kn.R_OMEGA]))
+        omega = float(self.ring[kn.R_OMEGA])
+        if omega > self._peak_speed:
+            self._peak_speed = omega
         rel, absolute = SPEED_TOLERANCE
         lo, hi = -absolute, self._peak_speed * (1.0 + rel) + absolute
+        fault = kn.speed_outlier(self.ball, self.cage, self.ring, lo, hi)  # one compiled pass per chunk
+        if fault == 0:
+            return
+        t = self.time
+        if fault == 1:
+            raise DynamicsDivergedError(f"dynamics diverged at t = {t:.6g} s: non-finite state ({self._step_hint()})")
         for name, speeds in (("cage speed", self.cage[:, kn.C_OMEGA]), ("ball orbit speed", self.ball[:, kn.B_OMEGA])):
             worst = float(speeds[np.argmax(np.abs(speeds - 0.5 * (lo + hi)))])
             if not lo <= worst <= hi:

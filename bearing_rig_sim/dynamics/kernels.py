@@ -709,3 +709,20 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
         e += 0.5 * jseg * cage[j, C_OMEGA] ** 2
         e += 0.5 * p[P_LINK_K] * link_strain(cage, j, z) ** 2
     return e
+
+
+@njit(cache=True)
+def speed_outlier(ball: np.ndarray, cage: np.ndarray, ring: np.ndarray, lo: float, hi: float) -> int:
+    """The first thing wrong with the state, in one pass: 0 none; 1 a non-finite value; 2 a cage
+    segment's speed outside [lo, hi] rad/s; 3 a ball's orbit speed outside it."""
+    if not (np.all(np.isfinite(ball)) and np.all(np.isfinite(cage)) and np.all(np.isfinite(ring))):
+        return 1
+    for k in range(cage.shape[0]):
+        w = cage[k, C_OMEGA]
+        if w < lo or w > hi:
+            return 2
+    for k in range(ball.shape[0]):
+        w = ball[k, B_OMEGA]
+        if w < lo or w > hi:
+            return 3
+    return 0

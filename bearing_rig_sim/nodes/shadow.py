@@ -34,7 +34,7 @@ from bearing_rig_msgs.msg import FibreOpticPulse, ShadowEstimate, ShadowResidual
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, DIAGNOSTICS, SPINDLE_PULSES, TWIN_ESTIMATE, TWIN_RESIDUAL
-from bearing_rig_sim.nodes.common import diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
+from bearing_rig_sim.nodes.common import PULSE_READER_QOS, diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
 from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.shadow import NODE_NAME, ResidualWindow, ShadowSettings, ShadowTwin, shipped_parameters
@@ -79,7 +79,7 @@ class ShadowNode(Node):
         self._residual_pub = self.create_publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
         self._estimate_pub = self.create_publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
         self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
-        sensor = qos_profile(SPINDLE_PULSES)
+        sensor = PULSE_READER_QOS  # best effort: matches a bench counter publishing sensor data, and the twin's reliable streams
         self.create_subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), sensor)
         self.create_subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), sensor)
         self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, qos_profile(AXIAL_LOAD_FORCE))

@@ -110,7 +110,9 @@ def test_reader_agrees_with_anyreader(traffic_bag: tuple[Path, int]) -> None:
             topic: (msgtype, sum(1 for t, _time, _f in expected if t == topic))
             for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()
         }
-        assert bag.topics[SPEEDS_TOPIC].qos is not None and bag.topics[SPEEDS_TOPIC].qos.reliability == "best_effort"
+        # the contract's reliable_stream profile, as offered by the twin (docs/interfaces.md)
+        speeds_qos = bag.topics[SPEEDS_TOPIC].qos
+        assert speeds_qos is not None and (speeds_qos.reliability, speeds_qos.depth) == ("reliable", 5000)
         assert bag.run_metadata["test_program"] == "steady 9000 rpm"
         got = [(m.topic, m.log_time_ns, message_fields(m.message, m.msgtype, store)) for m in bag.messages()]
     assert got == expected

@@ -100,7 +100,7 @@ def test_bag_info(steady_bag: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["bag", "info", str(steady_bag)]) == 0
     out = capsys.readouterr().out
     assert "state:      complete" in out and "duration:   6.000 s" in out
-    assert "/rig/speeds" in out and " 6000 " in out and "best_effort, volatile, keep_last 100" in out
+    assert "/rig/speeds" in out and " 6000 " in out and "reliable, volatile, keep_last 5000" in out
     assert "program: 2 lines (--metadata shows them)" in out and "project_version: " in out
     assert "problems:   none" in out
     assert main(["bag", "info", "--metadata", str(steady_bag)]) == 0

@@ -124,7 +124,7 @@ def test_a_protocol_client_receives_and_decodes_rig_messages() -> None:
         view.add_topic("/rig/slip_status", "bearing_rig_msgs/msg/SlipStatus")
         view.add_topic("/rig/speeds", "sensor_msgs/msg/JointState")
         client = ProtocolClient(view.url)
-        assert client.pump_until(lambda: len(client.channels) == 2 and client.server_info, timeout=10.0)
+        assert client.pump_until(lambda: len(client.channels) == 2 and client.server_info, timeout=30.0)
         client.subscribe("/rig/slip_status", "/rig/speeds")
 
         status = store.deserialize_cdr(_slip_status_cdr(store), "bearing_rig_msgs/msg/SlipStatus")

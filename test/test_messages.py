@@ -333,7 +333,7 @@ def test_set_axial_load_service_across_processes(ros_graph: Any) -> None:
 
     def call(load: float) -> Any:
         future = client.call_async(SetAxialLoad.Request(axial_load=load))
-        assert ros_graph.spin_until(future.done, timeout=15.0, executor=executor), f"no response for {load} N"
+        assert ros_graph.spin_until(future.done, timeout=30.0, executor=executor), f"no response for {load} N"
         return future.result()
 
     accepted = call(687.125)

@@ -101,7 +101,7 @@ def test_simulator_streams_only_while_active(ros_graph: Any) -> None:
     def primary_goals() -> list[int]:
         return [e.goal_state.id for e in client.events if e.goal_state.id in (inactive, active, unconfigured)]
 
-    assert client.spin_until(lambda: primary_goals() == expected, timeout=10.0), primary_goals()
+    assert client.spin_until(lambda: primary_goals() == expected, timeout=30.0), primary_goals()
     assert process.poll() is None
 
 

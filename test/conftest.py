@@ -29,6 +29,7 @@ from __future__ import annotations
 import fcntl
 import os
 import random
+import signal
 import subprocess
 import sys
 import tempfile
@@ -98,6 +99,10 @@ def lease_domain(timeout: float = 60.0) -> DomainLease:
             raise RuntimeError(f"no free ROS domain id in {DOMAIN_IDS} after {timeout} s (see {LOCK_DIR})")
         time.sleep(0.2)
 
+
+
+def _default_sigint() -> None:  # runs in the child between fork and exec
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
 
 class RosGraph:
     """One test's private ROS graph: its domain id, environment and the ROS objects to clean up.
@@ -189,6 +194,9 @@ class RosGraph:
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
+            # the default SIGINT, as from a terminal, even when the suite runs in the background
+            # of a script (which starts it with SIGINT ignored): tests send Ctrl-C to children
+            preexec_fn=_default_sigint,
         )
         self._processes.append(process)
         return process

@@ -341,3 +341,28 @@ def test_speed_changes_are_noticed_and_the_slope_forgets_the_ramp():
     # the strips' spacing is measured from the pulses (here: equal); its estimate from pulse times
     # known to about a nanosecond leaves 1e-5 percentage points at most
     assert monitor.status().slip_rate == pytest.approx(expected_slip(150.0, 0.41 * 150.0), abs=1e-5)
+
+
+def test_a_segment_is_stable_only_at_its_commanded_speed() -> None:
+    """The one time-to-stable rule: a STABLE status counts for a segment only when its windows
+    were measured at the commanded speed (within 1 % or 1 rad/s). The case: without real time on
+    a loaded host, the spindle took a 1500 rpm command late, and STABLE statuses at 900 rpm after
+    the planned ramp end made the segment "stable" with 900 rpm measured."""
+    import math
+
+    from bearing_rig_sim.analysis.stability import SlipState
+    from bearing_rig_sim.monitoring.schedule import TimeToStable, speed_tolerance
+
+    rpm = math.pi / 30.0
+    target = 1500 * rpm  # 157.08 rad/s; 1 % of it is 1.57 rad/s (> 1 rad/s)
+    assert speed_tolerance(target) == 0.01 * target
+    assert speed_tolerance(50 * rpm) == 1.0  # near rest the counter's 1 rad/s governs
+    rule = TimeToStable(ramp_end=10.0, target_speed=target)
+    stable = int(SlipState.STABLE)
+    assert not rule.observe(11.0, 10.5, stable, 0.99, 900 * rpm)  # the previous speed
+    assert not rule.observe(11.5, 10.5, stable, 0.99, target - 2.0)  # 1.3 % short
+    assert rule.observe(12.0, 10.5, stable, 0.99, target - 1.0)  # within 1 %
+    assert rule.time_to_stable == 2.0
+    # without a commanded speed (a stretch found by speed in a bag without a program) no check
+    free = TimeToStable(ramp_end=10.0)
+    assert free.observe(11.0, 10.5, stable, 0.99)

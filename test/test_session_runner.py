@@ -195,17 +195,20 @@ def test_interrupt_ends_the_running_segment(program: TestProgram) -> None:
 # -- conditions: measured beside commanded, disturbances from outside ------------------------------
 def test_a_speed_the_spindle_did_not_reach_is_marked(program: TestProgram) -> None:
     """The audit's load sweep: the drive refused 7000 rpm and stayed at 5000; the row said
-    "stable". Here n0900 is measured at 600 rpm (62.8 rad/s against 94.2)."""
+    "stable". Here n0900 is measured at 600 rpm (62.8 rad/s against 94.2): a STABLE status there
+    is not stable at 900 rpm, so the segment runs to its timeout, and the row says why."""
     runner = ProgramRunner(program)
     runner.start(0.0)
-    runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
+    runner.update(1.0)  # n0900: ramp 1.0 .. 2.5, timeout 4 s
     slow = status(3.7, StatusState.UNKNOWN)
     slow = SlipObservation(**{**slow.__dict__, "inner_ring_speed": rpm_to_rad_s(600.0)})
     runner.observe_status(slow)
     runner.observe_status(SlipObservation(**{**slow.__dict__, "time": 3.8, "state": StatusState.STABLE}))  # on windows after the ramp
     runner.update(3.9)
-    outcome = runner.outcomes[-1]
-    assert outcome.verdict is Verdict.STABLE
+    assert [o.name for o in runner.outcomes] == ["load_up"]  # n0900 goes on
+    runner.update(10.0)
+    outcome = runner.outcomes[1]
+    assert outcome.name == "n0900" and outcome.verdict is Verdict.TIMEOUT
     assert outcome.measured_speed == pytest.approx(rpm_to_rad_s(600.0))
     assert outcome.conditions == ("speed 600 rpm measured, 900 rpm commanded",)
     assert not outcome.conditions_met

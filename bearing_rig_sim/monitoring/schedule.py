@@ -14,8 +14,10 @@ silent sensor is still reported; offline the ticks catch up at the next pulse, a
 STABLE *on evidence from after the ramp's end*: its confidence P(slope >= k) is at least
 :data:`STABLE_CONFIDENCE` (so the present points, not a state held by hysteresis, say stable)
 and every slip window its slope rests on started at or after the ramp's end
-(:func:`evidence_start`). The time to stable is that status's stamp (its window's end) minus the
-ramp's end. The live session summary and ``analyze`` both use it, on the fields a SlipStatus
+(:func:`evidence_start`), at the commanded speed: the status's inner-ring speed within
+:func:`speed_tolerance` of the segment's target (a spindle that took the command late, or never
+reached it, is not stable at that speed on windows of the speed before). The time to stable is
+that status's stamp (its window's end) minus the ramp's end. The live session summary and ``analyze`` both use it, on the fields a SlipStatus
 carries, so they agree.
 """
 
@@ -102,22 +104,40 @@ def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slo
     return stamp - max(slope_span_s + window, min_slope_points * window)
 
 
+SPEED_TOLERANCE_FRACTION = 0.01
+"""The measured speed may differ from the commanded by 1 % ..."""
+SPEED_TOLERANCE_RAD_S = 1.0
+"""... or by 1 rad/s (9.5 rpm), whichever is wider: the pulse counter's resolution near rest."""
+
+
+def speed_tolerance(target_speed: float) -> float:
+    """Largest difference between measured and commanded inner-ring speed at which a segment is
+    at its commanded speed, rad/s."""
+    return max(SPEED_TOLERANCE_FRACTION * target_speed, SPEED_TOLERANCE_RAD_S)
+
+
 class TimeToStable:
     """The one "stable after the ramp" rule (module docstring).
 
     Args:
         ramp_end: end of the segment's ramp, rig s.
+        target_speed: the commanded inner-ring speed, rad/s; None: not checked.
     """
 
-    def __init__(self, ramp_end: float) -> None:
+    def __init__(self, ramp_end: float, target_speed: float | None = None) -> None:
         self.ramp_end = ramp_end
+        self.target_speed = target_speed
         self.stable_at: float | None = None
         """Stamp of the status that made the segment stable, s (None before)."""
 
-    def observe(self, stamp: float, evidence_from: float, state: int, confidence: float) -> bool:
+    def observe(self, stamp: float, evidence_from: float, state: int, confidence: float, inner_ring_speed: float = math.nan) -> bool:
         """A status stamped ``stamp`` whose verdict rests on data from ``evidence_from`` on (s,
-        :func:`evidence_start`); returns whether this status made the segment stable."""
+        :func:`evidence_start`), measured at ``inner_ring_speed`` (rad/s); returns whether this
+        status made the segment stable."""
         if self.stable_at is not None or state != SlipState.STABLE or not confidence >= STABLE_CONFIDENCE:
+            return False
+        target = self.target_speed
+        if target is not None and not abs(inner_ring_speed - target) <= speed_tolerance(target):
             return False
         if evidence_from >= self.ramp_end:
             self.stable_at = stamp

@@ -437,7 +437,7 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
-        self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence))
+        self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence), float(message.inner_ring_speed))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
         command, start = self._decoded(COMMAND, log_time_ns, data)

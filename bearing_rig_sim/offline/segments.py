@@ -86,8 +86,9 @@ class _Segment:
         self.final_state = int(SlipState.UNKNOWN)
         self.final_recorded = -1
         self.settings = settings
-        self.stable = TimeToStable(ramp_end)
-        self.recorded_stable = TimeToStable(ramp_end)
+        commanded = target if math.isfinite(target) else None  # a stretch found by speed has no command
+        self.stable = TimeToStable(ramp_end, commanded)
+        self.recorded_stable = TimeToStable(ramp_end, commanded)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):
@@ -104,7 +105,7 @@ class _Segment:
         self.final_state = row.state
         self.final_recorded = row.recorded_state
         if math.isfinite(row.window_end):
-            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence)
+            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence, row.inner_ring_speed)
         if row.time < self.ramp_end:
             return
         self.rows += 1
@@ -115,8 +116,8 @@ class _Segment:
         st = self.settings
         return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points)
 
-    def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
-        self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence)
+    def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
+        self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)
 
     def summary(self) -> SegmentSummary:
         return SegmentSummary(
@@ -219,11 +220,11 @@ class SegmentTracker:
         if self._open is not None:
             self._open.add_row(row)
 
-    def recorded(self, stamp: float, cage_speed: float, state: int, confidence: float) -> None:
-        """A recorded slip status: its stamp (window end, s), cage speed (rad/s), state and
-        confidence."""
+    def recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
+        """A recorded slip status: its stamp (window end, s), cage speed (rad/s), state,
+        confidence and inner-ring speed (rad/s)."""
         if self._open is not None:
-            self._open.add_recorded(stamp, cage_speed, state, confidence)
+            self._open.add_recorded(stamp, cage_speed, state, confidence, inner_ring_speed)
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

@@ -150,8 +150,11 @@ def node_command(spec: NodeSpec) -> list[str]:
 
 
 def _prepare_child() -> None:  # pragma: no cover - runs in the child between fork and exec
-    """Ask the kernel for SIGTERM when the parent dies (Linux ``PR_SET_PDEATHSIG``), and lower
-    the child's priority by :data:`CHILD_NICENESS`."""
+    """Ask the kernel for SIGTERM when the parent dies (Linux ``PR_SET_PDEATHSIG``), lower the
+    child's priority by :data:`CHILD_NICENESS`, and give it the default SIGINT: a session started
+    in the background by a script inherits SIGINT ignored, and its nodes would then ignore the
+    SIGINT that :func:`stop_all` stops them with."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
     try:
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)
     except (OSError, AttributeError):

@@ -45,7 +45,7 @@ from enum import Enum
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.load_control import settle_band
-from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
+from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start, speed_tolerance
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
 
@@ -66,16 +66,6 @@ LOAD_SETTLE_S = 0.5
 settle bound is under 0.37 s for any step within 0-1000 N (``settle_time_bound``), and a set-point
 sent at the start reaches the load controller within this too."""
 
-SPEED_TOLERANCE_FRACTION = 0.01
-"""The measured speed may differ from the commanded by 1 % ..."""
-SPEED_TOLERANCE_RAD_S = 1.0
-"""... or by 1 rad/s (9.5 rpm), whichever is wider: the pulse counter's resolution near rest."""
-
-
-def speed_tolerance(target_speed: float) -> float:
-    """Largest difference between measured and commanded inner-ring speed still meeting the
-    segment's conditions, rad/s."""
-    return max(SPEED_TOLERANCE_FRACTION * target_speed, SPEED_TOLERANCE_RAD_S)
 
 
 StatusState = SlipState
@@ -270,7 +260,7 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end))
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -356,7 +346,7 @@ class ProgramRunner:
         assert data.rule is not None
         st = self.monitor_settings
         evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points)
-        if data.rule.observe(status.time, evidence, int(status.state), status.confidence):
+        if data.rule.observe(status.time, evidence, int(status.state), status.confidence, status.inner_ring_speed):
             data.stable = status
 
     def observe_truth(self, time: float, slip_rate: float) -> None:

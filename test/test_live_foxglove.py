@@ -243,9 +243,9 @@ class _Sent:
 
 
 def test_a_replay_is_shown_with_its_stamps(tmp_path: Path) -> None:
-    from test_replay_player import TIMES_NS, write_pulse_bag  # the replay tests' bag of cage pulses
+    from test_replay_player import TIMES_NS, pulse_bytes, write_pulse_bag  # the replay tests' bag of cage pulses
 
-    from bearing_rig_sim.bags import open_bag
+    from bearing_rig_sim.bags import open_bag, rig_typestore
     from bearing_rig_sim.live.foxglove import LiveReplaySink
     from bearing_rig_sim.replay.player import ReplayOptions, replay_bag
 
@@ -262,7 +262,13 @@ def test_a_replay_is_shown_with_its_stamps(tmp_path: Path) -> None:
             client.subscribe("/rig/cage/pulses")
             assert client.pump_until(lambda: bool(client.received), 30.0, also=lambda: replay_bag(bag, sink, ReplayOptions(rate=100.0)))
         pulses = client.decoded("/rig/cage/pulses")
-        assert all(p.sensor_id for p in pulses)
+        # each decoded pulse is the bag's pulse of that index, field for field (the generated
+        # pulses have random strings, some of them empty)
+        store = rig_typestore()
+        for p in pulses:
+            sent = store.deserialize_cdr(pulse_bytes(p.pulse_index, TIMES_NS[p.pulse_index]), "bearing_rig_msgs/msg/FibreOpticPulse")
+            assert (p.sensor_id, p.strip_id, p.revolution) == (sent.sensor_id, sent.strip_id, sent.revolution)
+            assert p.header.stamp.sec * 10**9 + p.header.stamp.nanosec == TIMES_NS[p.pulse_index]
         stamps = {t for topic, t, _ in client.received if topic == "/rig/cage/pulses"}
         assert stamps <= set(TIMES_NS) and stamps  # log time = the pulse's own stamp
         assert inner.sent.count("/rig/cage/pulses") >= len(TIMES_NS)  # still published to ROS

@@ -9,6 +9,12 @@ those of another test run on the same machine:
   workers, two checkouts) on one host never share a domain. Within a run each test gets an
   id no earlier test used until all 101 have been used.
 * ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``: discovery stays on this host.
+* A domain id some live process still runs on (read from ``/proc/<pid>/environ``: an orphan of
+  an earlier run killed before its teardown) is passed over, and at teardown any process left on
+  the test's domain (a grandchild its parent did not stop) is killed and named in a warning
+  before the id is released, so no test ever attaches to another test's node.
+* Children started through the fixture die with the test process (``PR_SET_PDEATHSIG``), even
+  when pytest itself is killed.
 
 Both variables are set in ``os.environ`` for the test (undone afterwards) and in
 :attr:`RosGraph.env` for subprocesses. Contexts, nodes, executors and subprocesses made
@@ -26,6 +32,7 @@ Example::
 
 from __future__ import annotations
 
+import ctypes
 import fcntl
 import os
 import random
@@ -34,6 +41,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 from typing import IO, Any
 from collections.abc import Callable, Iterator, Sequence
@@ -90,6 +98,10 @@ def lease_domain(timeout: float = 60.0) -> DomainLease:
             except BlockingIOError:
                 handle.close()
                 continue
+            if processes_on_domain(domain_id):  # an orphan still talks on it: not isolated
+                fcntl.flock(handle, fcntl.LOCK_UN)
+                handle.close()
+                continue
             _used_this_session.add(domain_id)
             if len(_used_this_session) == len(ids):
                 _used_this_session.clear()
@@ -101,8 +113,55 @@ def lease_domain(timeout: float = 60.0) -> DomainLease:
 
 
 
-def _default_sigint() -> None:  # runs in the child between fork and exec
+def processes_on_domain(domain_id: int) -> dict[int, str]:
+    """Live processes of this host (other than this one) whose environment sets
+    ``ROS_DOMAIN_ID=domain_id``: pid -> command line. Empty where ``/proc`` cannot be read."""
+    key = f"ROS_DOMAIN_ID={domain_id}".encode()
+    found: dict[int, str] = {}
+    try:
+        entries = os.listdir("/proc")
+    except OSError:
+        return found
+    for entry in entries:
+        if not entry.isdigit() or int(entry) == os.getpid():
+            continue
+        try:
+            with open(f"/proc/{entry}/environ", "rb") as handle:
+                if key not in handle.read().split(b"\0"):
+                    continue
+            with open(f"/proc/{entry}/cmdline", "rb") as handle:
+                command = handle.read().replace(b"\0", b" ").decode(errors="replace").strip()
+        except OSError:  # gone meanwhile, or another user's
+            continue
+        if command:  # a zombie has an empty command line and talks on no graph
+            found[int(entry)] = command
+    return found
+
+
+def kill_processes_on_domain(domain_id: int, timeout: float = 10.0) -> dict[int, str]:
+    """SIGKILL every process :func:`processes_on_domain` finds and wait (up to ``timeout`` s)
+    until none is left; returns what was killed."""
+    leaked = processes_on_domain(domain_id)
+    for pid in leaked:
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except OSError:
+            pass
+    deadline = time.monotonic() + timeout
+    while leaked and processes_on_domain(domain_id) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    return leaked
+
+
+def _prepare_child() -> None:  # runs in the child between fork and exec
+    """Default SIGINT (tests send Ctrl-C to children, and a suite started in the background of
+    a script would pass SIGINT on ignored), and SIGKILL when the test process dies (Linux
+    ``PR_SET_PDEATHSIG``), so no child outlives a killed pytest as an orphan on a domain."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
+    except (OSError, AttributeError):
+        pass
 
 class RosGraph:
     """One test's private ROS graph: its domain id, environment and the ROS objects to clean up.
@@ -194,9 +253,7 @@ class RosGraph:
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
             text=True,
-            # the default SIGINT, as from a terminal, even when the suite runs in the background
-            # of a script (which starts it with SIGINT ignored): tests send Ctrl-C to children
-            preexec_fn=_default_sigint,
+            preexec_fn=_prepare_child,
         )
         self._processes.append(process)
         return process
@@ -213,6 +270,13 @@ class RosGraph:
             except subprocess.TimeoutExpired:
                 process.kill()
                 process.communicate()
+        leaked = kill_processes_on_domain(self.domain_id)
+        if leaked:
+            warnings.warn(
+                f"processes left on ROS domain {self.domain_id} at teardown, killed: "
+                + "; ".join(f"{pid}: {command[:200]}" for pid, command in leaked.items()),
+                stacklevel=1,
+            )
         for executor in self._executors:
             executor.shutdown(timeout_sec=1.0)
         for node in self._nodes:

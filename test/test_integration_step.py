@@ -261,17 +261,14 @@ def test_a_session_ends_with_exit_1_naming_the_divergence(ros_graph: Any, tmp_pa
     """``bearing-rig run --attach`` on the diverging simulator (and the shipped load controller
     and monitor): the session ends, exit status 1, naming the divergence, instead of waiting for
     a clock that no longer moves."""
-    import subprocess
-    import sys
 
     ros_graph.spawn_python("-c", DIVERGING_SIMULATOR)
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
     program = tmp_path / "program.yaml"
     program.write_text(DIVERGING_PROGRAM, encoding="utf-8")
-    session = subprocess.Popen(
-        [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), "--attach", "--no-record"],
-        env=ros_graph.env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    session = ros_graph.spawn_python(
+        "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), "--attach", "--no-record"
     )
     out, err = session.communicate(timeout=150)
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"

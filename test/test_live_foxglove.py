@@ -13,8 +13,6 @@ import json
 import math
 import signal
 import struct
-import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -192,13 +190,7 @@ def test_a_live_session_serves_speeds_and_slip_status(ros_graph: Any, tmp_path: 
         "  - {name: n1500, speed_rpm: 1500, ramp_s: 0.5, axial_load_n: 100, dwell_s: 600}\n",
         encoding="utf-8",
     )
-    session = subprocess.Popen(
-        [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--bag-dir", str(tmp_path / "bags"), "--foxglove", "0"],
-        env=ros_graph.env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+    session = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "run", str(program), "--bag-dir", str(tmp_path / "bags"), "--foxglove", "0")
     client = None
     try:
         assert session.stdout is not None

@@ -18,7 +18,6 @@ import os
 import re
 import signal
 import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -67,12 +66,8 @@ verdict t_stable conditions."""
 def start_session(ros_graph: Any, tmp_path: Path, *extra: str, program_text: str = SHORT_PROGRAM) -> subprocess.Popen[str]:
     program = tmp_path / "program.yaml"
     program.write_text(program_text, encoding="utf-8")
-    return subprocess.Popen(
-        [sys.executable, "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), *extra],
-        env=ros_graph.env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
+    return ros_graph.spawn_python(  # tracked: stopped at teardown whatever the test's outcome
+        "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), *extra
     )
 
 

@@ -328,6 +328,20 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()
 
 
+def test_an_attached_session_refuses_a_graph_with_two_simulators(ros_graph: Any, tmp_path: Path) -> None:
+    """Two simulators on one domain (a stray twin beside the one meant, or a twin beside the
+    bench) would interleave two sim times and two bearings in one summary: the session ends,
+    exit 1, naming the topic and the two publishers."""
+    for _ in range(2):
+        ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    assert f"more than one rig on ROS domain {ros_graph.domain_id}: 2 nodes publish /rig/truth (/simulator, /simulator)" in out + err
+
+
 def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_graph: Any, tmp_path: Path) -> None:
     """The audit's case: a set-point from another node during a segment (30 N against the
     program's 100 N) gave "stable" and exit 0. Now the segment is marked and the run exits 3."""

@@ -49,7 +49,12 @@ from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, hea
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 from bearing_rig_sim.simulation.health import stopped_reason
 
-__all__ = ["DRAIN_PERIOD_S", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
+__all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
+
+ONE_PUBLISHER_TOPICS = (TRUTH.name, AXIAL_LOAD_STATE.name, SLIP_STATUS.name)
+"""Topics a session's graph must have one publisher of, each a node's own output: one simulator
+(its ground truth, not ``/clock``, which anyone may publish: a stray stamp is the clock guard's
+business), one load controller, one monitor."""
 
 DRAIN_PERIOD_S = 0.02
 """Wall time between two takes of the recorder's queues, s."""
@@ -206,6 +211,18 @@ class SessionNode(Node):
     def subscribers_besides_recorder(self, topic: str) -> int:
         """Subscriptions to ``topic`` other than the recorder's."""
         return sum(1 for info in self.get_subscriptions_info_by_topic(topic) if info.node_name != self.tap.get_name())
+
+    def rival_publishers(self) -> str:
+        """What makes the graph hold more than one rig: a description of every topic of
+        :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does).
+        Two simulators would interleave two sim times; two load controllers would fight over
+        the load; two monitors would give two verdicts."""
+        found = []
+        for topic in ONE_PUBLISHER_TOPICS:
+            names = sorted(f"{info.node_namespace.rstrip('/')}/{info.node_name}" for info in self.get_publishers_info_by_topic(topic))
+            if len(names) > 1:
+                found.append(f"{len(names)} nodes publish {topic} ({', '.join(names)})")
+        return "; ".join(found)
 
     def missing(self) -> dict[str, str]:
         """Which node is not ready yet, and what is missing (empty when all are ready)."""

@@ -73,6 +73,9 @@ EXIT_OK, EXIT_FAILED, EXIT_CONDITIONS, EXIT_INTERRUPTED = 0, 1, 3, 130
 program ran to its end but some segment's speed or load was not as commanded, or was changed from
 outside (the summary marks which); stopped by a signal."""
 
+GRAPH_CHECK_PERIOD_S = 0.5
+"""Wall time between two looks at the graph for a second rig, s (:meth:`Session._check_graph`)."""
+
 CHUNK_SIZE = 256 * 1024
 """Uncompressed bytes per bag chunk: about 0.5 s of the rig's traffic, the most a killed session
 loses, and a chunk compressed in some 15 ms, a short hold-up of the session's loop."""
@@ -299,6 +302,7 @@ class _Session:
             executor.add_node(self.node)
             self.node.create_timer(DRAIN_PERIOD_S, self._tick)
             self.node.create_timer(1.0, self._show_progress)
+            self.node.create_timer(GRAPH_CHECK_PERIOD_S, self._check_graph)
             self.deadline = time.monotonic() + self.options.startup_timeout_s
             while self.phase is not _Phase.ENDED:
                 executor.spin_once(timeout_sec=0.1)
@@ -486,6 +490,19 @@ class _Session:
             self.session_log.flush()
         if not self.options.quiet:
             self.printer.message(line)
+
+    def _check_graph(self) -> None:
+        """End the session when a second rig shares its graph (see
+        :meth:`SessionNode.rival_publishers`): its results would mix two rigs."""
+        if self.phase is _Phase.ENDED or self.node is None:
+            return
+        rivals = self.node.rival_publishers()
+        if rivals:
+            self._end(
+                EXIT_FAILED,
+                f"more than one rig on ROS domain {self.env['ROS_DOMAIN_ID']}: {rivals}; a session runs one rig: "
+                "stop the other nodes, or run this session on a ROS_DOMAIN_ID of its own",
+            )
 
     def _show_progress(self) -> None:
         if self.phase is _Phase.ENDED or self.node is None or self.options.quiet:

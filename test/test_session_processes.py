@@ -140,3 +140,46 @@ def test_the_programs_bearing_is_the_one_the_nodes_use(tmp_path: Path) -> None:
         "simulator": {"bearing_file": str(other.resolve()), "calibration_file": ""},
         "monitor": {"bearing_file": str(other.resolve())},
     }
+
+
+@pytest.mark.ros
+def test_parameter_arguments_reach_a_node_unchanged(ros_graph: object) -> None:
+    """What ``bearing-rig run`` passes with ``-p`` is read back by rcl as it was meant: an
+    empty string (an uncalibrated run's ``calibration_file``; bare it made rcl refuse the whole
+    command line), a path with ``: `` and ``#`` in it, strings that read as a boolean or a
+    number, a boolean and a float."""
+    import rclpy
+    from rclpy.node import Node
+
+    from bearing_rig_sim.session.context import parameter_arguments
+
+    values: dict[str, str | bool | int | float] = {
+        "empty": "", "path": "/data/bearings: v2 #1/h7006c.yaml", "word": "true", "digits": "1.5",
+        "flag": False, "rate": 2.5, "count": 3,
+    }
+    context = rclpy.Context()
+    rclpy.init(args=["probe", "--ros-args", *parameter_arguments(values)], context=context)
+    try:
+        node = Node("probe", context=context)
+        read = {name: node.declare_parameter(name, type(value)() if not isinstance(value, bool) else True).value for name, value in values.items()}
+        node.destroy_node()
+    finally:
+        context.try_shutdown()
+    assert read == values
+    assert all(type(read[k]) is type(v) for k, v in values.items())
+
+
+def test_a_program_naming_a_file_that_is_no_bearing_data_is_refused_at_load(tmp_path: Path) -> None:
+    """The audit's case: a program naming any readable file (here a rig file) got it embedded as
+    the run's bearing; now it is read as the simulator would read it, and refused by key."""
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.session.context import check_bearing_file
+
+    program = tmp_path / "p.yaml"
+    program.write_text(
+        config_path("programs", "validation.yaml").read_text(encoding="utf-8").replace("bearings/h7006c.yaml", str(config_path("rig.yaml"))),
+        encoding="utf-8",
+    )
+    with pytest.raises(ConfigError, match=r"p\.yaml: bearing: not usable bearing data: .*rig\.yaml"):
+        check_bearing_file(load_program(program), program)
+    check_bearing_file(load_program(config_path("programs", "validation.yaml")), "validation.yaml")  # the shipped one reads

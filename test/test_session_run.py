@@ -15,6 +15,7 @@ the assertion expects it on any machine, however loaded.
 from __future__ import annotations
 
 import os
+import json
 import re
 import signal
 import subprocess
@@ -31,6 +32,7 @@ from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
 
 from bearing_rig_sim.bags import open_bag, rig_typestore
+from bearing_rig_sim.config import config_path
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -200,6 +202,25 @@ def child_pid(parent: int, script: str) -> int:
         if int(fields[1]) == parent and script in cmdline:
             return int(stat.parent.name)
     raise AssertionError(f"no child of {parent} runs {script}")
+
+
+def test_a_program_naming_another_bearing_file_runs_on_it(ros_graph: Any, tmp_path: Path) -> None:
+    """A program whose ``bearing`` is the user's own file (here a copy, in a folder whose name
+    has ``: `` and ``#`` in it): the simulator simulates that file, uncalibrated, and the run
+    ends normally. A bare ``-p calibration_file:=`` used to make rcl refuse the simulator's
+    command line."""
+    folder = tmp_path / "bearings: v2 #1"
+    folder.mkdir()
+    bearing = folder / "h7006c_variant.yaml"
+    bearing.write_text(config_path("bearings", "h7006c.yaml").read_text(encoding="utf-8"), encoding="utf-8")
+    text = SHORT_PROGRAM.replace("bearings/h7006c.yaml", json.dumps(str(bearing)))
+    session = start_session(ros_graph, tmp_path, "--no-record", program_text=text)
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    assert [row[1] for row in summary_rows(out)] == ["load_up", "n0900", "n1500"]
+    (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
+    log = (run / "logs" / "simulator.log").read_text(encoding="utf-8")
+    assert "simulating h7006c_variant.yaml" in log, log[-2000:]
 
 
 def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_path: Path) -> None:

@@ -18,6 +18,7 @@ metadata as string key/value pairs, so a bag says how it was made:
 
 from __future__ import annotations
 
+import json
 import re
 import shlex
 from datetime import datetime, UTC
@@ -27,13 +28,13 @@ from collections.abc import Mapping, Sequence
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.rig.program import TestProgram
 
-__all__ = ["NODE_PARAMETER_FILES", "make_run_id", "node_parameters", "run_context"]
+__all__ = ["NODE_PARAMETER_FILES", "check_bearing_file", "make_run_id", "node_parameters", "parameter_arguments", "run_context"]
 
 NODE_PARAMETER_FILES = ("simulator", "load_controller", "monitor")
 """Nodes whose ``config/<node>.yaml`` is recorded."""
 
 
-def node_parameters(program: TestProgram, simulator_defaults: Mapping[str, object]) -> dict[str, dict[str, str]]:
+def node_parameters(program: TestProgram, simulator_defaults: Mapping[str, object]) -> dict[str, dict[str, str | bool | int | float]]:
     """``-p`` overrides per node that make the nodes use the program's bearing file.
 
     The simulator and the monitor read their bearing file from their parameters; a program that
@@ -55,6 +56,45 @@ def node_parameters(program: TestProgram, simulator_defaults: Mapping[str, objec
         "simulator": {"bearing_file": bearing, "calibration_file": ""},
         "monitor": {"bearing_file": bearing},
     }
+
+
+def parameter_arguments(values: Mapping[str, str | bool | int | float]) -> list[str]:
+    """``-p name:=value`` ROS arguments for ``values``, each value written so that rcl's YAML
+    reading gives it back unchanged: booleans as ``true``/``false``, numbers as they are,
+    strings double-quoted (an empty string, a path with ``: `` or ``#`` in it, a string that
+    reads as a number or a boolean all stay strings).
+
+    Raises:
+        TypeError: a value of another type.
+    """
+    arguments = []
+    for name, value in values.items():
+        if isinstance(value, bool):
+            text = "true" if value else "false"
+        elif isinstance(value, (int, float)):
+            text = repr(value)
+        elif isinstance(value, str):
+            text = json.dumps(value)  # a JSON string is a YAML double-quoted scalar
+        else:
+            raise TypeError(f"parameter {name}: cannot pass a {type(value).__name__} on the command line")
+        arguments += ["-p", f"{name}:={text}"]
+    return arguments
+
+
+def check_bearing_file(program: TestProgram, program_file: str | Path) -> None:
+    """Read the program's bearing file as the simulator will (every key, unit and range), so a
+    file that is no bearing data is refused when the program is loaded, not by a node later.
+
+    Raises:
+        ConfigError: naming the program file, its ``bearing`` key and what is wrong.
+    """
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.dynamics.parameters import BearingParameters  # numba: only where a run starts
+
+    try:
+        BearingParameters.from_yaml(program.bearing_file)
+    except (ConfigError, ValueError) as exc:
+        raise ConfigError(str(program_file), "bearing", f"not usable bearing data: {exc}") from None
 
 
 def make_run_id(program_name: str, start: datetime) -> str:

@@ -50,7 +50,7 @@ from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_par
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
-from bearing_rig_sim.session.context import make_run_id, node_parameters, run_context
+from bearing_rig_sim.session.context import check_bearing_file, make_run_id, node_parameters, parameter_arguments, run_context
 from bearing_rig_sim.session.lifecycle import TransitionRecord, bring_up, shut_down
 from bearing_rig_sim.session.processes import (
     NODES,
@@ -134,16 +134,18 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     out = out if out is not None else sys.stdout
     err = err if err is not None else sys.stderr
     program = load_program(options.program)  # checked against the shipped rig, as the nodes use it
+    if not options.attach:  # attached, the simulator's own bearing file is the one it uses
+        check_bearing_file(program, options.program)
     commands = {} if options.attach else {name: node_command(spec) for name, spec in NODES.items()}
     simulator_defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
     overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime and not options.attach:
-        overrides.setdefault("simulator", {})["realtime"] = "false"
+        overrides.setdefault("simulator", {})["realtime"] = False
     if not options.attach:  # attached: the nodes' parameters are whoever started them's
         # the monitor judges slip against what the program's stability_criterion names
         overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion
     for name, values in overrides.items():
-        commands[name] = [*commands[name], "--ros-args", *(a for k, v in values.items() for a in ("-p", f"{k}:={v}"))]
+        commands[name] = [*commands[name], "--ros-args", *parameter_arguments(values)]
     if options.params_file is not None:
         params = Path(options.params_file)
         if not params.is_file():

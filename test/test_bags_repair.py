@@ -211,6 +211,29 @@ def test_corrupt_chunk_is_dropped_by_the_repair(tmp_path: Path) -> None:
         assert sum(1 for _ in reader.messages()) == total - lost
 
 
+def test_a_damaged_header_length_loses_no_message(tmp_path: Path) -> None:
+    """The header record's length field overwritten (2^62): the data and the summary at the
+    end are intact, so every message is still read (counted by the mcap library on an intact
+    copy), the damage is reported, and a repair writes a sound file with all of them."""
+    import struct
+
+    bag = tmp_path / "run"
+    record_traffic(bag)
+    file = bag / "run_0.mcap"
+    total = sum(n for _s, _e, n in chunk_bounds(file))
+    data = bytearray(file.read_bytes())
+    assert data[8] == 0x01  # the header record's opcode follows the 8-byte magic (MCAP spec)
+    data[9:17] = struct.pack("<Q", 1 << 62)
+    file.write_bytes(bytes(data))
+
+    with pytest.warns(BagWarning, match="the MCAP header record is damaged"), open_bag(bag) as reader:
+        assert sum(1 for _ in reader.messages()) == total
+    report = repair_bag(bag)
+    assert report.messages_recovered == total and report.messages_lost == 0
+    with open(file, "rb") as stream:
+        assert sum(1 for _ in make_reader(stream).iter_messages()) == total
+
+
 def test_every_chunk_damaged_is_every_message_lost(tmp_path: Path) -> None:
     bag = tmp_path / "run"
     record_traffic(bag)

@@ -208,14 +208,14 @@ def read_layout(bag_dir: Path) -> BagLayout:
     except FileNotFoundError:
         raise BagError(
             f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory (if a recording was "
-            "interrupted, `repair_bag` rebuilds it from the .mcap files)"
+            f"interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
         ) from None
     except OSError as exc:
         raise BagError(f"{source}: cannot read ({exc})") from None
     try:
         doc = parse_yaml(text, source)
     except ConfigError as exc:
-        raise BagError(f"{exc} (corrupt metadata; `repair_bag` rebuilds it)") from None
+        raise BagError(f"{exc} (corrupt metadata; `bearing-rig bag repair {bag_dir}` rebuilds it)") from None
     info = _get(doc, "rosbag2_bagfile_information", source, dict, "")
     where = "rosbag2_bagfile_information."
     version = _get(info, "version", source, int, where)

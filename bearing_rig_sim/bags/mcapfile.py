@@ -81,7 +81,8 @@ class FileIndex:
     Attributes:
         path: the file.
         indexed: True when the file had a valid summary (it was finished properly).
-        has_header: False when the file ends before its header record (nothing readable).
+        has_header: False when the file ends before its header record (nothing readable); True
+            also for a damaged header when the summary at the end locates the data.
         profile / library: from the header record.
         schemas / channels: by id.
         chunks: message groups, in file order.
@@ -403,6 +404,13 @@ def index_file(path: Path) -> FileIndex:
         length = struct.unpack_from("<Q", head, 1)[0] if len(head) == 9 else 0
         body = stream.read(min(length, 1 << 20)) if len(head) == 9 else b""
         if len(head) < 9 or len(body) < length:
+            if len(head) == 9 and _footer_ok(stream, index.file_size) and _index_from_summary(stream, index):
+                index.has_header = True  # its data are readable: the header holds only two names
+                index.problems.append(  # a damaged length field; the summary still finds every chunk
+                    f"{path.name}: the MCAP header record is damaged (it claims {length} bytes of a "
+                    f"{index.file_size}-byte file); read through the file's summary"
+                )
+                return index
             index.problems.append(
                 f"{path.name}: file ends after {index.file_size} bytes, before its header is complete "
                 "(recording interrupted as it started?): no data"
@@ -422,7 +430,7 @@ def index_file(path: Path) -> FileIndex:
         if not index.problems:
             index.problems.append(
                 f"{path.name}: no valid summary (index) at the end of the file; all "
-                f"{index.message_count} messages are readable, `repair_bag` restores the index"
+                f"{index.message_count} messages are readable, `bearing-rig bag repair` on its bag restores the index"
             )
     return index
 

@@ -338,7 +338,7 @@ class BagReader:
         if stated != held:
             self._report(
                 f"{self.path / 'metadata.yaml'}: states {stated} messages but the files hold {held} readable ones "
-                "(stale metadata after an interrupted recording? `repair_bag` rewrites it)"
+                f"(stale metadata after an interrupted recording? `bearing-rig bag repair {self.path}` rewrites it)"
             )
 
     def _decoder(self, msgtype: str) -> Callable[[bytes], object]:

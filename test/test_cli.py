@@ -218,6 +218,25 @@ def test_analyze_out_that_cannot_be_a_folder(tmp_path: Path, capsys: pytest.Capt
     assert f"--out {in_the_way / 'sub'}: cannot create the folder" in err
 
 
+@pytest.mark.parametrize("command", ["reproduce", "sweep", "shadow"])
+def test_every_out_folder_is_checked_before_the_work(command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--out`` under a file: one line naming the option, where a traceback came after the
+    work (``reproduce``)."""
+    from bearing_rig_sim.config import config_path
+
+    in_the_way = tmp_path / "file"
+    in_the_way.write_text("")
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    first = {"reproduce": [], "sweep": [str(config_path("sweeps", "paper_load_grid.yaml"))], "shadow": ["--bag", str(bag)]}[command]
+    err = one_line_error([command, *first, "--out", str(in_the_way / "sub")], capsys)
+    assert f"--out {in_the_way / 'sub'}: cannot create the folder" in err
+
+
+def test_reproduce_refuses_a_worker_count_below_one(capsys: pytest.CaptureFixture[str]) -> None:
+    assert "--workers must be >= 1, got 0" in one_line_error(["reproduce", "--workers", "0"], capsys)
+
+
 def test_calibrate_writes_under_out_by_default_and_never_replaces_a_file_unasked(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -206,10 +206,12 @@ def read_layout(bag_dir: Path) -> BagLayout:
     try:
         text = path.read_bytes()
     except FileNotFoundError:
-        raise BagError(
-            f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory (if a recording was "
-            f"interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
-        ) from None
+        hint = (
+            f" (if a recording was interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
+            if bag_dir.is_dir() and any(bag_dir.glob("*.mcap"))
+            else ""
+        )
+        raise BagError(f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory{hint}") from None
     except OSError as exc:
         raise BagError(f"{source}: cannot read ({exc})") from None
     try:

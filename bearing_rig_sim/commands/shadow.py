@@ -61,10 +61,11 @@ def run(args: argparse.Namespace) -> int:
         settings = settings.replace(recalibrate=True, recalibrate_parameter=args.recalibrate or settings.recalibrate_parameter)
     if args.bag is None:
         return _live(args, settings)
+    from bearing_rig_sim.commands import output_folder
     from bearing_rig_sim.commands.bag import bag_warnings_as_lines
     from bearing_rig_sim.shadow.offline import shadow_bag
 
-    out = args.out if args.out is not None else Path("out") / "shadow" / args.bag.resolve().name
+    out = output_folder(args.out if args.out is not None else Path("out") / "shadow" / args.bag.resolve().name, "--out")
     with bag_warnings_as_lines():
         result = shadow_bag(args.bag, out, settings)
     c = result.counts

@@ -33,6 +33,7 @@ def run(args: argparse.Namespace) -> int:
     """Run the sweep, write the table and the map, print a summary."""
     import pyarrow.parquet as pq
 
+    from bearing_rig_sim.commands import output_folder
     from bearing_rig_sim.errors import RigError
     from bearing_rig_sim.sweep.operating_map import boundaries, plot_operating_map
     from bearing_rig_sim.sweep.points import INTEGRATE, SOLVE
@@ -42,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     if args.workers is not None and args.workers < 1:
         raise RigError(f"--workers must be >= 1, got {args.workers}")
     spec = load_spec(args.spec)
-    out = args.out or Path("sweeps") / spec.name
+    out = output_folder(args.out or Path("sweeps") / spec.name, "--out")  # before the points run
     outcome = run_sweep(
         spec, out, scheduler=args.scheduler, workers=args.workers, method=INTEGRATE if args.integrate else SOLVE, progress=not args.no_progress
     )

@@ -183,3 +183,40 @@ def test_a_program_naming_a_file_that_is_no_bearing_data_is_refused_at_load(tmp_
     with pytest.raises(ConfigError, match=r"p\.yaml: bearing: not usable bearing data: .*rig\.yaml"):
         check_bearing_file(load_program(program), program)
     check_bearing_file(load_program(config_path("programs", "validation.yaml")), "validation.yaml")  # the shipped one reads
+
+
+@pytest.mark.parametrize(
+    "text, problem",
+    [
+        ("root:x:0:0:root:/root:/bin/bash\n", "maps node names to blocks; its top level is a str"),
+        ("simulater:\n  ros__parameters:\n    rate: 2.0\n", "simulater: no node of a session has this name (its nodes: simulator, load_controller, monitor; did you mean simulator?)"),
+        ("load_controller:\n  ros__parameters:\n    kp: 3.0\n", "load_controller.ros__parameters.kp: load_controller has no such parameter"),
+        ("/**:\n  ros__parameters:\n    nosuch: 1\n", "/**.ros__parameters.nosuch: simulator load_controller monitor have no such parameter"),
+        ("simulator:\n  ros__parameters:\n    rate: -5.0\n", "simulator.ros__parameters: rate: must be > 0"),
+        ("simulator:\n  ros__parameters:\n    rate: fast\n", "simulator.ros__parameters: rate: must be a number"),
+        ("monitor:\n  rate: 2.0\n", "monitor: must be a mapping with a ros__parameters mapping"),
+    ],
+)
+def test_a_parameter_file_is_checked_against_the_nodes_before_a_run(tmp_path: Path, text: str, problem: str) -> None:
+    """rclpy drops a parameter no node declares without a word, so a misspelt name or node
+    would change nothing; each case is refused by name before any node starts."""
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.session.context import check_parameter_file
+
+    path = tmp_path / "params.yaml"
+    path.write_text(text, encoding="utf-8")
+    with pytest.raises(ConfigError) as caught:
+        check_parameter_file(path)
+    assert str(caught.value).startswith(f"{path}: ") and problem in str(caught.value), str(caught.value)
+
+
+def test_a_sound_parameter_file_passes(tmp_path: Path) -> None:
+    from bearing_rig_sim.session.context import check_parameter_file
+
+    path = tmp_path / "params.yaml"
+    path.write_text(
+        "/**:\n  ros__parameters:\n    use_sim_time: false\n    rate: 2.0\n"
+        "/rig/load_controller:\n  ros__parameters:\n    use_sim_time: true\n",
+        encoding="utf-8",
+    )
+    check_parameter_file(path)

@@ -155,19 +155,23 @@ def lifecycle_diagnostics(bag: Path) -> list[tuple[str, str]]:
 
 
 def test_a_node_failing_to_configure_is_named_and_the_bag_finalised(ros_graph: Any, tmp_path: Path) -> None:
+    # a file that exists (the settings check before start passes) but holds no bearing geometry,
+    # which the monitor reads only in on_configure
+    hollow = tmp_path / "hollow_bearing.yaml"
+    hollow.write_text("geometry: {}\n", encoding="utf-8")
     params = tmp_path / "params.yaml"
-    params.write_text("monitor:\n  ros__parameters:\n    bearing_file: bearings/missing.yaml\n", encoding="utf-8")
+    params.write_text(f"monitor:\n  ros__parameters:\n    bearing_file: {json.dumps(str(hollow))}\n", encoding="utf-8")
     session = start_session(ros_graph, tmp_path, "--params-file", str(params))
     out, err = session.communicate(timeout=120)
     assert session.returncode == 1, f"{out[-3000:]}\n{err[-3000:]}"
-    assert "the monitor node failed to configure: " in err and "missing.yaml" in err, err[-3000:]
+    assert "the monitor node failed to configure: " in err and "hollow_bearing.yaml" in err, err[-3000:]
     assert "summary (failed)" in out
     lines = [line for line in out.splitlines() if line.startswith("lifecycle: ")]
     assert lines[:2] == [
         "lifecycle: simulator configure: unconfigured -> inactive",
         "lifecycle: load_controller configure: unconfigured -> inactive",
     ]
-    assert lines[2].startswith("lifecycle: monitor configure FAILED, stays unconfigured: ") and "missing.yaml" in lines[2]
+    assert lines[2].startswith("lifecycle: monitor configure FAILED, stays unconfigured: ") and "hollow_bearing.yaml" in lines[2]
     assert lines[3:] == [
         "lifecycle: load_controller cleanup: inactive -> unconfigured",
         "lifecycle: simulator cleanup: inactive -> unconfigured",

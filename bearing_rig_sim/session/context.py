@@ -28,7 +28,7 @@ from collections.abc import Mapping, Sequence
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.rig.program import TestProgram
 
-__all__ = ["NODE_PARAMETER_FILES", "check_bearing_file", "make_run_id", "node_parameters", "parameter_arguments", "run_context"]
+__all__ = ["NODE_PARAMETER_FILES", "check_bearing_file", "check_parameter_file", "make_run_id", "node_parameters", "parameter_arguments", "run_context"]
 
 NODE_PARAMETER_FILES = ("simulator", "load_controller", "monitor")
 """Nodes whose ``config/<node>.yaml`` is recorded."""
@@ -95,6 +95,80 @@ def check_bearing_file(program: TestProgram, program_file: str | Path) -> None:
         BearingParameters.from_yaml(program.bearing_file)
     except (ConfigError, ValueError) as exc:
         raise ConfigError(str(program_file), "bearing", f"not usable bearing data: {exc}") from None
+
+
+def _flatten(block: Mapping[object, object], prefix: str = "") -> dict[str, object]:
+    """ROS 2 parameter names of a ``ros__parameters`` block: nested mappings join with ``.``."""
+    flat: dict[str, object] = {}
+    for key, value in block.items():
+        name = f"{prefix}{key}"
+        if isinstance(value, dict):
+            flat.update(_flatten(value, f"{name}."))
+        else:
+            flat[name] = value
+    return flat
+
+
+def check_parameter_file(path: Path) -> None:
+    """Check a ``--params-file`` against the session's nodes before any starts: every block is
+    for one of them (by name, ``/ns/name``, or a wildcard ``/**``), every parameter is one the
+    node declares (rclpy silently drops the others: a misspelt name would change nothing), and
+    each node's values, laid over its shipped ones, pass its settings check (types, units,
+    ranges), as they will at configure.
+
+    Raises:
+        ConfigError: naming the file, the block and key, and what is wrong (with the names a
+            misspelt one may have meant).
+    """
+    import difflib
+
+    from bearing_rig_sim.config import ConfigError, read_yaml_file
+    from bearing_rig_sim.load_control.settings import LoadControllerSettings
+    from bearing_rig_sim.monitoring.settings import MonitorSettings, shipped_parameters as monitor_shipped
+    from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS
+    from bearing_rig_sim.simulation.settings import SimulatorSettings
+
+    source = str(path)
+    data = read_yaml_file(path)
+    if not isinstance(data, dict):
+        raise ConfigError(source, "", f"a ROS 2 parameter file maps node names to blocks; its top level is a {type(data).__name__}")
+    nodes = list(NODE_PARAMETERS)
+    given: dict[str, dict[str, object]] = {name: {} for name in nodes}
+    for key, block in data.items():
+        last = str(key).rstrip("/").rsplit("/", 1)[-1]
+        wildcard = last in ("*", "**")
+        if not wildcard and last not in NODE_PARAMETERS:
+            near = difflib.get_close_matches(last, nodes, n=1)
+            raise ConfigError(
+                source, str(key), f"no node of a session has this name (its nodes: {', '.join(nodes)}"
+                + (f"; did you mean {near[0]}?)" if near else ")")
+            )
+        params = block.get("ros__parameters") if isinstance(block, dict) else None
+        if not isinstance(params, dict):
+            raise ConfigError(source, str(key), "must be a mapping with a ros__parameters mapping")
+        targets = nodes if wildcard else [last]
+        for name, value in _flatten(params).items():
+            known = [n for n in targets if name in NODE_PARAMETERS[n] or name == "use_sim_time"]
+            if not known:
+                names = sorted({p for n in targets for p in NODE_PARAMETERS[n]})
+                near = difflib.get_close_matches(name, names, n=1)
+                raise ConfigError(
+                    source, f"{key}.ros__parameters.{name}",
+                    f"{' '.join(targets)} {'has' if len(targets) == 1 else 'have'} no such parameter"
+                    + (f"; did you mean {near[0]}?" if near else f" (see config/{targets[0]}.yaml)"),
+                )
+            for n in known:
+                given[n][name] = value
+    shipped = {
+        "simulator": (SimulatorSettings.shipped_parameters, SimulatorSettings.from_values),
+        "load_controller": (LoadControllerSettings.shipped_parameters, LoadControllerSettings.from_values),
+        "monitor": (monitor_shipped, MonitorSettings.from_values),
+    }
+    for node, values in given.items():
+        values.pop("use_sim_time", None)
+        if values:
+            defaults, validate = shipped[node]
+            validate({**defaults(), **values}, f"{source}: {node}.ros__parameters")
 
 
 def make_run_id(program_name: str, start: datetime) -> str:

@@ -50,7 +50,7 @@ from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_par
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
-from bearing_rig_sim.session.context import check_bearing_file, make_run_id, node_parameters, parameter_arguments, run_context
+from bearing_rig_sim.session.context import check_bearing_file, check_parameter_file, make_run_id, node_parameters, parameter_arguments, run_context
 from bearing_rig_sim.session.lifecycle import TransitionRecord, bring_up, shut_down
 from bearing_rig_sim.session.processes import (
     NODES,
@@ -150,6 +150,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
         params = Path(options.params_file)
         if not params.is_file():
             raise RigError(f"--params-file: no such file: {params}")
+        if not options.attach:
+            check_parameter_file(params)
         for name in commands:
             commands[name] = commands[name] + ["--ros-args", "--params-file", str(params.resolve())]
     start = datetime.now(UTC)

@@ -297,3 +297,62 @@ def test_monitor_warns_of_lost_pulses_with_counts_and_no_fault(ros_graph):
     probe.wait(lambda: any(d.level == DiagnosticStatus.WARN and lost_cage(d) >= 20 for d in probe.diag("monitor")), "WARN with the lost pulses")
     probe.wait(lambda: bool(probe.status) and probe.status[-1].state == SlipStatus.STATE_STABLE, "a stable verdict at the end")
     assert all(s.state != SlipStatus.STATE_FAULT for s in probe.status)
+
+
+STOPPABLE_READER = """
+import rclpy
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock
+from bearing_rig_sim.interfaces import CLOCK
+from bearing_rig_sim.nodes.common import qos_profile
+rclpy.init()
+node = Node("slow_reader")
+seen = []
+def first(msg):
+    if not seen:
+        print("got the clock", flush=True)
+    seen.append(1)
+node.create_subscription(Clock, "/clock", first, qos_profile(CLOCK))  # reliable, as the recorder
+rclpy.spin(node)
+"""
+
+
+@pytest.mark.slow
+def test_without_real_time_the_simulator_waits_for_a_reliable_reader_then_goes_on(ros_graph):
+    """Without real time the simulator runs only as fast as its reliable readers acknowledge
+    (the recorder loses nothing): a reader process stopped with SIGSTOP holds the simulated time
+    still, seen as periodic reports with one sim time; after ACK_GIVE_UP_S of wall time the
+    simulator warns and goes on, and does not wait for that reader again."""
+    import os
+    import select
+
+    from bearing_rig_sim.nodes.simulator import ACK_GIVE_UP_S
+
+    reader = ros_graph.spawn_python("-c", STOPPABLE_READER)
+    start(ros_graph, "simulator", flags=("--no-realtime",))
+    probe = Probe(ros_graph)
+    assert reader.stdout is not None
+    ready, _, _ = select.select([reader.stdout], [], [], WAIT)
+    assert ready and reader.stdout.readline().strip() == "got the clock"
+    os.kill(reader.pid, signal.SIGSTOP)
+    try:
+        def warned() -> bool:
+            return any("went on without a reliable reader: /clock" in s.message for s in probe.diag("simulator"))
+
+        probe.wait(warned, "the simulator to give up on the stopped reader", timeout=ACK_GIVE_UP_S + WAIT)
+        reports = probe.diag("simulator")
+        i = next(k for k, s in enumerate(reports) if "went on without a reliable reader" in s.message)
+        times = [float({kv.key: kv.value for kv in s.values}["sim_time_s"]) for s in reports[:i]]
+        held = times[-1]
+        # held: at 1 report a second, most of the ACK_GIVE_UP_S wait shows one sim time
+        assert sum(1 for t in times if t == held) >= ACK_GIVE_UP_S / 2, times[-15:]
+        assert {kv.key: kv.value for kv in reports[i].values}["reader_stalls"] == "1"
+
+        def went_on() -> bool:
+            return any(float({kv.key: kv.value for kv in s.values}["sim_time_s"]) > held + 2.0 for s in probe.diag("simulator")[i:])
+
+        probe.wait(went_on, "the simulated time to go on without the stopped reader")
+        # and it went on without waiting again (each wait would be a stall of its own)
+        assert {kv.key: kv.value for kv in probe.diag("simulator")[-1].values}["reader_stalls"] == "1"
+    finally:
+        os.kill(reader.pid, signal.SIGCONT)

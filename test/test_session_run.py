@@ -353,6 +353,36 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()
 
 
+BEST_EFFORT_PULSE_SIMULATOR = """
+import sys
+import bearing_rig_sim.nodes.common as common
+from bearing_rig_sim.interfaces import CAGE_PULSES, SPINDLE_PULSES
+contract = common.qos_profile
+def bench_like(topic):  # a bench's counter driver: pulses as plain sensor data
+    return common.SENSOR_QOS if topic in (SPINDLE_PULSES, CAGE_PULSES) else contract(topic)
+common.qos_profile = bench_like
+from bearing_rig_sim.nodes.simulator import main
+sys.exit(main(["simulator", "--autostart", "--no-realtime"]))
+"""
+
+
+def test_an_attached_session_records_pulses_a_bench_publishes_best_effort(ros_graph: Any, tmp_path: Path) -> None:
+    """Attached to nodes whose pulse writers offer only best effort (as a bench's counter
+    driver may), the recorder reads those topics best effort and records them; a reliable
+    reader is incompatible with such a writer and recorded nothing."""
+    ros_graph.spawn_python("-c", BEST_EFFORT_PULSE_SIMULATOR)
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    session = start_session(ros_graph, tmp_path, "--attach")
+    out, err = session.communicate(timeout=150)
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    for topic in ("/rig/spindle/pulses", "/rig/cage/pulses"):
+        assert f"recording {topic} best effort: /simulator publishes it best effort" in out, out[-3000:]
+    counts = check_bag_decodes(the_bag(tmp_path))
+    assert counts.get("/rig/spindle/pulses", 0) > 0 and counts.get("/rig/cage/pulses", 0) > 0, counts
+    assert "recording /rig/speeds best effort" not in out  # the contract's reliable streams stay reliable
+
+
 def test_an_attached_session_refuses_a_graph_with_two_simulators(ros_graph: Any, tmp_path: Path) -> None:
     """Two simulators on one domain (a stray twin beside the one meant, or a twin beside the
     bench) would interleave two sim times and two bearings in one summary: the session ends,

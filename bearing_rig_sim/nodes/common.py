@@ -23,6 +23,7 @@ from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedE
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
+from bearing_rig_sim.dds_profile import use_rig_profile
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import Topic
@@ -188,6 +189,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
             start out of its range or of the wrong type); an unknown executor kind.
     """
     args, autostart = split_autostart(sys.argv if argv is None else argv)
+    use_rig_profile()  # the rig's Fast DDS profile unless the user gave one (writer heartbeat)
     try:
         rclpy.init(args=ros_args_with_defaults(node_name, args))
     except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line

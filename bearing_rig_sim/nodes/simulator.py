@@ -1,16 +1,16 @@
 """The simulator node: the rig's digital twin on the bench's topics (a thin shell around
 :class:`~bearing_rig_sim.simulation.twin.RigTwin`).
 
-Publishes (interface table, docs/interfaces.md):
+Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, history 5000):
 
-* ``/clock`` (rosgraph_msgs/Clock, reliable, depth 10): the simulated time, once per chunk
+* ``/clock`` (rosgraph_msgs/Clock, reliable stream): the simulated time, once per chunk
   (1 kHz simulated with 1 ms chunks), so the other nodes can run on ``use_sim_time``;
-* ``/rig/spindle/pulses``, ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse, sensor data):
-  one per strip passage, stamped with the pulse time on the simulated clock;
-* ``/rig/speeds`` (sensor_msgs/JointState, sensor data, ``speeds_rate_hz`` simulated): names
+* ``/rig/spindle/pulses``, ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse, reliable
+  stream): one per strip passage, stamped with the pulse time on the simulated clock;
+* ``/rig/speeds`` (sensor_msgs/JointState, reliable stream, ``speeds_rate_hz`` simulated): names
   ``inner_ring`` and ``cage``, velocity from the pulse counters (rad/s), position the
   pulse-counted angle (rad), effort empty;
-* ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, sensor data, ``truth_rate_hz`` simulated):
+* ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, reliable stream, ``truth_rate_hz`` simulated):
   the engine's ground truth with the achieved real-time factor and the overrun count;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
   on every change of level (see :mod:`bearing_rig_sim.health`).
@@ -23,8 +23,11 @@ logged reason and an ERROR on /diagnostics; the node goes on.
 
 One timer on the steady clock drives the loop (no threads), and sends the periodic diagnostics
 when due: in real time it runs the chunks the wall clock asks for (:class:`~bearing_rig_sim.simulation.pacing.RealTimePacer`), otherwise a
-batch of ``max_batch_chunks`` per call, as fast as possible. ``simulator --no-realtime`` sets
-the parameter ``realtime`` to false.
+batch of ``max_batch_chunks`` per call, as fast as its reliable readers take the streams: every
+:data:`ACK_WINDOW_CHUNKS` chunks the loop waits until each reliable reader (the session's
+recorder) has acknowledged all it was sent, so no sample leaves the writers' history unread and a
+recording holds every message. ``simulator --no-realtime`` sets the parameter ``realtime`` to
+false.
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
 drive, sensors), publishers, subscriptions and timers are made at configure; the simulated time
@@ -44,6 +47,7 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
+from rclpy.duration import Duration
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -79,11 +83,32 @@ NO_REALTIME_FLAG = "--no-realtime"
 
 MAX_UINT32 = 2**32 - 1
 
-FORCE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+FORCE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT)
 """The force reader: best effort, deep enough for 1 s at 1 kHz. Each loop applies the latest force
 queued, so a sample lost in transport is superseded by the next one a millisecond later; a
 reliable reader here cost the load controller some 3 % of a core in acknowledgements. (The
 recorder reads the force reliably: the publisher is reliable.)"""
+
+
+ACK_WINDOW_CHUNKS = 2000
+"""Without real time, chunks published between two waits for every reliable reader (the
+session's recorder above all) to acknowledge all it was sent. The reliable streams keep 5000
+samples for a reader that has not acknowledged them (the contract's history); a 1 kHz stream
+publishes one per chunk, so a window of 2000 keeps every sample a slow reader still needs in the
+writer's history, and the run goes as fast as its slowest reliable reader, never faster. Readers
+acknowledge when a writer's heartbeat asks: every 50 ms with the rig's Fast DDS profile
+(:mod:`bearing_rig_sim.dds_profile`), so a wait costs a few tens of milliseconds per window;
+under Fast DDS's default of 3 s, a window would wait up to 3 s. (In real time the pace is the
+wall clock's: a reader that falls 5 s behind loses samples, as on a bench.)"""
+
+ACK_POLL_S = 0.005
+"""Longest block on one acknowledgement check, s of wall time; the loop then yields to the
+executor (commands, lifecycle services) and checks again."""
+
+ACK_GIVE_UP_S = 10.0
+"""Wall time a reader may acknowledge nothing (a stopped process) before the loop goes on
+without it, with a WARN on /diagnostics, s; it is not waited for again until every reader has
+caught up."""
 
 
 class SimulatorNode(ManagedNode):
@@ -129,6 +154,13 @@ class SimulatorNode(ManagedNode):
         self._speeds_every = max(1, round(1.0 / (s.speeds_rate_hz * s.chunk_s)))
         self._truth_every = max(1, round(1.0 / (s.truth_rate_hz * s.chunk_s)))
         self._chunks = 0
+        self._acked_chunks = 0
+        """Chunks published when every reliable reader had last acknowledged all it was sent."""
+        self._held_since: float | None = None
+        """Wall time (monotonic) the loop began waiting for acknowledgements, or None."""
+        self._gave_up = False
+        """A reader stayed unacknowledging past :data:`ACK_GIVE_UP_S`; not waited for again until
+        every reader has acknowledged all."""
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
         self._anchor = True
@@ -141,6 +173,13 @@ class SimulatorNode(ManagedNode):
         self._speeds_pub = self.publisher(JointState, SPEEDS.name, qos_profile(SPEEDS))
         self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, qos_profile(TRUTH))
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self._stream_pubs = {
+            topic.name: pub
+            for topic, pub in (
+                (CLOCK, self._clock_pub), (SPINDLE_PULSES, self._pulse_pubs["spindle"]), (CAGE_PULSES, self._pulse_pubs["cage"]),
+                (SPEEDS, self._speeds_pub), (TRUTH, self._truth_pub),
+            )
+        }
         self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
         # instead of one per message), from a reader on a node no executor spins.
@@ -192,6 +231,9 @@ class SimulatorNode(ManagedNode):
             self._report()
         if self.health.halted:
             return
+        if not self.pacer.realtime and (self._held_since is not None or self._chunks - self._acked_chunks >= ACK_WINDOW_CHUNKS):
+            if not self._readers_caught_up(now):
+                return
         if self._anchor:
             self.pacer.start(self.twin.time)
             self._anchor = False
@@ -206,6 +248,26 @@ class SimulatorNode(ManagedNode):
             self._publish_chunk(out)
         self.pacer.record(self.twin.time)
         self._publish_diagnostics_on_change()
+
+    def _readers_caught_up(self, now: float) -> bool:
+        """Without real time: has every reliable reader acknowledged all the streams sent it?
+        Blocks at most :data:`ACK_POLL_S`; after :data:`ACK_GIVE_UP_S` of waiting, goes on
+        without the laggard (a WARN names the topics)."""
+        behind = [name for name, pub in self._stream_pubs.items() if not pub.wait_for_all_acked(Duration(seconds=ACK_POLL_S if name == CLOCK.name else 0.0))]
+        if not behind or self._gave_up:
+            # a laggard given up on is not waited for again until every reader has caught up
+            # (or its proxy is gone): a stopped process would otherwise hold each window anew
+            self._gave_up = self._gave_up and bool(behind)
+            self._acked_chunks, self._held_since = self._chunks, None
+            return True
+        if self._held_since is None:
+            self._held_since = now
+        elif now - self._held_since > ACK_GIVE_UP_S:
+            self.health.reader_stalled(f"{', '.join(behind)} unacknowledged for {now - self._held_since:.0f} s")
+            self.get_logger().warning(f"going on without a reliable reader: {', '.join(behind)} unacknowledged for {now - self._held_since:.0f} s")
+            self._acked_chunks, self._held_since, self._gave_up = self._chunks, None, True
+            return True
+        return False
 
     def _publish_chunk(self, out: TickOutput) -> None:
         self._chunks += 1
@@ -334,6 +396,7 @@ class SimulatorNode(ManagedNode):
             "spindle_pulses": self._pulses["spindle"],
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,
+            "reader_stalls": self.health.reader_stalls,
             STOPPED_KEY: self.health.halted,
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)

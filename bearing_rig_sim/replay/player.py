@@ -342,8 +342,11 @@ class RosReplaySink:
         import rclpy
         from rclpy.node import Node
 
+        from bearing_rig_sim.dds_profile import use_rig_profile
+
         self._rclpy = rclpy
         self.context = rclpy.Context()
+        use_rig_profile()  # a reliable reader of the replay gets a heartbeat every 50 ms, not 3 s
         rclpy.init(args=args or [], context=self.context)
         self.node = Node(node_name, context=self.context)
         self._publishers: dict[str, Any] = {}

@@ -212,6 +212,33 @@ class SessionNode(Node):
         """Subscriptions to ``topic`` other than the recorder's."""
         return sum(1 for info in self.get_subscriptions_info_by_topic(topic) if info.node_name != self.tap.get_name())
 
+    def adapt_to_publishers(self) -> list[str]:
+        """Read best effort every recorded topic that some publisher offers only best effort
+        (a bench's own sensor driver, attached to): a reliable reader never matches such a
+        writer and would record nothing of it (rosbag2 adapts its readers in the same way). The
+        reliable reader is drained, then replaced. Returns a line per topic changed."""
+        changes = []
+        for i, (topic, msgtype, subscription) in enumerate(self._recorded):
+            if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
+                continue
+            weak = sorted(
+                f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+                for info in self.get_publishers_info_by_topic(topic.name)
+                if info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+            )
+            if not weak:
+                continue
+            self.take()  # what the reliable reader holds goes to the bag first
+            qos = reader_qos(topic)
+            qos.reliability = ReliabilityPolicy.BEST_EFFORT
+            self.tap.destroy_subscription(subscription)
+            self._recorded[i] = (topic, msgtype, self.tap.create_subscription(msgtype, topic.name, _unused, qos, raw=True))
+            changes.append(
+                f"recording {topic.name} best effort: {', '.join(weak)} publishes it best effort "
+                "(a reliable reader receives nothing from such a writer)"
+            )
+        return changes
+
     def rival_publishers(self) -> str:
         """What makes the graph hold more than one rig: a description of every topic of
         :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does).

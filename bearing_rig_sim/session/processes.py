@@ -15,14 +15,9 @@ Graph isolation: unless the user set ``ROS_DOMAIN_ID``, a session takes a privat
 ``ROS_AUTOMATIC_DISCOVERY_RANGE``, discovery stays on this host (``LOCALHOST``).
 
 Transport: unless the user gave a Fast DDS profile (``FASTRTPS_DEFAULT_PROFILES_FILE`` or
-``FASTDDS_DEFAULT_PROFILES_FILE``), every process of a session uses
-:data:`TRANSPORT_PROFILE_XML`: the shared-memory transport with deeper buffers than Fast DDS's
-defaults (512 KiB segment, 512 descriptors per port, about 0.1 s of the rig's traffic). On a busy
-two-core host a node's receive thread can be held up for a few hundred milliseconds; with the
-defaults the writer's segment or the reader's port then fills and messages are dropped, on every
-topic at once, for every reader. Measured: with the defaults the recorder lost 100-600 ms
-stretches of every simulator topic in most sessions; with this profile none in the sessions
-tried (see the README).
+``FASTDDS_DEFAULT_PROFILES_FILE``), every process of a session uses the rig's profile
+(:mod:`bearing_rig_sim.dds_profile`: shared memory with deep buffers, a 50 ms writer heartbeat),
+written to ``<run-id>/logs/fastdds_profile.xml``.
 """
 
 from __future__ import annotations
@@ -43,6 +38,7 @@ from pathlib import Path
 from typing import IO
 from collections.abc import Iterator, Mapping, Sequence
 
+from bearing_rig_sim.dds_profile import PROFILE_VARIABLES, RIG_PROFILE_XML, apply_rig_profile
 from bearing_rig_sim.errors import RigError
 
 __all__ = [
@@ -69,38 +65,8 @@ CHILD_NICENESS = 5
 down (lower real-time factor, overruns it reports) before the recorder falls behind and loses
 messages."""
 
-TRANSPORT_PROFILE_XML = """<?xml version="1.0" encoding="UTF-8"?>
-<!-- Fast DDS profile of a bearing-rig session (bearing_rig_sim.session.processes): shared memory
-     with an 8 MiB segment and 8192 descriptors per port (about 2 s of the rig's traffic), plus
-     UDPv4 for discovery and other hosts. -->
-<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">
-  <transport_descriptors>
-    <transport_descriptor>
-      <transport_id>rig_shm</transport_id>
-      <type>SHM</type>
-      <segment_size>8388608</segment_size>
-      <port_queue_capacity>8192</port_queue_capacity>
-    </transport_descriptor>
-    <transport_descriptor>
-      <transport_id>rig_udp</transport_id>
-      <type>UDPv4</type>
-    </transport_descriptor>
-  </transport_descriptors>
-  <participant profile_name="bearing_rig_session" is_default_profile="true">
-    <rtps>
-      <userTransports>
-        <transport_id>rig_shm</transport_id>
-        <transport_id>rig_udp</transport_id>
-      </userTransports>
-      <useBuiltinTransports>false</useBuiltinTransports>
-    </rtps>
-  </participant>
-</profiles>
-"""
-"""The session's Fast DDS participant profile (see the module documentation)."""
-
-PROFILE_VARIABLES = ("FASTRTPS_DEFAULT_PROFILES_FILE", "FASTDDS_DEFAULT_PROFILES_FILE")
-"""Environment variables through which a user gives Fast DDS a profile of their own."""
+TRANSPORT_PROFILE_XML = RIG_PROFILE_XML
+"""The session's Fast DDS profile (:mod:`bearing_rig_sim.dds_profile`)."""
 
 DOMAIN_LOCK_DIR = Path(tempfile.gettempdir()) / "bearing_rig_sim-session-domains"
 
@@ -368,15 +334,10 @@ def session_environment(base: Mapping[str, str]) -> tuple[dict[str, str], Domain
 
 
 def apply_transport_profile(env: dict[str, str], directory: Path) -> Path | None:
-    """Unless ``env`` names a Fast DDS profile already, write :data:`TRANSPORT_PROFILE_XML` to
-    ``directory/fastdds_profile.xml`` and name it in ``env``; returns the file written, or None."""
-    if any(env.get(name, "").strip() for name in PROFILE_VARIABLES):
-        return None
-    profile = Path(directory) / "fastdds_profile.xml"
-    profile.parent.mkdir(parents=True, exist_ok=True)
-    profile.write_text(TRANSPORT_PROFILE_XML, encoding="utf-8")
-    env["FASTRTPS_DEFAULT_PROFILES_FILE"] = str(profile)
-    return profile
+    """Unless ``env`` names a Fast DDS profile already, write the rig's profile
+    (:data:`TRANSPORT_PROFILE_XML`) to ``directory/fastdds_profile.xml`` and name it in ``env``;
+    returns the file written, or None."""
+    return apply_rig_profile(env, directory)
 
 
 SESSION_VARIABLES = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", *PROFILE_VARIABLES)

@@ -496,10 +496,13 @@ class _Session:
             self.printer.message(line)
 
     def _check_graph(self) -> None:
-        """End the session when a second rig shares its graph (see
+        """Adapt the recorder to best-effort publishers (:meth:`SessionNode.adapt_to_publishers`);
+        end the session when a second rig shares its graph (see
         :meth:`SessionNode.rival_publishers`): its results would mix two rigs."""
         if self.phase is _Phase.ENDED or self.node is None:
             return
+        for line in self.node.adapt_to_publishers():
+            self._event(line)
         rivals = self.node.rival_publishers()
         if rivals:
             self._end(

@@ -44,6 +44,11 @@ class SimulatorHealth:
         self.refused = 0
         """Inputs refused since the start (1)."""
         self._reported_overruns = 0
+        self.reader_stalls = 0
+        """Times (without real time) the loop stopped waiting for a reliable reader that
+        acknowledged nothing for the give-up time, and went on without it."""
+        self._stalled = ""
+        self._reported_stalls = 0
 
     def refuse(self, kind: str, reason: str, now: float) -> None:
         """Note a refused input of ``kind`` (e.g. "spindle command", "axial force") at ``now``."""
@@ -53,6 +58,12 @@ class SimulatorHealth:
     def halt(self, reason: str) -> None:
         """Note that the simulation stopped for good (diverged engine)."""
         self.halted = reason
+
+    def reader_stalled(self, what: str) -> None:
+        """Note that the loop went on without the acknowledgement of a reliable reader (``what``
+        names the topics still unacknowledged and for how long)."""
+        self.reader_stalls += 1
+        self._stalled = what
 
     def assess(self, now: float, overruns: int, load_clamped: bool, min_load: float) -> Health:
         """The health at ``now`` given the loop's overrun count so far and the load flag.
@@ -71,6 +82,8 @@ class SimulatorHealth:
         new = overruns - self._reported_overruns
         if new > 0:
             warnings.append(f"{new} overrun(s): the loop fell behind the wall clock")
+        if self.reader_stalls > self._reported_stalls:
+            warnings.append(f"went on without a reliable reader: {self._stalled}")
         if load_clamped:
             warnings.append(f"axial force below the engine's minimum; {min_load:g} N applied")
         if warnings:
@@ -80,3 +93,4 @@ class SimulatorHealth:
     def reported(self, overruns: int) -> None:
         """The periodic report went out with this overrun count: later ones are new."""
         self._reported_overruns = overruns
+        self._reported_stalls = self.reader_stalls

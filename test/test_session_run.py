@@ -258,6 +258,17 @@ def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_pat
     assert counts.get("/rig/speeds", 0) > 0
 
 
+HOSTILE_CLOCK_PROGRAM = """
+name: hostile_clock
+description: load up, then 900 rpm held long enough for an attack on /clock to land mid-run
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, dwell_s: 20.0}
+"""
+
+
 def test_hostile_clock_stamps_during_a_session_are_refused_and_reported(ros_graph: Any, tmp_path: Path) -> None:
     """The audit's attacks: one /clock at 2^31 - 1 s hung a session and moved 98 % of its bag to
     2038; one before 1970 killed the load controller. Now the session ends normally (the load
@@ -268,14 +279,18 @@ def test_hostile_clock_stamps_during_a_session_are_refused_and_reported(ros_grap
 
     from bearing_rig_sim.nodes.common import RELIABLE_QOS
 
-    session = start_session(ros_graph, tmp_path)
-    seen = read_until(session, "segment 2/3 n0900:")
+    # The attacker exists before the session, so discovery runs during the nodes' bring-up, and
+    # the program holds 900 rpm for 20 s of sim time: the session cannot end before the attack
+    # has matched (made after the session, on a loaded host the match came too late: the program
+    # had ended and its subscribers were gone).
     node = ros_graph.node("clock_attacker")
     clock = node.create_publisher(Clock, "/clock", RELIABLE_QOS)
+    session = start_session(ros_graph, tmp_path, program_text=HOSTILE_CLOCK_PROGRAM)
     # the recorder and the load controller (at least) subscribe /clock; the recorder (reliable) matched
     assert ros_graph.spin_until(
-        lambda: node.count_subscribers("/clock") >= 2 and clock.get_subscription_count() >= 2, timeout=30.0, nodes=[node]
+        lambda: node.count_subscribers("/clock") >= 2 and clock.get_subscription_count() >= 2, timeout=120.0, nodes=[node]
     )
+    seen = read_until(session, "segment 2/2 n0900:")
     for _ in range(3):
         clock.publish(Clock(clock=Time(sec=2**31 - 1, nanosec=0)))
         clock.publish(Clock(clock=Time(sec=-5, nanosec=0)))
@@ -404,9 +419,9 @@ def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_grap
 
     from bearing_rig_sim.nodes.common import RELIABLE_QOS
 
-    # n0900 held for 5 s of sim time rather than until stable: the set-point lands inside it
-    # however fast the run goes.
-    program = SHORT_PROGRAM.replace("until_stable: true, timeout_s: 8.0}", "dwell_s: 5.0}", 1)
+    # n0900 held for 20 s of sim time rather than until stable: the set-point lands inside it
+    # however fast the run goes, even with the test process held up for seconds on a loaded host.
+    program = SHORT_PROGRAM.replace("until_stable: true, timeout_s: 8.0}", "dwell_s: 20.0}", 1)
     session = start_session(ros_graph, tmp_path, program_text=program)
     node = ros_graph.node("meddler")
     setpoint = node.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)

@@ -351,12 +351,23 @@ def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> N
     assert round(clock_ns[0] / 1_000_000) == 1, f"/clock in the bag starts at {clock_ns[0] * 1e-9:.3f} s, not at the first 1 ms chunk"
 
 
+SIMULATOR_NODE = ("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+
+
+def start_rig_nodes(ros_graph: Any, *simulators: tuple[str, ...]) -> None:
+    """Start the rig's nodes on the test's graph as a launch file would, for ``run --attach``:
+    each simulator given (``python`` arguments; default: one shipped simulator without real
+    time), the load controller and the monitor."""
+    for simulator in simulators or (SIMULATOR_NODE,):
+        ros_graph.spawn_python(*simulator)
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+
+
 def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:
     """What launch/rig.launch.py does: nodes brought up elsewhere, the program run by
     ``bearing-rig run --attach --no-record`` on the environment's domain."""
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    start_rig_nodes(ros_graph)
     session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
     out, err = session.communicate(timeout=150)
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
@@ -385,9 +396,7 @@ def test_an_attached_session_records_pulses_a_bench_publishes_best_effort(ros_gr
     """Attached to nodes whose pulse writers offer only best effort (as a bench's counter
     driver may), the recorder reads those topics best effort and records them; a reliable
     reader is incompatible with such a writer and recorded nothing."""
-    ros_graph.spawn_python("-c", BEST_EFFORT_PULSE_SIMULATOR)
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    start_rig_nodes(ros_graph, ("-c", BEST_EFFORT_PULSE_SIMULATOR))
     session = start_session(ros_graph, tmp_path, "--attach")
     out, err = session.communicate(timeout=150)
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
@@ -402,10 +411,7 @@ def test_an_attached_session_refuses_a_graph_with_two_simulators(ros_graph: Any,
     """Two simulators on one domain (a stray twin beside the one meant, or a twin beside the
     bench) would interleave two sim times and two bearings in one summary: the session ends,
     exit 1, naming the topic and the two publishers."""
-    for _ in range(2):
-        ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    start_rig_nodes(ros_graph, SIMULATOR_NODE, SIMULATOR_NODE)
     session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
     out, err = session.communicate(timeout=150)
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"

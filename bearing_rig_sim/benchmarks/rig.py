@@ -46,12 +46,12 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from bearing_rig_sim.dds_profile import apply_rig_profile
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.session.processes import (
     NODES,
     NodeProcess,
-    apply_transport_profile,
     node_command,
     own_ros_environment,
     session_environment,
@@ -212,7 +212,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
 
     logs = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-rig-"))
     env, lease = session_environment(os.environ)
-    apply_transport_profile(env, logs)
+    apply_rig_profile(env, logs)
     children = [NodeProcess(name, node_command(spec) + ["--autostart"], logs / f"{name}.log") for name, spec in NODES.items()]
     context = rclpy.Context()
     probe = None

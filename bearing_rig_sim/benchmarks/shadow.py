@@ -154,7 +154,8 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
 
     from bearing_rig_msgs.msg import FibreOpticPulse, ShadowResidual
     from bearing_rig_sim.interfaces import CAGE_PULSES, TWIN_RESIDUAL
-    from bearing_rig_sim.session.processes import NodeProcess, NodeSpec, apply_transport_profile, node_command, own_ros_environment, session_environment, stop_all
+    from bearing_rig_sim.dds_profile import apply_rig_profile
+    from bearing_rig_sim.session.processes import NodeProcess, NodeSpec, node_command, own_ros_environment, session_environment, stop_all
     from bearing_rig_sim.session.recorder import header_stamp_ns
     from bearing_rig_sim.shadow.offline import shadow_bag
 
@@ -162,7 +163,7 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
     bag = write_bench_bag(bench, work / "bench")
     expected = shadow_bag(bag, None).counts["windows"]
     env, lease = session_environment(os.environ)
-    apply_transport_profile(env, work)
+    apply_rig_profile(env, work)
     shadow = NodeProcess("shadow", node_command(NodeSpec("shadow", "bearing-rig-shadow")), work / "shadow.log")
     replay = NodeProcess("replay", [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"], work / "replay.log")
     context = rclpy.Context()

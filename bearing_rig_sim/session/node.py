@@ -212,6 +212,15 @@ class SessionNode(Node):
         """Subscriptions to ``topic`` other than the recorder's."""
         return sum(1 for info in self.get_subscriptions_info_by_topic(topic) if info.node_name != self.tap.get_name())
 
+    def publisher_names(self, topic: str, reliability: ReliabilityPolicy | None = None) -> list[str]:
+        """The nodes publishing ``topic`` (``/namespace/name``, sorted), only those offering
+        ``reliability`` when given."""
+        return sorted(
+            f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+            for info in self.get_publishers_info_by_topic(topic)
+            if reliability is None or info.qos_profile.reliability == reliability
+        )
+
     def adapt_to_publishers(self) -> list[str]:
         """Read best effort every recorded topic that some publisher offers only best effort
         (a bench's own sensor driver, attached to): a reliable reader never matches such a
@@ -221,11 +230,7 @@ class SessionNode(Node):
         for i, (topic, msgtype, subscription) in enumerate(self._recorded):
             if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
                 continue
-            weak = sorted(
-                f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-                for info in self.get_publishers_info_by_topic(topic.name)
-                if info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
-            )
+            weak = self.publisher_names(topic.name, ReliabilityPolicy.BEST_EFFORT)
             if not weak:
                 continue
             self.take()  # what the reliable reader holds goes to the bag first
@@ -246,7 +251,7 @@ class SessionNode(Node):
         the load; two monitors would give two verdicts."""
         found = []
         for topic in ONE_PUBLISHER_TOPICS:
-            names = sorted(f"{info.node_namespace.rstrip('/')}/{info.node_name}" for info in self.get_publishers_info_by_topic(topic))
+            names = self.publisher_names(topic)
             if len(names) > 1:
                 found.append(f"{len(names)} nodes publish {topic} ({', '.join(names)})")
         return "; ".join(found)

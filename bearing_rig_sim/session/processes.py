@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import IO
 from collections.abc import Iterator, Mapping, Sequence
 
-from bearing_rig_sim.dds_profile import PROFILE_VARIABLES, RIG_PROFILE_XML, apply_rig_profile
+from bearing_rig_sim.dds_profile import PROFILE_VARIABLES
 from bearing_rig_sim.errors import RigError
 
 __all__ = [
@@ -47,14 +47,12 @@ __all__ = [
     "DomainLease",
     "NodeProcess",
     "NodeSpec",
-    "apply_transport_profile",
     "lease_domain",
     "node_command",
     "own_ros_environment",
     "session_environment",
     "stop_all",
     "SESSION_VARIABLES",
-    "TRANSPORT_PROFILE_XML",
 ]
 
 SESSION_DOMAIN_IDS = range(102, 233)
@@ -64,9 +62,6 @@ CHILD_NICENESS = 5
 """The nodes run this much nicer than the session process: on a busy host the simulation slows
 down (lower real-time factor, overruns it reports) before the recorder falls behind and loses
 messages."""
-
-TRANSPORT_PROFILE_XML = RIG_PROFILE_XML
-"""The session's Fast DDS profile (:mod:`bearing_rig_sim.dds_profile`)."""
 
 DOMAIN_LOCK_DIR = Path(tempfile.gettempdir()) / "bearing_rig_sim-session-domains"
 
@@ -331,13 +326,6 @@ def session_environment(base: Mapping[str, str]) -> tuple[dict[str, str], Domain
     if not env.get("ROS_AUTOMATIC_DISCOVERY_RANGE", "").strip():
         env["ROS_AUTOMATIC_DISCOVERY_RANGE"] = "LOCALHOST"
     return env, lease
-
-
-def apply_transport_profile(env: dict[str, str], directory: Path) -> Path | None:
-    """Unless ``env`` names a Fast DDS profile already, write the rig's profile
-    (:data:`TRANSPORT_PROFILE_XML`) to ``directory/fastdds_profile.xml`` and name it in ``env``;
-    returns the file written, or None."""
-    return apply_rig_profile(env, directory)
 
 
 SESSION_VARIABLES = ("ROS_DOMAIN_ID", "ROS_AUTOMATIC_DISCOVERY_RANGE", *PROFILE_VARIABLES)

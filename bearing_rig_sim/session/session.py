@@ -46,6 +46,7 @@ from types import FrameType
 from typing import Any, TextIO
 from collections.abc import Sequence
 
+from bearing_rig_sim.dds_profile import apply_rig_profile
 from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bags import BagWriter
@@ -56,7 +57,6 @@ from bearing_rig_sim.session.processes import (
     NODES,
     DomainLease,
     NodeProcess,
-    apply_transport_profile,
     node_command,
     own_ros_environment,
     session_environment,
@@ -173,7 +173,7 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     try:
         writer: Any = BagWriter(bag_path, metadata=context, chunk_size=CHUNK_SIZE) if options.record else _NoBag(bag_path)
         if not options.attach:
-            apply_transport_profile(env, writer.path / "logs")
+            apply_rig_profile(env, writer.path / "logs")
         view = None
         if options.foxglove_port is not None:
             from bearing_rig_sim.live.foxglove import FoxgloveLiveView

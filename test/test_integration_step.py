@@ -202,14 +202,25 @@ def test_each_impossible_state_is_named(params: BearingParameters, column: int, 
 DIVERGING_SIMULATOR = """
 import sys
 import bearing_rig_sim.dynamics.engine as engine
+import bearing_rig_sim.dynamics.kernels as kn
 made = engine.BearingDynamics.__init__
 def bypass(self, *args, **kwargs):  # the issue's 1 ms step, past the construction check
     kwargs.update(time_step=1e-3, check_step=False)
     made(self, *args, **kwargs)
 engine.BearingDynamics.__init__ = bypass
+advance = engine.BearingDynamics.advance
+def diverging(self, *args, **kwargs):  # once the spindle turns, the cage runs backwards
+    if self.inner_ring_speed > 1.0:
+        self.cage[:, kn.C_OMEGA] = -self.inner_ring_speed
+    return advance(self, *args, **kwargs)
+engine.BearingDynamics.advance = diverging
 from bearing_rig_sim.nodes.simulator import main
 sys.exit(main(["simulator", "--autostart", "--no-realtime"]))
 """
+"""A simulator on the 1 ms step whose state leaves the bounds as soon as the spindle turns. The
+1 ms step alone diverges in most runs, but not in all: started at rest under a load that rises
+later (as the load controller raises it), it sometimes stays within the bounds through the whole
+program (one run in three of the session test), so the divergence is made certain."""
 
 
 @pytest.mark.ros

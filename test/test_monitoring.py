@@ -206,6 +206,37 @@ def test_a_stop_is_not_a_sensor_loss():
     assert "stopped" in status.detail
 
 
+def test_a_spindle_turned_by_hand_at_rest_is_no_fault():
+    """Half a revolution by hand (two strips pass), then 30 s at rest, the cage never pulsing: the
+    spindle never ran, the cage was never passed by (0 of the 5 revolutions of the rule), so no
+    shaft is lost (issue 12: a stopped shaft is not a fault)."""
+    monitor = make()
+    feed(monitor, train([0.20, 0.45], 4, "spindle"))
+    for now in np.arange(0.5, 30.0, 0.1):
+        monitor.check(float(now))
+    status = monitor.status()
+    assert status.faults == () and status.state is MonitorState.UNKNOWN
+
+
+def test_a_spindle_sensor_lost_during_the_run_up_is_a_fault_once_the_cage_turned_on():
+    """The spindle's sensor dies after three pulses, while the cage turns on at constant speed:
+    lost once the cage has turned silent_shaft_revolutions (5) since the spindle's last pulse, at
+    5 * 2 pi / CAGE = 0.487 s after it, confirmed at the next check (checks every 0.1 s)."""
+    monitor = make()
+    assert monitor.settings.silent_shaft_revolutions == 5.0
+    spindle = constant(INNER, 4, 0.0, 0.03)  # crossings at 10, 20, 30 ms
+    assert len(spindle) == 3
+    times = []
+    feed(monitor, train(spindle, 4, "spindle"), train(constant(CAGE, 4, 0.0, 3.0), 4, "cage"),
+         on_check=lambda status: times.append((bool(status.faults), status.faults)))
+    faulted = [i for i, (fault, _) in enumerate(times) if fault]
+    assert faulted, "the lost spindle sensor was never reported"
+    # check k is at about 0.1 k s; the rule is met at 0.03 + 0.487 s, confirmed one check later
+    first = faulted[0] * 0.1
+    assert 0.5 <= first <= 0.75
+    assert times[faulted[0]][1][0].startswith("spindle: no pulse for")
+
+
 def test_lost_pulses_are_a_warning_with_counts_and_the_slip_stays_exact():
     """Three cage pulses lost: counted, a warning held for fault_hold_s, never a fault; the
     window whose closing pulse was lost is skipped and every other window's slip is exact."""

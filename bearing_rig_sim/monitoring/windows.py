@@ -41,7 +41,10 @@ revolutions of the shaft, so they hold at any speed:
 **A stop is not a fault.** When both shafts have been silent for :data:`STOP_SILENCE_PERIODS` of
 their last pulse periods and each one's last period was longer than the one before by more than
 :data:`STOP_PERIOD_GROWTH` (both were slowing down), the rig has stopped. A shaft that falls
-silent at a steady or rising speed is lost.
+silent at a steady or rising speed is lost. A shaft that has not yet turned
+:data:`ESTABLISHED_REVOLUTIONS` revolutions has no running speed: like a shaft silent since the
+start, it is lost only once the other has turned ``silent_shaft_revolutions`` since its last
+pulse (a spindle turned by hand at rest is no fault).
 
 Units: s, rad/s; revolutions and pulses are counts.
 """
@@ -75,6 +78,13 @@ STEADY_PERIOD_CHANGE = 0.002
 enough to measure the strips' spacing from (1): at 20 rad/s^2 and 900 rpm a revolution's period
 changes by 1.4 %, so ramps are excluded; jitter of microseconds changes a 67 ms period by
 about 0.003 %."""
+
+ESTABLISHED_REVOLUTIONS = 2
+"""Pulses of this many revolutions since a shaft's restart make it a running shaft, judged by
+its own silence (1). Until then a silent shaft is judged as one silent since the start: lost
+only once the other shaft has turned ``silent_shaft_revolutions`` since its last pulse, so a
+spindle turned by hand at rest, or a stray edge of a strip standing at the sensor, is no
+fault."""
 
 SPACING_AVERAGE_REVOLUTIONS = 32
 """Revolutions over which each strip's spacing error is averaged (exponential weight 1/32)."""
@@ -155,6 +165,13 @@ class _Shaft:
     recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
     recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
     steady_period: float | None = None  # period of the last whole revolution measured, s
+    other_pulses_at_last: int = 0  # the other shaft's pulses received when this one last pulsed
+
+    def established(self) -> bool:
+        """Whether the shaft has turned :data:`ESTABLISHED_REVOLUTIONS` since its restart, so that
+        its pulse period is a running speed (a shaft turned by hand a fraction of a revolution
+        at rest has no speed to fall silent from)."""
+        return bool(self.strip_count) and self.pulses >= ESTABLISHED_REVOLUTIONS * (self.strip_count or 0)
 
     def revolutions(self) -> float:
         """Revolutions counted since the shaft's restart (pulses received / strips)."""
@@ -300,6 +317,7 @@ class SlipWindows:
             s.offset = (pulse.strip_id - index) % pulse.strip_count
         s.last_time, s.last_index = t, index
         s.pulses += 1
+        s.other_pulses_at_last = self._shafts["cage" if shaft == "spindle" else "spindle"].pulses
         self.silent.pop(shaft, None)
         self._suspect.discard(shaft)
         self.stopped = ""
@@ -418,10 +436,12 @@ class SlipWindows:
         for name in SHAFTS:
             s = self._shafts[name]
             other = self._shafts["cage" if name == "spindle" else "spindle"]
-            if s.last_time is None:
-                turned = other.revolutions()
+            if s.last_time is None or not s.established():
+                since = 0 if s.last_time is None else s.other_pulses_at_last
+                turned = (other.pulses - since) / other.strip_count if other.strip_count else 0.0
                 if turned >= rules.silent_shaft_revolutions:
-                    quiet[name] = f"{name}: no pulse since the start while the {other.name} turned {turned:.3g} revolutions"
+                    when = "since the start" if s.last_time is None else f"for {now - s.last_time:.3g} s"
+                    quiet[name] = f"{name}: no pulse {when} while the {other.name} turned {turned:.3g} revolutions"
                 continue
             limit = rules.loss_min_timeout_s
             if s.last_period is not None and s.strip_count:

@@ -142,7 +142,7 @@ MONITOR = [
     ParameterSpec("max_lost_fraction", "fraction of pulses lost over the horizon that is a sustained loss", "1", 0.0, 1.0),
     ParameterSpec("loss_silence_revolutions", "a shaft silent for this many of its revolutions is lost", "1", 0.0, 1e4, low_exclusive=True),
     ParameterSpec("loss_min_timeout_s", "sensor loss never sooner than this without a pulse", "s", 0.0, 600.0, low_exclusive=True),
-    ParameterSpec("silent_shaft_revolutions", "a shaft silent from the start is lost once the other turned this many revolutions", "1", 0.0, 1e4, low_exclusive=True),
+    ParameterSpec("silent_shaft_revolutions", "a shaft silent from the start (or not yet running) is lost once the other turned this many revolutions since its last pulse", "1", 0.0, 1e4, low_exclusive=True),
     ParameterSpec("fault_hold_s", "a malformed pulse stays a fault, a loss a warning, this long (rig time)", "s", 0.0, 600.0),
     ParameterSpec("clock_jump_tolerance_s", "a pulse this far before its predecessor is a clock jump (reset all)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("status_rate_hz", "status checks and messages per second of rig time, plus one per slip window", "Hz", 0.0, 1000.0, low_exclusive=True),

@@ -265,6 +265,23 @@ def test_lost_pulses_are_a_warning_with_counts_and_the_slip_stays_exact():
     assert finite and max(abs(s - expected_slip(INNER, CAGE)) for s in finite) < 1e-8
 
 
+def test_an_exact_repeat_of_a_pulse_is_dropped_and_counted_without_a_restart():
+    """Every 50th cage pulse delivered twice (a merged or re-sent recording): the repeats are
+    counted, no counting restarts, and the windows are exactly those of the clean train (so the
+    slip is the closed form's)."""
+    clean, doubled = make(), make()
+    spindle = train(constant(INNER, 4, 0.0, 10.0), 4, "spindle")
+    cage = train(constant(CAGE, 4, 0.0, 10.0), 4, "cage")
+    repeated = [p for i, p in enumerate(cage) for _ in range(2 if i % 50 == 25 else 1)]
+    feed(clean, spindle, cage)
+    feed(doubled, spindle, repeated)
+    status = doubled.status()
+    assert status.duplicates == (0, len(repeated) - len(cage)) and len(repeated) > len(cage)
+    assert not any("restarted" in note for note in status.notes)
+    assert status.windows == clean.status().windows
+    assert status.slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-6)
+
+
 def test_a_clock_jump_back_resets_to_unknown():
     monitor = make()
     feed(monitor, train(constant(INNER, 4, 0.0, 3.0), 4, "spindle"), train(constant(CAGE, 4, 0.0, 3.0), 4, "cage"))

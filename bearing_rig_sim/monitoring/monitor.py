@@ -53,7 +53,8 @@ class MonitorStatus:
     ``time`` is the end of the latest window (None before the first); speeds, slip and slope
     are NaN when not known; ``faults`` lists the active faults' reasons, ``warnings`` the recent
     losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
-    the pulses lost per shaft since the start and ``windows_skipped`` the cage windows skipped.
+    the pulses lost per shaft since the start, ``windows_skipped`` the cage windows skipped and
+    ``duplicates`` the exact repeats of a pulse dropped per shaft (spindle, cage).
     ``confidence`` is P(slope >= k) (0 while no slope is known).
     """
 
@@ -75,6 +76,7 @@ class MonitorStatus:
     warnings: tuple[str, ...] = ()
     lost: tuple[int, int] = (0, 0)
     windows_skipped: int = 0
+    duplicates: tuple[int, int] = (0, 0)
     window_start: float | None = None
 
     def message_fields(self) -> dict[str, object]:
@@ -346,5 +348,6 @@ class SlipMonitor:
             warnings=warnings,
             lost=(books["spindle"].lost, books["cage"].lost),
             windows_skipped=books["cage"].windows_skipped,
+            duplicates=(books["spindle"].duplicates, books["cage"].duplicates),
             window_start=latest.start_time if latest is not None else None,
         )

@@ -137,6 +137,8 @@ class LossBooks:
         lost: pulses missing from ``pulse_index``.
         gaps: gaps in ``pulse_index`` (one gap may lose several pulses).
         windows_skipped: cage windows whose closing pulse was lost (cage only).
+        duplicates: exact repeats of the shaft's previous pulse (same index and stamp, as a
+            merged or re-sent recording gives), dropped without restarting the shaft.
         last_gap: (rig time, pulses lost) of the latest gap; None before any.
     """
 
@@ -144,6 +146,7 @@ class LossBooks:
     lost: int = 0
     gaps: int = 0
     windows_skipped: int = 0
+    duplicates: int = 0
     last_gap: tuple[float, int] | None = None
 
 
@@ -274,6 +277,9 @@ class SlipWindows:
                 self.reset()
                 self.events.append(("reset", t, f"reset: {shaft} pulse at {t:.6f} s after one at {last_time:.6f} s (clock jumped back)"))
                 s = self._shafts[shaft]
+            elif index == last_index and t == last_time:
+                self.books[shaft].duplicates += 1
+                return []
             elif t <= last_time or index <= last_index:
                 self.events.append(
                     (

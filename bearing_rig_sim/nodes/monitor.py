@@ -212,6 +212,8 @@ class MonitorNode(ManagedNode):
             "spindle_pulses_lost": status.lost[0],
             "cage_pulses_lost": status.lost[1],
             "cage_windows_skipped": status.windows_skipped,
+            "spindle_pulses_duplicated": status.duplicates[0],
+            "cage_pulses_duplicated": status.duplicates[1],
             "faults": " | ".join(status.faults),
             "warnings": " | ".join(status.warnings),
         }

@@ -143,6 +143,7 @@ class SlipMonitor:
             min_points=settings.min_slope_points,
             resolution=settings.slip_resolution_pct,
             change_threshold=settings.change_threshold,
+            max_span=max(settings.slope_max_span_s, settings.slope_span_s) if self.criterion == "time" else None,
         )
         self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)

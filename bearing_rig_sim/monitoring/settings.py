@@ -33,6 +33,8 @@ class MonitorSettings:
         critical_slope_pct_per_s: k2, %/s.
         critical_slope_pct_per_n: k1, %/N.
         slope_span_s: trailing window of the slope against time, s.
+        slope_max_span_s: longest stretch of a steady series the slope against time may rest on
+            when the trailing window cannot decide, s (>= slope_span_s).
         slope_span_n: trailing window of the slope against load, N.
         load_step_n: with the load criterion, the windows are averaged in bins of this width of
             measured load, one slip point per bin, N.
@@ -59,6 +61,7 @@ class MonitorSettings:
     critical_slope_pct_per_s: float
     critical_slope_pct_per_n: float
     slope_span_s: float
+    slope_max_span_s: float
     slope_span_n: float
     load_step_n: float
     min_slope_points: int
@@ -100,6 +103,7 @@ class MonitorSettings:
             critical_slope_pct_per_s=s.number("critical_slope_pct_per_s"),
             critical_slope_pct_per_n=s.number("critical_slope_pct_per_n"),
             slope_span_s=s.number("slope_span_s", gt=0.0),
+            slope_max_span_s=s.number("slope_max_span_s", gt=0.0),
             slope_span_n=s.number("slope_span_n", gt=0.0),
             load_step_n=s.number("load_step_n", gt=0.0),
             min_slope_points=s.integer("min_slope_points", ge=3),

@@ -131,6 +131,7 @@ MONITOR = [
     ParameterSpec("critical_slope_pct_per_s", "critical slope k2 of the stability criterion (slip against time)", "%/s", -10.0, 0.0),
     ParameterSpec("critical_slope_pct_per_n", "critical slope k1 of the stability criterion (slip against axial load)", "%/N", -1.0, 0.0),
     ParameterSpec("slope_span_s", "trailing window of the slope against time", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("slope_max_span_s", "longest steady stretch the slope against time may rest on when the trailing window cannot decide", "s", 0.0, 3600.0, low_exclusive=True),
     ParameterSpec("slope_span_n", "trailing window of the slope against axial load", "N", 0.0, 10_000.0, low_exclusive=True),
     ParameterSpec("load_step_n", "with the load criterion: width of the load bins, one slip point each", "N", 0.0, 1000.0, low_exclusive=True),
     ParameterSpec("min_slope_points", "points needed for a slope", "1", 3, 100_000, integer=True),

@@ -81,3 +81,16 @@ def test_write_tables_replaces_a_stale_table(tmp_path: Path) -> None:
     text = (tmp_path / "README.md").read_text(encoding="utf-8")
     assert "/old" not in text and interfaces.markdown_table() in text and text.endswith("\nafter\n")
     assert interfaces.write_tables(tmp_path) == []
+
+
+def test_every_topic_type_resolves_to_its_generated_class() -> None:
+    """The session records with the class named by the table's ``pkg/msg/Name`` (no second,
+    hand-written list): each resolves to the generated class of that package and name."""
+    from bearing_rig_sim.session.node import MESSAGE_TYPES, message_class
+
+    for t in interfaces.TOPICS:
+        package, _, name = t.msgtype.split("/")
+        cls = MESSAGE_TYPES[t.msgtype]
+        assert cls.__name__ == name and cls.__module__.startswith(f"{package}.msg"), t.name
+    with pytest.raises(AttributeError):
+        message_class("std_msgs/msg/NoSuchMessage")

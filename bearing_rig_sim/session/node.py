@@ -13,19 +13,17 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
+import importlib
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from bearing_rig_msgs.msg import AxialLoadState, FibreOpticPulse, ShadowEstimate, ShadowResidual, SimulatorTruth, SlipStatus, SpindleCommand
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
+from bearing_rig_msgs.msg import SpindleCommand
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
-from rosgraph_msgs.msg import Clock
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
@@ -42,6 +40,7 @@ from bearing_rig_sim.interfaces import (
     SPEEDS,
     SPINDLE_COMMAND,
     SPINDLE_PULSES,
+    TOPICS,
     TRUTH,
 )
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
@@ -49,7 +48,7 @@ from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, hea
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 from bearing_rig_sim.simulation.health import stopped_reason
 
-__all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode"]
+__all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode", "message_class"]
 
 ONE_PUBLISHER_TOPICS = (TRUTH.name, AXIAL_LOAD_STATE.name, SLIP_STATUS.name)
 """Topics a session's graph must have one publisher of, each a node's own output: one simulator
@@ -68,21 +67,19 @@ the 3x of a session without real time. The reader's history drops its oldest sam
 wait (reliable or not): at 5000 a session held up for two seconds on a busy host lost stretches of
 /clock."""
 
-MESSAGE_TYPES: dict[str, type] = {
-    "rosgraph_msgs/msg/Clock": Clock,
-    "bearing_rig_msgs/msg/SpindleCommand": SpindleCommand,
-    "bearing_rig_msgs/msg/FibreOpticPulse": FibreOpticPulse,
-    "sensor_msgs/msg/JointState": JointState,
-    "bearing_rig_msgs/msg/SimulatorTruth": SimulatorTruth,
-    "std_msgs/msg/Float64": Float64,
-    "bearing_rig_msgs/msg/AxialLoadState": AxialLoadState,
-    "geometry_msgs/msg/WrenchStamped": WrenchStamped,
-    "bearing_rig_msgs/msg/SlipStatus": SlipStatus,
-    "diagnostic_msgs/msg/DiagnosticArray": DiagnosticArray,
-    "bearing_rig_msgs/msg/ShadowResidual": ShadowResidual,
-    "bearing_rig_msgs/msg/ShadowEstimate": ShadowEstimate,
-}
-"""The rclpy class of each recorded type."""
+def message_class(msgtype: str) -> type:
+    """The rclpy class of a ``pkg/msg/Name`` message type (from its generated ``pkg.msg`` module).
+
+    Raises:
+        ImportError: the package's Python module is not installed.
+        AttributeError: the package has no such message.
+    """
+    package, _, name = msgtype.split("/")
+    return getattr(importlib.import_module(f"{package}.msg"), name)
+
+
+MESSAGE_TYPES: dict[str, type] = {topic.msgtype: message_class(topic.msgtype) for topic in TOPICS}
+"""The rclpy class of each message type of the interface table (:data:`interfaces.TOPICS`)."""
 
 _LEVEL_NAMES = {0: "OK", 1: "WARN", 2: "ERROR", 3: "STALE"}
 

@@ -405,7 +405,8 @@ class TrailingSlope:
     stays what it was (UNKNOWN at the start of a series). Since the test is repeated at every
     point, a held verdict is overturned only once the opposite one has been reached over
     :data:`OVERTURN_CONFIRM` of the span (not after a detected change in the slip:
-    the held verdict's points are gone, and the new ones decide afresh). A verdict thus changes only when the data puts the
+    the held verdict's points are gone, and the new ones decide afresh), or at once when the
+    longer stretch (below) reaches the same opposite verdict. A verdict thus changes only when the data puts the
     slope clearly on the other side of k, so noise on a plateau cannot flap it.
 
     **Changes in the slip itself** (a load step, a lubrication event, anything): each new point
@@ -647,6 +648,11 @@ class TrailingSlope:
             since = self._overturn[1] if self._overturn is not None and self._overturn[0] is decided else self._x[-1]
             self._overturn = (decided, since)
             if self._x[-1] - since < OVERTURN_CONFIRM * self.span:
+                longer = self._longer_line()
+                if longer is None or self._clear(longer[0]) is not decided:
+                    return
+                # the longer stretch, far less scattered, already says so: overturn now
+                self._state, self._anchor, self._overturn, self._used = decided, self._hx[-longer[0][5]], None, longer
                 return
         if decided is not SlipState.UNKNOWN:
             self._state, self._anchor, self._overturn = decided, self._x[0], None

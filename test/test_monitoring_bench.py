@@ -126,7 +126,8 @@ RETURN_S = 2.5
 """Allowance for a held verdict to be overturned after the true change (s): the slope is that
 of the line through the last second of windows (about 0.6 s behind its last point on a decay),
 clear of k by the 95 % bound, and a held verdict is overturned only once the opposite one has
-been reached over half a second (analysis.streaming.OVERTURN_CONFIRM)."""
+been reached over half a second, or the longer stretch reaches it too
+(analysis.streaming.OVERTURN_CONFIRM)."""
 
 
 def test_slip_step_and_exponential_decay_at_constant_speed() -> None:

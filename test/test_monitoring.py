@@ -265,6 +265,21 @@ def test_lost_pulses_are_a_warning_with_counts_and_the_slip_stays_exact():
     assert finite and max(abs(s - expected_slip(INNER, CAGE)) for s in finite) < 1e-8
 
 
+def test_both_sensors_lost_just_after_the_first_window_are_both_faults():
+    """The spindle has run 2 s at 1500 rpm; the cage sensor has given only 6 pulses (its first
+    window) when both fall silent at a steady speed: the rig has started, so each shaft is judged
+    by its own silence, both lost (a cage with under 2 revolutions of pulses is not 'at rest'
+    once the spindle runs)."""
+    monitor = make()
+    cage_start = 2.0 - 5.5 * (TWO_PI / 4) / CAGE
+    feed(monitor, train(constant(INNER, 4, 0.0, 2.0), 4, "spindle"), train(constant(CAGE, 4, cage_start, 2.0), 4, "cage"))
+    assert monitor.status().windows >= 1
+    monitor.check(3.0)
+    monitor.check(3.1)
+    faults = monitor.status().faults
+    assert len(faults) == 2 and faults[0].startswith("spindle: no pulse for") and faults[1].startswith("cage: no pulse for")
+
+
 def test_an_exact_repeat_of_a_pulse_is_dropped_and_counted_without_a_restart():
     """Every 50th cage pulse delivered twice (a merged or re-sent recording): the repeats are
     counted, no counting restarts, and the windows are exactly those of the clean train (so the

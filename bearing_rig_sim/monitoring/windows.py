@@ -41,10 +41,10 @@ revolutions of the shaft, so they hold at any speed:
 **A stop is not a fault.** When both shafts have been silent for :data:`STOP_SILENCE_PERIODS` of
 their last pulse periods and each one's last period was longer than the one before by more than
 :data:`STOP_PERIOD_GROWTH` (both were slowing down), the rig has stopped. A shaft that falls
-silent at a steady or rising speed is lost. A shaft that has not yet turned
-:data:`ESTABLISHED_REVOLUTIONS` revolutions has no running speed: like a shaft silent since the
-start, it is lost only once the other has turned ``silent_shaft_revolutions`` since its last
-pulse (a spindle turned by hand at rest is no fault).
+silent at a steady or rising speed is lost. Until either shaft has turned
+:data:`ESTABLISHED_REVOLUTIONS` revolutions the rig has not started: a silent shaft is then
+lost only once the other has turned ``silent_shaft_revolutions`` since its last pulse (a
+spindle turned by hand at rest is no fault).
 
 Units: s, rad/s; revolutions and pulses are counts.
 """
@@ -80,11 +80,11 @@ changes by 1.4 %, so ramps are excluded; jitter of microseconds changes a 67 ms 
 about 0.003 %."""
 
 ESTABLISHED_REVOLUTIONS = 2
-"""Pulses of this many revolutions since a shaft's restart make it a running shaft, judged by
-its own silence (1). Until then a silent shaft is judged as one silent since the start: lost
-only once the other shaft has turned ``silent_shaft_revolutions`` since its last pulse, so a
-spindle turned by hand at rest, or a stray edge of a strip standing at the sensor, is no
-fault."""
+"""Pulses of this many revolutions since a shaft's restart make it a running shaft (1). Until
+either shaft runs, the rig has not started, and a silent shaft is judged as one silent since the
+start: lost only once the other shaft has turned ``silent_shaft_revolutions`` since its last
+pulse, so a spindle turned by hand at rest, or a stray edge of a strip standing at the sensor,
+is no fault. Once one shaft runs, each is judged by its own silence."""
 
 SPACING_AVERAGE_REVOLUTIONS = 32
 """Revolutions over which each strip's spacing error is averaged (exponential weight 1/32)."""
@@ -439,10 +439,11 @@ class SlipWindows:
             return
         rules = self.rules
         quiet: dict[str, str] = {}
+        started = any(x.established() for x in self._shafts.values())
         for name in SHAFTS:
             s = self._shafts[name]
             other = self._shafts["cage" if name == "spindle" else "spindle"]
-            if s.last_time is None or not s.established():
+            if s.last_time is None or not started:
                 since = 0 if s.last_time is None else s.other_pulses_at_last
                 turned = (other.pulses - since) / other.strip_count if other.strip_count else 0.0
                 if turned >= rules.silent_shaft_revolutions:

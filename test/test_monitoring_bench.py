@@ -254,6 +254,19 @@ def test_a_bench_bag_analysed_offline_gives_the_schedules_statuses(tmp_path: Pat
     assert result.first_time == pytest.approx(scenario.epoch_s, abs=0.1)
 
 
+def test_a_bench_bag_of_unstamped_pulses_is_analysed_on_its_log_times(tmp_path: Path) -> None:
+    """A counter that leaves the header stamps at zero: `analyze` says so and uses the log
+    (reception) times, which here are the pulse times, so it gives the same states as the
+    stamped bag; without the fallback every pulse would be out of order (all at 0 s)."""
+    scenario = BenchScenario(12.0, constant(W900), step_decay, epicyclic_ratio=RATIO, seed=5)
+    stamped = analyse_bag(write_bench_bag(tmp_path / "stamped", scenario))
+    rows: list = []
+    with pytest.warns(UserWarning, match="zero header stamp"):
+        unstamped = analyse_bag(write_bench_bag(tmp_path / "unstamped", BenchScenario(**{**scenario.__dict__, "unstamped": True})), on_row=rows.append)
+    assert unstamped.windows == stamped.windows > 60
+    assert [r.state for r in rows] == [int(s) for s in run(scenario).states]
+
+
 def test_axial_load_criterion_judges_slip_against_the_measured_load() -> None:
     """A load sweep at 900 rpm, 100 -> 700 N in 50 N steps held 3 s, slip falling with load
     as 0.8 + 4 ((500 - F) / 400)^2 % up to 500 N and flat beyond. Against load, with k1: slipping

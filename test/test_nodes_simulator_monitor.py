@@ -299,6 +299,32 @@ def test_monitor_warns_of_lost_pulses_with_counts_and_no_fault(ros_graph):
     assert all(s.state != SlipStatus.STATE_FAULT for s in probe.status)
 
 
+def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
+    """A counter that leaves the header stamps at zero, publishing 900 rpm at 2 % slip at the
+    pulses' own pace: the monitor uses the reception times (without that, every pulse after the
+    first is out of order at 0 s and no window ever closes), so slip windows close, the median
+    slip is the published 2 % within the reception jitter's reach, and no status is a FAULT."""
+    from bearing_rig_sim.synthetic.bench import BenchScenario, bench_pulses
+
+    start(ros_graph, "monitor", "loss_min_timeout_s:=30.0", "silent_shaft_revolutions:=1000.0")
+    probe = Probe(ros_graph)
+    publishers = {shaft: probe.node.create_publisher(FibreOpticPulse, f"/rig/{shaft}/pulses", SENSOR_QOS) for shaft in ("spindle", "cage")}
+    probe.wait(lambda: all(p.get_subscription_count() > 0 for p in publishers.values()), "the monitor's pulse subscriptions")
+    w = 900 * RPM
+    scenario = BenchScenario(8.0, lambda t: t * 0.0 + w, lambda t: t * 0.0 + 2.0, epicyclic_ratio=epicyclic_ratio(), jitter_s=0.0)
+    begin = time.monotonic()
+    for shaft, pulse in bench_pulses(scenario):
+        due = begin + pulse.time - scenario.epoch_s
+        while time.monotonic() < due:
+            probe.executor.spin_once(timeout_sec=max(0.0, min(0.005, due - time.monotonic())))
+        msg = FibreOpticPulse(sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index)
+        publishers[shaft].publish(msg)  # header.stamp left at zero
+    probe.wait(lambda: sum(math.isfinite(s.slip_rate) for s in probe.status) >= 10, "ten statuses with a slip")
+    slips = sorted(s.slip_rate for s in probe.status if math.isfinite(s.slip_rate))
+    assert abs(slips[len(slips) // 2] - 2.0) < 0.5
+    assert all(s.state != SlipStatus.STATE_FAULT for s in probe.status)
+
+
 STOPPABLE_READER = """
 import rclpy
 from rclpy.node import Node

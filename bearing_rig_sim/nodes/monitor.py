@@ -121,8 +121,15 @@ class MonitorNode(ManagedNode):
     @survives_shutdown
     def _on_pulse(self, shaft: str, msg: FibreOpticPulse) -> None:
         try:
+            stamp = from_stamp(msg.header.stamp)
+            if stamp == 0.0 and (received := self._clock_now()) > 1.0:  # not stamped (0 is genuine at a clock's start)
+                stamp = received
+                self.get_logger().warning(
+                    f"{shaft} pulses with a zero header stamp: their reception times are used, whose delivery jitter scatters the slip",
+                    once=True,
+                )
             pulse = Pulse(
-                time=from_stamp(msg.header.stamp),
+                time=stamp,
                 strip_id=int(msg.strip_id),
                 strip_count=int(msg.strip_count),
                 revolution=int(msg.revolution),

@@ -41,6 +41,7 @@ Units: SI inside (s, rad/s, N), slip in percent; the CSV files speak rpm, percen
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import struct
@@ -115,6 +116,10 @@ _NAN = math.nan
 # ---------------------------------------------------------------------------------------------
 # Pulses: a decoder of the fields the monitor uses
 # ---------------------------------------------------------------------------------------------
+UNSTAMPED_AFTER_NS = 1_000_000_000
+"""A pulse stamped exactly 0 whose log time is later than this (ns) was not stamped (a counter
+that leaves the header empty); at the start of a clock from zero, a stamp of 0 is genuine."""
+
 _HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
 _U32 = struct.Struct("<I")
 _STRIPS = struct.Struct("<HH")
@@ -289,6 +294,7 @@ class OfflineAnalysis:
         self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context}
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0
+        self._unstamped = 0
         self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
@@ -370,7 +376,7 @@ class OfflineAnalysis:
             result.csv_files = [sink.path for sink in self._sinks] + [write_segments_csv(self._csv_dir / SEGMENTS_CSV, result.segments)]
         return result
 
-    def _on_pulse(self, topic: str, _log_time_ns: int, data: bytes) -> None:
+    def _on_pulse(self, topic: str, log_time_ns: int, data: bytes) -> None:
         try:
             pulse = decode_pulse(data) if data[:2] == b"\x00\x01" else _pulse_from_message(self._decode_pulse_message(data))
         except BagError as exc:
@@ -378,6 +384,14 @@ class OfflineAnalysis:
             if self._bad_pulses == 1:
                 self._report(f"{self.bag.path.name}: topic {topic}: {exc}; such pulses are skipped")
             return
+        if pulse.time == 0.0 and log_time_ns > UNSTAMPED_AFTER_NS:  # a counter that does not stamp: the reception time
+            self._unstamped += 1
+            if self._unstamped == 1:
+                self._report(
+                    f"{self.bag.path.name}: topic {topic}: pulses with a zero header stamp; their log (reception) "
+                    "times are used, whose delivery jitter scatters the slip"
+                )
+            pulse = dataclasses.replace(pulse, time=log_time_ns * 1e-9)
         shaft = self._shaft_of[topic]
         self.result.pulses[shaft] += 1
         for scheduled in self.schedule.on_pulse(shaft, pulse):

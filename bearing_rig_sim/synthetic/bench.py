@@ -73,6 +73,8 @@ class BenchScenario:
         load_rate_hz: load-cell rate, Hz.
         epoch_s: the bench clock at t = 0, s.
         seed: of the jitter and losses.
+        unstamped: the pulses' header stamps are left at zero (a counter that does not stamp);
+            :func:`write_bench_bag` then carries the pulse times only as log times.
     """
 
     duration_s: float
@@ -91,6 +93,7 @@ class BenchScenario:
     load_rate_hz: float = 100.0
     epoch_s: float = BENCH_EPOCH_S
     seed: int = 0
+    unstamped: bool = False
 
 
 def _angles(scenario: BenchScenario) -> tuple[np.ndarray, dict[str, np.ndarray]]:
@@ -186,7 +189,7 @@ def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
 
     messages: list[tuple[float, str, Any]] = []
     for shaft, p in bench_pulses(scenario):
-        message = types[pulse_type](header=header(p.time), sensor_id=shaft, strip_id=p.strip_id, strip_count=p.strip_count, revolution=p.revolution, pulse_index=p.pulse_index)
+        message = types[pulse_type](header=header(0.0 if scenario.unstamped else p.time), sensor_id=shaft, strip_id=p.strip_id, strip_count=p.strip_count, revolution=p.revolution, pulse_index=p.pulse_index)
         messages.append((p.time, PULSE_TOPICS[shaft].name, message))
     vector = types["geometry_msgs/msg/Vector3"]
     for when, force in load_samples(scenario):

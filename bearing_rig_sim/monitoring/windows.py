@@ -59,6 +59,8 @@ from dataclasses import dataclass, field
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, Pulse
 
 SHAFTS = ("spindle", "cage")
+OTHER = {"spindle": "cage", "cage": "spindle"}
+"""Each shaft's counterpart."""
 
 MAX_PENDING_WINDOWS = 1000
 """Most cage windows kept waiting for spindle pulses; older ones are dropped (1)."""
@@ -176,9 +178,10 @@ class _Shaft:
         at rest has no speed to fall silent from)."""
         return bool(self.strip_count) and self.pulses >= ESTABLISHED_REVOLUTIONS * (self.strip_count or 0)
 
-    def revolutions(self) -> float:
-        """Revolutions counted since the shaft's restart (pulses received / strips)."""
-        return self.pulses / self.strip_count if self.strip_count else 0.0
+    def revolutions_since(self, pulses: int) -> float:
+        """Revolutions counted since the shaft had received ``pulses`` since its restart (pulses
+        received since then / strips; 0 with no strip count yet)."""
+        return (self.pulses - pulses) / self.strip_count if self.strip_count else 0.0
 
     def slowing(self) -> bool:
         """Whether the last pulse period was longer than the one before (STOP_PERIOD_GROWTH)."""
@@ -323,7 +326,7 @@ class SlipWindows:
             s.offset = (pulse.strip_id - index) % pulse.strip_count
         s.last_time, s.last_index = t, index
         s.pulses += 1
-        s.other_pulses_at_last = self._shafts["cage" if shaft == "spindle" else "spindle"].pulses
+        s.other_pulses_at_last = self._shafts[OTHER[shaft]].pulses
         self.silent.pop(shaft, None)
         self._suspect.discard(shaft)
         self.stopped = ""
@@ -442,10 +445,9 @@ class SlipWindows:
         started = any(x.established() for x in self._shafts.values())
         for name in SHAFTS:
             s = self._shafts[name]
-            other = self._shafts["cage" if name == "spindle" else "spindle"]
+            other = self._shafts[OTHER[name]]
             if s.last_time is None or not started:
-                since = 0 if s.last_time is None else s.other_pulses_at_last
-                turned = (other.pulses - since) / other.strip_count if other.strip_count else 0.0
+                turned = other.revolutions_since(0 if s.last_time is None else s.other_pulses_at_last)
                 if turned >= rules.silent_shaft_revolutions:
                     when = "since the start" if s.last_time is None else f"for {now - s.last_time:.3g} s"
                     quiet[name] = f"{name}: no pulse {when} while the {other.name} turned {turned:.3g} revolutions"

@@ -11,7 +11,7 @@ from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorState, MonitorStatus, MonitorWindow, SlipMonitor
 from bearing_rig_sim.monitoring.schedule import PulseMerger, ScheduledStatus, StatusSchedule, TimeToStable
 from bearing_rig_sim.monitoring.settings import NODE_NAME, SHIPPED_FILE, MonitorSettings, shipped_parameters
-from bearing_rig_sim.monitoring.windows import LossRules, SlipWindow, SlipWindows
+from bearing_rig_sim.monitoring.windows import LossRules, SlipWindow, SlipWindows, unstamped
 
 __all__ = [
     "NODE_NAME",
@@ -30,4 +30,5 @@ __all__ = [
     "StatusSchedule",
     "TimeToStable",
     "shipped_parameters",
+    "unstamped",
 ]

@@ -469,6 +469,18 @@ class SlipWindows:
             self.silent = {name: f"{reason}: sensor loss" for name, reason in confirmed.items()}
 
 
+UNSTAMPED_AFTER_S = 1.0
+"""A pulse stamped exactly 0 that arrives later than this on the receiver's clock (s) was not
+stamped (a counter that leaves the header empty); at the start of a clock from zero, a stamp
+of 0 is genuine."""
+
+
+def unstamped(stamp: float, received: float) -> bool:
+    """Whether a pulse stamped ``stamp`` (s) and received at ``received`` (s, the receiver's
+    clock or the bag's log time) was not stamped, so that its reception time must stand in."""
+    return stamp == 0.0 and received > UNSTAMPED_AFTER_S
+
+
 def _malformed(pulse: Pulse) -> str:
     """Why a pulse cannot be used ("" if it can)."""
     t = pulse.time

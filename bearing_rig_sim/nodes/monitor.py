@@ -48,6 +48,7 @@ from bearing_rig_sim.monitoring import (
     SlipState,
     StatusSchedule,
     shipped_parameters,
+    unstamped,
 )
 from bearing_rig_sim.nodes.common import (
     ERROR,
@@ -122,7 +123,7 @@ class MonitorNode(ManagedNode):
     def _on_pulse(self, shaft: str, msg: FibreOpticPulse) -> None:
         try:
             stamp = from_stamp(msg.header.stamp)
-            if stamp == 0.0 and (received := self._clock_now()) > 1.0:  # not stamped (0 is genuine at a clock's start)
+            if stamp == 0.0 and unstamped(stamp, received := self._clock_now()):  # (the clock is read only for a zero stamp)
                 stamp = received
                 self.get_logger().warning(
                     f"{shaft} pulses with a zero header stamp: their reception times are used, whose delivery jitter scatters the slip",

@@ -53,7 +53,7 @@ from collections.abc import Callable
 
 
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
-from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters
+from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -116,10 +116,6 @@ _NAN = math.nan
 # ---------------------------------------------------------------------------------------------
 # Pulses: a decoder of the fields the monitor uses
 # ---------------------------------------------------------------------------------------------
-UNSTAMPED_AFTER_NS = 1_000_000_000
-"""A pulse stamped exactly 0 whose log time is later than this (ns) was not stamped (a counter
-that leaves the header empty); at the start of a clock from zero, a stamp of 0 is genuine."""
-
 _HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
 _U32 = struct.Struct("<I")
 _STRIPS = struct.Struct("<HH")
@@ -384,7 +380,7 @@ class OfflineAnalysis:
             if self._bad_pulses == 1:
                 self._report(f"{self.bag.path.name}: topic {topic}: {exc}; such pulses are skipped")
             return
-        if pulse.time == 0.0 and log_time_ns > UNSTAMPED_AFTER_NS:  # a counter that does not stamp: the reception time
+        if unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
             self._unstamped += 1
             if self._unstamped == 1:
                 self._report(

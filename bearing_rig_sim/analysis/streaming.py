@@ -642,29 +642,30 @@ class TrailingSlope:
             self._used = None
             return
         self._used = (self._line, self._x[-1] - self._x[0])
-        decided = self._clear(self._line)
-        if decided is not SlipState.UNKNOWN and decided is not self._state and self._state is not SlipState.UNKNOWN and self._anchor is not None:
+        decided, held = self._clear(self._line), self._state
+        if decided is not SlipState.UNKNOWN:
+            if decided is held or held is SlipState.UNKNOWN or self._anchor is None:
+                self._state, self._anchor, self._overturn = decided, self._x[0], None
+                return
             # an overturn of the held verdict: reached over OVERTURN_CONFIRM of the span first
             since = self._overturn[1] if self._overturn is not None and self._overturn[0] is decided else self._x[-1]
             self._overturn = (decided, since)
-            if self._x[-1] - since < OVERTURN_CONFIRM * self.span:
-                longer = self._longer_line()
-                if longer is None or self._clear(longer[0]) is not decided:
-                    return
-                # the longer stretch, far less scattered, already says so: overturn now
-                self._state, self._anchor, self._overturn, self._used = decided, self._hx[-longer[0][5]], None, longer
+            if self._x[-1] - since >= OVERTURN_CONFIRM * self.span:
+                self._state, self._anchor, self._overturn = decided, self._x[0], None
                 return
-        if decided is not SlipState.UNKNOWN:
-            self._state, self._anchor, self._overturn = decided, self._x[0], None
-            return
+        # the trailing window cannot decide, or its overturn is not confirmed yet: the longer
+        # stretch decides, or (far less scattered) confirms that overturn at once
         longer = self._longer_line()
-        if longer is not None:
-            decided = self._clear(longer[0])
-            if decided is not SlipState.UNKNOWN:
-                if decided is not self._state or self._anchor is None:
-                    self._anchor = self._hx[-longer[0][5]]
-                self._state = decided
-                self._used = longer
+        if longer is None:
+            return
+        line, _span = longer
+        by_longer = self._clear(line)
+        if by_longer is SlipState.UNKNOWN or (decided is not SlipState.UNKNOWN and by_longer is not decided):
+            return
+        if by_longer is not held or self._anchor is None:
+            self._anchor = self._hx[-line[5]]  # the first of its points
+            self._overturn = None
+        self._state, self._used = by_longer, longer
 
     def _make_verdict(self) -> SlopeVerdict:
         k = self.critical_slope

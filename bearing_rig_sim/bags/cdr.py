@@ -1,65 +1,149 @@
-"""CDR bytes as stored in bags: normalising what rclpy hands over, and decoding leniently.
+"""CDR bytes as stored in bags: the project's one CDR module.
+
+* :func:`make_decoder`: any message type into a rosbags message object, leniently (below).
+* :func:`make_normaliser`: what the recorder stores, trailing padding trimmed (below).
+* :func:`decode_pulse`: the hand-tuned decoder of the ``FibreOpticPulse`` fields the slip monitor
+  uses (offline analysis reads hundreds of thousands of them: no message objects are built).
+* :func:`header_stamp_ns`: the leading ``builtin_interfaces/Time`` of a message, not decoded.
 
 Fast-CDR (the middleware's serializer, behind ``rclpy.serialization.serialize_message`` and raw
 subscriptions) sizes its buffer with the worst-case alignment of every empty sequence of 8-byte
-elements (``float64[]``, ``int64[]``...), so such a message carries 4 to 12 bytes of padding after
-its last field; the padding is uninitialised memory. rosbags' strict decoder refuses a message with
-more than 3 bytes after its end ("CDR message size mismatch"); ``mcap_ros2`` accepts it.
-
-The recorder stores every message of a type that contains a sequence trimmed to its encoded
-length: the length is found by walking the bytes with rosbags' generated size function (no Python
-objects built, a few microseconds), so both decoders accept what the project writes. Types without
-sequences have an exact Fast-CDR size and are stored as received.
-
-Bags written by other tools (``ros2 bag record`` on the physical bench) keep the padding: the
-project's reader therefore decodes leniently, ignoring bytes after the message.
+elements (``float64[]``...), so such a message carries 4 to 12 bytes of padding after its last
+field. rosbags' ``deserialize_cdr`` refuses more than 3 bytes after the end ("CDR message size
+mismatch"). The length a message really occupies is therefore found by walking its bytes along
+the type's field definitions (:func:`encoded_length`: lengths and alignment only, a few
+microseconds); the recorder stores messages of types with sequences cut to that length, and the
+reader decodes the cut bytes with rosbags' public ``Typestore.deserialize_cdr``. Bags written by
+other tools (``ros2 bag record`` on the physical bench) keep the padding and decode all the same.
 """
 
 from __future__ import annotations
 
 import struct
-from typing import Any, Callable, cast
+from typing import Any, NamedTuple, cast
+from collections.abc import Callable
 
 from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.interfaces import CAGE_PULSES
+
+PULSE_TYPE = CAGE_PULSES.msgtype
+"""``bearing_rig_msgs/msg/FibreOpticPulse``."""
 
 CdrBytes = bytes | memoryview
 """Serialized message: 4-byte encapsulation header, then the CDR body."""
 
-_MALFORMED = (SerdeError, struct.error, IndexError, ValueError, UnicodeDecodeError)
-"""What rosbags' generated (de)serializers raise on bytes that are not a message of the type."""
+LITTLE_ENDIAN = b"\x00\x01"
+BIG_ENDIAN = b"\x00\x00"
 
-_LITTLE_ENDIAN = b"\x00\x01"
-_BIG_ENDIAN = b"\x00\x00"
+_MALFORMED = (SerdeError, struct.error, IndexError, ValueError, UnicodeDecodeError)
+"""What walking or decoding bytes that are not a message of the type raises."""
+
+_SIZES = {"bool": 1, "byte": 1, "char": 1, "int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4,
+          "uint32": 4, "int64": 8, "uint64": 8, "float32": 4, "float64": 8}  # fmt: skip
+"""Bytes (and CDR alignment) of the primitive types."""
+
+_U32 = {True: struct.Struct("<I").unpack_from, False: struct.Struct(">I").unpack_from}
+Walk = Callable[[memoryview, int, Callable[..., tuple[int, ...]]], int]
+"""``walk(body, position, read_u32) -> position after the item``."""
 
 
 def has_sequences(typestore: Typestore, msgtype: str, _seen: frozenset[str] = frozenset()) -> bool:
     """True when the type, or a type nested in it, has a variable-length sequence field."""
     if msgtype in _seen:
         return False
-    seen = _seen | {msgtype}
     for _name, desc in typestore.fielddefs[msgtype][1]:
         kind, arg = cast("tuple[Nodetype, Any]", desc)
         if kind == Nodetype.SEQUENCE:
             return True
-        if kind == Nodetype.NAME and has_sequences(typestore, arg, seen):
+        nested = arg if kind == Nodetype.NAME else arg[0][1] if kind == Nodetype.ARRAY and arg[0][0] == Nodetype.NAME else None
+        if nested is not None and has_sequences(typestore, nested, _seen | {msgtype}):
             return True
-        if kind == Nodetype.ARRAY:
-            (subkind, subarg), _count = arg
-            if subkind == Nodetype.NAME and has_sequences(typestore, subarg, seen):
-                return True
     return False
 
 
-def _check_header(data: CdrBytes, msgtype: str) -> bool:
-    """True for little-endian CDR; raises for anything that is not plain CDR."""
-    header = bytes(data[:2])
-    if len(data) < 4 or header not in (_LITTLE_ENDIAN, _BIG_ENDIAN):
-        raise BagError(f"{msgtype}: {len(data)} bytes are not a CDR message (bad encapsulation header {bytes(data[:4]).hex()})")
-    return header == _LITTLE_ENDIAN
+def _string(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
+    position = (position + 3) & ~3
+    return position + 4 + u32(body, position)[0]
+
+
+def _primitives(size: int, count: int) -> Walk:
+    def walk(_body: memoryview, position: int, _u32: Callable[..., tuple[int, ...]]) -> int:
+        return ((position + size - 1) & -size) + size * count
+
+    return walk
+
+
+def _repeat(item: Walk, count: int | None) -> Walk:
+    """``count`` items, or a sequence (uint32 count first) when ``count`` is None."""
+
+    def walk(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
+        n = count
+        if n is None:
+            position = (position + 3) & ~3
+            n = u32(body, position)[0]
+            position += 4
+        for _ in range(n):
+            position = item(body, position, u32)
+        return position
+
+    return walk
+
+
+def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
+    """The walk over one field (raises KeyError for a type it cannot walk: ``wstring``)."""
+    if kind == Nodetype.BASE:
+        return _string if arg[0] == "string" else _primitives(_SIZES[arg[0]], 1)
+    if kind == Nodetype.NAME:
+        steps = [_walker(typestore, *cast("tuple[Nodetype, Any]", desc)) for _name, desc in typestore.fielddefs[arg][1]]
+
+        def walk(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
+            for step in steps:
+                position = step(body, position, u32)
+            return position
+
+        return walk
+    (subkind, subarg), length = arg
+    count = length if kind == Nodetype.ARRAY else None
+    if subkind == Nodetype.BASE and subarg[0] != "string":
+        size = _SIZES[subarg[0]]
+        if count is not None:
+            return _primitives(size, count)
+
+        def sequence(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
+            position = (position + 3) & ~3
+            n = u32(body, position)[0]
+            return ((position + 4 + size - 1) & -size) + size * n if n else position + 4
+
+        return sequence
+    return _repeat(_walker(typestore, subkind, subarg), count)
+
+
+def _length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], int] | None:
+    """A function giving the bytes a message of ``msgtype`` occupies, header included (raises
+    :class:`BagError` for bytes that end before the message does or are not CDR); None when the
+    type holds a field the walk does not know."""
+    try:
+        walk = _walker(typestore, Nodetype.NAME, msgtype)
+    except KeyError:
+        return None
+
+    def length(data: CdrBytes) -> int:
+        header = bytes(data[:2])
+        if len(data) < 4 or header not in (LITTLE_ENDIAN, BIG_ENDIAN):
+            raise BagError(f"{msgtype}: {len(data)} bytes are not a CDR message (bad encapsulation header {bytes(data[:4]).hex()})")
+        try:
+            end = 4 + walk(memoryview(data)[4:], 0, _U32[header == LITTLE_ENDIAN])
+        except _MALFORMED as exc:
+            raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({exc})") from None
+        if end > len(data):
+            raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({end} needed)")
+        return end
+
+    return length
 
 
 def encoded_length(typestore: Typestore, msgtype: str, data: CdrBytes) -> int:
@@ -68,19 +152,10 @@ def encoded_length(typestore: Typestore, msgtype: str, data: CdrBytes) -> int:
     Raises:
         BagError: the bytes end before the message does, or are not CDR.
     """
-    little = _check_header(data, msgtype)
-    msgdef = typestore.get_msgdef(msgtype)
-    body = memoryview(data)[4:]
-    try:
-        if little:
-            end, _ = msgdef.getsize_cdr_to_ros1(body, 0, None, 0, typestore)
-        else:
-            _, end = msgdef.deserialize_cdr_be(body, 0, msgdef.cls, typestore)
-    except _MALFORMED as exc:
-        raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({exc})") from None
-    if 4 + end > len(data):
-        raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({4 + end} needed)")
-    return 4 + end
+    length = _length_function(typestore, msgtype)
+    if length is None:
+        raise BagError(f"{msgtype}: a field type the CDR walk does not know (wstring?)")
+    return length(data)
 
 
 def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], CdrBytes] | None:
@@ -88,50 +163,78 @@ def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], 
     when the type's Fast-CDR size is exact (no sequences) and bytes can be stored as received.
 
     The function raises :class:`BagError` for bytes that are not a complete message."""
-    if not has_sequences(typestore, msgtype):
+    length = _length_function(typestore, msgtype) if has_sequences(typestore, msgtype) else None
+    if length is None:
         return None
-    walk = typestore.get_msgdef(msgtype).getsize_cdr_to_ros1
 
     def normalise(data: CdrBytes) -> CdrBytes:
-        if data[:2] != _LITTLE_ENDIAN:
-            length = encoded_length(typestore, msgtype, data)
-        else:
-            try:
-                length = 4 + walk(memoryview(data)[4:], 0, None, 0, typestore)[0]
-            except _MALFORMED as exc:
-                raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({exc})") from None
-            if length > len(data):
-                raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({length} needed)")
-        return data[:length] if length < len(data) else data
+        end = length(data)
+        return data[:end] if end < len(data) else data
 
     return normalise
 
 
 def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], object]:
-    """A function decoding serialized messages of ``msgtype`` into rosbags message objects.
-
-    Bytes after the end of the message (Fast-CDR padding) are ignored. A malformed message raises
-    :class:`BagError`.
-    """
-    msgdef = typestore.get_msgdef(msgtype)
-    cls = msgdef.cls
-    little_func = msgdef.deserialize_cdr_le
-    big_func = msgdef.deserialize_cdr_be
+    """A function decoding serialized messages of ``msgtype`` into rosbags message objects with
+    rosbags' ``deserialize_cdr``; bytes after the end of the message (Fast-CDR padding) are
+    ignored. A malformed or truncated message raises :class:`BagError`."""
+    length = _length_function(typestore, msgtype)
+    deserialize = typestore.deserialize_cdr
 
     def decode(data: CdrBytes) -> object:
-        header = data[:2]
-        if header == _LITTLE_ENDIAN:
-            func = little_func
-        elif header == _BIG_ENDIAN:
-            func = big_func
-        else:
-            raise BagError(f"{msgtype}: not a CDR message (encapsulation header {bytes(data[:4]).hex()})")
+        end = length(data) if length is not None else len(data)
         try:
-            message, end = func(memoryview(data)[4:], 0, cls, typestore)
+            return deserialize(data[:end] if end < len(data) else data, msgtype)
         except _MALFORMED as exc:
             raise BagError(f"{msgtype}: malformed message of {len(data)} bytes ({exc})") from None
-        if 4 + end > len(data):
-            raise BagError(f"{msgtype}: message of {len(data)} bytes is truncated ({4 + end} needed)")
-        return message
 
     return decode
+
+
+class PulseFields(NamedTuple):
+    """The fields of a ``FibreOpticPulse`` the slip monitor uses."""
+
+    time_s: float
+    """``header.stamp`` as ``sec + nanosec * 1e-9`` (s)."""
+    strip_id: int
+    strip_count: int
+    revolution: int
+    pulse_index: int
+    sensor_id: str
+
+
+_PULSE_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
+_STRIPS = struct.Struct("<HH")
+_COUNTS = struct.Struct("<QQ")
+
+
+def decode_pulse(data: CdrBytes) -> PulseFields:
+    """A little-endian CDR ``FibreOpticPulse``, decoded by hand (no message object is built).
+
+    Raises:
+        BagError: not little-endian CDR, or the bytes end before the message does.
+    """
+    if bytes(data[:2]) != LITTLE_ENDIAN:
+        raise BagError(f"{PULSE_TYPE}: not little-endian CDR (encapsulation {bytes(data[:4]).hex()})")
+    try:
+        sec, nanosec, length = _PULSE_HEAD.unpack_from(data, 4)
+        pos = (12 + length + 3) & ~3  # body offsets; the body starts at byte 4
+        (length,) = _U32[True](data, 4 + pos)
+        sensor = bytes(data[8 + pos : 8 + pos + max(length - 1, 0)]).decode("utf-8")
+        pos = (pos + 4 + length + 1) & ~1
+        strip_id, strip_count = _STRIPS.unpack_from(data, 4 + pos)
+        pos = (pos + 4 + 7) & ~7
+        revolution, pulse_index = _COUNTS.unpack_from(data, 4 + pos)
+    except (struct.error, UnicodeDecodeError) as exc:
+        raise BagError(f"{PULSE_TYPE}: malformed message of {len(data)} bytes ({exc})") from None
+    return PulseFields(sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensor)
+
+
+def header_stamp_ns(data: CdrBytes | bytearray) -> int | None:
+    """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
+    short or its encapsulation is not plain CDR (big or little endian)."""
+    kind = bytes(data[:2])
+    if len(data) < 12 or kind not in (LITTLE_ENDIAN, BIG_ENDIAN):
+        return None
+    sec, nanosec = struct.unpack_from("<iI" if kind == LITTLE_ENDIAN else ">iI", data, 4)
+    return int(sec) * 1_000_000_000 + int(nanosec)

@@ -44,7 +44,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import struct
 import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -54,6 +53,7 @@ from collections.abc import Callable
 
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
+from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -116,32 +116,13 @@ _NAN = math.nan
 # ---------------------------------------------------------------------------------------------
 # Pulses: a decoder of the fields the monitor uses
 # ---------------------------------------------------------------------------------------------
-_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
-_U32 = struct.Struct("<I")
-_STRIPS = struct.Struct("<HH")
-_COUNTS = struct.Struct("<QQ")
-
-
 def decode_pulse(data: bytes | memoryview) -> Pulse:
-    """A little-endian CDR ``FibreOpticPulse`` as a :class:`Pulse` (time = ``sec + nanosec * 1e-9``).
+    """A little-endian CDR ``FibreOpticPulse`` as a :class:`Pulse` (:func:`bearing_rig_sim.bags.cdr.decode_pulse`).
 
     Raises:
         BagError: not little-endian CDR, or the bytes end before the message does.
     """
-    if bytes(data[:2]) != b"\x00\x01":
-        raise BagError(f"{PULSE_TYPE}: not little-endian CDR (encapsulation {bytes(data[:4]).hex()})")
-    try:
-        sec, nanosec, length = _HEAD.unpack_from(data, 4)
-        pos = (12 + length + 3) & ~3  # body offsets; the body starts at byte 4
-        (length,) = _U32.unpack_from(data, 4 + pos)
-        sensor = bytes(data[8 + pos : 8 + pos + max(length - 1, 0)]).decode("utf-8")
-        pos = (pos + 4 + length + 1) & ~1
-        strip_id, strip_count = _STRIPS.unpack_from(data, 4 + pos)
-        pos = (pos + 4 + 7) & ~7
-        revolution, pulse_index = _COUNTS.unpack_from(data, 4 + pos)
-    except (struct.error, UnicodeDecodeError) as exc:
-        raise BagError(f"{PULSE_TYPE}: malformed message of {len(data)} bytes ({exc})") from None
-    return Pulse(sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensor)
+    return Pulse(*pulse_fields(data))
 
 
 def _pulse_from_message(message: Any) -> Pulse:

@@ -13,7 +13,8 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
-from typing import Any, Callable
+from typing import Any
+from collections.abc import Callable
 
 import yaml
 from rosbags.interfaces import Qos
@@ -128,7 +129,7 @@ def parse_qos_profiles(value: Any, source: str) -> list[Qos]:
         return []
     try:
         return parse_qos(value)
-    except Exception as exc:  # noqa: BLE001 - rosbags raises KeyError/TypeError/ReaderError here
+    except Exception as exc:  # rosbags raises KeyError/TypeError/ReaderError here
         raise BagError(f"{source}: offered_qos_profiles is not a list of QoS profiles ({exc})") from None
 
 

@@ -17,7 +17,8 @@ import itertools
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import BinaryIO, Callable, Iterable, Iterator
+from typing import BinaryIO
+from collections.abc import Callable, Iterable, Iterator
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
@@ -130,7 +131,7 @@ def _open_chunk(chunk: Chunk) -> list[McapRecord]:
     """The records of a chunk, decompressed and checksummed by the mcap library."""
     try:
         return breakup_chunk(chunk, validate_crc=True)
-    except Exception as exc:  # noqa: BLE001 - zstandard, lz4 and mcap raise their own classes
+    except Exception as exc:  # zstandard, lz4 and mcap raise their own classes
         raise DamagedRecord(f"chunk does not decompress or fails its checksum ({exc})") from None
 
 
@@ -176,7 +177,7 @@ def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, in
             try:
                 data, size = get_chunk_data_stream(chunk, validate_crc=True)
                 messages = _chunk_messages(data.read(size), keep)
-            except Exception as exc:  # noqa: BLE001 - zstandard, lz4 and mcap raise their own classes
+            except Exception as exc:  # zstandard, lz4 and mcap raise their own classes
                 raise DamagedRecord(f"chunk does not decompress or fails its checksum ({exc})") from None
     except _UNREADABLE as exc:
         raise DamagedRecord(f"unreadable at offset {ref.offset} ({exc or type(exc).__name__})") from None
@@ -322,7 +323,7 @@ def index_file(path: Path) -> FileIndex:
     """
     index = FileIndex(path=path)
     try:
-        stream = open(path, "rb")  # noqa: SIM115 - closed below
+        stream = open(path, "rb")  # closed below
     except OSError as exc:
         raise BagError(f"{path}: cannot open ({exc.strerror or exc})") from None
     with stream:
@@ -425,7 +426,7 @@ def iter_file_messages(
     ]
     refs.sort(key=lambda r: (r.start_ns, r.offset))
     try:
-        stream = open(index.path, "rb")  # noqa: SIM115 - closed in finally
+        stream = open(index.path, "rb")  # closed in finally
     except OSError as exc:
         report(f"{index.path}: cannot open ({exc.strerror or exc})")
         return

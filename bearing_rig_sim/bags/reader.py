@@ -27,7 +27,8 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Callable, Iterable, Iterator, Literal, NamedTuple, cast
+from typing import Any, Literal, NamedTuple, cast
+from collections.abc import Callable, Iterable, Iterator
 
 from rosbags.interfaces import Nodetype
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -283,14 +284,14 @@ class BagReader:
                 parsed.add((msgtype, text))
                 try:
                     bag_types.update(_parse_definition(msgtype, encoding, text))
-                except Exception as exc:  # noqa: BLE001 - rosbags parser errors have several classes
+                except Exception as exc:  # rosbags parser errors have several classes
                     self._report(f"{index.path.name}: the bag's definition of {msgtype} does not parse ({exc}); using the built-in one if any")
         if all(name in rig.fielddefs and _same_fields(rig.fielddefs[name], d) for name, d in bag_types.items()):
             return rig
         store = get_typestore(Stores.EMPTY)
         try:
             store.register(bag_types)
-        except Exception as exc:  # noqa: BLE001 - TypesysError and parser errors
+        except Exception as exc:  # TypesysError and parser errors
             self._report(f"{self.path}: the bag's message definitions are inconsistent ({exc}); using the built-in ones")
             return rig
         needed = {
@@ -300,7 +301,7 @@ class BagReader:
         if missing:
             try:
                 store.register({name: rig.fielddefs[name] for name in missing})
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:
                 self._report(f"{self.path}: built-in definitions of {', '.join(sorted(missing))} clash with the bag's ({exc})")
         return store
 

@@ -17,7 +17,8 @@ methods and its ``identifier`` and ``suffix`` registered in :data:`STORAGE_FORMA
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Callable, Iterable, Iterator, Protocol
+from typing import Protocol
+from collections.abc import Callable, Iterable, Iterator
 
 from bearing_rig_sim.bags import mcapfile
 from bearing_rig_sim.bags.errors import BagError

@@ -35,12 +35,12 @@ def msg_folder() -> Path:
     if local.is_dir():
         return local
     try:
-        from ament_index_python.packages import get_package_share_directory  # noqa: PLC0415
+        from ament_index_python.packages import get_package_share_directory
 
         installed = Path(get_package_share_directory(RIG_MSG_PACKAGE)) / "msg"
         if installed.is_dir():
             return installed
-    except Exception:  # noqa: BLE001 - ament index absent or package not installed
+    except Exception:  # ament index absent or package not installed
         pass
     raise BagError(
         f"cannot find the {RIG_MSG_PACKAGE} message definitions: neither {local} nor an installed "
@@ -75,7 +75,7 @@ def new_rig_typestore() -> Typestore:
     for name, text in rig_message_texts().items():
         try:
             types.update(get_types_from_msg(text, name))
-        except Exception as exc:  # noqa: BLE001 - rosbags parse errors have several classes
+        except Exception as exc:  # rosbags parse errors have several classes
             raise BagError(f"{name}: cannot parse its .msg definition: {exc}") from exc
     store.register(types)
     return store

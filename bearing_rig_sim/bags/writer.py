@@ -30,7 +30,8 @@ import operator
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any, Callable, Literal, cast
+from typing import IO, Any, Literal, cast
+from collections.abc import Callable
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
 from rosbags.typesys.store import Typestore
@@ -77,7 +78,7 @@ class CountingSink:
 
     def __init__(self, path: Path) -> None:
         try:
-            self._file = open(path, "xb", buffering=0)  # noqa: SIM115 - closed by close()
+            self._file = open(path, "xb", buffering=0)  # closed by close()
         except FileExistsError:
             raise BagError(f"{path}: exists already, not overwriting") from None
         except OSError as exc:
@@ -291,7 +292,7 @@ class BagWriter:
             raise BagError(f"topic {topic} carries {entry.msgtype}, got a {msgtype or type(message).__name__}")
         try:
             data = bytes(self._typestore.serialize_cdr(message, msgtype))
-        except Exception as exc:  # noqa: BLE001 - rosbags raises several classes for bad field values
+        except Exception as exc:  # rosbags raises several classes for bad field values
             raise BagError(f"topic {topic}: cannot serialize the {msgtype} ({exc})") from None
         self._append(entry, log_time_ns, data)
 

@@ -298,7 +298,7 @@ def test_empty_file_of_a_split_bag_is_reported(tmp_path: Path, traffic_bag: tupl
     [
         ("rosbag2_bagfile_information: [unclosed", "not valid YAML"),
         ("something_else: {}", "rosbag2_bagfile_information is missing"),
-        ("rosbag2_bagfile_information: {version: 9, storage_identifier: sqlite3}", "storage 'sqlite3' is not supported"),
+        ("rosbag2_bagfile_information: {version: 9, storage_identifier: rosbag_v1, relative_file_paths: [], topics_with_message_count: []}", "storage .rosbag_v1. is not supported"),
         ("rosbag2_bagfile_information: {version: 9, storage_identifier: mcap}", "relative_file_paths is missing"),
         # hostile metadata: an alias bomb (a few hundred bytes, gigabytes once expanded) and nesting
         # that used to end in a RecursionError

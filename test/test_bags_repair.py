@@ -15,7 +15,7 @@ from mcap.reader import make_reader
 from rosbags.highlevel import AnyReader
 
 from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, repair_bag
-from bearing_rig_sim.bags.repair import main as repair_main
+from bearing_rig_sim.cli import main as cli_main
 from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic
 
 REPO = Path(__file__).resolve().parents[1]
@@ -296,8 +296,8 @@ def test_repair_from_the_command_line(tmp_path: Path, capsys: pytest.CaptureFixt
     bag = tmp_path / "run"
     record_traffic(bag)
     (bag / "metadata.yaml").unlink()
-    assert repair_main([str(bag), str(tmp_path / "missing")]) == 2
+    assert cli_main(["bag", "repair", str(bag), str(tmp_path / "missing")]) == 2
     out, err = capsys.readouterr()
     assert "metadata.yaml: rebuilt from the files" in out
-    assert err.startswith("error: ") and "missing: not a bag directory" in err
+    assert err.startswith("bearing-rig: error: ") and "missing: not a bag directory" in err
     assert (bag / "metadata.yaml").exists()

@@ -26,6 +26,12 @@ def test_mypy_passes_on_the_package() -> None:
     assert result.returncode == 0, result.stdout + result.stderr
 
 
+def test_mypy_strict_passes_on_bags() -> None:
+    """bags/ is typed to mypy's strictest settings (imported modules are checked as usual)."""
+    result = run("mypy", "--strict", "--follow-imports=silent", "--cache-dir", "/dev/null", "bearing_rig_sim/bags")
+    assert result.returncode == 0, result.stdout + result.stderr
+
+
 def test_every_type_ignore_gives_its_reason() -> None:
     bare = []
     for path in sorted((ROOT / "bearing_rig_sim").rglob("*.py")):

@@ -3,7 +3,8 @@
 * :class:`BagWriter` (:mod:`.writer`): the recorder; raw CDR or rosbags message objects in,
   a rosbag2 v9 bag directory out (zstd chunks, ``ros2msg`` schemas, offered QoS, run context).
 * :func:`open_bag` / :class:`BagReader` (:mod:`.reader`): topics, counts, time range, run context,
-  messages decoded in time order, streamed; damaged bags read as far as they go, with warnings.
+  messages decoded in time order, streamed; damaged bags read as far as they go, with warnings;
+  MCAP (:mod:`.mcapfile`) or SQLite 3 (:mod:`.sqlite`) storage behind one seam (:mod:`.storage`).
 * :func:`repair_bag` (:mod:`.repair`): restores the index of a bag whose recording was killed.
 * :func:`rig_typestore` (:mod:`.typestore`): ROS 2 Jazzy types plus ``bearing_rig_msgs``.
 

@@ -28,6 +28,7 @@ from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.typestore import dependencies
 from bearing_rig_sim.interfaces import CAGE_PULSES
 
 PULSE_TYPE = CAGE_PULSES.msgtype
@@ -51,18 +52,9 @@ Walk = Callable[[memoryview, int, Callable[..., tuple[int, ...]]], int]
 """``walk(body, position, read_u32) -> position after the item``."""
 
 
-def has_sequences(typestore: Typestore, msgtype: str, _seen: frozenset[str] = frozenset()) -> bool:
+def has_sequences(typestore: Typestore, msgtype: str) -> bool:
     """True when the type, or a type nested in it, has a variable-length sequence field."""
-    if msgtype in _seen:
-        return False
-    for _name, desc in typestore.fielddefs[msgtype][1]:
-        kind, arg = cast("tuple[Nodetype, Any]", desc)
-        if kind == Nodetype.SEQUENCE:
-            return True
-        nested = arg if kind == Nodetype.NAME else arg[0][1] if kind == Nodetype.ARRAY and arg[0][0] == Nodetype.NAME else None
-        if nested is not None and has_sequences(typestore, nested, _seen | {msgtype}):
-            return True
-    return False
+    return any(desc[0] == Nodetype.SEQUENCE for name in dependencies(typestore, [msgtype]) for _field, desc in typestore.fielddefs[name][1])
 
 
 def _string(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:

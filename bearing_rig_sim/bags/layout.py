@@ -14,15 +14,14 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
 from typing import Any
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import yaml
 from rosbags.interfaces import Qos
 from rosbags.rosbag2.metadata import dump_qos_v9, parse_qos
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import STORAGE_FORMATS
-from bearing_rig_sim.bags.mcapfile import FileIndex
+from bearing_rig_sim.bags.storage import FileIndex
 from bearing_rig_sim.config import ConfigError, parse_yaml
 
 METADATA_FILE = "metadata.yaml"
@@ -199,8 +198,8 @@ def read_layout(bag_dir: Path) -> BagLayout:
     """Parse ``<bag_dir>/metadata.yaml``.
 
     Raises:
-        BagError: the file is missing, not YAML, or misses keys a reader needs; the storage is
-            not MCAP; the bag uses rosbag2 file or message compression.
+        BagError: the file is missing, not YAML, or misses keys a reader needs; the bag uses
+            rosbag2 file or message compression.
     """
     path = bag_dir / METADATA_FILE
     source = str(path)
@@ -223,8 +222,6 @@ def read_layout(bag_dir: Path) -> BagLayout:
     where = "rosbag2_bagfile_information."
     version = _get(info, "version", source, int, where)
     storage = _get(info, "storage_identifier", source, str, where)
-    if storage not in STORAGE_FORMATS:
-        raise BagError(f"{source}: storage {storage!r} is not supported (this project reads: {', '.join(STORAGE_FORMATS)})")
     mode = str(info.get("compression_mode") or "").lower()
     if mode not in ("", "none"):
         raise BagError(
@@ -275,12 +272,11 @@ def read_layout(bag_dir: Path) -> BagLayout:
 
 
 def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | None = None) -> str:
-    """Message type of a channel: its schema's name, else the type ``metadata.yaml`` gives the
+    """Message type of a channel: as its storage gives it, else the type ``metadata.yaml`` gives the
     topic, else empty."""
     channel = index.channels[channel_id]
-    schema = index.schemas.get(channel.schema_id)
-    if schema is not None and schema.name:
-        return schema.name
+    if channel.msgtype:
+        return channel.msgtype
     if previous is not None:
         for topic in previous.topics:
             if topic.name == channel.topic:
@@ -289,7 +285,7 @@ def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | Non
 
 
 def layout_from_indexes(
-    indexes: list[FileIndex],
+    indexes: Sequence[FileIndex],
     previous: BagLayout | None,
     report: Callable[[str], None],
     type_hash_of: Callable[[str], str] = lambda _msgtype: "",
@@ -315,7 +311,7 @@ def layout_from_indexes(
                     report(str(exc))
                     qos = []
                 entry = topics[channel.topic] = TopicEntry(
-                    channel.topic, msgtype, qos, channel.metadata.get("topic_type_hash", ""), 0, channel.message_encoding
+                    channel.topic, msgtype, qos, channel.metadata.get("topic_type_hash", ""), 0, channel.encoding
                 )
             elif msgtype and entry.msgtype and msgtype != entry.msgtype:
                 report(f"{index.path.name}: topic {channel.topic} carries {msgtype} here but {entry.msgtype} before; left out")

@@ -29,12 +29,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-
-ProblemSink = Callable[[str], None]
-"""Receives a one-line description of each problem met while reading."""
-
-MessageTuple = tuple[int, int, int, bytes]
-"""A message as (log_time_ns, channel_id, publish_time_ns, data)."""
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
 """What the mcap library raises on bytes that are not the records they should be (a CRC mismatch
@@ -66,43 +61,24 @@ class ChunkRef:
 
 
 @dataclass
-class FileIndex:
-    """What one MCAP file holds, from its summary or from a scan.
+class McapIndex(FileIndex):
+    """What one MCAP file holds, from its summary or from a scan (see :class:`.storage.FileIndex`).
 
     Attributes:
-        path: the file.
-        indexed: True when the file had a valid summary (it was finished properly).
-        has_header: False when the file ends before its header record (nothing readable); True
-            also for a damaged header when the summary at the end locates the data.
         profile / library: from the header record.
-        schemas / channels: by id (the mcap library's records).
         chunks: message groups, in file order.
-        metadata: metadata records by name.
-        message_count / channel_counts / start_ns / end_ns: statistics (times in ns).
         readable_bytes: offset after the last record that could be read (file size if intact).
         file_size: size of the file in bytes.
         compression: compression of the first chunk (``zstd``, ``lz4`` or ``""``).
-        problems: what was wrong, one line each.
         damaged_bytes: bytes of the chunks :func:`check_chunks` found damaged.
     """
 
-    path: Path
-    indexed: bool = False
-    has_header: bool = False
     profile: str = ""
     library: str = ""
-    schemas: dict[int, Schema] = field(default_factory=dict)
-    channels: dict[int, Channel] = field(default_factory=dict)
     chunks: list[ChunkRef] = field(default_factory=list)
-    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
-    message_count: int = 0
-    channel_counts: dict[int, int] = field(default_factory=dict)
-    start_ns: int = 0
-    end_ns: int = 0
     readable_bytes: int = 0
     file_size: int = 0
     compression: str = ""
-    problems: list[str] = field(default_factory=list)
     damaged_bytes: int = 0
 
     @property
@@ -110,15 +86,16 @@ class FileIndex:
         """Bytes at the end of the file that belong to no complete record."""
         return max(0, self.file_size - self.readable_bytes)
 
-    def count(self, channel_id: int, log_time: int) -> None:
-        """Add one message to the statistics."""
-        if self.message_count == 0:
-            self.start_ns = self.end_ns = log_time
-        else:
-            self.start_ns = min(self.start_ns, log_time)
-            self.end_ns = max(self.end_ns, log_time)
-        self.message_count += 1
-        self.channel_counts[channel_id] = self.channel_counts.get(channel_id, 0) + 1
+    def add_channel(self, channel: Channel, schemas: dict[int, Schema]) -> None:
+        """Record a channel; its type is its schema's name."""
+        schema = schemas.get(channel.schema_id)
+        msgtype = schema.name if schema is not None else ""
+        self.channels[channel.id] = ChannelInfo(channel.topic, msgtype, channel.message_encoding, dict(channel.metadata))
+
+    def add_schema(self, schema: Schema) -> None:
+        """Record a schema's definition (ros2msg or ros2idl text)."""
+        if schema.name:
+            self.definitions.setdefault(schema.name, (schema.encoding, schema.data.decode("utf-8", errors="replace")))
 
 
 def _one_record(stream: BinaryIO, offset: int) -> McapRecord:
@@ -201,7 +178,7 @@ def _record_kind(opcode: bytes) -> str:
         return "unknown"
 
 
-def _index_from_summary(stream: BinaryIO, index: FileIndex) -> bool:
+def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
     """Fill ``index`` from the summary section; False when there is none usable."""
     try:
         stream.seek(-len(MCAP0_MAGIC), io.SEEK_END)
@@ -217,8 +194,10 @@ def _index_from_summary(stream: BinaryIO, index: FileIndex) -> bool:
         return False  # messages outside chunks, or definitions not repeated: only a scan finds them
     if any(c.chunk_start_offset + c.chunk_length > index.file_size for c in summary.chunk_indexes):
         return False
-    index.schemas = dict(summary.schemas)
-    index.channels = dict(summary.channels)
+    for schema in summary.schemas.values():
+        index.add_schema(schema)
+    for channel in summary.channels.values():
+        index.add_channel(channel, summary.schemas)
     index.chunks = [
         ChunkRef(
             c.chunk_start_offset,
@@ -248,11 +227,12 @@ def _index_from_summary(stream: BinaryIO, index: FileIndex) -> bool:
     return True
 
 
-def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: FileIndex) -> None:
+def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> None:
     """Fill ``index`` from the records after the header: a damaged chunk is skipped, the scan
     stops at the first record that cannot be read (cut by the end of the file)."""
     name = index.path.name
     start = stream.tell()
+    schemas: dict[int, Schema] = {}
     loose: list[tuple[int, int, int]] = []  # (offset after the record, channel, log time) of messages outside chunks
     run_start = start
 
@@ -286,17 +266,19 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: FileIndex) -> 
                         channels.add(item.channel_id)
                         index.count(item.channel_id, item.log_time)
                     elif isinstance(item, Schema):
-                        index.schemas[item.id] = item
+                        schemas[item.id] = item
+                        index.add_schema(item)
                     elif isinstance(item, Channel):
-                        index.channels[item.id] = item
+                        index.add_channel(item, schemas)
                 if not index.chunks and not index.compression:
                     index.compression = record.compression
                 if times:
                     index.chunks.append(ChunkRef(start, end, min(times), max(times), frozenset(channels)))
             elif isinstance(record, Schema):
-                index.schemas[record.id] = record
+                schemas[record.id] = record
+                index.add_schema(record)
             elif isinstance(record, Channel):
-                index.channels[record.id] = record
+                index.add_channel(record, schemas)
             elif isinstance(record, Metadata):
                 index.metadata.setdefault(record.name, {}).update(record.metadata)
             start = end
@@ -315,13 +297,13 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: FileIndex) -> 
     index.readable_bytes = start
 
 
-def index_file(path: Path) -> FileIndex:
+def index_file(path: Path) -> McapIndex:
     """Index one MCAP file: from its summary when it has a valid one, else by scanning it.
 
     Raises:
         BagError: the file cannot be opened or is not MCAP (bad magic, no header).
     """
-    index = FileIndex(path=path)
+    index = McapIndex(path=path)
     try:
         stream = open(path, "rb")  # closed below
     except OSError as exc:
@@ -364,7 +346,7 @@ def index_file(path: Path) -> FileIndex:
     return index
 
 
-def check_chunks(index: FileIndex) -> list[str]:
+def check_chunks(index: McapIndex) -> list[str]:
     """Decompress and checksum every chunk of an indexed file: one line per damaged chunk. The
     bytes those chunks occupy (bounded by the end of the file) are left in ``index.damaged_bytes``."""
     problems = []
@@ -395,7 +377,7 @@ def _lazy_chunk(
 
 
 def iter_file_messages(
-    index: FileIndex,
+    index: McapIndex,
     channel_ids: Iterable[int] | None = None,
     start_ns: int | None = None,
     stop_ns: int | None = None,
@@ -439,3 +421,25 @@ def iter_file_messages(
                 yield log_time, channel_id, publish_time, data
     finally:
         stream.close()
+
+
+class McapFormat:
+    """MCAP storage files (https://mcap.dev/spec), one index per file."""
+
+    identifier = "mcap"
+
+    def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
+        """See :func:`index_file`."""
+        return [index_file(f) for f in files]
+
+    def messages(
+        self,
+        index: FileIndex,
+        channel_ids: Iterable[int] | None = None,
+        start_ns: int | None = None,
+        stop_ns: int | None = None,
+        report: ProblemSink = lambda _msg: None,
+    ) -> Iterator[MessageTuple]:
+        """See :func:`iter_file_messages`."""
+        assert isinstance(index, McapIndex)
+        return iter_file_messages(index, channel_ids, start_ns, stop_ns, report)

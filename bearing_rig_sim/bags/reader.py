@@ -27,21 +27,38 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import Any, Literal, NamedTuple, cast
+from typing import Literal, NamedTuple
 from collections.abc import Callable, Iterable, Iterator
 
-from rosbags.interfaces import Nodetype
+from rosbags.interfaces.typing import Constdefs, Fielddefs, Typesdict
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
-from bearing_rig_sim.bags.mcapfile import FileIndex
-from bearing_rig_sim.bags.storage import storage_for_file
+from bearing_rig_sim.bags.mcapfile import McapFormat
+from bearing_rig_sim.bags.sqlite import Sqlite3Format
+from bearing_rig_sim.bags.storage import FileIndex, StorageFormat
 from bearing_rig_sim.bags.qos import QosSpec
-from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, rig_typestore
+from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, dependencies, rig_typestore
 from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
+
+
+STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sqlite3Format()}
+"""The storage formats this project reads, by ``storage_identifier`` (see :mod:`.storage`)."""
+
+
+def storage_format(identifier: str) -> StorageFormat:
+    """The format of a ``storage_identifier``.
+
+    Raises:
+        BagError: a format this project does not read (the message lists those it does).
+    """
+    try:
+        return STORAGE_FORMATS[identifier]
+    except KeyError:
+        raise BagError(f"storage {identifier!r} is not supported (this project reads: {', '.join(sorted(STORAGE_FORMATS))})") from None
 
 
 class BagMessage(NamedTuple):
@@ -76,31 +93,14 @@ class TopicInfo:
     decodable: bool
 
 
-def _dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
-    """The types and every type they use, recursively."""
-    todo, found = list(names), set()
-    while todo:
-        name = todo.pop()
-        if name in found or name not in store.fielddefs:
-            continue
-        found.add(name)
-        for _field, desc in store.fielddefs[name][1]:
-            kind, arg = cast("tuple[Nodetype, Any]", desc)
-            if kind == Nodetype.NAME:
-                todo.append(arg)
-            elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:
-                todo.append(arg[0][1])
-    return found
-
-
-def _same_fields(a: tuple, b: tuple) -> bool:
+def _same_fields(a: tuple[Constdefs, Fielddefs], b: tuple[Constdefs, Fielddefs]) -> bool:
     return [(n.lower(), d) for n, d in a[1]] == [(n.lower(), d) for n, d in b[1]]
 
 
-def _parse_definition(msgtype: str, encoding: str, text: str) -> dict:
+def _parse_definition(msgtype: str, encoding: str, text: str) -> Typesdict:
     if encoding == "ros2msg":
         return get_types_from_msg(text, msgtype)
-    types: dict = {}
+    types: Typesdict = {}
     separator = SCHEMA_SEPARATOR + "\n"
     if text.startswith(separator + "IDL: "):
         for section in text.split(separator)[1:]:
@@ -133,8 +133,13 @@ class BagReader:
         self._closed = False
         if not self.path.exists():
             raise BagError(f"{self.path}: no such bag (the path does not exist)")
+        self._format = STORAGE_FORMATS["mcap"]
         if self.path.is_dir():
             self.layout = read_layout(self.path)
+            try:
+                self._format = storage_format(self.layout.storage_identifier)
+            except BagError as exc:
+                raise BagError(f"{self.path / 'metadata.yaml'}: {exc}") from None
             files = [self.path / f.path for f in self.layout.files]
             missing = [f for f in files if not f.is_file()]
             if files and len(missing) == len(files):
@@ -144,7 +149,8 @@ class BagReader:
             files = [f for f in files if f not in missing]
         else:
             files = [self.path]
-        self._indexes: list[FileIndex] = [storage_for_file(f).index(f) for f in files]
+        self._files = files
+        self._indexes: list[FileIndex] = self._format.indexes(self.path, files) if files else []
         if self._indexes and not any(i.has_header for i in self._indexes):
             raise BagError(f"{self.path}: nothing readable: " + "; ".join(p for i in self._indexes for p in i.problems))
         for index in self._indexes:
@@ -161,7 +167,7 @@ class BagReader:
     @property
     def files(self) -> list[Path]:
         """The storage files read."""
-        return [i.path for i in self._indexes]
+        return list(self._files)
 
     @property
     def topics(self) -> dict[str, TopicInfo]:
@@ -201,7 +207,7 @@ class BagReader:
     def verify(self) -> BagCheck:
         """Read every chunk: checksums, unreadable messages, log-time outliers (see
         :mod:`.verify`); slower than opening, which reads the index only."""
-        return verify_indexes(self._indexes)
+        return verify_indexes(self._indexes, self._format.messages)
 
     @property
     def complete(self) -> bool:
@@ -273,12 +279,10 @@ class BagReader:
         """The shared rig store when the bag's definitions agree with it, else a store built
         from the bag's own definitions completed with the rig's."""
         rig = rig_typestore()
-        bag_types: dict = {}
+        bag_types: Typesdict = {}
         parsed: set[tuple[str, str]] = set()
         for index in self._indexes:
-            for schema in index.schemas.values():
-                msgtype, encoding = schema.name, schema.encoding
-                text = schema.data.decode("utf-8", errors="replace")
+            for msgtype, (encoding, text) in index.definitions.items():
                 if not text or (msgtype, text) in parsed or encoding not in ("ros2msg", "ros2idl", "omgidl"):
                     continue
                 parsed.add((msgtype, text))
@@ -297,7 +301,7 @@ class BagReader:
         needed = {
             channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels
         } | ({t.msgtype for t in self.layout.topics} if self.layout else set())
-        missing = {name for name in _dependencies(rig, needed) if name not in store.fielddefs}
+        missing = {name for name in dependencies(rig, needed) if name not in store.fielddefs}
         if missing:
             try:
                 store.register({name: rig.fielddefs[name] for name in missing})
@@ -366,7 +370,7 @@ class BagReader:
                     for cid in wanted
                 }
             )
-            messages = storage_for_file(index.path).messages(index, wanted, start_ns, stop_ns, self._report)
+            messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
             streams.append((index.start_ns, index.end_ns, ((t, tagged, cid, data) for t, cid, _pub, data in messages)))
         streams.sort(key=lambda s: s[0])
         in_order = all(b[0] > a[1] for a, b in zip(streams, streams[1:]))

@@ -12,42 +12,33 @@ Foxglove's indexed loading) need the index back. :func:`repair_bag` rebuilds it:
 3. ``metadata.yaml`` is rebuilt from what the files hold (the old one, if any and different, is
    kept as ``metadata.yaml.orig``).
 
-Repairing a bag that needs nothing changes nothing. From a shell, until the ``bearing-rig``
-command has its ``bag repair`` sub-command: ``python -m bearing_rig_sim.bags repair BAG...``.
+Repairing a bag that needs nothing changes nothing. From a shell: ``bearing-rig bag repair BAG...``.
 """
 
 from __future__ import annotations
 
-import argparse
 import os
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import IO, Any, Literal, cast
+from typing import Literal
 
-from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
-
-import bearing_rig_sim
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import (
     METADATA_FILE,
     BagLayout,
     layout_from_indexes,
-    qos_yaml,
     read_layout,
     same_layout,
     storage_file_index,
     write_layout,
 )
-from bearing_rig_sim.bags.mcapfile import FileIndex
-from bearing_rig_sim.bags.storage import storage_for_file
-from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
-from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink
+from bearing_rig_sim.bags.mcapfile import McapIndex, check_chunks, index_file, iter_file_messages
+from bearing_rig_sim.bags.typestore import rig_typestore, type_hash
+from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink, register_topic, start_mcap
 
 BACKUP_SUFFIX = ".orig"
 """Appended to the name of a file the repair replaced (``run_0.mcap.orig``)."""
 
-_COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "": CompressionType.NONE}
 
 
 @dataclass
@@ -143,44 +134,28 @@ def _storage_files(bag_dir: Path, previous: BagLayout | None) -> list[Path]:
     return files
 
 
-def _type_hash(msgtype: str) -> str:
-    store = rig_typestore()
-    return store.hash_rihs01(msgtype) if msgtype in store.fielddefs else ""
-
-
-def _rewrite(index: FileIndex, previous: BagLayout | None, problems: list[str]) -> Path:
+def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) -> Path:
     """Write the readable content of a damaged file to ``<name>.repairing``; returns that path."""
     target = index.path.with_name(index.path.name + ".repairing")
     if target.exists():
         target.unlink()
     sink = CountingSink(target)
-    writer = Writer(cast(IO[Any], sink), chunk_size=DEFAULT_CHUNK_SIZE, compression=_COMPRESSION.get(index.compression, CompressionType.ZSTD))
     try:
-        writer.start(profile=index.profile or "ros2", library=index.library or f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
+        writer = start_mcap(sink, DEFAULT_CHUNK_SIZE, index.compression, index.profile or "ros2", index.library)
         for name, values in index.metadata.items():
             writer.add_metadata(name, values)
-        schema_ids: dict[int, int] = {}
-        schema_by_name: dict[str, int] = {}
-        for old_id, schema in sorted(index.schemas.items()):
-            schema_ids[old_id] = schema_by_name[schema.name] = writer.register_schema(schema.name, schema.encoding, schema.data)
-        channel_ids: dict[int, int] = {}
-        for old_id, channel in sorted(index.channels.items()):
-            channel_ids[old_id] = writer.register_channel(
-                channel.topic, channel.message_encoding, schema_ids.get(channel.schema_id, 0), dict(channel.metadata)
-            )
+        schema_by_name = {name: writer.register_schema(name, encoding, text.encode()) for name, (encoding, text) in index.definitions.items()}
+        channel_ids = {
+            old_id: writer.register_channel(channel.topic, channel.encoding, schema_by_name.get(channel.msgtype, 0), dict(channel.metadata))
+            for old_id, channel in sorted(index.channels.items())
+        }
         # Topics metadata.yaml declares but whose channel records were lost with the last chunk.
         present = {c.topic for c in index.channels.values()}
         store = rig_typestore()
         for topic in previous.topics if previous is not None else []:
-            if topic.name in present or topic.msgtype not in store.fielddefs:
-                continue
-            schema_id = schema_by_name.get(topic.msgtype)
-            if schema_id is None:
-                text = msg_definition_text(topic.msgtype, store).encode()
-                schema_id = schema_by_name[topic.msgtype] = writer.register_schema(topic.msgtype, "ros2msg", text)
-            metadata = {"offered_qos_profiles": qos_yaml(topic.qos), "topic_type_hash": topic.type_hash or _type_hash(topic.msgtype)}
-            writer.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
-        for log_time, channel_id, publish_time, data in storage_for_file(index.path).messages(index, report=problems.append):
+            if topic.name not in present and topic.msgtype in store.fielddefs:
+                register_topic(writer, schema_by_name, topic, store)
+        for log_time, channel_id, publish_time, data in iter_file_messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()
     except BaseException:
@@ -209,10 +184,10 @@ def repair_bag(path: str | Path) -> RepairReport:
     files = _storage_files(bag_dir, previous)
     if not files:
         raise BagError(f"{bag_dir}: no .mcap file, nothing to repair")
-    indexes: list[FileIndex] = []
+    indexes: list[McapIndex] = []
     for file in files:
         try:
-            index = storage_for_file(file).index(file)
+            index = index_file(file)
         except BagError as exc:
             backup = _backup_path(file)
             os.replace(file, backup)
@@ -220,7 +195,7 @@ def repair_bag(path: str | Path) -> RepairReport:
             continue
         chunk_bytes_lost = 0
         if index.indexed and not index.problems:
-            index.problems.extend(storage_for_file(file).check(index))
+            index.problems.extend(check_chunks(index))
             chunk_bytes_lost = index.damaged_bytes
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
@@ -232,13 +207,13 @@ def repair_bag(path: str | Path) -> RepairReport:
         entry.backup = _backup_path(file)
         os.replace(file, entry.backup)
         os.replace(rebuilt, file)
-        index = storage_for_file(file).index(file)
+        index = index_file(file)
         entry.messages_recovered = index.message_count
         entry.messages_lost = max(0, counted - index.message_count)
         report.files.append(entry)
         indexes.append(index)
     problems: list[str] = []
-    layout = layout_from_indexes(indexes, previous, problems.append, _type_hash)
+    layout = layout_from_indexes(indexes, previous, problems.append, type_hash)
     if problems and report.files:
         report.files[0].problems.extend(problems)
     if previous is None or not same_layout(previous, layout):
@@ -249,18 +224,3 @@ def repair_bag(path: str | Path) -> RepairReport:
         write_layout(bag_dir, layout)
         report.metadata_rewritten = True
     return report
-
-
-def main(argv: list[str] | None = None) -> int:
-    """Repair each bag named in ``argv`` and say what was done; exit status 2 if a path is not
-    a bag (``python -m bearing_rig_sim.bags repair BAG...``)."""
-    parser = argparse.ArgumentParser(description="Restore the index of bags whose recording was interrupted.")
-    parser.add_argument("bags", nargs="+", type=Path, metavar="BAG", help="bag directory")
-    status = 0
-    for bag in parser.parse_args(argv).bags:
-        try:
-            print(repair_bag(bag).summary())
-        except BagError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            status = 2
-    return status

@@ -1,44 +1,97 @@
-"""The storage seam of the bag code: what reading and repairing a bag need from one storage file,
-whatever its format.
+"""The storage seam: what reading a bag needs from its storage, whatever the format.
 
-A rosbag2 bag is a directory with ``metadata.yaml`` (:mod:`.layout`) and storage files whose format
-``metadata.yaml`` names (``storage_identifier``). Everything above this module (the reader, repair,
-``bag info``, offline analysis) talks to a :class:`StorageFormat`; only the format's own module
-knows its records. One format is implemented: MCAP (:mod:`.mcapfile`), the rosbag2 default since
-Iron and the format Foxglove opens.
-
-Adding a storage format: a module with an ``index`` (file -> :class:`~.mcapfile.FileIndex`:
-channels, schemas, message groups with their time ranges, statistics, problems), a ``messages``
-iterator in log-time order and a ``check`` of every message group; an object with those three
-methods and its ``identifier`` and ``suffix`` registered in :data:`STORAGE_FORMATS`. The writer
-(:mod:`.writer`) writes MCAP.
+rosbag2 keeps messages in storage files of the format ``metadata.yaml`` names
+(``storage_identifier``): MCAP (:mod:`.mcapfile`; the rosbag2 default since Iron and what this
+project records) or SQLite 3 (:mod:`.sqlite`; the default before, what older benches record).
+A format turns a bag's storage into :class:`FileIndex` objects (channels, type definitions,
+counts, time range, run context, problems) and streams messages in log-time order; the reader,
+``bag info`` and the offline analysis see nothing else. The repair of a killed recording is
+MCAP's alone (:mod:`.repair`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
-from collections.abc import Callable, Iterable, Iterator
-
-from bearing_rig_sim.bags import mcapfile
-from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.mcapfile import FileIndex
 
 ProblemSink = Callable[[str], None]
 """Receives a one-line description of each problem met while reading."""
 
+MessageTuple = tuple[int, int, int, bytes]
+"""A message as (log_time_ns, channel_id, publish_time_ns, serialized data)."""
+
+
+@dataclass(frozen=True)
+class ChannelInfo:
+    """A topic as one storage file (or bag) holds it.
+
+    Attributes:
+        topic: topic name.
+        msgtype: message type (``pkg/msg/Name``); empty when the storage does not say.
+        encoding: message encoding (``cdr``).
+        metadata: rosbag2's ``offered_qos_profiles`` (YAML text) and ``topic_type_hash``.
+    """
+
+    topic: str
+    msgtype: str
+    encoding: str
+    metadata: Mapping[str, str]
+
+
+@dataclass
+class FileIndex:
+    """What a storage file (or, for a format read a bag at a time, a bag) holds.
+
+    Attributes:
+        path: the file (or bag directory).
+        indexed: True when it was finished properly (its own index is complete).
+        has_header: False when nothing at all is readable.
+        channels: by the storage's channel id.
+        definitions: message definitions the storage carries, by type: (encoding, text) with
+            encoding ``ros2msg`` or ``ros2idl``.
+        metadata: named string maps (the run context under ``bearing_rig_sim``).
+        message_count / channel_counts / start_ns / end_ns: statistics (times in ns).
+        problems: what was wrong, one line each.
+    """
+
+    path: Path
+    indexed: bool = False
+    has_header: bool = False
+    channels: dict[int, ChannelInfo] = field(default_factory=dict)
+    definitions: dict[str, tuple[str, str]] = field(default_factory=dict)
+    metadata: dict[str, dict[str, str]] = field(default_factory=dict)
+    message_count: int = 0
+    channel_counts: dict[int, int] = field(default_factory=dict)
+    start_ns: int = 0
+    end_ns: int = 0
+    problems: list[str] = field(default_factory=list)
+
+    def count(self, channel_id: int, log_time: int) -> None:
+        """Add one message to the statistics."""
+        if self.message_count == 0:
+            self.start_ns = self.end_ns = log_time
+        else:
+            self.start_ns = min(self.start_ns, log_time)
+            self.end_ns = max(self.end_ns, log_time)
+        self.message_count += 1
+        self.channel_counts[channel_id] = self.channel_counts.get(channel_id, 0) + 1
+
 
 class StorageFormat(Protocol):
-    """One storage file format of rosbag2 bags."""
+    """One storage format of rosbag2 bags."""
 
     identifier: str
-    """``storage_identifier`` in ``metadata.yaml`` (``"mcap"``)."""
-    suffix: str
-    """File name suffix of its storage files (``".mcap"``)."""
+    """``storage_identifier`` in ``metadata.yaml`` (``"mcap"``, ``"sqlite3"``)."""
 
-    def index(self, path: Path) -> FileIndex:
-        """What the file holds, from its own index or by scanning it; damage goes into
-        ``problems``. Raises :class:`~.errors.BagError` when the file is not of this format."""
+    def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
+        """What the bag at ``bag`` (a directory, or a single storage file) holds in ``files``;
+        damage goes into the indexes' ``problems``.
+
+        Raises:
+            BagError: a file is not of this format, or nothing can be read.
+        """
         ...
 
     def messages(
@@ -48,63 +101,7 @@ class StorageFormat(Protocol):
         start_ns: int | None = None,
         stop_ns: int | None = None,
         report: ProblemSink = ...,
-    ) -> Iterator[tuple[int, int, int, bytes]]:
-        """Messages as (log_time_ns, channel_id, publish_time_ns, data) in log-time order,
-        streamed; damaged groups reported through ``report`` and skipped."""
+    ) -> Iterator[MessageTuple]:
+        """Messages with ``start_ns <= log_time < stop_ns`` in log-time order, streamed;
+        damaged parts are reported through ``report`` and skipped."""
         ...
-
-    def check(self, index: FileIndex) -> list[str]:
-        """Read and verify every message group (checksums, decompression): a line per damaged one;
-        the bytes of the damaged groups are left in ``index.damaged_bytes``."""
-        ...
-
-
-class McapFormat:
-    """MCAP storage files (https://mcap.dev/spec), read by :mod:`.mcapfile`."""
-
-    identifier = "mcap"
-    suffix = ".mcap"
-
-    def index(self, path: Path) -> FileIndex:
-        """See :func:`.mcapfile.index_file`."""
-        return mcapfile.index_file(path)
-
-    def messages(
-        self,
-        index: FileIndex,
-        channel_ids: Iterable[int] | None = None,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        report: ProblemSink = lambda _msg: None,
-    ) -> Iterator[tuple[int, int, int, bytes]]:
-        """See :func:`.mcapfile.iter_file_messages`."""
-        return mcapfile.iter_file_messages(index, channel_ids, start_ns, stop_ns, report)
-
-    def check(self, index: FileIndex) -> list[str]:
-        """See :func:`.mcapfile.check_chunks`."""
-        return mcapfile.check_chunks(index)
-
-
-STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat()}
-"""The storage formats this project reads, by ``storage_identifier``."""
-
-
-def storage_format(identifier: str) -> StorageFormat:
-    """The format of a ``storage_identifier``.
-
-    Raises:
-        BagError: a format this project does not read (the message lists those it does).
-    """
-    try:
-        return STORAGE_FORMATS[identifier]
-    except KeyError:
-        known = ", ".join(sorted(STORAGE_FORMATS))
-        raise BagError(f"storage {identifier!r} is not supported (this project reads: {known})") from None
-
-
-def storage_for_file(path: Path) -> StorageFormat:
-    """The format of a storage file, by its suffix; MCAP when the suffix names none."""
-    for fmt in STORAGE_FORMATS.values():
-        if path.name.endswith(fmt.suffix):
-            return fmt
-    return STORAGE_FORMATS["mcap"]

@@ -8,8 +8,12 @@ custom types are built into a rosbags type store from their ``.msg`` text, found
 from __future__ import annotations
 
 import functools
+from collections.abc import Iterable
 from pathlib import Path
+from typing import Any, cast
 
+from rosbags.interfaces import Nodetype
+from rosbags.interfaces.typing import Typesdict
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
 
@@ -71,7 +75,7 @@ def rig_typestore() -> Typestore:
 def new_rig_typestore() -> Typestore:
     """A fresh, unshared store with the same types as :func:`rig_typestore`."""
     store = get_typestore(Stores.ROS2_JAZZY)
-    types: dict = {}
+    types: Typesdict = {}
     for name, text in rig_message_texts().items():
         try:
             types.update(get_types_from_msg(text, name))
@@ -104,6 +108,24 @@ def msg_definition_text(msgtype: str, typestore: Typestore | None = None) -> str
 
 
 def type_hash(msgtype: str, typestore: Typestore | None = None) -> str:
-    """The type's RIHS01 hash (the ``type_description_hash`` rosidl generates)."""
+    """The type's RIHS01 hash (the ``type_description_hash`` rosidl generates); empty for a type
+    the store does not know."""
     store = typestore if typestore is not None else rig_typestore()
-    return store.hash_rihs01(msgtype)
+    return store.hash_rihs01(msgtype) if msgtype in store.fielddefs else ""
+
+
+def dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
+    """The types and every type they use, recursively."""
+    todo, found = list(names), set()
+    while todo:
+        name = todo.pop()
+        if name in found or name not in store.fielddefs:
+            continue
+        found.add(name)
+        for _field, desc in store.fielddefs[name][1]:
+            kind, arg = cast("tuple[Nodetype, Any]", desc)
+            if kind == Nodetype.NAME:
+                todo.append(arg)
+            elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:
+                todo.append(arg[0][1])
+    return found

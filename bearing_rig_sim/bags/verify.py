@@ -4,7 +4,7 @@ Opening a bag reads its index only (fast, and enough to list topics and counts);
 bytes were damaged after the recording (a bad disk, a truncated copy) still looks fine there.
 :func:`verify_bag` reads every chunk once:
 
-* **Chunks**: each is read through the file's storage format (:mod:`.storage`; for MCAP
+* **Chunks**: each is read through the bag's storage format (:mod:`.storage`; for MCAP
   decompressed and its CRC-32 compared); a chunk that fails is named, and the messages the index
   promised but no chunk delivered are counted as unreadable.
 * **Timeline**: the log times of all readable messages are grouped into stretches with no gap
@@ -19,8 +19,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from bearing_rig_sim.bags.mcapfile import FileIndex
-from bearing_rig_sim.bags.storage import storage_for_file
+from collections.abc import Callable, Iterator
+
+from bearing_rig_sim.bags.storage import FileIndex, MessageTuple
 
 __all__ = ["TIMELINE_GAP_NS", "BagCheck", "Stretch", "verify_indexes"]
 
@@ -100,15 +101,15 @@ def _merge(stretches: list[Stretch]) -> list[Stretch]:
     return merged
 
 
-def verify_indexes(indexes: list[FileIndex]) -> BagCheck:
-    """Read every message of the indexed files through their storage format (see the module
-    documentation)."""
+def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
+    """Read every message of the indexed files with their storage format's ``messages`` (see
+    the module documentation)."""
     check = BagCheck()
     pieces: list[Stretch] = []
     for index in indexes:
         check.messages_indexed += index.message_count
         current: Stretch | None = None
-        for log_time, _channel, _publish, _data in storage_for_file(index.path).messages(index, report=check.damaged.append):
+        for log_time, _channel, _publish, _data in messages(index, report=check.damaged.append):
             check.messages_read += 1
             if current is not None and log_time - current.end_ns <= TIMELINE_GAP_NS:
                 current.end_ns = max(current.end_ns, log_time)

@@ -30,7 +30,7 @@ import operator
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
-from typing import IO, Any, Literal, cast
+from typing import IO, Any, Literal, Protocol, cast
 from collections.abc import Callable
 
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
@@ -58,6 +58,37 @@ DEFAULT_CHUNK_SIZE = 1 << 20
 """Uncompressed bytes per chunk (1 MiB: about 2 s of the rig's traffic, the most a kill loses)."""
 
 Compression = Literal["zstd", "none"]
+COMPRESSION = {"zstd": CompressionType.ZSTD, "lz4": CompressionType.LZ4, "none": CompressionType.NONE, "": CompressionType.NONE}
+"""The mcap writer's chunk compression by name (``""`` as a chunk index names none)."""
+
+
+class McapWriter(Protocol):
+    """The methods of mcap's ``Writer`` the project calls (the package carries no annotations)."""
+
+    def register_schema(self, name: str, encoding: str, data: bytes) -> int: ...
+    def register_channel(self, topic: str, message_encoding: str, schema_id: int, metadata: dict[str, str]) -> int: ...
+    def add_metadata(self, name: str, data: dict[str, str]) -> None: ...
+    def add_message(self, channel_id: int, log_time: int, data: bytes, publish_time: int) -> None: ...
+    def flush(self) -> None: ...
+    def finish(self) -> None: ...
+
+
+def start_mcap(sink: CountingSink, chunk_size: int, compression: str, profile: str = "ros2", library: str = "") -> McapWriter:
+    """An mcap ``Writer`` started on ``sink``, naming this project as the library by default."""
+    writer = Writer(cast(IO[Any], sink), chunk_size=chunk_size, compression=COMPRESSION.get(compression, CompressionType.ZSTD))
+    writer.start(profile=profile, library=library or f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
+    return cast(McapWriter, writer)
+
+
+def register_topic(mcap: McapWriter, schema_ids: dict[str, int], topic: TopicEntry, typestore: Typestore) -> int:
+    """Register a topic's channel as rosbag2 does (a ``ros2msg`` schema per type, registered once
+    in ``schema_ids``; offered QoS and type hash in the channel metadata); returns its id."""
+    schema_id = schema_ids.get(topic.msgtype)
+    if schema_id is None:
+        text = msg_definition_text(topic.msgtype, typestore)
+        schema_id = schema_ids[topic.msgtype] = mcap.register_schema(topic.msgtype, "ros2msg", text.encode())
+    metadata = {"offered_qos_profiles": qos_yaml(topic.qos), "topic_type_hash": topic.type_hash or type_hash(topic.msgtype, typestore)}
+    return mcap.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
 
 
 def normalise_msgtype(msgtype: str) -> str:
@@ -170,7 +201,7 @@ class BagWriter:
         except OSError as exc:
             raise BagError(f"{self._path}: cannot create the bag directory ({exc.strerror or exc})") from None
 
-        self._compression = CompressionType.ZSTD if compression == "zstd" else CompressionType.NONE
+        self._compression = compression
         self._chunk_size = chunk_size
         self._max_file_bytes = max_file_bytes
         self._run_context = run_context
@@ -180,7 +211,7 @@ class BagWriter:
         self._last_time = -1
         self._nudged = 0
         self._sink: CountingSink | None = None
-        self._mcap: Writer | None = None
+        self._mcap: McapWriter | None = None
         self._schema_ids: dict[str, int] = {}
         self._start_file()
 
@@ -376,8 +407,7 @@ class BagWriter:
     def _start_file(self) -> None:
         name = storage_file_name(self._path, len(self._files))
         self._sink = CountingSink(self._path / name)
-        self._mcap = Writer(cast(IO[Any], self._sink), chunk_size=self._chunk_size, compression=self._compression)
-        self._mcap.start(profile="ros2", library=f"bearing_rig_sim {bearing_rig_sim.__version__}; {LIBRARY_IDENTIFIER}")
+        self._mcap = start_mcap(self._sink, self._chunk_size, self._compression)
         self._mcap.add_metadata(RUN_METADATA_RECORD, dict(self._run_context))
         self._schema_ids = {}
         self._files.append(FileEntry(path=name))
@@ -387,17 +417,8 @@ class BagWriter:
 
     def _register(self, topic: _Topic) -> None:
         assert self._mcap is not None
-        schema_id = self._schema_ids.get(topic.msgtype)
-        if schema_id is None:
-            text = msg_definition_text(topic.msgtype, self._typestore)
-            schema_id = self._mcap.register_schema(topic.msgtype, "ros2msg", text.encode())
-            self._schema_ids[topic.msgtype] = schema_id
-        topic.channel_id = self._mcap.register_channel(
-            topic.name,
-            "cdr",
-            schema_id,
-            {"offered_qos_profiles": qos_yaml([topic.qos.to_rosbags()]), "topic_type_hash": topic.type_hash},
-        )
+        entry = TopicEntry(topic.name, topic.msgtype, [topic.qos.to_rosbags()], topic.type_hash)
+        topic.channel_id = register_topic(self._mcap, self._schema_ids, entry, self._typestore)
 
     def _finish_file(self) -> None:
         assert self._mcap is not None and self._sink is not None

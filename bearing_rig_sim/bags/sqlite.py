@@ -1,0 +1,72 @@
+"""rosbag2 bags with SQLite 3 storage (``.db3`` files), read through rosbags' rosbag2 reader.
+
+SQLite 3 was rosbag2's default storage before Iron; bags older benches recorded use it. A bag is
+read as a whole (one :class:`~.storage.FileIndex` for all its ``.db3`` files): topics, counts and
+the time range as its ``metadata.yaml`` states them, message definitions from the database
+(rosbag2 stores them since Iron), messages in time order. Such a bag is finished when written
+(every message is a committed row), so there is nothing to repair.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+from rosbags.interfaces import ConnectionExtRosbag2, MessageDefinitionFormat
+from rosbags.rosbag2 import Reader, ReaderError
+
+from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.bags.layout import qos_yaml
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink
+
+_ENCODINGS = {MessageDefinitionFormat.MSG: "ros2msg", MessageDefinitionFormat.IDL: "ros2idl"}
+
+
+class Sqlite3Format:
+    """SQLite 3 storage, one index per bag."""
+
+    identifier = "sqlite3"
+
+    def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
+        """The bag's topics, definitions and statistics (see the module documentation).
+
+        Raises:
+            BagError: rosbags cannot open the bag (a database missing or not SQLite).
+        """
+        index = FileIndex(path=bag, indexed=True, has_header=True)
+        try:
+            with Reader(bag) as reader:
+                for conn in reader.connections:
+                    ext = conn.ext
+                    assert isinstance(ext, ConnectionExtRosbag2)  # a rosbag2 bag's connections
+                    metadata = {"offered_qos_profiles": qos_yaml(ext.offered_qos_profiles), "topic_type_hash": conn.digest}
+                    index.channels[conn.id] = ChannelInfo(conn.topic, conn.msgtype, ext.serialization_format, metadata)
+                    index.channel_counts[conn.id] = conn.msgcount
+                    if conn.msgdef.format in _ENCODINGS:
+                        index.definitions.setdefault(conn.msgtype, (_ENCODINGS[conn.msgdef.format], conn.msgdef.data))
+                index.message_count = reader.message_count
+                if reader.message_count:
+                    index.start_ns, index.end_ns = reader.start_time, reader.end_time - 1
+        except ReaderError as exc:
+            raise BagError(f"{bag}: cannot read the SQLite 3 bag ({exc})") from None
+        return [index]
+
+    def messages(
+        self,
+        index: FileIndex,
+        channel_ids: Iterable[int] | None = None,
+        start_ns: int | None = None,
+        stop_ns: int | None = None,
+        report: ProblemSink = lambda _msg: None,
+    ) -> Iterator[MessageTuple]:
+        """Messages in time order, as rosbags reads them from the databases."""
+        wanted = None if channel_ids is None else set(channel_ids)
+        try:
+            with Reader(index.path) as reader:
+                connections = [c for c in reader.connections if wanted is None or c.id in wanted]
+                if not connections:
+                    return
+                for conn, log_time, data in reader.messages(connections, start=start_ns, stop=stop_ns):
+                    yield log_time, conn.id, log_time, data
+        except ReaderError as exc:
+            report(f"{index.path}: reading stopped ({exc})")

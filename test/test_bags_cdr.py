@@ -38,7 +38,10 @@ def test_normaliser_trims_padding_of_types_with_sequences_only() -> None:
     normalise = make_normaliser(STORE, "sensor_msgs/msg/JointState")
     assert normalise is not None and bytes(normalise(exact + bytes(8))) == exact
     assert has_sequences(STORE, "sensor_msgs/msg/JointState") and not has_sequences(STORE, "std_msgs/msg/Float64")
-    assert make_normaliser(STORE, "std_msgs/msg/Float64") is None
+    float64 = b"\x00\x01\x00\x00" + bytes(8)
+    assert make_normaliser(STORE, "std_msgs/msg/Float64")(float64) is float64
+    with pytest.raises(BagError, match="not a CDR message"):
+        make_normaliser(STORE, "std_msgs/msg/Float64")(b"\x00\x07" + float64[2:])
     with pytest.raises(BagError, match="do not hold a complete message"):
         normalise(exact[:-4])
     with pytest.raises(BagError, match="not a CDR message"):

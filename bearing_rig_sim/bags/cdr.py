@@ -114,6 +114,18 @@ def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
     return _repeat(_walker(typestore, subkind, subarg), count)
 
 
+def little_endian(msgtype: str, data: CdrBytes | bytearray) -> bool:
+    """True for little-endian CDR, False for big-endian.
+
+    Raises:
+        BagError: the bytes do not start with a plain CDR encapsulation header.
+    """
+    header = bytes(data[:2])
+    if len(data) < 4 or header not in (LITTLE_ENDIAN, BIG_ENDIAN):
+        raise BagError(f"{msgtype}: {len(data)} bytes are not a CDR message (bad encapsulation header {bytes(data[:4]).hex()})")
+    return header == LITTLE_ENDIAN
+
+
 def _length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], int] | None:
     """A function giving the bytes a message of ``msgtype`` occupies, header included (raises
     :class:`BagError` for bytes that end before the message does or are not CDR); None when the
@@ -124,11 +136,8 @@ def _length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes],
         return None
 
     def length(data: CdrBytes) -> int:
-        header = bytes(data[:2])
-        if len(data) < 4 or header not in (LITTLE_ENDIAN, BIG_ENDIAN):
-            raise BagError(f"{msgtype}: {len(data)} bytes are not a CDR message (bad encapsulation header {bytes(data[:4]).hex()})")
         try:
-            end = 4 + walk(memoryview(data)[4:], 0, _U32[header == LITTLE_ENDIAN])
+            end = 4 + walk(memoryview(data)[4:], 0, _U32[little_endian(msgtype, data)])
         except _MALFORMED as exc:
             raise BagError(f"{msgtype}: {len(data)} bytes do not hold a complete message ({exc})") from None
         if end > len(data):
@@ -150,14 +159,20 @@ def encoded_length(typestore: Typestore, msgtype: str, data: CdrBytes) -> int:
     return length(data)
 
 
-def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], CdrBytes] | None:
-    """A function trimming trailing padding from serialized messages of ``msgtype``, or None
-    when the type's Fast-CDR size is exact (no sequences) and bytes can be stored as received.
+def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], CdrBytes]:
+    """A function returning serialized messages of ``msgtype`` as the recorder stores them:
+    trailing padding trimmed for a type with sequences; as received for a type without (its
+    Fast-CDR size is exact), once its encapsulation header is checked.
 
-    The function raises :class:`BagError` for bytes that are not a complete message."""
+    The function raises :class:`BagError` for bytes that are not a (complete) message."""
     length = _length_function(typestore, msgtype) if has_sequences(typestore, msgtype) else None
     if length is None:
-        return None
+
+        def check(data: CdrBytes) -> CdrBytes:
+            little_endian(msgtype, data)
+            return data
+
+        return check
 
     def normalise(data: CdrBytes) -> CdrBytes:
         end = length(data)
@@ -206,7 +221,7 @@ def decode_pulse(data: CdrBytes) -> PulseFields:
     Raises:
         BagError: not little-endian CDR, or the bytes end before the message does.
     """
-    if bytes(data[:2]) != LITTLE_ENDIAN:
+    if not little_endian(PULSE_TYPE, data):
         raise BagError(f"{PULSE_TYPE}: not little-endian CDR (encapsulation {bytes(data[:4]).hex()})")
     try:
         sec, nanosec, length = _PULSE_HEAD.unpack_from(data, 4)
@@ -225,8 +240,11 @@ def decode_pulse(data: CdrBytes) -> PulseFields:
 def header_stamp_ns(data: CdrBytes | bytearray) -> int | None:
     """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
     short or its encapsulation is not plain CDR (big or little endian)."""
-    kind = bytes(data[:2])
-    if len(data) < 12 or kind not in (LITTLE_ENDIAN, BIG_ENDIAN):
+    if len(data) < 12:
         return None
-    sec, nanosec = struct.unpack_from("<iI" if kind == LITTLE_ENDIAN else ">iI", data, 4)
+    try:
+        little = little_endian("header", data)
+    except BagError:
+        return None
+    sec, nanosec = struct.unpack_from("<iI" if little else ">iI", data, 4)
     return int(sec) * 1_000_000_000 + int(nanosec)

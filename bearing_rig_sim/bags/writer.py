@@ -145,7 +145,7 @@ class _Topic:
     msgtype: str
     qos: QosSpec
     type_hash: str
-    normalise: Callable[[CdrBytes], CdrBytes] | None
+    normalise: Callable[[CdrBytes], CdrBytes]
     channel_id: int = 0
     count: int = 0
 
@@ -299,13 +299,10 @@ class BagWriter:
             raise BagError(f"topic {topic!r} was not added to the bag (call add_topic first)")
         if not isinstance(data, (bytes, bytearray, memoryview)):
             raise BagError(f"topic {topic}: data must be serialized bytes, got {type(data).__name__}")
-        if entry.normalise is not None:
-            try:
-                data = entry.normalise(data)
-            except BagError as exc:
-                raise BagError(f"topic {topic}: {exc}") from None
-        elif data[:2] not in (b"\x00\x01", b"\x00\x00") or len(data) < 4:
-            raise BagError(f"topic {topic}: {len(data)} bytes are not a CDR message (bad encapsulation header)")
+        try:
+            data = entry.normalise(data)
+        except BagError as exc:
+            raise BagError(f"topic {topic}: {exc}") from None
         self._append(entry, log_time_ns, data)
 
     def write_message(self, topic: str, log_time_ns: int, message: object) -> None:

@@ -170,6 +170,28 @@ def test_truncated_file_is_rebuilt_from_its_complete_chunks(tmp_path: Path) -> N
     assert rebuilt["custom_data"] == original["rosbag2_bagfile_information"]["custom_data"]
 
 
+@pytest.mark.slow
+def test_a_cut_anywhere_loses_only_the_chunk_it_falls_in(tmp_path: Path) -> None:
+    """A kill may leave the file cut at any byte: reading and repair keep every chunk that ends
+    before the cut (chunk bounds and counts from the mcap library's reading of the intact file)."""
+    source = tmp_path / "run"
+    record_traffic(source)
+    chunks = chunk_bounds(source / "run_0.mcap")
+    size = (source / "run_0.mcap").stat().st_size
+    for k in range(1, 25):
+        cut = size * k // 25
+        bag = tmp_path / f"cut{k}"
+        shutil.copytree(source, bag)
+        os.truncate(bag / "run_0.mcap", cut)
+        expected = sum(n for _start, end, n in chunks if end <= cut)
+        with pytest.warns(BagWarning), open_bag(bag) as reader:
+            assert sum(1 for _ in reader.messages()) == expected, cut
+        assert repair_bag(bag).messages_recovered == expected, cut
+        with open_bag(bag) as reader:
+            assert reader.complete and reader.message_count == expected
+        shutil.rmtree(bag)
+
+
 def test_lost_metadata_yaml_is_rebuilt_identically(tmp_path: Path) -> None:
     bag = tmp_path / "run"
     record_traffic(bag)

@@ -1,4 +1,4 @@
-"""Reading rig bags: rosbag2 directories with MCAP storage, or a single ``.mcap`` file.
+"""Reading rig bags: rosbag2 directories with MCAP or SQLite 3 storage, or a single ``.mcap`` file.
 
 ::
 
@@ -12,8 +12,8 @@ Messages come in log-time order, decoded into rosbags message objects, streamed 
 carries (so an old bag keeps decoding after a message changes), falling back to ROS 2 Jazzy's
 and ``bearing_rig_msgs``' own.
 
-Damage is reported, not fatal: a file whose recording was killed (no summary) is read up to its
-last complete chunk, a corrupt chunk is skipped, a topic whose type is unknown is left out; each
+Damage is reported, not fatal: an MCAP file whose recording was killed (no summary) is read up to
+its last complete chunk, a corrupt chunk is skipped, a topic whose type is unknown is left out; each
 problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
 :attr:`BagReader.problems`. ``strict=True`` turns them into :class:`BagError`. Padding that
 Fast-CDR leaves after a message (bags from ``ros2 bag record``) is ignored.
@@ -120,7 +120,8 @@ class BagReader:
 
     Raises:
         BagError: the path does not exist or is not a bag, ``metadata.yaml`` is missing or
-            corrupt, a storage file is not MCAP, or (strict) anything is damaged.
+            corrupt, names a storage format this project does not read, a storage file is not of
+            its format, or (strict) anything is damaged.
     """
 
     def __init__(self, path: str | Path, *, strict: bool = False) -> None:

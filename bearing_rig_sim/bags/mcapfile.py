@@ -170,12 +170,14 @@ def _records(stream: BinaryIO) -> Iterator[McapRecord]:
         return
 
 
-def _record_kind(opcode: bytes) -> str:
-    """``"chunk"``, ``"message index"``... for a record's first byte."""
+def _record_head(head: bytes) -> tuple[str, str]:
+    """The kind (``"chunk"``, ``"message index"``...) and `` of <size>`` of a record, from its
+    first bytes (the size is left empty when the length field itself is cut)."""
     try:
-        return Opcode(opcode[0]).name.lower().replace("_", " ")
+        kind = Opcode(head[0]).name.lower().replace("_", " ")
     except (ValueError, IndexError):
-        return "unknown"
+        kind = "unknown"
+    return kind, f" of {9 + _RECORD_HEAD.unpack(head)[1]}" if len(head) == 9 else ""
 
 
 def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
@@ -289,10 +291,9 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
             index.problems.append(f"{name}: file ends after {start} bytes without a summary (recording interrupted?)")
         else:
             stream.seek(start)
-            kind = _record_kind(stream.read(1))
-            cut = isinstance(exc, (EndOfFile, struct.error))
-            state = "cut by the end of the file" if cut else f"damaged ({exc})"
-            index.problems.append(f"{name}: {kind} record at offset {start} is {state} ({index.file_size - start} bytes present)")
+            kind, size = _record_head(stream.read(9))
+            state = "cut by the end of the file" if isinstance(exc, (EndOfFile, struct.error)) else f"damaged ({exc})"
+            index.problems.append(f"{name}: {kind} record at offset {start} is {state} ({index.file_size - start}{size} bytes present)")
     close_loose_run()
     index.readable_bytes = start
 

@@ -20,7 +20,7 @@ other tools (``ros2 bag record`` on the physical bench) keep the padding and dec
 from __future__ import annotations
 
 import struct
-from typing import Any, NamedTuple, cast
+from typing import Any, cast
 from collections.abc import Callable
 
 from rosbags.interfaces import Nodetype
@@ -198,16 +198,10 @@ def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], obj
     return decode
 
 
-class PulseFields(NamedTuple):
-    """The fields of a ``FibreOpticPulse`` the slip monitor uses."""
-
-    time_s: float
-    """``header.stamp`` as ``sec + nanosec * 1e-9`` (s)."""
-    strip_id: int
-    strip_count: int
-    revolution: int
-    pulse_index: int
-    sensor_id: str
+PulseFields = tuple[float, int, int, int, int, str]
+"""The fields of a ``FibreOpticPulse`` the slip monitor uses: ``header.stamp`` as
+``sec + nanosec * 1e-9`` (s), ``strip_id``, ``strip_count``, ``revolution``, ``pulse_index``,
+``sensor_id`` (a plain tuple: it is built hundreds of thousands of times per analysis)."""
 
 
 _PULSE_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
@@ -234,7 +228,7 @@ def decode_pulse(data: CdrBytes) -> PulseFields:
         revolution, pulse_index = _COUNTS.unpack_from(data, 4 + pos)
     except (struct.error, UnicodeDecodeError) as exc:
         raise BagError(f"{PULSE_TYPE}: malformed message of {len(data)} bytes ({exc})") from None
-    return PulseFields(sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensor)
+    return sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensor
 
 
 def header_stamp_ns(data: CdrBytes | bytearray) -> int | None:

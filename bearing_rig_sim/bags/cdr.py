@@ -135,3 +135,18 @@ def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], obj
         return message
 
     return decode
+
+
+def header_stamp_ns(data: bytes | bytearray | memoryview) -> int | None:
+    """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
+    short or its encapsulation is not plain CDR (big or little endian)."""
+    if len(data) < 12:
+        return None
+    kind = bytes(data[:2])
+    if kind == b"\x00\x01":
+        sec, nanosec = struct.unpack_from("<iI", data, 4)
+    elif kind == b"\x00\x00":
+        sec, nanosec = struct.unpack_from(">iI", data, 4)
+    else:
+        return None
+    return sec * 1_000_000_000 + nanosec

@@ -111,7 +111,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     CDR bytes); see the module documentation. The cage turns at the epicyclic speed of H7006C
     (0.4283 n_i) less a slip of 1-1.5 % plus 2 % decaying with a 2 s time constant after each
     speed change."""
-    from bearing_rig_sim.rig.program import step_ramp
+    from bearing_rig_sim.rig.speed_profile import step_ramp
 
     store = rig_typestore()
     types = store.types

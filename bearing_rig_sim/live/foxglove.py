@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import Any
 from collections.abc import Callable
 
+from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import CLOCK
 
@@ -142,8 +143,6 @@ class LiveReplaySink:
         return bool(self.inner.can_publish(topic))
 
     def publish(self, topic: str, data: bytes) -> None:
-        from bearing_rig_sim.session.recorder import header_stamp_ns
-
         self.inner.publish(topic, data)
         stamp = header_stamp_ns(data)
         if topic == CLOCK.name and stamp is not None:

@@ -24,13 +24,12 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
 
 from __future__ import annotations
 
-import struct
 from typing import Protocol
 from collections.abc import Iterable, Sequence
 
-from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
-
+from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.clock_guard import ClockGuard
+from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",
@@ -64,21 +63,6 @@ class MessageWriter(Protocol):
     def add_topic(self, name: str, msgtype: str, qos: str) -> None: ...
 
     def write(self, topic: str, log_time_ns: int, data: bytes) -> None: ...
-
-
-def header_stamp_ns(data: bytes | bytearray | memoryview) -> int | None:
-    """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
-    short or its encapsulation is not plain CDR (big or little endian)."""
-    if len(data) < 12:
-        return None
-    kind = bytes(data[:2])
-    if kind == b"\x00\x01":
-        sec, nanosec = struct.unpack_from("<iI", data, 4)
-    elif kind == b"\x00\x00":
-        sec, nanosec = struct.unpack_from(">iI", data, 4)
-    else:
-        return None
-    return sec * 1_000_000_000 + nanosec
 
 
 class LogTimeRule:

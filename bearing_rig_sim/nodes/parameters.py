@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
+
 __all__ = ["NODE_PARAMETERS", "ParameterSpec", "spec_for"]
 
 
@@ -87,7 +89,7 @@ SIMULATOR = [
         ("rig_file", "rig data file: sensors (strip counts, jitter, drop probability) and loading chain"),
         ("model", "engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)"),
     ),
-    ParameterSpec("chunk_s", "simulated time per engine call and per /clock message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
+    ParameterSpec("chunk_s", f"simulated time per engine call and per {CLOCK.name} message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
     ParameterSpec("realtime", "lock the simulated time to the wall clock (false: as fast as possible)"),
     ParameterSpec("rate", "simulated seconds per wall second when in real time", "1", 0.0, 100.0, low_exclusive=True),
     ParameterSpec("loop_period_s", "period of the loop timer in real time (wall clock)", "s", 1e-4, 0.1),
@@ -99,10 +101,10 @@ SIMULATOR = [
     ParameterSpec("initial_axial_load_n", "axial load until the loading chain's first force message", "N", 0.0, 10_000.0),
     ParameterSpec("max_command_lead_s", "how far ahead of the rig clock a command's stamp may be", "s", 0.0, 3600.0),
     ParameterSpec("counter_timeout_s", "the pulse counters show 0 after this long without a pulse", "s", 0.0, 60.0, low_exclusive=True),
-    ParameterSpec("speeds_rate_hz", "rate of /rig/speeds in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),
-    ParameterSpec("truth_rate_hz", "rate of /rig/truth in simulated time", "Hz", 0.0, 100_000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
-    ParameterSpec("fault_hold_s", "a refused command or force keeps /diagnostics at ERROR this long (wall clock)", "s", 0.0, 600.0),
+    ParameterSpec("speeds_rate_hz", f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("truth_rate_hz", f"rate of {TRUTH.name} in simulated time", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("fault_hold_s", f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", "s", 0.0, 600.0),
 ]
 
 LOAD_CONTROLLER = [
@@ -116,11 +118,11 @@ LOAD_CONTROLLER = [
         read_only=False,
     ),
     ParameterSpec("engage_clutch_on_start", "close the magnet clutch when the node is configured"),
-    ParameterSpec("state_rate_hz", "rate of /rig/axial_load/state in simulated time", "Hz", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_period_s", "simulated time between two periodic /diagnostics", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("state_rate_hz", f"rate of {AXIAL_LOAD_STATE.name} in simulated time", "Hz", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_period_s", f"simulated time between two periodic {DIAGNOSTICS.name}", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("max_clock_gap_s", "longest clock advance stepped at once (a larger jump is stepped as this much)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("force_rate_hz", "rate of the force messages (one chain step each) in simulated time", "Hz", 0.0, 10_000.0, low_exclusive=True),
-    ParameterSpec("step_period_s", "wall time between two wake-ups stepping the chain to the /clock time", "s", 0.001, 0.1),
+    ParameterSpec("step_period_s", f"wall time between two wake-ups stepping the chain to the {CLOCK.name} time", "s", 0.001, 0.1),
 ]
 
 MONITOR = [
@@ -147,7 +149,7 @@ MONITOR = [
     ParameterSpec("fault_hold_s", "a malformed pulse stays a fault, a loss a warning, this long (rig time)", "s", 0.0, 600.0),
     ParameterSpec("clock_jump_tolerance_s", "a pulse this far before its predecessor is a clock jump (reset all)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("status_rate_hz", "status checks and messages per second of rig time, plus one per slip window", "Hz", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
 ]
 
 NODE_PARAMETERS: dict[str, dict[str, ParameterSpec]] = {

@@ -13,7 +13,7 @@ import pytest
 
 from bearing_rig_sim.analysis import AnalysisError
 from bearing_rig_sim.analysis.stability import K1_AXIAL_LOAD, K2_TIME, SlipState
-from bearing_rig_sim.analysis.streaming import RMSE_JUMP, StreamingStability, Verdict
+from bearing_rig_sim.analysis.streaming import RMSE_JUMP, StreamingStability, Verdict, t_quantile_95
 
 LAM, K, D = 3.5, -1.52, 1.29  # paper Table 7, 20 rad/s^2
 LOAD_TERMS = [(3.0, 0.0, 150.0), (1.5, 700.0, 2000.0)]  # slip falling with load to a plateau
@@ -249,3 +249,17 @@ def test_deferred_refits_run_only_when_asked() -> None:
     assert lazy.refit_if_due() is True and lazy.refits == 1
     assert lazy.refit_if_due() is False  # nothing new since the fit
     assert lazy.verdict().state == eager.verdict().state
+
+
+# -- the Student's t quantile of the monitor's slope test --------------------------------------
+@pytest.mark.parametrize(
+    ("dof", "table"),
+    [(1, 6.314), (2, 2.920), (5, 2.015), (10, 1.812), (20, 1.725), (21, 1.721), (30, 1.697), (40, 1.684), (60, 1.671), (120, 1.658)],
+)
+def test_t_quantile_matches_the_one_sided_5_percent_column_of_a_t_table(dof: int, table: float) -> None:
+    """t(0.95; dof) as any statistics table prints it to three decimals (e.g. the NIST/SEMATECH
+    e-Handbook, table 1.3.6.7.2, column 0.05); above 20 degrees of freedom it stays above the
+    normal 1.645, which would make the test anti-conservative."""
+    assert t_quantile_95(dof) == pytest.approx(table, abs=5e-4)
+    if dof > 20:
+        assert t_quantile_95(dof) > 1.645 + 0.01

@@ -57,12 +57,14 @@ extrapolation beyond the fitted points is trusted as far as the covariance says.
 from __future__ import annotations
 
 import bisect
+import functools
 import math
 import statistics
 from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import t as student_t
 
 from bearing_rig_sim.analysis.gaussian import GaussianFit, select_gaussian_fit
 from bearing_rig_sim.analysis.inputs import AnalysisError, FloatArray, finite_number, positive_int
@@ -330,17 +332,11 @@ class StreamingStability:
 
 
 # -- the monitor's verdict: a trailing-window slope with a confidence interval ------------------
-T_QUANTILE_95: tuple[float, ...] = (
-    6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812,
-    1.796, 1.782, 1.771, 1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725,
-)
-"""One-sided 95 % quantiles of Student's t for 1 .. 20 degrees of freedom (any statistics
-table); beyond 20 the normal value 1.645 is used, within 5 % of the table's."""
-
-
+@functools.lru_cache(maxsize=256)
 def t_quantile_95(dof: int) -> float:
-    """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom."""
-    return T_QUANTILE_95[dof - 1] if dof <= len(T_QUANTILE_95) else 1.645
+    """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom
+    (``scipy.stats.t.ppf``; cached, as the monitor asks for the same few at every point)."""
+    return float(student_t.ppf(0.95, dof))
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,8 @@ from pathlib import Path
 from collections.abc import Iterator
 from typing import Any
 
+import psutil
+
 from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
@@ -228,9 +230,7 @@ def measure_analysis(path: str, out: str) -> dict:
 
 
 def _current_rss_mb() -> float:
-    with open("/proc/self/statm", encoding="ascii") as statm:
-        pages = int(statm.read().split()[1])
-    return pages * resource.getpagesize() / 2**20
+    return float(psutil.Process().memory_info().rss) / 2**20
 
 
 def measure_read(path: str) -> dict:

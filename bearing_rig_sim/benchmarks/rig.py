@@ -23,7 +23,7 @@ time from a probe in the benchmark's own process. Rows (one JSON object each):
   ``p50_ms``, ``p99_ms``, ``max_ms`` over all windows; ``on_change_*`` over those whose state
   differs from the previous status's. Target: p99 <= 5 ms.
 * ``case: "cpu"``, one row per process (``node``): user + system CPU time over the window from
-  ``/proc/<pid>/stat`` (the probe's from ``os.times``), as ``cpu_pct`` of one core; and
+  psutil (the probe's from ``os.times``), as ``cpu_pct`` of one core; and
   ``node: "nodes_total"``, the three nodes together, against ``target_pct`` 100 (the rig within
   one core at 1 kHz).
 

@@ -11,7 +11,7 @@ so the app decodes the rig's own types (``bearing_rig_msgs``) and plots them on 
 The server is the ``foxglove-sdk`` package's (its own threads; ``write`` only queues), bound to
 ``127.0.0.1`` only: the view is for the machine the rig runs on (an SSH tunnel takes it further).
 Open the Foxglove app, "Open connection", "Foxglove WebSocket", ``ws://localhost:PORT``, then
-import the layout ``config/foxglove/rig.json`` (README, "Live view in Foxglove").
+import the layout ``config/foxglove/rig.json`` (docs/guide.md, "Live view in Foxglove").
 """
 
 from __future__ import annotations

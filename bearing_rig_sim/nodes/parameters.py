@@ -19,7 +19,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
+from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
+from bearing_rig_sim.load_control.settings import LoadControllerSettings
+from bearing_rig_sim.settings_model import NodeSettings
 
 __all__ = ["NODE_PARAMETERS", "ParameterSpec", "spec_for"]
 
@@ -82,6 +84,17 @@ def _files(*specs: tuple[str, str]) -> list[ParameterSpec]:
     return [ParameterSpec(name, text) for name, text in specs]
 
 
+def specs_of(settings: type[NodeSettings]) -> list[ParameterSpec]:
+    """The specs of a settings class declared with :mod:`bearing_rig_sim.settings_model`: its
+    YAML checks and its ROS descriptors come from the same fields (the load controller's)."""
+    return [
+        ParameterSpec(
+            f.name, f.description, f.unit, f.low, f.high, integer=f.integer, read_only=not f.live, low_exclusive=f.low_exclusive
+        )
+        for f in settings.parameter_fields()
+    ]
+
+
 SIMULATOR = [
     *_files(
         ("bearing_file", "bearing data file (absolute, or relative to the package's config/)"),
@@ -107,23 +120,7 @@ SIMULATOR = [
     ParameterSpec("fault_hold_s", f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", "s", 0.0, 600.0),
 ]
 
-LOAD_CONTROLLER = [
-    ParameterSpec("rig_file", "rig data file with the loading chain ('' = the shipped config/rig.yaml)"),
-    ParameterSpec(
-        "axial_load_setpoint_n",
-        "axial-load set-point; also settable by topic and service; mirrors the one in force",
-        "N",
-        0.0,
-        10_000.0,
-        read_only=False,
-    ),
-    ParameterSpec("engage_clutch_on_start", "close the magnet clutch when the node is configured"),
-    ParameterSpec("state_rate_hz", f"rate of {AXIAL_LOAD_STATE.name} in simulated time", "Hz", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_period_s", f"simulated time between two periodic {DIAGNOSTICS.name}", "s", 0.0, 600.0, low_exclusive=True),
-    ParameterSpec("max_clock_gap_s", "longest clock advance stepped at once (a larger jump is stepped as this much)", "s", 0.0, 600.0, low_exclusive=True),
-    ParameterSpec("force_rate_hz", "rate of the force messages (one chain step each) in simulated time", "Hz", 0.0, 10_000.0, low_exclusive=True),
-    ParameterSpec("step_period_s", f"wall time between two wake-ups stepping the chain to the {CLOCK.name} time", "s", 0.001, 0.1),
-]
+LOAD_CONTROLLER = specs_of(LoadControllerSettings)
 
 MONITOR = [
     ParameterSpec("bearing_file", "bearing data file: geometry for the epicyclic cage speed (relative to config/)"),

@@ -5,8 +5,10 @@ nodes, the session, replay and the live view runs without ROS.
 
 * :mod:`bearing_rig_sim.interfaces`: the topic and service contract, written once.
 * :mod:`bearing_rig_sim.config`: validated YAML configuration; :mod:`bearing_rig_sim.errors`.
+* :mod:`bearing_rig_sim.settings_model`: the declarative model of a node's parameters (pydantic).
 * :mod:`bearing_rig_sim.health`: the health levels every node core reports.
 * :mod:`bearing_rig_sim.clock_guard`: validation of a simulation clock read from outside.
+* :mod:`bearing_rig_sim.executors`: where many independent jobs run (forked processes or Dask).
 * :mod:`bearing_rig_sim.dynamics`: the bearing's equations of motion and steady states (numpy + numba).
 * :mod:`bearing_rig_sim.rig`: sensor and loading-chain models of the bench, test programs.
 * :mod:`bearing_rig_sim.analysis`: slip rate, Gaussian fits, slope criterion, streaming verdict.

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from bearing_rig_sim.interfaces import CLOCK
+
 __all__ = ["DEFAULT_CONFIRMATIONS", "DEFAULT_MAX_STEP_NS", "ClockGuard", "ClockVerdict"]
 
 DEFAULT_MAX_STEP_NS: int = 10_000_000_000
@@ -56,7 +58,7 @@ class ClockGuard:
     """
 
     def __init__(
-        self, *, max_step_ns: int = DEFAULT_MAX_STEP_NS, confirmations: int = DEFAULT_CONFIRMATIONS, name: str = "/clock"
+        self, *, max_step_ns: int = DEFAULT_MAX_STEP_NS, confirmations: int = DEFAULT_CONFIRMATIONS, name: str = CLOCK.name
     ) -> None:
         if isinstance(max_step_ns, bool) or not isinstance(max_step_ns, int) or max_step_ns <= 0:
             raise ValueError(f"max_step_ns: must be a positive integer, got {max_step_ns!r}")

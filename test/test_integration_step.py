@@ -24,7 +24,7 @@ from bearing_rig_sim.dynamics.step_limit import sweep_traction
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.nodes.common import diagnostic_status
 from bearing_rig_sim.rig.fibre_optic import FibreOpticConfig
-from bearing_rig_sim.rig.program import SpeedProfileKind
+from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth, stopped_reason
 from bearing_rig_sim.simulation.twin import RigTwin

@@ -12,14 +12,8 @@ import numpy as np
 import pytest
 
 from bearing_rig_sim.config import ConfigError, config_path
-from bearing_rig_sim.rig.program import (
-    SegmentSpeed,
-    SpeedProfileKind,
-    RigLimits,
-    load_program,
-    step_ramp,
-    step_ramp_rate,
-)
+from bearing_rig_sim.rig.program import RigLimits, load_program
+from bearing_rig_sim.rig.speed_profile import SegmentSpeed, SpeedProfileKind, step_ramp, step_ramp_rate
 
 RPM = 2.0 * math.pi / 60.0
 

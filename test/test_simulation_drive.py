@@ -13,7 +13,7 @@ import math
 import pytest
 
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.rig.program import SpeedProfileKind
+from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleCommandError, SpindleDrive, profile_from_code
 
 STEP, ACCEL = SpeedProfileKind.STEP, SpeedProfileKind.CONSTANT_ACCELERATION

@@ -20,7 +20,7 @@ from bearing_rig_sim.analysis.slip import BearingKinematics, whole_revolution_sl
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters
 from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
-from bearing_rig_sim.rig.program import SpeedProfileKind
+from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import AxialLoadError, RigTwin, TwinError
 

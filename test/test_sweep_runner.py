@@ -129,7 +129,7 @@ def wait_for_file(path: Path, proc: subprocess.Popen[bytes], timeout: float) -> 
 
 @pytest.mark.slow
 def test_the_same_sweep_on_a_dask_scheduler_and_worker_started_on_localhost(tmp_path: Path) -> None:
-    """As the README shows: `dask scheduler`, `dask worker`, then `bearing-rig sweep
+    """As docs/guide.md shows: `dask scheduler`, `dask worker`, then `bearing-rig sweep
     --scheduler` (loopback only)."""
     bindir = Path(sys.executable).parent
     scheduler_file = tmp_path / "scheduler.json"

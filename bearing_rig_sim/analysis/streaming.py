@@ -1,346 +1,39 @@
-"""The slope criterion on points arriving one by one.
+"""The slope criterion on points arriving one by one: :class:`TrailingSlope`, the monitor's verdict.
 
-Two forms, x being the time (s) or the axial load (N):
+x is the time (s) or the axial load (N). The verdict is the slope of a least-squares line through
+the slip of a trailing window, decided only when its one-sided 95 % bound (Student's t,
+:func:`t_quantile_95`) is on one side of k (with hysteresis), with change detection on the slip
+itself; microseconds per point (see its docstring; ``bearing-rig bench analysis`` measures it).
 
-* :class:`TrailingSlope`, **the monitor's verdict**: the slope of a least-squares line through the
-  slip of a trailing window, decided only when its one-sided 95 % bound is on one side of k (with
-  hysteresis), with change detection on the slip itself; microseconds per point (see its
-  docstring). A global Gaussian does not describe a slip that steps and decays, or a plateau
-  (a 1-term fit to a flat series runs to its width bound and reports R^2 below zero), and its
-  refits cost milliseconds on the pulse path.
-* :class:`StreamingStability`: the paper's own form, the Gaussian sum refitted on a fixed policy
-  over the whole series, with the onset of the stable state; kept for studies and the
-  ``bearing-rig bench analysis`` streaming case. The rest of this docstring describes it.
-
-**Refit policy** (cheap enough for ``add`` at 10-100 Hz):
-
-* no fit until ``min_points`` points are held (state "unknown");
-* then a refit every ``refit_interval`` added points, or sooner when x has advanced by more than
-  ``max_fit_age`` (unit of x) since the last fit;
-* the first fit and every ``full_refit_every``-th one run the full multi-start search of
-  :func:`~bearing_rig_sim.analysis.gaussian.select_gaussian_fit`; the others are warm-started from
-  the previous fit alone: one least-squares run per term count, of at most 25 evaluations per
-  term, which the next refit continues if it has not converged (a poorly determined fit, such as
-  two terms on the load data before the plateau shows, would otherwise crawl for hundreds of
-  evaluations); a warm refit whose RMSE is more than :data:`RMSE_JUMP` times the previous one is
-  replaced by a full one;
-* between refits ``add`` only stores the point (microseconds), and :meth:`verdict` uses the last
-  fit, evaluated at the latest x (a short extrapolation beyond the fitted data).
-
-Cost (``bearing_rig_sim.benchmarks.analysis`` measures it): for the time criterion (1 term,
-1000 points at 100 Hz) a warm refit takes about 5 ms and a full one about 50 ms, so ``add`` has a
-p50 of a few microseconds and a p99 of about 6 ms; :meth:`verdict` about 0.4 ms. The 2-term fits
-of the load criterion cost about ten times more (a full one about 0.2 s); its points come one per
-load step, seconds apart. ``window`` bounds the points kept, and so the cost, on long runs. With
-few points the RMSE itself is uncertain, so :data:`RMSE_JUMP` also triggers some full refits that
-were not needed: they cost time, not accuracy.
-
-**Verdict.** Over the fitted curve from the first held x to the latest one, the stable onset is
-found as in :func:`~bearing_rig_sim.analysis.stability.stable_onset`; the state is "stable" if the
-slope at the latest x is >= the critical slope, "slipping" otherwise.
-
-**Confidence** in [0, 1], the product of three factors, each in [0, 1]:
-
-* margin: erf(z / sqrt 2) = 2 Phi(z) - 1 with z = |slope - k| / se(slope), the standard error of
-  the fitted slope at the latest x from the fit's parameter covariance (delta method). It is 0
-  when the slope sits on the critical value and tends to 1 when the side of k is many standard
-  errors clear; it is the probability that the true slope is on the reported side of k, less
-  the probability that it is not, under the fit's normal approximation;
-* fit quality: the fit's R-square, clipped to [0, 1] (0 if undefined);
-* freshness: n_fit / (n_fit + n_new), n_fit the points fitted and n_new those added since.
-
-It is a score for ranking and thresholding verdicts, not a calibrated probability: the margin
-factor ignores model error (a Gaussian sum that does not describe the data) and the
-extrapolation beyond the fitted points is trusted as far as the covariance says.
+The paper's own form, a Gaussian sum fitted to the whole series with the onset of the stable
+state (:mod:`bearing_rig_sim.analysis.gaussian`, :func:`~bearing_rig_sim.analysis.stability.stable_onset`),
+serves the studies and the reproduction on complete series. It does not serve online: a global
+Gaussian does not describe a slip that steps and decays, or a plateau (a 1-term fit to a flat
+series runs to its width bound and reports R^2 below zero), and its refits cost milliseconds on
+the pulse path.
 """
 
 from __future__ import annotations
 
 import bisect
+import functools
 import math
 import statistics
 from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.stats import t as student_t
 
-from bearing_rig_sim.analysis.gaussian import GaussianFit, select_gaussian_fit
 from bearing_rig_sim.analysis.inputs import AnalysisError, FloatArray, finite_number, positive_int
-from bearing_rig_sim.analysis.stability import (
-    K1_AXIAL_LOAD,
-    K2_TIME,
-    SlipState,
-    StabilityResult,
-    stable_onset,
-)
-
-RMSE_JUMP: float = 1.2
-"""A warm refit whose RMSE exceeds the previous fit's by this factor has lost track of the data
-(the noise level does not jump): the full multi-start search is run at once instead."""
-
-CRITERIA: dict[str, tuple[float, int, int, str]] = {
-    "time": (K2_TIME, 1, 12, "s"),
-    "axial_load": (K1_AXIAL_LOAD, 2, 14, "N"),
-}
-"""Per criterion: default critical slope (%/unit of x), default max_terms (the paper's choice:
-1 term for slip against time, Table 6; 2 for slip against load, Table 4), default min_points
-(14 is the paper's load grid, 50-700 N in steps of 50 N) and the unit of x."""
+from bearing_rig_sim.analysis.stability import SlipState
 
 
-@dataclass(frozen=True)
-class Verdict:
-    """The current verdict of :class:`StreamingStability`.
-
-    Attributes:
-        state: "unknown" (no fit yet), "slipping" or "stable" (a :class:`SlipState`, compares
-            equal to the string).
-        slope: fitted slope at the latest x, %/s or %/N; None while unknown.
-        critical_slope: k, same unit.
-        confidence: in [0, 1], see the module docstring; 0 while unknown.
-        onset: onset of the stable state (s or N), None if not stable. If the fitted curve is
-            stable over all the points held and earlier points have been dropped by ``window``,
-            this is the first x held: the onset was at that x or before.
-        n_points: points held.
-        fit_rmse: RMSE of the fit in use, percent; None while unknown.
-        x: the latest x (s or N); None before the first point.
-        detail: one readable line on how the verdict was reached.
-    """
-
-    state: SlipState
-    slope: float | None
-    critical_slope: float
-    confidence: float
-    onset: float | None
-    n_points: int
-    fit_rmse: float | None
-    x: float | None
-    detail: str
-
-
-class StreamingStability:
-    """Online slope criterion on (x, slip %) points; see the module docstring for the policy.
-
-    Args:
-        criterion: "time" (x in s, default k = K2_TIME %/s, 1 term) or "axial_load" (x in N,
-            default k = K1_AXIAL_LOAD %/N, up to 2 terms).
-        critical_slope: k in percent per unit of x; None for the criterion's default.
-        max_terms: most Gaussian terms tried at each refit; None for the criterion's default.
-        refit_interval: refit after this many added points (>= 1).
-        min_points: points needed before the first fit; None for the criterion's default; at
-            least 3 max_terms + 1.
-        window: keep only the latest ``window`` points (None: keep all); >= min_points.
-        max_fit_age: also refit when x has advanced by more than this (unit of x) since the last
-            fit; None: by point count only.
-        full_refit_every: every this-many-th refit is a full multi-start fit (>= 1; 1 makes every
-            refit a full one).
-
-    Raises:
-        AnalysisError: an unknown criterion or an option out of range.
-    """
-
-    def __init__(
-        self,
-        criterion: str,
-        critical_slope: float | None = None,
-        max_terms: int | None = None,
-        refit_interval: int = 10,
-        min_points: int | None = None,
-        window: int | None = None,
-        max_fit_age: float | None = None,
-        full_refit_every: int = 20,
-        defer_refit: bool = False,
-    ) -> None:
-        if criterion not in CRITERIA:
-            raise AnalysisError(f"criterion: must be one of {', '.join(CRITERIA)}, got {criterion!r}")
-        default_k, default_terms, default_min, unit = CRITERIA[criterion]
-        self.criterion = criterion
-        self.defer_refit = defer_refit
-        """True: :meth:`add` only stores; the caller runs :meth:`refit_if_due` when it has time
-        (keeps a latency-sensitive caller's per-point cost at microseconds)."""
-        self.unit = unit
-        self.critical_slope = default_k if critical_slope is None else finite_number("critical_slope", critical_slope)
-        self.max_terms = default_terms if max_terms is None else positive_int("max_terms", max_terms)
-        self.refit_interval = positive_int("refit_interval", refit_interval)
-        self.full_refit_every = positive_int("full_refit_every", full_refit_every)
-        self.min_points = max(default_min, 3 * self.max_terms + 1) if min_points is None else positive_int("min_points", min_points)
-        if self.min_points < 3 * self.max_terms + 1:
-            raise AnalysisError(
-                f"min_points: a {self.max_terms}-term fit needs at least {3 * self.max_terms + 1}, got {self.min_points}"
-            )
-        self.window = None if window is None else positive_int("window", window)
-        if self.window is not None and self.window < self.min_points:
-            raise AnalysisError(f"window: must be >= min_points = {self.min_points}, got {self.window}")
-        self.max_fit_age = None if max_fit_age is None else finite_number("max_fit_age", max_fit_age)
-        if self.max_fit_age is not None and not self.max_fit_age > 0.0:
-            raise AnalysisError(f"max_fit_age: must be > 0 {unit}, got {self.max_fit_age!r}")
-        self.reset()
-
-    # -- state ---------------------------------------------------------------------------------
-    def reset(self) -> None:
-        """Forget every point and fit (after a clock jump, a new run or a fault)."""
-        self._x: FloatArray = np.empty(256)
-        self._y: FloatArray = np.empty(256)
-        self._start = 0
-        self._end = 0
-        self._dropped = False
-        self._fit: GaussianFit | None = None
-        self._fits: list[GaussianFit] = []
-        self._since_fit = 0
-        self._fit_x = -math.inf
-        self._refits = 0
-        self._full_refits = 0
-        self._onset_cache: tuple[tuple[int, float], StabilityResult] | None = None
-
-    @property
-    def n_points(self) -> int:
-        """Points held."""
-        return self._end - self._start
-
-    @property
-    def fit(self) -> GaussianFit | None:
-        """The fit in use (None before the first)."""
-        return self._fit
-
-    @property
-    def refits(self) -> int:
-        """Refits since the last reset (each counted once, warm or full)."""
-        return self._refits
-
-    @property
-    def full_refits(self) -> int:
-        """Refits since the last reset that ran the full multi-start search."""
-        return self._full_refits
-
-    def points(self) -> tuple[FloatArray, FloatArray]:
-        """Copies of the points held: x (s or N) and slip (percent)."""
-        return self._x[self._start : self._end].copy(), self._y[self._start : self._end].copy()
-
-    # -- input ---------------------------------------------------------------------------------
-    def add(self, x: float, slip_pct: float) -> None:
-        """Add one point: x in s (time) or N (axial load), slip in percent.
-
-        Refits if the policy says so (see the module docstring); otherwise only stores.
-
-        Raises:
-            AnalysisError: a non-finite value, or x not greater than the previous x (a clock
-                that jumped back, or a load that did not increase); the point is not added and
-                the state is unchanged. Call :meth:`reset` to start again.
-        """
-        xv = finite_number("x", x)
-        yv = finite_number("slip_pct", slip_pct)
-        if self._end > self._start and not xv > self._x[self._end - 1]:
-            last = float(self._x[self._end - 1])
-            raise AnalysisError(
-                f"x: must increase, got {xv!r} {self.unit} after {last!r} {self.unit} "
-                "(clock jump or non-monotonic sweep); call reset() to start a new series"
-            )
-        if self._end == self._x.size:
-            self._make_room()
-        self._x[self._end] = xv
-        self._y[self._end] = yv
-        self._end += 1
-        if self.window is not None and self.n_points > self.window:
-            self._start = self._end - self.window
-            self._dropped = True
-        self._since_fit += 1
-        if not self.defer_refit:
-            self.refit_if_due()
-
-    def refit_if_due(self) -> bool:
-        """Refit now if the refit policy says one is due; return whether it refitted. :meth:`add`
-        calls it unless ``defer_refit``; between refits the verdict uses the last fit."""
-        if self._end == self._start or self.n_points < self.min_points:
-            return False
-        if not self._refit_due(float(self._x[self._end - 1])):
-            return False
-        self._refit()
-        return True
-
-    def _make_room(self) -> None:
-        live = self.n_points
-        if live * 2 > self._x.size:
-            new_x, new_y = np.empty(self._x.size * 2), np.empty(self._x.size * 2)
-        else:
-            new_x, new_y = self._x, self._y
-        new_x[:live] = self._x[self._start : self._end]
-        new_y[:live] = self._y[self._start : self._end]
-        self._x, self._y, self._start, self._end = new_x, new_y, 0, live
-
-    def _refit_due(self, x: float) -> bool:
-        if self._fit is None or self._since_fit >= self.refit_interval:
-            return True
-        return self.max_fit_age is not None and x - self._fit_x > self.max_fit_age
-
-    def _refit(self) -> None:
-        xs, ys = self._x[self._start : self._end], self._y[self._start : self._end]
-        previous = self._fit
-        full = previous is None or self._refits % self.full_refit_every == 0
-        if not full:
-            starts = {f.n_terms: f.params for f in self._fits}
-            chosen, fits = select_gaussian_fit(xs, ys, self.max_terms, starts=starts, multistart=False)
-            full = previous is not None and chosen.rmse > RMSE_JUMP * previous.rmse  # lost track
-        if full:
-            chosen, fits = select_gaussian_fit(xs, ys, self.max_terms)
-            self._full_refits += 1
-        self._fit, self._fits = chosen, fits
-        self._since_fit = 0
-        self._fit_x = float(xs[-1])
-        self._refits += 1
-
-    # -- output --------------------------------------------------------------------------------
-    def verdict(self) -> Verdict:
-        """The current verdict (cheap between refits: one slope evaluation and an onset search
-        on the last fit, cached until the next point)."""
-        n = self.n_points
-        k = self.critical_slope
-        latest = float(self._x[self._end - 1]) if n else None
-        fit = self._fit
-        if fit is None or latest is None:
-            detail = f"collecting points: {n} of the {self.min_points} needed for a first fit"
-            return Verdict(SlipState.UNKNOWN, None, k, 0.0, None, n, None, latest, detail)
-        first = float(self._x[self._start])
-        result = self._onset(first, latest)
-        slope = result.slope_at_end
-        se = float(fit.slope_standard_error(latest))
-        z = abs(slope - k) / se if se > 0.0 else math.inf  # an undetermined slope (se = inf): z = 0
-        margin = math.erf(z / math.sqrt(2.0))
-        quality = min(max(fit.r_square, 0.0), 1.0) if math.isfinite(fit.r_square) else 0.0
-        freshness = fit.n_points / (fit.n_points + self._since_fit)
-        confidence = margin * quality * freshness
-        state = SlipState.STABLE if result.reached else SlipState.SLIPPING
-        relation = ">=" if state is SlipState.STABLE else "<"
-        u = self.unit
-        detail = (
-            f"{fit.n_terms}-term Gaussian fit of {fit.n_points} points (R^2 {fit.r_square:.4f}, RMSE {fit.rmse:.3g} %), "
-            f"{self._since_fit} point(s) since; slope {slope:.3g} +- {se:.2g} %/{u} {relation} k = {k:g} %/{u}"
-        )
-        onset = result.onset
-        if result.stable_from_start and self._dropped:
-            detail += f"; stable over all points held, onset at or before {first:g} {u}"
-        elif onset is not None:
-            detail += f"; stable since {onset:.4g} {u}"
-        return Verdict(state, slope, k, confidence, onset, n, fit.rmse, latest, detail)
-
-    def _onset(self, first: float, latest: float) -> StabilityResult:
-        key = (self._refits, latest)
-        if self._onset_cache is None or self._onset_cache[0] != key:
-            assert self._fit is not None
-            self._onset_cache = (key, stable_onset(self._fit, first, latest, self.critical_slope))
-        return self._onset_cache[1]
-
-
-# -- the monitor's verdict: a trailing-window slope with a confidence interval ------------------
-T_QUANTILE_95: tuple[float, ...] = (
-    6.314, 2.920, 2.353, 2.132, 2.015, 1.943, 1.895, 1.860, 1.833, 1.812,
-    1.796, 1.782, 1.771, 1.761, 1.753, 1.746, 1.740, 1.734, 1.729, 1.725,
-)
-"""One-sided 95 % quantiles of Student's t for 1 .. 20 degrees of freedom (any statistics
-table); beyond 20 the normal value 1.645 is used, within 5 % of the table's."""
-
-
+@functools.lru_cache(maxsize=256)
 def t_quantile_95(dof: int) -> float:
-    """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom."""
-    return T_QUANTILE_95[dof - 1] if dof <= len(T_QUANTILE_95) else 1.645
+    """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom
+    (``scipy.stats.t.ppf``; cached, as the monitor asks for the same few at every point)."""
+    return float(student_t.ppf(0.95, dof))
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,8 @@ from pathlib import Path
 from collections.abc import Iterator
 from typing import Any
 
+import psutil
+
 from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
@@ -111,7 +113,7 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     CDR bytes); see the module documentation. The cage turns at the epicyclic speed of H7006C
     (0.4283 n_i) less a slip of 1-1.5 % plus 2 % decaying with a 2 s time constant after each
     speed change."""
-    from bearing_rig_sim.rig.program import step_ramp
+    from bearing_rig_sim.rig.speed_profile import step_ramp
 
     store = rig_typestore()
     types = store.types
@@ -228,9 +230,7 @@ def measure_analysis(path: str, out: str) -> dict:
 
 
 def _current_rss_mb() -> float:
-    with open("/proc/self/statm", encoding="ascii") as statm:
-        pages = int(statm.read().split()[1])
-    return pages * resource.getpagesize() / 2**20
+    return float(psutil.Process().memory_info().rss) / 2**20
 
 
 def measure_read(path: str) -> dict:

@@ -23,7 +23,7 @@ time from a probe in the benchmark's own process. Rows (one JSON object each):
   ``p50_ms``, ``p99_ms``, ``max_ms`` over all windows; ``on_change_*`` over those whose state
   differs from the previous status's. Target: p99 <= 5 ms.
 * ``case: "cpu"``, one row per process (``node``): user + system CPU time over the window from
-  ``/proc/<pid>/stat`` (the probe's from ``os.times``), as ``cpu_pct`` of one core; and
+  psutil (the probe's from ``os.times``), as ``cpu_pct`` of one core; and
   ``node: "nodes_total"``, the three nodes together, against ``target_pct`` 100 (the rig within
   one core at 1 kHz).
 
@@ -49,6 +49,17 @@ import numpy as np
 from bearing_rig_sim.dds_profile import apply_rig_profile
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import (
+    AXIAL_LOAD_SETPOINT,
+    AXIAL_LOAD_STATE,
+    CAGE_PULSES,
+    CLOCK,
+    SLIP_STATUS,
+    SPEEDS,
+    SPINDLE_COMMAND,
+    SPINDLE_PULSES,
+    TRUTH,
+)
 from bearing_rig_sim.session.processes import (
     NODES,
     NodeProcess,
@@ -92,21 +103,21 @@ class _Probe:
         reliable = QoSProfile(depth=5000, reliability=ReliabilityPolicy.RELIABLE)
         latched = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.types = {
-            "/clock": Clock,
-            "/rig/speeds": JointState,
-            "/rig/cage/pulses": FibreOpticPulse,
-            "/rig/spindle/pulses": FibreOpticPulse,
-            "/rig/slip_status": SlipStatus,
-            "/rig/truth": SimulatorTruth,
-            "/rig/axial_load/state": AxialLoadState,
+            CLOCK.name: Clock,
+            SPEEDS.name: JointState,
+            CAGE_PULSES.name: FibreOpticPulse,
+            SPINDLE_PULSES.name: FibreOpticPulse,
+            SLIP_STATUS.name: SlipStatus,
+            TRUTH.name: SimulatorTruth,
+            AXIAL_LOAD_STATE.name: AxialLoadState,
         }
-        qos = {"/clock": reliable, "/rig/slip_status": latched, "/rig/axial_load/state": reliable}
+        qos = {CLOCK.name: reliable, SLIP_STATUS.name: latched, AXIAL_LOAD_STATE.name: reliable}
         self.subs = {
             name: self.tap.create_subscription(msgtype, name, lambda _m: None, qos.get(name, best), raw=True)
             for name, msgtype in self.types.items()
         }
-        self.spindle = self.node.create_publisher(SpindleCommand, "/rig/spindle/command", STATUS_QOS)
-        self.setpoint = self.node.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
+        self.spindle = self.node.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
+        self.setpoint = self.node.create_publisher(Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
         self._command_types = (SpindleCommand, Float64)
 
     def take(self) -> dict[str, list[tuple[int, bytes]]]:
@@ -123,12 +134,12 @@ class _Probe:
     def missing(self, seen: dict[str, int]) -> dict[str, str]:
         """Which node is not up yet (as the session judges it)."""
         missing = {}
-        if not seen.get("/clock") or self.node.count_subscribers("/rig/spindle/command") == 0:
-            missing["simulator"] = "no /clock, or nobody subscribes /rig/spindle/command"
-        if not seen.get("/rig/axial_load/state") or self.node.count_subscribers("/rig/axial_load/setpoint") == 0:
-            missing["load_controller"] = "no /rig/axial_load/state, or nobody subscribes /rig/axial_load/setpoint"
-        if self.node.count_publishers("/rig/slip_status") == 0:
-            missing["monitor"] = "nobody publishes /rig/slip_status"
+        if not seen.get(CLOCK.name) or self.node.count_subscribers(SPINDLE_COMMAND.name) == 0:
+            missing["simulator"] = f"no {CLOCK.name}, or nobody subscribes {SPINDLE_COMMAND.name}"
+        if not seen.get(AXIAL_LOAD_STATE.name) or self.node.count_subscribers(AXIAL_LOAD_SETPOINT.name) == 0:
+            missing["load_controller"] = f"no {AXIAL_LOAD_STATE.name}, or nobody subscribes {AXIAL_LOAD_SETPOINT.name}"
+        if self.node.count_publishers(SLIP_STATUS.name) == 0:
+            missing["monitor"] = f"nobody publishes {SLIP_STATUS.name}"
         return missing
 
     def command(self, speed_rad_s: float, load_n: float) -> None:
@@ -167,20 +178,20 @@ class _Series:
         for name, items in taken.items():
             self.seen[name] = self.seen.get(name, 0) + len(items)
             for received, raw in items:
-                if name == "/clock":
+                if name == CLOCK.name:
                     self.clock.append((received, header_stamp_ns(raw) or 0))
-                elif name == "/rig/speeds":
+                elif name == SPEEDS.name:
                     self.speeds.append((received, header_stamp_ns(raw) or 0))
-                elif name == "/rig/spindle/pulses":
+                elif name == SPINDLE_PULSES.name:
                     self.spindle.append((header_stamp_ns(raw) or 0, received))
-                elif name == "/rig/cage/pulses":
+                elif name == CAGE_PULSES.name:
                     self.pulses[header_stamp_ns(raw) or 0] = received
                     while len(self.pulses) > PULSES_KEPT:
                         self.pulses.popitem(last=False)
-                elif name == "/rig/slip_status":
+                elif name == SLIP_STATUS.name:
                     msg = deserialize_message(raw, types[name])
                     self.statuses.append((received, header_stamp_ns(raw) or 0, int(msg.state)))
-                elif name == "/rig/truth":
+                elif name == TRUTH.name:
                     msg = deserialize_message(raw, types[name])
                     self.truth.append((received, float(msg.real_time_factor), int(msg.overruns)))
 
@@ -299,7 +310,7 @@ def _rows(args: argparse.Namespace, series: _Series, wall_start: int, wall_end: 
     sim_start, sim_end = _sim_at(clock, wall_start), _sim_at(clock, wall_end)
     rate = _configured_speed_rate()
     if sim_start is None or sim_end is None or sim_end <= sim_start:
-        yield {"bench": "rig", "case": "speeds", "error": "no /clock during the window"}
+        yield {"bench": "rig", "case": "speeds", "error": f"no {CLOCK.name} during the window"}
     else:
         stamps = {s for _, s in series.speeds if sim_start < s <= sim_end}
         expected = int(round((sim_end - sim_start) * 1e-9 * rate))

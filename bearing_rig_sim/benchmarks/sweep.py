@@ -94,7 +94,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
 
 def _cluster_rows(loads: list[float], method: str, repeats: int) -> Iterator[dict]:
     from bearing_rig_sim.sweep.points import INTEGRATE, SOLVE
-    from bearing_rig_sim.sweep.runner import open_client, run_sweep
+    from bearing_rig_sim.executors import open_client
+    from bearing_rig_sim.sweep.runner import run_sweep
     from bearing_rig_sim.sweep.spec import spec_from_section
     from bearing_rig_sim.config import Section
 

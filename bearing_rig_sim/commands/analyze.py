@@ -3,7 +3,7 @@
 Runs the monitor offline over the bag's fibre-optic pulses (deterministic: the same bag gives the
 same report), then writes ``report.md``, PNG plots of speeds, slip, axial load and state against
 time, and the derived series as CSV into DIR (default ``out/analyze/<bag name>``). Bags of the
-physical bench on the same topics are analysed alike (README, "Replay and offline analysis").
+physical bench on the same topics are analysed alike (docs/guide.md, "Replay and offline analysis").
 A damaged bag is analysed as far as it reads, with a warning; a bag without the pulse topics is
 an error.
 """

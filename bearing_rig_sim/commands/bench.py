@@ -24,6 +24,7 @@ from collections.abc import Iterable
 from bearing_rig_sim.errors import RigError
 
 BENCHMARKS: dict[str, str] = {
+    "analysis": "bearing_rig_sim.benchmarks.analysis",
     "bags": "bearing_rig_sim.benchmarks.bags",
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
     "rig": "bearing_rig_sim.benchmarks.rig",

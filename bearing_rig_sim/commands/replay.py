@@ -21,19 +21,19 @@ from bearing_rig_sim.interfaces import CLOCK
 
 def register(subparsers: Any) -> None:
     """Add ``replay`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("replay", help="republish a bag into ROS 2 with its timing and /clock", description=__doc__)
+    p = subparsers.add_parser("replay", help=f"republish a bag into ROS 2 with its timing and {CLOCK.name}", description=__doc__)
     p.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")
     p.add_argument("--rate", type=float, default=1.0, help="bag seconds per wall second (default 1)")
     p.add_argument("--loop", action="store_true", help="start again at the end (the clock jumps back), until Ctrl-C")
-    p.add_argument("--topics", nargs="+", metavar="T", default=None, help="topics to replay (default: all; /clock always)")
+    p.add_argument("--topics", nargs="+", metavar="T", default=None, help=f"topics to replay (default: all; {CLOCK.name} always)")
     p.add_argument("--start", type=float, default=0.0, metavar="S", help="start S seconds after the bag's first message")
     p.add_argument("--duration", type=float, default=None, metavar="D", help="replay D seconds of the bag (default: to the end)")
-    p.add_argument("--clock-hz", type=float, default=100.0, metavar="HZ", help="rate of the /clock made when the bag has none, per bag second (default 100)")
+    p.add_argument("--clock-hz", type=float, default=100.0, metavar="HZ", help=f"rate of the {CLOCK.name} made when the bag has none, per bag second (default 100)")
     p.add_argument("--delay", type=float, default=0.5, metavar="S", help="wall seconds to wait before the first message, for discovery (default 0.5)")
     p.add_argument(
         "--wait-for-subscribers",
         action="store_true",
-        help="start as soon as every replayed topic (except /clock) has a subscriber, waiting at most --delay seconds",
+        help=f"start as soon as every replayed topic (except {CLOCK.name}) has a subscriber, waiting at most --delay seconds",
     )
     p.add_argument("--quiet", action="store_true", help="no summary line")
     add_foxglove_argument(p)

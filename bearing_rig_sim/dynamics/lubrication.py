@@ -19,9 +19,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, cast
+
+from scipy.optimize import brentq
 
 from bearing_rig_sim.config import Section, config_path, load_yaml
 
@@ -270,21 +273,24 @@ def gyroscopic_moment(ball_inertia: float, roll_speed: float, orbit_speed: float
 
 def harris_thrust_angle(axial_load: float, ball_count: int, free_angle: float, b_total: float, ball_diameter: float, k_n: float) -> float:
     """Loaded contact angle (rad) under a pure thrust load, from Harris and Kotzalas' equation
-    sin(a) (cos(a0)/cos(a) - 1)^1.5 = F_a / (Z K_n (B D)^1.5), solved by bisection.
+    sin(a) (cos(a0)/cos(a) - 1)^1.5 = F_a / (Z K_n (B D)^1.5), solved by ``brentq`` between the
+    free angle and 89 degrees (the left side grows on that interval; a load it cannot carry below
+    89 degrees gives 89 degrees, no load or a negative one the free angle).
 
     Args: axial load (N), ball count, free angle (rad), total curvature B = f_i + f_o - 1 (1),
     ball diameter (m), combined load-deflection constant K_n (N/m^1.5).
     """
     rhs = axial_load / (ball_count * k_n * (b_total * ball_diameter) ** 1.5)
+
+    def excess(angle: float) -> float:
+        return math.sin(angle) * (math.cos(free_angle) / math.cos(angle) - 1.0) ** 1.5 - rhs
+
     lo, hi = free_angle, math.radians(89.0)
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        f = math.sin(mid) * (math.cos(free_angle) / math.cos(mid) - 1.0) ** 1.5 - rhs
-        if f > 0.0:
-            hi = mid
-        else:
-            lo = mid
-    return 0.5 * (lo + hi)
+    if excess(lo) >= 0.0:
+        return lo
+    if excess(hi) <= 0.0:
+        return hi
+    return float(brentq(excess, lo, hi, xtol=1e-15, rtol=4 * sys.float_info.epsilon))
 
 
 SKF_ACBB_SINGLE_ROW = {"R1": 5.03e-7, "R2": 1.97, "R3": 1.90e-12, "S1": 1.30e-2, "S2": 0.68, "S3": 1.91e-12, "KZ": 4.4}

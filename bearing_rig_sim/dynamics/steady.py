@@ -37,6 +37,7 @@ pockets; :data:`ORIGIN_ROLLING_START`) or from a neighbouring point's solution
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -402,3 +403,10 @@ class SteadySolver:
             iterations=iterations,
             stable=stable,
         )
+
+
+@functools.lru_cache(maxsize=16)
+def solver_for(params: BearingParameters) -> SteadySolver:
+    """One solver per parameter set and process (the engine and its kernels built once), shared
+    by calibration and the sweep's workers."""
+    return SteadySolver(params)

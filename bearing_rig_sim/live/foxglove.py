@@ -11,7 +11,7 @@ so the app decodes the rig's own types (``bearing_rig_msgs``) and plots them on 
 The server is the ``foxglove-sdk`` package's (its own threads; ``write`` only queues), bound to
 ``127.0.0.1`` only: the view is for the machine the rig runs on (an SSH tunnel takes it further).
 Open the Foxglove app, "Open connection", "Foxglove WebSocket", ``ws://localhost:PORT``, then
-import the layout ``config/foxglove/rig.json`` (README, "Live view in Foxglove").
+import the layout ``config/foxglove/rig.json`` (docs/guide.md, "Live view in Foxglove").
 """
 
 from __future__ import annotations
@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import Any
 from collections.abc import Callable
 
+from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import CLOCK
 
@@ -142,8 +143,6 @@ class LiveReplaySink:
         return bool(self.inner.can_publish(topic))
 
     def publish(self, topic: str, data: bytes) -> None:
-        from bearing_rig_sim.session.recorder import header_stamp_ns
-
         self.inner.publish(topic, data)
         stamp = header_stamp_ns(data)
         if topic == CLOCK.name and stamp is not None:

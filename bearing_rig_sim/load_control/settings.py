@@ -10,11 +10,14 @@ clutch, PI gains, interlock levels) are in the rig file, section ``loading_chain
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar
 
-from bearing_rig_sim.config import NodeSettingsFile, Section, config_path
+from pydantic import field_validator
+
+from bearing_rig_sim.config import Section, config_path
+from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CLOCK, DIAGNOSTICS
+from bearing_rig_sim.settings_model import Flag, NodeSettings, Number, param
 
 __all__ = ["NODE_NAME", "SHIPPED_FILE", "LoadControllerSettings", "shipped_parameters"]
 
@@ -25,63 +28,47 @@ SHIPPED_FILE = "load_controller.yaml"
 """The shipped parameter file, under ``config/``."""
 
 
-@dataclass(frozen=True)
-class LoadControllerSettings(NodeSettingsFile):
-    """The load controller's validated parameters (SI units; the unit is in each name).
+class LoadControllerSettings(NodeSettings):
+    """The load controller's validated parameters (SI units; the unit is in each name), declared
+    once (:mod:`bearing_rig_sim.settings_model`): the YAML checks, the errors and the node's ROS
+    descriptors come from these fields.
 
-    Attributes:
-        rig_file: rig data file with the loading chain.
-        axial_load_setpoint_n: set-point at configure, N (the chain refuses one above its
-            ``max_setpoint_n``).
-        engage_clutch_on_start: close the magnet clutch at configure.
-        state_rate_hz: rate of ``/rig/axial_load/state``, simulated Hz.
-        force_rate_hz: rate of the force messages (``/rig/bearing/axial_force``,
-            ``/rig/axial_load/force``): one chain step per sample, simulated Hz.
-        diagnostics_period_s: simulated time between two periodic ``/diagnostics``, s.
-        max_clock_gap_s: longest clock advance stepped at once, s.
-        step_period_s: wall time between two wake-ups that step the chain to the ``/clock``
-            time in force samples, s.
+    ``use_sim_time`` may be in the file and must be true: the chain is stepped on the
+    simulation clock. ``rig_file`` is resolved to an existing file ('' = the shipped
+    ``config/rig.yaml``; a relative name is under ``config/``).
     """
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-    rig_file: Path
-    axial_load_setpoint_n: float
-    engage_clutch_on_start: bool
-    state_rate_hz: float
-    force_rate_hz: float
-    diagnostics_period_s: float
-    max_clock_gap_s: float
-    step_period_s: float
+    rig_file: Path = param("rig data file with the loading chain ('' = the shipped config/rig.yaml)")
+    axial_load_setpoint_n: Number = param(
+        "axial-load set-point; also settable by topic and service; mirrors the one in force", unit="N", ge=0.0, le=10_000.0, live=True
+    )
+    engage_clutch_on_start: Flag = param("close the magnet clutch when the node is configured")
+    state_rate_hz: Number = param(f"rate of {AXIAL_LOAD_STATE.name} in simulated time", unit="Hz", gt=0.0, le=1000.0)
+    diagnostics_period_s: Number = param(f"simulated time between two periodic {DIAGNOSTICS.name}", unit="s", gt=0.0, le=600.0)
+    max_clock_gap_s: Number = param(
+        "longest clock advance stepped at once (a larger jump is stepped as this much)", unit="s", gt=0.0, le=600.0
+    )
+    force_rate_hz: Number = param("rate of the force messages (one chain step each) in simulated time", unit="Hz", gt=0.0, le=10_000.0)
+    step_period_s: Number = param(f"wall time between two wake-ups stepping the chain to the {CLOCK.name} time", unit="s", ge=0.001, le=0.1)
 
     @classmethod
-    def from_section(cls, s: Section) -> LoadControllerSettings:
-        """Validate the parameters in ``s`` (every key required, none unknown besides
-        ``use_sim_time``, which must be true: the chain is stepped on the simulation clock).
-
-        Raises:
-            ConfigError: naming the source, the key and the allowed range.
-        """
-        s.reject_unknown([*(f.name for f in fields(cls)), "use_sim_time"])
+    def check_other_keys(cls, s: Section) -> None:
         if s.data.get("use_sim_time") is False:
             raise s.error("use_sim_time", "steps the loading chain on the simulation clock: use_sim_time must be true")
-        raw = s.data.get("rig_file")
+
+    @field_validator("rig_file", mode="before")
+    @classmethod
+    def _existing_rig_file(cls, raw: object) -> Path:
         if not isinstance(raw, str):
-            raise s.error("rig_file", f"must be a file name ('' = the shipped rig.yaml), got {raw!r}")
+            raise ValueError(f"must be a file name ('' = the shipped rig.yaml), got {raw!r}")
         rig = Path(raw) if raw and Path(raw).is_absolute() else config_path(*(Path(raw).parts if raw else ("rig.yaml",)))
         if not rig.is_file():
-            raise s.error("rig_file", f"file not found: {raw!r} (looked for {rig})")
-        return cls(
-            rig_file=rig,
-            axial_load_setpoint_n=s.number("axial_load_setpoint_n", ge=0.0),
-            engage_clutch_on_start=s.boolean("engage_clutch_on_start"),
-            state_rate_hz=s.number("state_rate_hz", gt=0.0, le=1000.0),
-            force_rate_hz=s.number("force_rate_hz", gt=0.0, le=10_000.0),
-            diagnostics_period_s=s.number("diagnostics_period_s", gt=0.0),
-            max_clock_gap_s=s.number("max_clock_gap_s", gt=0.0),
-            step_period_s=s.number("step_period_s", ge=0.001, le=0.1),
-        )
+            raise ValueError(f"file not found: {raw!r} (looked for {rig})")
+        return rig
 
 
 def shipped_parameters() -> dict[str, Any]:

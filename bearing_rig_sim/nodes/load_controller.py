@@ -128,7 +128,7 @@ class LoadControllerNode(ManagedNode):
         if self.get_parameter("use_sim_time").value:
             self._time_source.detach_node()
         self._clock_tap: Node | None = None
-        self.clock_guard = ClockGuard(name=f"{NODE_NAME}: /clock")
+        self.clock_guard = ClockGuard(name=f"{NODE_NAME}: {CLOCK.name}")
         """Negative and far-jumping /clock stamps are refused (see :mod:`bearing_rig_sim.clock_guard`)."""
 
     def configure(self) -> None:
@@ -172,7 +172,7 @@ class LoadControllerNode(ManagedNode):
         self._mirror_setpoint()
         self.get_logger().info(
             f"loading chain from {settings.rig_file}; clutch {'engaged' if settings.engage_clutch_on_start else 'released'}; "
-            f"set-point {operation.setpoint:g} N; stepping on /clock every {settings.step_period_s * 1e3:g} ms"
+            f"set-point {operation.setpoint:g} N; stepping on {CLOCK.name} every {settings.step_period_s * 1e3:g} ms"
         )
 
     def activate(self) -> None:

@@ -19,6 +19,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
+from bearing_rig_sim.load_control.settings import LoadControllerSettings
+from bearing_rig_sim.settings_model import NodeSettings
+
 __all__ = ["NODE_PARAMETERS", "ParameterSpec", "spec_for"]
 
 
@@ -80,6 +84,17 @@ def _files(*specs: tuple[str, str]) -> list[ParameterSpec]:
     return [ParameterSpec(name, text) for name, text in specs]
 
 
+def specs_of(settings: type[NodeSettings]) -> list[ParameterSpec]:
+    """The specs of a settings class declared with :mod:`bearing_rig_sim.settings_model`: its
+    YAML checks and its ROS descriptors come from the same fields (the load controller's)."""
+    return [
+        ParameterSpec(
+            f.name, f.description, f.unit, f.low, f.high, integer=f.integer, read_only=not f.live, low_exclusive=f.low_exclusive
+        )
+        for f in settings.parameter_fields()
+    ]
+
+
 SIMULATOR = [
     *_files(
         ("bearing_file", "bearing data file (absolute, or relative to the package's config/)"),
@@ -87,7 +102,7 @@ SIMULATOR = [
         ("rig_file", "rig data file: sensors (strip counts, jitter, drop probability) and loading chain"),
         ("model", "engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)"),
     ),
-    ParameterSpec("chunk_s", "simulated time per engine call and per /clock message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
+    ParameterSpec("chunk_s", f"simulated time per engine call and per {CLOCK.name} message (whole engine steps of 40 us)", "s", 4e-5, 0.1),
     ParameterSpec("realtime", "lock the simulated time to the wall clock (false: as fast as possible)"),
     ParameterSpec("rate", "simulated seconds per wall second when in real time", "1", 0.0, 100.0, low_exclusive=True),
     ParameterSpec("loop_period_s", "period of the loop timer in real time (wall clock)", "s", 1e-4, 0.1),
@@ -99,29 +114,13 @@ SIMULATOR = [
     ParameterSpec("initial_axial_load_n", "axial load until the loading chain's first force message", "N", 0.0, 10_000.0),
     ParameterSpec("max_command_lead_s", "how far ahead of the rig clock a command's stamp may be", "s", 0.0, 3600.0),
     ParameterSpec("counter_timeout_s", "the pulse counters show 0 after this long without a pulse", "s", 0.0, 60.0, low_exclusive=True),
-    ParameterSpec("speeds_rate_hz", "rate of /rig/speeds in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),
-    ParameterSpec("truth_rate_hz", "rate of /rig/truth in simulated time", "Hz", 0.0, 100_000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
-    ParameterSpec("fault_hold_s", "a refused command or force keeps /diagnostics at ERROR this long (wall clock)", "s", 0.0, 600.0),
+    ParameterSpec("speeds_rate_hz", f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("truth_rate_hz", f"rate of {TRUTH.name} in simulated time", "Hz", 0.0, 100_000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("fault_hold_s", f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", "s", 0.0, 600.0),
 ]
 
-LOAD_CONTROLLER = [
-    ParameterSpec("rig_file", "rig data file with the loading chain ('' = the shipped config/rig.yaml)"),
-    ParameterSpec(
-        "axial_load_setpoint_n",
-        "axial-load set-point; also settable by topic and service; mirrors the one in force",
-        "N",
-        0.0,
-        10_000.0,
-        read_only=False,
-    ),
-    ParameterSpec("engage_clutch_on_start", "close the magnet clutch when the node is configured"),
-    ParameterSpec("state_rate_hz", "rate of /rig/axial_load/state in simulated time", "Hz", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_period_s", "simulated time between two periodic /diagnostics", "s", 0.0, 600.0, low_exclusive=True),
-    ParameterSpec("max_clock_gap_s", "longest clock advance stepped at once (a larger jump is stepped as this much)", "s", 0.0, 600.0, low_exclusive=True),
-    ParameterSpec("force_rate_hz", "rate of the force messages (one chain step each) in simulated time", "Hz", 0.0, 10_000.0, low_exclusive=True),
-    ParameterSpec("step_period_s", "wall time between two wake-ups stepping the chain to the /clock time", "s", 0.001, 0.1),
-]
+LOAD_CONTROLLER = specs_of(LoadControllerSettings)
 
 MONITOR = [
     ParameterSpec("bearing_file", "bearing data file: geometry for the epicyclic cage speed (relative to config/)"),
@@ -147,7 +146,7 @@ MONITOR = [
     ParameterSpec("fault_hold_s", "a malformed pulse stays a fault, a loss a warning, this long (rig time)", "s", 0.0, 600.0),
     ParameterSpec("clock_jump_tolerance_s", "a pulse this far before its predecessor is a clock jump (reset all)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("status_rate_hz", "status checks and messages per second of rig time, plus one per slip window", "Hz", 0.0, 1000.0, low_exclusive=True),
-    ParameterSpec("diagnostics_rate_hz", "rate of /diagnostics besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
 ]
 
 NODE_PARAMETERS: dict[str, dict[str, ParameterSpec]] = {

@@ -1,7 +1,7 @@
 """What the node shells share beyond nodes/common.py: the managed-node base and parameters.
 
 * :class:`ManagedNode`: an ``rclpy`` lifecycle node with the rig's contract, the one every node
-  of the rig follows (README, "Managed nodes"):
+  of the rig follows (docs/reference.md, "Managed nodes"):
 
   - **unconfigured** (after start): parameters declared, nothing else; nothing published;
   - **configure**: the parameters are validated by the node's ROS-free settings class and the

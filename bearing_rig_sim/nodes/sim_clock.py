@@ -14,6 +14,7 @@ from collections.abc import Callable
 from rclpy.node import Node
 
 from bearing_rig_sim.clock_guard import ClockGuard
+from bearing_rig_sim.interfaces import CLOCK
 
 __all__ = ["guard_sim_clock"]
 
@@ -27,7 +28,7 @@ def guard_sim_clock(node: Node, guard: ClockGuard | None = None) -> ClockGuard:
     Works whether the node's ``/clock`` subscription exists yet or not (``use_sim_time`` may be
     set later). Returns the guard, whose ``refused`` and ``jumps`` count what it did.
     """
-    guard = guard if guard is not None else ClockGuard(name=f"{node.get_name()}: /clock")
+    guard = guard if guard is not None else ClockGuard(name=f"{node.get_name()}: {CLOCK.name}")
     source: Any = node._time_source
     logger = node.get_logger()
     forward: Callable[[Any], None] = source.clock_callback

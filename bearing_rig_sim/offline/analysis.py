@@ -51,6 +51,7 @@ from typing import Any, cast
 from collections.abc import Callable
 
 
+from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
@@ -76,26 +77,26 @@ from bearing_rig_sim.offline.series import (
 )
 from bearing_rig_sim.rig.fibre_optic import Pulse
 
-PULSE_TYPE = "bearing_rig_msgs/msg/FibreOpticPulse"
-PULSE_TOPICS: dict[str, str] = {"spindle": "/rig/spindle/pulses", "cage": "/rig/cage/pulses"}
+PULSE_TYPE = contract.CAGE_PULSES.msgtype
+PULSE_TOPICS: dict[str, str] = {shaft: t.name for shaft, t in contract.PULSE_TOPICS.items()}
 """Shaft -> pulse topic: what the analysis cannot do without."""
 
-SPEEDS, TRUTH, STATUS, COMMAND = "/rig/speeds", "/rig/truth", "/rig/slip_status", "/rig/spindle/command"
+SPEEDS, TRUTH, STATUS, COMMAND = (t.name for t in (contract.SPEEDS, contract.TRUTH, contract.SLIP_STATUS, contract.SPINDLE_COMMAND))
 LOAD_STATE, LOAD_SETPOINT, LOAD_CELL, BEARING_FORCE = (
-    "/rig/axial_load/state",
-    "/rig/axial_load/setpoint",
-    "/rig/axial_load/force",
-    "/rig/bearing/axial_force",
+    t.name for t in (contract.AXIAL_LOAD_STATE, contract.AXIAL_LOAD_SETPOINT, contract.AXIAL_LOAD_FORCE, contract.BEARING_AXIAL_FORCE)
 )
 CONTEXT_TOPICS: dict[str, str] = {
-    SPEEDS: "sensor_msgs/msg/JointState",
-    TRUTH: "bearing_rig_msgs/msg/SimulatorTruth",
-    STATUS: "bearing_rig_msgs/msg/SlipStatus",
-    COMMAND: "bearing_rig_msgs/msg/SpindleCommand",
-    LOAD_STATE: "bearing_rig_msgs/msg/AxialLoadState",
-    LOAD_SETPOINT: "std_msgs/msg/Float64",
-    LOAD_CELL: "geometry_msgs/msg/WrenchStamped",
-    BEARING_FORCE: "geometry_msgs/msg/WrenchStamped",
+    t.name: t.msgtype
+    for t in (
+        contract.SPEEDS,
+        contract.TRUTH,
+        contract.SLIP_STATUS,
+        contract.SPINDLE_COMMAND,
+        contract.AXIAL_LOAD_STATE,
+        contract.AXIAL_LOAD_SETPOINT,
+        contract.AXIAL_LOAD_FORCE,
+        contract.BEARING_AXIAL_FORCE,
+    )
 }
 """Topics read when present, with the type they must carry."""
 

@@ -27,7 +27,20 @@ from collections.abc import Sequence
 import bearing_rig_sim
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
-from bearing_rig_sim.offline.analysis import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
+from bearing_rig_sim.offline.analysis import (
+    BEARING_FORCE,
+    COMMAND,
+    CONTEXT_TOPICS,
+    LOAD_CELL,
+    LOAD_SETPOINT,
+    LOAD_STATE,
+    PULSE_TOPICS,
+    PULSE_TYPE,
+    SPEEDS,
+    STATUS,
+    TRUTH,
+    OfflineResult,
+)
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
 
@@ -39,14 +52,14 @@ _STATE_NAMES = {int(s): s.name.lower() for s in SlipState}
 _RUN_KEYS = ("run_id", "started_utc", "program_file", "command_line", "project_version", "realtime", "ros_domain_id")
 _TOPIC_USE = {
     **{topic: "slip windows and verdicts (offline monitor)" for topic in PULSE_TOPICS.values()},
-    "/rig/speeds": "pulse counter's speeds (plot)",
+    SPEEDS: "pulse counter's speeds (plot)",
     TRUTH: "true speeds, slip and load (plots, segment means)",
-    "/rig/slip_status": "recorded verdicts (comparison)",
+    STATUS: "recorded verdicts (comparison)",
     COMMAND: "program segments",
-    "/rig/axial_load/state": "set-point, load cell and bearing force",
-    "/rig/axial_load/setpoint": "axial-load set-point",
-    "/rig/axial_load/force": "load cell",
-    "/rig/bearing/axial_force": "force on the bearing",
+    LOAD_STATE: "set-point, load cell and bearing force",
+    LOAD_SETPOINT: "axial-load set-point",
+    LOAD_CELL: "load cell",
+    BEARING_FORCE: "force on the bearing",
 }
 
 
@@ -141,8 +154,8 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
                 ("inner_ring_speed", "inner ring (spindle pulses)", _RPM, {"linewidth": 1.4}),
                 ("cage_speed", "cage (cage pulses)", _RPM, {"linewidth": 1.4}),
                 ("theoretical_cage_speed", "epicyclic cage speed", _RPM, {"linestyle": "--", "linewidth": 1.0}),
-                ("counter_inner_ring_speed", "inner ring (/rig/speeds)", _RPM, {"linestyle": ":", **thin}),
-                ("counter_cage_speed", "cage (/rig/speeds)", _RPM, {"linestyle": ":", **thin}),
+                ("counter_inner_ring_speed", f"inner ring ({SPEEDS})", _RPM, {"linestyle": ":", **thin}),
+                ("counter_cage_speed", f"cage ({SPEEDS})", _RPM, {"linestyle": ":", **thin}),
                 ("truth_cage_speed", "cage (truth)", _RPM, {"linestyle": "-.", **thin}),
             ],
             "no slip window in the bag",
@@ -153,8 +166,8 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
             "slip (%)",
             [
                 ("slip_rate", "from the sensors (offline monitor)", 1.0, {"linewidth": 1.4}),
-                ("recorded_slip_rate", "recorded /rig/slip_status", 1.0, {"linestyle": "--", "linewidth": 1.0}),
-                ("truth_slip_rate", "truth (/rig/truth)", 1.0, {"linestyle": ":", "linewidth": 1.0}),
+                ("recorded_slip_rate", f"recorded {STATUS}", 1.0, {"linestyle": "--", "linewidth": 1.0}),
+                ("truth_slip_rate", f"truth ({TRUTH})", 1.0, {"linestyle": ":", "linewidth": 1.0}),
             ],
             "no slip window in the bag",
         ),
@@ -166,7 +179,7 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
                 ("axial_load_setpoint", "set-point", 1.0, {"linestyle": "--", "linewidth": 1.0}),
                 ("load_cell_force", "load cell", 1.0, thin),
                 ("bearing_force", "force on the bearing", 1.0, {"linewidth": 1.2}),
-                ("truth_axial_load", "truth (/rig/truth)", 1.0, {"linestyle": ":", "linewidth": 1.0}),
+                ("truth_axial_load", f"truth ({TRUTH})", 1.0, {"linestyle": ":", "linewidth": 1.0}),
             ],
             "no axial-load topic in the bag",
         ),
@@ -185,7 +198,7 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
         drawn = False
         for transitions, label, style in (
             (result.transitions, "offline monitor", {"linewidth": 1.6}),
-            (result.recorded_transitions, "recorded /rig/slip_status", {"linestyle": "--", "linewidth": 1.0}),
+            (result.recorded_transitions, f"recorded {STATUS}", {"linestyle": "--", "linewidth": 1.0}),
         ):
             xs, ys = _step(transitions, result.first_time, result.last_time)
             if xs:
@@ -280,7 +293,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     if result.recorded_statuses:
         lines.append(f"* final verdict recorded: **{state_name(result.final_recorded_state)}** ({result.recorded_statuses} status messages)")
     else:
-        lines.append("* recorded verdicts: none (the bag has no /rig/slip_status)")
+        lines.append(f"* recorded verdicts: none (the bag has no {STATUS})")
     total = sum(result.state_durations.values())
     if total > 0.0:
         shares = ", ".join(
@@ -291,7 +304,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     if result.transitions_dropped:
         lines.append(f"* {result.transitions_dropped} further state changes were counted but not kept for the status plot")
     stable = sum(s.final_state == SlipState.STABLE for s in result.segments)
-    source = "program segments (from /rig/spindle/command)" if result.segment_source == "program" else "constant-speed stretches (no spindle command in the bag)"
+    source = f"program segments (from {COMMAND})" if result.segment_source == "program" else "constant-speed stretches (no spindle command in the bag)"
     lines += [f"* {len(result.segments)} {source}: {stable} end stable; {_agreement(result.segments)}", ""]
     lines += ["## Segments", ""]
     if result.segments:

@@ -180,7 +180,7 @@ class ReplayStats:
         count = self.message_count
         mean = self.total_late / count if count else 0.0
         return (
-            f"{count} messages published in {self.loops} pass(es) ({self.clock_messages} on /clock); "
+            f"{count} messages published in {self.loops} pass(es) ({self.clock_messages} on {CLOCK.name}); "
             f"lateness mean {mean * 1e3:.3g} ms, max {self.max_late * 1e3:.3g} ms"
         )
 

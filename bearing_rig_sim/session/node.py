@@ -257,17 +257,17 @@ class SessionNode(Node):
         """Which node is not ready yet, and what is missing (empty when all are ready)."""
         missing = {}
         if self.clock_count == 0:
-            missing["simulator"] = "no /clock received"
+            missing["simulator"] = f"no {CLOCK.name} received"
         elif self.subscribers_besides_recorder(SPINDLE_COMMAND.name) == 0:
-            missing["simulator"] = "nobody subscribes /rig/spindle/command"
+            missing["simulator"] = f"nobody subscribes {SPINDLE_COMMAND.name}"
         if self.live.state_count == 0:
-            missing["load_controller"] = "no /rig/axial_load/state received"
+            missing["load_controller"] = f"no {AXIAL_LOAD_STATE.name} received"
         elif self.subscribers_besides_recorder(AXIAL_LOAD_SETPOINT.name) == 0:
-            missing["load_controller"] = "nobody subscribes /rig/axial_load/setpoint"
+            missing["load_controller"] = f"nobody subscribes {AXIAL_LOAD_SETPOINT.name}"
         if self.count_publishers(SLIP_STATUS.name) == 0:
-            missing["monitor"] = "nobody publishes /rig/slip_status"
+            missing["monitor"] = f"nobody publishes {SLIP_STATUS.name}"
         elif self.subscribers_besides_recorder(CAGE_PULSES.name) == 0:
-            missing["monitor"] = "nobody subscribes /rig/cage/pulses"
+            missing["monitor"] = f"nobody subscribes {CAGE_PULSES.name}"
         return missing
 
     # -- recording --------------------------------------------------------------------------------

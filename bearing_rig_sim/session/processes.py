@@ -38,6 +38,8 @@ from pathlib import Path
 from typing import IO
 from collections.abc import Iterator, Mapping, Sequence
 
+import psutil
+
 from bearing_rig_sim.dds_profile import PROFILE_VARIABLES
 from bearing_rig_sim.errors import RigError
 
@@ -233,7 +235,7 @@ class NodeProcess:
             self._log.close()
 
     def cpu_seconds(self) -> float | None:
-        """User + system CPU time it used so far, s (Linux ``/proc/<pid>/stat``); None if unknown."""
+        """User + system CPU time it used so far, s; None if unknown."""
         pid = self.pid
         if pid is None:
             return None
@@ -241,14 +243,13 @@ class NodeProcess:
 
 
 def process_cpu_seconds(pid: int) -> float | None:
-    """utime + stime of a process, s, from ``/proc/<pid>/stat``; None when it cannot be read."""
+    """User + system CPU time of a process (not its children), s, by psutil; None when it cannot
+    be read (no such process, or no access)."""
     try:
-        text = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
+        times = psutil.Process(pid).cpu_times()
+    except psutil.Error:
         return None
-    fields = text[text.rindex(")") + 2 :].split()  # after "pid (comm) "; field 3 is fields[0]
-    ticks = int(fields[11]) + int(fields[12])  # utime, stime: fields 14 and 15 of proc(5)
-    return ticks / os.sysconf("SC_CLK_TCK")
+    return float(times.user + times.system)
 
 
 def stop_all(processes: Sequence[NodeProcess], timeout: float = 5.0) -> None:

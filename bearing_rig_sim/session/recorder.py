@@ -28,9 +28,8 @@ from typing import Protocol
 from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.bags.cdr import header_stamp_ns
-from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
-
 from bearing_rig_sim.clock_guard import ClockGuard
+from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",

@@ -49,6 +49,7 @@ from collections.abc import Sequence
 from bearing_rig_sim.dds_profile import apply_rig_profile
 from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import CLOCK, SLIP_STATUS, SPEEDS
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import check_bearing_file, check_parameter_file, make_run_id, node_parameters, parameter_arguments, run_context
@@ -592,15 +593,15 @@ class _Session:
             self.out.flush()
             return status
         self.out.write(
-            f"\nbag: {self.writer.path} ({total} messages; /clock {counts.get('/clock', 0)}, /rig/speeds "
-            f"{counts.get('/rig/speeds', 0)}, /rig/slip_status {counts.get('/rig/slip_status', 0)}); node logs in "
-            f"{self.writer.path / 'logs'}\n"
+            f"\nbag: {self.writer.path} ({total} messages; "
+            + ", ".join(f"{t.name} {counts.get(t.name, 0)}" for t in (CLOCK, SPEEDS, SLIP_STATUS))
+            + f"); node logs in {self.writer.path / 'logs'}\n"
         )
         rule = self.recorder.rule
         if rule.clock_guard.refused or rule.clock_guard.jumps:
             first = f"; first: {rule.clock_notes[0]}" if rule.clock_notes else ""
             self.out.write(
-                f"clock: {rule.clock_guard.refused} /clock stamp(s) refused (kept off the bag's timeline), "
+                f"clock: {rule.clock_guard.refused} {CLOCK.name} stamp(s) refused (kept off the bag's timeline), "
                 f"{rule.clock_guard.jumps} confirmed jump(s){first}\n"
             )
         self.out.flush()

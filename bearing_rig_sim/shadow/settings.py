@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
-from dataclasses import dataclass
 from pathlib import Path
+from typing import Any, ClassVar
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from pydantic import ValidationInfo, field_validator
+
+from bearing_rig_sim.config import load_yaml
+from bearing_rig_sim.interfaces import DIAGNOSTICS
+from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
 from bearing_rig_sim.simulation.settings import resolve_config_file
 
 NODE_NAME = "shadow"
@@ -16,141 +19,106 @@ NODE_NAME = "shadow"
 SHIPPED_FILE = "shadow.yaml"
 """The shipped parameter file, under ``config/``."""
 
+MODELS = ("reduced", "stiff")
+"""The engine's models (``reduced`` runs in real time)."""
 
-def _resolve(s: Section, key: str, *, empty_ok: bool = False) -> Path | None:
+
+def _config_file(raw: object, *, empty_ok: bool) -> Path | None:
     """A file parameter (absolute or under ``config/``); ``""`` is None where ``empty_ok``."""
-    raw = s.data.get(key)
     if not isinstance(raw, str) or (not raw and not empty_ok):
-        raise s.error(key, f"must be a file name (absolute or relative to config/), got {raw!r}")
+        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
     path = resolve_config_file(raw)
     if path is not None and not path.is_file():
-        raise s.error(key, f"file not found: {raw!r} (looked for {path})")
+        raise ValueError(f"file not found: {raw!r} (looked for {path})")
     return path
 
 
-def _string_or_empty(s: Section, key: str) -> str:
-    if key not in s:
-        raise s.error(key, "missing")
-    raw = s.data[key]
-    if not isinstance(raw, str):
-        raise s.error(key, f"must be a string (empty for the default), got {raw!r}")
-    return raw
+class ShadowSettings(NodeSettings):
+    """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason), declared
+    once (:mod:`bearing_rig_sim.settings_model`). ``calibration_rms_slip_pct`` below zero is
+    replaced by the calibration file's ``calibration.rms_slip_pct``; ``error_after_s`` must
+    exceed ``warn_after_s``."""
 
+    NODE_NAME: ClassVar[str] = NODE_NAME
+    SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-@dataclass(frozen=True)
-class ShadowSettings:
-    """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason).
+    bearing_file: Path = param("bearing data file (absolute, or relative to config/)")
+    calibration_file: Path | None = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
+    model: str = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    chunk_s: Number = param("engine advance per call", unit="s", gt=0.0, le=0.1)
+    window_revolutions: Integer = param("whole cage revolutions per slip window (the monitor's)", unit="1", ge=1, le=1000)
+    min_inner_ring_speed_rad_s: Number = param("slower windows are not compared", unit="rad/s", gt=0.0)
+    calibration_rms_slip_pct: Number = param(
+        "the calibration's RMS slip error (negative: read from the calibration file)", unit="percentage points", lt=100.0
+    )
+    timing_jitter_std_s: Number = param("the bench sensors' pulse-timing jitter", unit="s", ge=0.0, le=1e-3)
+    band_coverage: Number = param("band half-width in standard uncertainties", unit="1", gt=0.0, le=10.0)
+    warn_after_s: Number = param("a residual outside the band longer than this is a WARN", unit="s", gt=0.0)
+    error_after_s: Number = param("... longer than this an ERROR (more than warn_after_s)", unit="s")
+    settle_s: Number = param("windows starting sooner than this after an engine (re)start are not compared", unit="s", ge=0.0, le=10.0)
+    max_speed_gap_s: Number = param("speed points further apart restart the engine", unit="s", gt=0.0)
+    load_average_s: Number = param("averaging time of the load-cell force", unit="s", gt=0.0, le=10.0)
+    load_timeout_s: Number = param("no load-cell sample for this long is a dropout", unit="s", gt=0.0)
+    recalibrate: Flag = param("track a calibration parameter online")
+    recalibrate_parameter: str = param("the calibration file's parameter tracked (section.key; '' = its first)")
+    forgetting_factor: Number = param("of the recursive least squares, per compared steady window", unit="1", gt=0.5, le=1.0)
+    probe_step_fraction: Number = param("initial offset of the probe engine from the calibrated value", unit="1", gt=0.0, lt=1.0)
+    steady_speed_fraction: Number = param(
+        "windows whose spindle speed is within this fraction of the previous one's are steady", unit="1", ge=0.0, lt=1.0
+    )
+    status_rate_hz: Number = param("status publication rate of the node (wall clock)", unit="Hz", gt=0.0)
+    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0)
 
-    Attributes:
-        bearing_file: bearing data.
-        calibration_file: calibration laid over it (None: the uncalibrated bearing file).
-        model: the engine's model (``"reduced"`` for real time).
-        chunk_s: engine advance per call, s.
-        window_revolutions: whole cage revolutions per slip window (the monitor's).
-        min_inner_ring_speed_rad_s: slower windows are not compared, rad/s.
-        calibration_rms_slip_pct: the calibration's RMS slip error, percentage points; negative:
-            read from the calibration file.
-        timing_jitter_std_s: the bench sensors' pulse-timing jitter, s.
-        band_coverage: band half-width in standard uncertainties (1).
-        warn_after_s: residual outside the band longer than this: WARN, s.
-        error_after_s: ... longer than this: ERROR, s.
-        settle_s: windows starting sooner than this after an engine (re)start are not compared, s.
-        max_speed_gap_s: speed points further apart restart the engine, s.
-        load_average_s: averaging time of the load-cell force, s.
-        load_timeout_s: no load-cell sample for this long is a dropout, s.
-        recalibrate: track a calibration parameter online.
-        recalibrate_parameter: the calibration file's parameter tracked (``section.key``); "" for its
-            first one.
-        forgetting_factor: of the recursive least squares, per compared steady window (1).
-        probe_step_fraction: initial offset of the probe engine from the calibrated value (1).
-        steady_speed_fraction: windows whose spindle speed is within this fraction of the previous
-            one's are steady (1).
-        status_rate_hz, diagnostics_rate_hz: publication rates of the node, wall Hz.
-    """
-
-    bearing_file: Path
-    calibration_file: Path | None
-    model: str
-    chunk_s: float
-    window_revolutions: int
-    min_inner_ring_speed_rad_s: float
-    calibration_rms_slip_pct: float
-    timing_jitter_std_s: float
-    band_coverage: float
-    warn_after_s: float
-    error_after_s: float
-    settle_s: float
-    max_speed_gap_s: float
-    load_average_s: float
-    load_timeout_s: float
-    recalibrate: bool
-    recalibrate_parameter: str
-    forgetting_factor: float
-    probe_step_fraction: float
-    steady_speed_fraction: float
-    status_rate_hz: float
-    diagnostics_rate_hz: float
-
+    @field_validator("bearing_file", mode="before")
     @classmethod
-    def from_section(cls, s: Section) -> ShadowSettings:
-        """Validate the parameters in ``s`` (every key required, none unknown besides
-        ``use_sim_time``).
+    def _bearing_file(cls, raw: object) -> Path | None:
+        return _config_file(raw, empty_ok=False)
 
-        Raises:
-            ConfigError: naming the source, the key and the allowed range.
-        """
-        s.reject_unknown([*cls.__dataclass_fields__, "use_sim_time"])
-        bearing = _resolve(s, "bearing_file")
-        assert bearing is not None
-        warn = s.number("warn_after_s", gt=0.0)
-        settings = cls(
-            bearing_file=bearing,
-            calibration_file=_resolve(s, "calibration_file", empty_ok=True),
-            model=s.choice("model", ["reduced", "stiff"]),
-            chunk_s=s.number("chunk_s", gt=0.0, le=0.1),
-            window_revolutions=s.integer("window_revolutions", ge=1, le=1000),
-            min_inner_ring_speed_rad_s=s.number("min_inner_ring_speed_rad_s", gt=0.0),
-            calibration_rms_slip_pct=s.number("calibration_rms_slip_pct", lt=100.0),
-            timing_jitter_std_s=s.number("timing_jitter_std_s", ge=0.0, le=1e-3),
-            band_coverage=s.number("band_coverage", gt=0.0, le=10.0),
-            warn_after_s=warn,
-            error_after_s=s.number("error_after_s", gt=warn),
-            settle_s=s.number("settle_s", ge=0.0, le=10.0),
-            max_speed_gap_s=s.number("max_speed_gap_s", gt=0.0),
-            load_average_s=s.number("load_average_s", gt=0.0, le=10.0),
-            load_timeout_s=s.number("load_timeout_s", gt=0.0),
-            recalibrate=s.boolean("recalibrate"),
-            recalibrate_parameter=_string_or_empty(s, "recalibrate_parameter"),
-            forgetting_factor=s.number("forgetting_factor", gt=0.5, le=1.0),
-            probe_step_fraction=s.number("probe_step_fraction", gt=0.0, lt=1.0),
-            steady_speed_fraction=s.number("steady_speed_fraction", ge=0.0, lt=1.0),
-            status_rate_hz=s.number("status_rate_hz", gt=0.0),
-            diagnostics_rate_hz=s.number("diagnostics_rate_hz", gt=0.0),
-        )
-        if settings.calibration_rms_slip_pct < 0.0:
-            rms = calibration_rms(settings.calibration_file)
-            if rms is None:
-                raise s.error(
-                    "calibration_rms_slip_pct",
-                    "negative means 'read calibration.rms_slip_pct of the calibration file', but "
-                    + ("no calibration file is given" if settings.calibration_file is None else f"{settings.calibration_file} has none"),
-                )
-            settings = dataclasses.replace(settings, calibration_rms_slip_pct=rms)
-        return settings
-
+    @field_validator("calibration_file", mode="before")
     @classmethod
-    def from_values(cls, values: dict[str, object], source: str = "shadow parameters") -> ShadowSettings:
-        """Validate a flat mapping of parameter values (the node's ROS parameters)."""
-        return cls.from_section(Section(dict(values), source))
+    def _calibration_file(cls, raw: object) -> Path | None:
+        return _config_file(raw, empty_ok=True)
 
+    @field_validator("model", mode="before")
     @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> ShadowSettings:
-        """Read ``shadow: ros__parameters:`` of a parameter file (default: the shipped one)."""
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
+    def _model(cls, raw: object) -> str:
+        if raw not in MODELS:
+            raise ValueError(f"must be one of {', '.join(MODELS)}, got {raw!r}")
+        return str(raw)
 
-    def replace(self, **changes: object) -> ShadowSettings:
+    @field_validator("recalibrate_parameter", mode="before")
+    @classmethod
+    def _string_or_empty(cls, raw: object) -> str:
+        if not isinstance(raw, str):
+            raise ValueError(f"must be a string (empty for the default), got {raw!r}")
+        return raw
+
+    @field_validator("error_after_s")
+    @classmethod
+    def _after_warn(cls, value: float, info: ValidationInfo) -> float:
+        warn = info.data.get("warn_after_s")
+        if warn is not None and not value > warn:
+            raise ValueError(f"must be > {warn} (warn_after_s), got {value!r}")
+        return value
+
+    @field_validator("calibration_rms_slip_pct")
+    @classmethod
+    def _rms_from_calibration(cls, value: float, info: ValidationInfo) -> float:
+        if value >= 0.0 or "calibration_file" not in info.data:
+            return value
+        calibration = info.data["calibration_file"]
+        rms = calibration_rms(calibration)
+        if rms is None:
+            raise ValueError(
+                "negative means 'read calibration.rms_slip_pct of the calibration file', but "
+                + ("no calibration file is given" if calibration is None else f"{calibration} has none")
+            )
+        return rms
+
+    def replace(self, **changes: Any) -> ShadowSettings:
         """A copy with some values changed (not re-validated: for tests and the command line)."""
-        return dataclasses.replace(self, **changes)  # type: ignore[arg-type]  # keys checked against the dataclass fields above
+        return self.model_copy(update=changes)
 
 
 def calibration_rms(path: Path | None) -> float | None:
@@ -169,6 +137,4 @@ def calibration_rms(path: Path | None) -> float | None:
 
 def shipped_parameters() -> dict[str, object]:
     """The raw values of the shipped ``config/shadow.yaml`` (the node's declared defaults)."""
-    section = ros_parameters(load_yaml(config_path(SHIPPED_FILE)), NODE_NAME)
-    ShadowSettings.from_section(section)
-    return dict(section.data)
+    return ShadowSettings.shipped_parameters()

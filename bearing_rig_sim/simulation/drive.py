@@ -2,7 +2,7 @@
 
 The dynamics engine takes the inner-ring motion as a constant angular acceleration per call of
 ``advance`` (one chunk). :class:`SpindleDrive` holds the current speed command, a
-:class:`~bearing_rig_sim.rig.program.SegmentSpeed` that starts from the speed the spindle had
+:class:`~bearing_rig_sim.rig.speed_profile.SegmentSpeed` that starts from the speed the spindle had
 when the command took effect, and gives for a chunk ``[t, t + h]`` the constant acceleration
 ``(w(t + h) - w_now) / h`` that brings the inner ring from its present speed ``w_now`` to the
 profile's speed at the chunk's end. The engine's speed therefore equals the profile at every
@@ -10,7 +10,7 @@ chunk boundary (whatever small drift it had is corrected in the next chunk), and
 it is the chord of the profile:
 
 * STEP ramp (the paper's drive function, docs/paper.md section 5): ``w`` is
-  :func:`~bearing_rig_sim.rig.program.step_ramp`; its slope is zero at both ends, so the first
+  :func:`~bearing_rig_sim.rig.speed_profile.step_ramp`; its slope is zero at both ends, so the first
   and last chunks of a ramp accelerate gently. A ramp time of 0 is a jump, spread over one
   chunk (a motor cannot jump; one chunk is 1 ms by default).
 * Constant acceleration: ``|a|`` towards the target until the target is reached, then 0; the
@@ -34,7 +34,7 @@ import math
 from dataclasses import dataclass
 
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.rig.program import SegmentSpeed, SpeedProfileKind
+from bearing_rig_sim.rig.speed_profile import SegmentSpeed, SpeedProfileKind
 
 
 class SpindleCommandError(RigError):

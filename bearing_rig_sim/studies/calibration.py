@@ -13,10 +13,9 @@ from __future__ import annotations
 
 import csv
 import math
-import multiprocessing
 import os
-from concurrent.futures import Executor, ProcessPoolExecutor
-from contextlib import AbstractContextManager
+from concurrent.futures import Executor
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 from collections.abc import Callable, Iterable, Sequence
@@ -28,8 +27,9 @@ from scipy.optimize import least_squares
 from bearing_rig_sim.config import check_number, rad_s_to_rpm, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters, DynamicsDivergedError
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
+from bearing_rig_sim.dynamics.steady import solver_for
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.sweep.points import solver_for
+from bearing_rig_sim.executors import process_pool
 
 DEFAULT_FITTED: tuple[str, ...] = ("yield_stress", "consistency")
 """Parameters fitted by default: the Herschel-Bulkley yield stress and consistency of the grease
@@ -195,29 +195,6 @@ def _collect(results: Iterable[SteadyState], total: int, progress: Callable[[int
     return out
 
 
-def process_pool(workers: int) -> AbstractContextManager[Executor]:
-    """Where points run in parallel: on the Dask cluster named by ``DASK_SCHEDULER_ADDRESS``
-    when it is set (:func:`bearing_rig_sim.sweep.runner.cluster_executor`), else on ``workers``
-    forked processes (they inherit the compiled kernels and start at once)."""
-    import dask
-
-    if dask.config.get("scheduler-address", None):
-        from bearing_rig_sim.sweep.runner import cluster_executor  # Dask's client only when used
-
-        return cluster_executor(workers)
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"))
-
-
-class _no_pool:
-    """Context manager standing in for a pool when running in this process."""
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-
 LUBRICANT_FIELDS = ("yield_stress", "consistency", "fill_fraction", "eyring_stress")
 """Calibratable names that are properties of the bearing's lubricant."""
 
@@ -302,7 +279,7 @@ def calibrate(
             shown = ", ".join(f"{k} = {v:.4g}" for k, v in values.items())
             raise CalibrationError(f"the engine diverged at the fit's trial {shown}: {exc}") from None
 
-    with process_pool(min(workers, len(points))) if workers > 1 else _no_pool() as pool:
+    with process_pool(min(workers, len(points))) if workers > 1 else nullcontext() as pool:
         # Slip is reported to 0.01 %: a relative step of 1e-4 in the log-parameters is ample.
         fit = least_squares(
             lambda x: np.array([s.slip_pct for s in model(x, pool)]) - target, x0, diff_step=1e-3, xtol=1e-4, ftol=1e-6, max_nfev=40

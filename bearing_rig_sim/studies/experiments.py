@@ -18,7 +18,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
-from bearing_rig_sim.studies.calibration import SteadyState, process_pool, steady_states
+from bearing_rig_sim.executors import process_pool
+from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 

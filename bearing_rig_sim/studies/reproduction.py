@@ -16,8 +16,11 @@ import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+from collections.abc import Callable
 
 import numpy as np
+from tqdm import tqdm
 
 from bearing_rig_sim import __version__
 from bearing_rig_sim.analysis.stability import K1_AXIAL_LOAD
@@ -133,33 +136,30 @@ def load_raw(path: Path) -> RawResults:
     )
 
 
-class ProgressBar:
-    """A one-line progress bar on stderr (silent when ``enabled`` is false)."""
+def _bar(label: str, enabled: bool, total: int | None = None) -> Any:
+    """A tqdm progress bar on stderr for one experiment (silent when ``enabled`` is false)."""
+    return tqdm(desc=f"{label:<18}", total=total, unit="pt", disable=not enabled, file=sys.stderr)
 
-    def __init__(self, label: str, enabled: bool = True) -> None:
-        self.label = label
-        self.enabled = enabled
-        self.tty = sys.stderr.isatty()
 
-    def __call__(self, done: int, total: int) -> None:
-        if not self.enabled or (not self.tty and done < total):
-            return
-        width = 30
-        filled = int(width * done / max(total, 1))
-        sys.stderr.write(f"\r{self.label:<22} [{'#' * filled}{'.' * (width - filled)}] {done}/{total}")
-        if done >= total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
+def _follow(bar: Any) -> Callable[[int, int], None]:
+    """The ``progress(done, total)`` callback of the experiments, moving ``bar``."""
+
+    def progress(done: int, total: int) -> None:
+        bar.total = total
+        bar.update(done - bar.n)
+
+    return progress
 
 
 def run_experiments(params: BearingParameters, workers: int | None = None, progress: bool = True) -> RawResults:
     """Run the three experiments (both cores by default)."""
-    validation = validation_table(params, workers=workers, progress=ProgressBar("validation table", progress))
-    sweep = load_sweep(params, workers=workers, progress=ProgressBar("load sweep", progress))
-    bar = ProgressBar("acceleration sweep", progress)
-    bar(0, len(ACCELERATIONS))
-    accel = acceleration_sweep(params, duration=ACCELERATION_DURATION_S, workers=workers)
-    bar(len(ACCELERATIONS), len(ACCELERATIONS))
+    with _bar("validation table", progress) as bar:
+        validation = validation_table(params, workers=workers, progress=_follow(bar))
+    with _bar("load sweep", progress) as bar:
+        sweep = load_sweep(params, workers=workers, progress=_follow(bar))
+    with _bar("acceleration sweep", progress, total=len(ACCELERATIONS)) as bar:
+        accel = acceleration_sweep(params, duration=ACCELERATION_DURATION_S, workers=workers)
+        bar.update(len(ACCELERATIONS))
     return RawResults(validation, sweep, accel)
 
 

@@ -11,13 +11,13 @@ A :class:`SweepTask` is a small batch of points of one kind:
   criterion, peak slip).
 
 Each point becomes one row (:func:`evaluate`): a mapping of the columns of :data:`COLUMNS`.
-Workers keep one solver per bearing parameter set (:func:`solver_for`), so the engine is built
+Workers keep one solver per bearing parameter set
+(:func:`~bearing_rig_sim.dynamics.steady.solver_for`), so the engine is built
 and its compiled kernels are loaded once per worker process.
 """
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import math
@@ -35,7 +35,7 @@ from bearing_rig_sim.dynamics.steady import (
     STATE_ROLLING,
     STATE_SKID,
     SteadyPoint,
-    SteadySolver,
+    solver_for,
 )
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, SPEED_AXIS
@@ -120,12 +120,6 @@ def parameters_for(base: BearingParameters, point: dict[str, float]) -> BearingP
             changes[field] = value
     params = base.replace(**changes) if changes else base
     return params.with_lubricant(**rheology) if rheology else params
-
-
-@functools.lru_cache(maxsize=16)
-def solver_for(params: BearingParameters) -> SteadySolver:
-    """One solver per parameter set and worker process (the engine and its kernels once)."""
-    return SteadySolver(params)
 
 
 def evaluate(task: SweepTask) -> list[dict[str, Any]]:

@@ -12,22 +12,19 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import logging
-import os
 import sys
 import time
 from collections import defaultdict
-from concurrent.futures import Executor
-from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 
 from bearing_rig_sim import __version__
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.executors import open_client
 from bearing_rig_sim.sweep.points import (
     INTEGRATE,
     KIND_CONTINUATION,
@@ -155,39 +152,6 @@ def _progress_bar(total: int, enabled: bool) -> Any:
     from tqdm import tqdm
 
     return tqdm(total=total, unit="pt", desc="sweep", disable=not enabled, file=sys.stderr, smoothing=0.1)
-
-
-def open_client(scheduler: str | None, workers: int | None) -> tuple[Any, Any]:
-    """A Dask client on ``scheduler`` (address) or on a new ``LocalCluster`` of ``workers``
-    single-threaded worker processes (default: one per core). Returns (client, cluster or
-    None); close both when done."""
-    from distributed import Client, LocalCluster
-
-    if scheduler:
-        try:
-            return Client(scheduler, timeout="20s"), None
-        except OSError as exc:
-            raise SweepRunError(f"cannot reach the Dask scheduler at {scheduler}: {exc}") from exc
-    n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=logging.ERROR)
-    return Client(cluster), cluster
-
-
-@contextmanager
-def cluster_executor(workers: int | None = None) -> Iterator[Executor]:
-    """A ``concurrent.futures`` executor on Dask workers, for code written against a process
-    pool (calibration, the paper's experiments): the cluster whose address is in Dask's
-    configuration (``DASK_SCHEDULER_ADDRESS``) if there is one, else a ``LocalCluster`` of
-    ``workers`` processes. Results of ``map`` come in order."""
-    import dask
-
-    client, cluster = open_client(dask.config.get("scheduler-address", None), workers)
-    try:
-        yield client.get_executor(pure=False)
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
 
 
 def run_sweep(

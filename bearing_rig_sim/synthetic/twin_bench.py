@@ -21,7 +21,7 @@ from typing import Any
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, SPINDLE_PULSES
 from bearing_rig_sim.rig.fibre_optic import Pulse
-from bearing_rig_sim.rig.program import SpeedProfileKind
+from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import RigTwin
 

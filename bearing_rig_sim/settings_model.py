@@ -1,0 +1,232 @@
+"""One declarative model of a node's parameters (pydantic v2), from which come the validation of
+its YAML file and of its ROS parameters in force, the one-line errors naming the file, the key
+and the allowed range, and the description, unit and range of each parameter that the node
+declares to ROS.
+
+A settings class derives from :class:`NodeSettings` and declares each parameter once::
+
+    class LoadControllerSettings(NodeSettings):
+        NODE_NAME: ClassVar[str] = "load_controller"
+        SHIPPED_FILE: ClassVar[str] = "load_controller.yaml"
+
+        state_rate_hz: Number = param("rate of the state topic in simulated time", unit="Hz", gt=0.0, le=1000.0)
+
+* :data:`Number`, :data:`Integer` and :data:`Flag` are the YAML value kinds (a number is finite
+  and never a boolean; YAML 1.1's unsigned exponents such as ``2.0e9``, which PyYAML reads as
+  strings, are numbers);
+* :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``) and
+  whether the parameter may change while the node runs;
+* :meth:`NodeSettings.from_section` (and ``from_values``, ``from_yaml``) validates a mapping and
+  raises :class:`~bearing_rig_sim.config.ConfigError` for the first problem in field order, in
+  the project's words (``load_controller.yaml: state_rate_hz: must be > 0.0, got 0``);
+* :meth:`NodeSettings.parameter_fields` lists what the ROS descriptors are made from.
+
+The defaults live only in the shipped files under ``config/``: every parameter is required.
+No ROS import.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, ClassVar, Self
+
+import annotated_types
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic_core import ErrorDetails
+
+from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+
+__all__ = ["Flag", "Integer", "NodeSettings", "Number", "ParameterField", "param"]
+
+
+def _number(value: object) -> float:
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())  # YAML 1.1 reads "2.0e9" as a string; YAML 1.2 as a float
+        except ValueError:
+            raise ValueError(f"must be a number, got {value!r}") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"must be finite, got {value!r}")
+    return float(value)
+
+
+def _integer(value: object) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"must be an integer, got {value!r}")
+    return value
+
+
+def _flag(value: object) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"must be true or false, got {value!r}")
+    return value
+
+
+Number = Annotated[float, BeforeValidator(_number)]
+"""A finite real number (an integer is taken as one; a boolean is not)."""
+
+Integer = Annotated[int, BeforeValidator(_integer)]
+"""An integer (a boolean is not)."""
+
+Flag = Annotated[bool, BeforeValidator(_flag)]
+"""A YAML boolean (``true`` or ``false``, nothing that merely converts to one)."""
+
+
+def param(
+    description: str,
+    *,
+    unit: str = "",
+    gt: float | None = None,
+    ge: float | None = None,
+    lt: float | None = None,
+    le: float | None = None,
+    live: bool = False,
+) -> Any:
+    """One parameter of a settings class: what it is, its SI unit (``"1"`` for a pure number,
+    ``""`` for text, files and flags), its allowed range, and whether it may be set while the
+    node runs (``live``; otherwise it is read at configure and read-only to ROS)."""
+    return Field(description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "live": live})
+
+
+@dataclass(frozen=True)
+class ParameterField:
+    """What a node declares to ROS about one parameter, as the settings class states it.
+
+    Attributes:
+        name: the parameter's name.
+        description: what it is.
+        unit: SI unit, ``"1"``, or ``""``.
+        low, high: the allowed range (None where unbounded or not a number).
+        low_exclusive, high_exclusive: the bound itself is refused.
+        integer: an integer parameter.
+        live: may be set while the node runs.
+    """
+
+    name: str
+    description: str
+    unit: str
+    low: float | None
+    high: float | None
+    low_exclusive: bool
+    high_exclusive: bool
+    integer: bool
+    live: bool
+
+
+_BOUND_WORDS = {
+    "greater_than": (">", "gt"),
+    "greater_than_equal": (">=", "ge"),
+    "less_than": ("<", "lt"),
+    "less_than_equal": ("<=", "le"),
+}
+
+
+def _problem(error: ErrorDetails) -> str:
+    """One validation error in the project's words."""
+    kind = error["type"]
+    ctx = error.get("ctx", {})
+    if kind == "missing":
+        return "missing (required)"
+    if kind in _BOUND_WORDS:
+        word, key = _BOUND_WORDS[kind]
+        return f"must be {word} {ctx[key]}, got {error['input']!r}"
+    if kind == "value_error":
+        return str(ctx["error"])
+    return str(error["msg"])
+
+
+class NodeSettings(BaseModel):
+    """Base of a node's settings: a frozen model whose fields are its parameters (see the module
+    documentation). Set ``NODE_NAME`` (the node's name, its block in a parameter file) and
+    ``SHIPPED_FILE`` (under ``config/``, the only place the defaults live); ``OTHER_KEYS`` are
+    keys a parameter file may hold that are not the node's own (rclpy's ``use_sim_time``), to be
+    checked by :meth:`check_other_keys`."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
+
+    NODE_NAME: ClassVar[str]
+    SHIPPED_FILE: ClassVar[str]
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ()
+
+    @classmethod
+    def check_other_keys(cls, s: Section) -> None:
+        """Check the values of :attr:`OTHER_KEYS` in ``s`` (none by default); raise ``s.error``."""
+
+    @classmethod
+    def from_section(cls, s: Section) -> Self:
+        """Validate the parameters in ``s``: every parameter required, no unknown key.
+
+        Raises:
+            ConfigError: the first problem, naming the source, the key and the allowed range.
+        """
+        s.reject_unknown([*cls.model_fields, *cls.OTHER_KEYS])
+        cls.check_other_keys(s)
+        values = {k: v for k, v in s.data.items() if k in cls.model_fields and v is not None}
+        try:
+            return cls.model_validate(values)
+        except ValidationError as exc:
+            first = exc.errors()[0]
+            raise s.error(".".join(str(part) for part in first["loc"]), _problem(first)) from None
+
+    @classmethod
+    def from_values(cls, values: Mapping[str, Any], source: str | None = None) -> Self:
+        """Validate a flat mapping of parameter values (the node's ROS parameters in force).
+
+        Raises:
+            ConfigError: naming the key and the allowed range.
+        """
+        return cls.from_section(Section(dict(values), source or f"{cls.NODE_NAME} parameters"))
+
+    @classmethod
+    def from_yaml(cls, path: str | Path | None = None) -> Self:
+        """Read ``<node>: ros__parameters:`` of a parameter file (default: the shipped one).
+
+        Raises:
+            ConfigError: naming the file and the key.
+        """
+        return cls.from_section(ros_parameters(load_yaml(path or config_path(cls.SHIPPED_FILE)), cls.NODE_NAME))
+
+    @classmethod
+    def shipped_parameters(cls) -> dict[str, Any]:
+        """The raw values of the shipped file (the node's declared defaults), checked valid.
+
+        Raises:
+            ConfigError: the shipped file is missing or malformed.
+        """
+        section = ros_parameters(load_yaml(config_path(cls.SHIPPED_FILE)), cls.NODE_NAME)
+        cls.from_section(section)  # the defaults themselves must be valid
+        return dict(section.data)
+
+    @classmethod
+    def parameter_fields(cls) -> list[ParameterField]:
+        """Every parameter as the node declares it to ROS, in field order."""
+        out = []
+        for name, info in cls.model_fields.items():
+            bounds: dict[str, float] = {}
+            for item in info.metadata:
+                for key in ("gt", "ge", "lt", "le"):
+                    if isinstance(item, getattr(annotated_types, key.capitalize())):
+                        bounds[key] = float(getattr(item, key))
+            extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+            low = bounds.get("gt", bounds.get("ge"))
+            high = bounds.get("lt", bounds.get("le"))
+            out.append(
+                ParameterField(
+                    name=name,
+                    description=info.description or "",
+                    unit=str(extra.get("unit", "")),
+                    low=low,
+                    high=high,
+                    low_exclusive="gt" in bounds,
+                    high_exclusive="lt" in bounds,
+                    integer=info.annotation is int,
+                    live=bool(extra.get("live", False)),
+                )
+            )
+        return out
+

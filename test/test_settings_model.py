@@ -1,0 +1,123 @@
+"""The declarative parameter model: one declaration per parameter gives the YAML checks, the
+one-line errors (file, key, range) and what the node declares to ROS."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import ClassVar
+
+import pytest
+
+from bearing_rig_sim.config import ConfigError, Section
+from bearing_rig_sim.load_control.settings import LoadControllerSettings
+from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
+
+
+class Toy(NodeSettings):
+    NODE_NAME: ClassVar[str] = "toy"
+    SHIPPED_FILE: ClassVar[str] = "toy.yaml"
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
+
+    rate_hz: Number = param("how often", unit="Hz", gt=0.0, le=1000.0)
+    count: Integer = param("how many", unit="1", ge=1, le=10)
+    gain: Number = param("how much", unit="1", ge=-1.0, lt=1.0, live=True)
+    enabled: Flag = param("whether")
+
+
+GOOD = {"rate_hz": 100, "count": 3, "gain": 0.5, "enabled": True}
+
+
+def error_of(values: dict[str, object]) -> str:
+    with pytest.raises(ConfigError) as caught:
+        Toy.from_section(Section(values, "config/toy.yaml", "toy.ros__parameters"))
+    return str(caught.value)
+
+
+def test_valid_values_are_taken_in_si_and_frozen() -> None:
+    toy = Toy.from_values({**GOOD, "rate_hz": "2.0e2", "use_sim_time": True})
+    assert (toy.rate_hz, toy.count, toy.gain, toy.enabled) == (200.0, 3, 0.5, True)
+    assert isinstance(toy.rate_hz, float)
+    with pytest.raises(Exception, match="frozen"):
+        toy.rate_hz = 1.0  # type: ignore[misc]  # the model is frozen: assignment is what is tested
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"rate_hz": 0}, "config/toy.yaml: toy.ros__parameters.rate_hz: must be > 0.0, got 0.0"),
+        ({"rate_hz": 1000.5}, "toy.ros__parameters.rate_hz: must be <= 1000.0, got 1000.5"),
+        ({"rate_hz": "fast"}, "rate_hz: must be a number, got 'fast'"),
+        ({"rate_hz": True}, "rate_hz: must be a number, got True"),
+        ({"rate_hz": float("inf")}, "rate_hz: must be finite, got inf"),
+        ({"count": 2.5}, "count: must be an integer, got 2.5"),
+        ({"count": 0}, "count: must be >= 1, got 0"),
+        ({"gain": 1.0}, "gain: must be < 1.0, got 1.0"),
+        ({"enabled": "yes"}, "enabled: must be true or false, got 'yes'"),
+        ({"enabled": None}, "enabled: missing (required)"),
+        ({"speed": 3}, "toy.ros__parameters.speed: unknown key; allowed keys: count, enabled, gain, rate_hz, use_sim_time"),
+    ],
+)
+def test_errors_are_one_line_naming_file_key_and_range(change: dict[str, object], message: str) -> None:
+    text = error_of({**GOOD, **change})
+    assert message in text and "\n" not in text
+
+
+def test_a_missing_key_is_named_and_the_first_problem_in_field_order_wins() -> None:
+    values = dict(GOOD)
+    del values["gain"]
+    assert error_of(values).endswith("gain: missing (required)")
+    assert error_of({**GOOD, "rate_hz": -1, "count": 99}).endswith("rate_hz: must be > 0.0, got -1.0")
+
+
+def test_parameter_fields_state_the_declared_ranges() -> None:
+    fields = {f.name: f for f in Toy.parameter_fields()}
+    assert [f.name for f in Toy.parameter_fields()] == ["rate_hz", "count", "gain", "enabled"]
+    rate = fields["rate_hz"]
+    assert (rate.description, rate.unit, rate.low, rate.high, rate.low_exclusive, rate.high_exclusive) == ("how often", "Hz", 0.0, 1000.0, True, False)
+    assert fields["count"].integer and not fields["rate_hz"].integer
+    assert (fields["gain"].low, fields["gain"].high, fields["gain"].high_exclusive, fields["gain"].live) == (-1.0, 1.0, True, True)
+    assert (fields["enabled"].low, fields["enabled"].high, fields["enabled"].live) == (None, None, False)
+
+
+@pytest.mark.parametrize("field", [f for f in LoadControllerSettings.parameter_fields() if f.low is not None and f.high is not None], ids=lambda f: f.name)
+def test_load_controller_file_checks_are_its_declared_ranges(field: object) -> None:
+    """The range the node declares to ROS is the one its YAML is checked against: each end is
+    accepted (or refused when exclusive) and a value beyond the top is refused, naming both."""
+    from bearing_rig_sim.settings_model import ParameterField
+
+    assert isinstance(field, ParameterField) and field.low is not None and field.high is not None
+    shipped = LoadControllerSettings.shipped_parameters()
+    LoadControllerSettings.from_values({**shipped, field.name: field.high})
+    beyond = field.high * 1.5 + 1.0
+    with pytest.raises(ConfigError, match=rf"{field.name}: must be <= {field.high}, got {beyond}"):
+        LoadControllerSettings.from_values({**shipped, field.name: beyond})
+    if field.low_exclusive:
+        with pytest.raises(ConfigError, match=rf"{field.name}: must be > {field.low}"):
+            LoadControllerSettings.from_values({**shipped, field.name: field.low})
+    else:
+        LoadControllerSettings.from_values({**shipped, field.name: field.low})
+
+
+def test_load_controller_reads_the_shipped_file_and_refuses_sim_time_off(tmp_path: Path) -> None:
+    settings = LoadControllerSettings.from_yaml()
+    assert settings.rig_file.name == "rig.yaml" and settings.rig_file.is_file()
+    bad = tmp_path / "lc.yaml"
+    bad.write_text("load_controller:\n  ros__parameters:\n    use_sim_time: false\n")
+    with pytest.raises(ConfigError, match=r"lc.yaml: load_controller.ros__parameters.use_sim_time: .*must be true"):
+        LoadControllerSettings.from_yaml(bad)
+
+
+def test_shadow_settings_bounds_that_depend_on_another_value() -> None:
+    """error_after_s is checked against warn_after_s, and a negative calibration RMS is read from
+    the calibration file (0.1083 pp in the shipped h7006c_table3.yaml, calibration.rms_slip_pct)."""
+    from bearing_rig_sim.shadow.settings import ShadowSettings
+
+    shipped = ShadowSettings.shipped_parameters()
+    with pytest.raises(ConfigError, match=r"error_after_s: must be > 2.0 \(warn_after_s\), got 1.5"):
+        ShadowSettings.from_values({**shipped, "warn_after_s": 2.0, "error_after_s": 1.5})
+    settings = ShadowSettings.from_values({**shipped, "calibration_file": "calibration/h7006c_table3.yaml", "calibration_rms_slip_pct": -1.0})
+    assert settings.calibration_rms_slip_pct == pytest.approx(0.1083)
+    with pytest.raises(ConfigError, match="calibration_rms_slip_pct: negative means .* no calibration file is given"):
+        ShadowSettings.from_values({**shipped, "calibration_file": "", "calibration_rms_slip_pct": -1.0})
+    with pytest.raises(ConfigError, match="model: must be one of reduced, stiff, got 'fast'"):
+        ShadowSettings.from_values({**shipped, "model": "fast"})

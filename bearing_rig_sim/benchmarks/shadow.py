@@ -164,7 +164,7 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
     expected = shadow_bag(bag, None).counts["windows"]
     env, lease = session_environment(os.environ)
     apply_rig_profile(env, work)
-    shadow = NodeProcess("shadow", node_command(NodeSpec("shadow", "bearing-rig-shadow")), work / "shadow.log")
+    shadow = NodeProcess("shadow", [*node_command(NodeSpec("shadow", "bearing-rig-shadow")), "--autostart"], work / "shadow.log")
     replay = NodeProcess("replay", [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"], work / "replay.log")
     context = rclpy.Context()
     pulses: list[tuple[int, bytes]] = []

@@ -13,11 +13,11 @@ import re
 import sys
 from pathlib import Path
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from rclpy._rclpy_pybind11 import RCLError
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -164,14 +164,25 @@ def node_executor(kind: str | None = None) -> Executor:
     return EventsExecutor()
 
 
-def spin_until_shutdown(executor: Executor) -> None:
+def spin_until_shutdown(executor: Executor, logger: Any = None) -> None:
     """Spin ``executor`` until the context shuts down (Ctrl-C, SIGTERM, ``rclpy.shutdown``).
 
     One ``spin_once`` at a time: the events executor's own ``spin()`` in rclpy 7.1.6 neither runs
-    timers nor returns on a signal, its ``spin_once`` does both.
+    timers nor returns on a signal, its ``spin_once`` does both. An exception raised by a
+    callback (service, subscription, timer) never ends the node: it is logged on ``logger`` (at
+    most once a second) and the spin goes on.
     """
     while rclpy.ok():
-        executor.spin_once(timeout_sec=SPIN_SLICE_S)
+        try:
+            executor.spin_once(timeout_sec=SPIN_SLICE_S)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            raise
+        except Exception as exc:
+            if not rclpy.ok():
+                break
+            if logger is not None:
+                text = " ".join(str(exc).split()) or type(exc).__name__
+                logger.error(f"a callback failed, the node carries on: {type(exc).__name__}: {text}", throttle_duration_sec=1.0)
 
 
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
@@ -192,7 +203,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
     use_rig_profile()  # the rig's Fast DDS profile unless the user gave one (writer heartbeat)
     try:
         rclpy.init(args=ros_args_with_defaults(node_name, args))
-    except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
+    except RuntimeError as exc:  # rcl refused a malformed --params-file or -p: a user's error, said in one line
         raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
     try:
@@ -211,7 +222,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
                 print(f"{node_name}: error: {failed}", file=sys.stderr)
                 return 2
         executor.add_node(node)
-        spin_until_shutdown(executor)
+        spin_until_shutdown(executor, node.get_logger())
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:

@@ -66,7 +66,6 @@ from rclpy.clock import ClockType, ROSClock
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.time import Time as RosTime
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
@@ -78,6 +77,7 @@ from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
 from bearing_rig_sim.nodes.common import (
+    drain,
     qos_profile,
     ERROR,
     OK,
@@ -95,7 +95,7 @@ from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
 SETPOINT_PARAMETER = "axial_load_setpoint_n"
 DIAGNOSTIC_NAME = "load_controller: axial load"
-CLOCK_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
+CLOCK_QOS = qos_profile("clock_reader")
 """The /clock reader's QoS: every tick of a step period kept (100 ms of a 1 kHz clock), so that
 the clock guard sees the stamps in a row it needs to confirm a restarted clock."""
 
@@ -195,27 +195,23 @@ class LoadControllerNode(ManagedNode):
         """The latest /clock stamp queued since the last call that the clock guard accepts
         (None when none came): negative and far-jumping stamps are refused and logged."""
         latest = None
-        handle = self._clock_sub.handle
         guard = self.clock_guard
-        with handle:
-            # Taken serialized and read in place (a hundred a wake-up): no message objects.
-            while (taken := handle.take_message(Clock, True)) is not None:
-                sec, nanosec = clock_stamp(taken[0])
-                verdict = guard.check(sec * 1_000_000_000 + nanosec)
-                if verdict.note:
-                    self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
-                if verdict.accepted:
-                    latest = (sec, nanosec)
+        # Taken serialized and read in place (a hundred a wake-up): no message objects.
+        for raw, _info in drain(self._clock_sub, Clock):
+            sec, nanosec = clock_stamp(raw)
+            verdict = guard.check(sec * 1_000_000_000 + nanosec)
+            if verdict.note:
+                self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
+            if verdict.accepted:
+                latest = (sec, nanosec)
         return None if latest is None else Time(sec=latest[0], nanosec=latest[1])
 
     @survives_shutdown
     def _on_step(self) -> None:
         """Apply the set-points that came, step the chain to the latest /clock in force samples
         and publish them."""
-        handle = self._setpoint_sub.handle
-        with handle:
-            while (taken := handle.take_message(Float64, False)) is not None:
-                self._on_setpoint(taken[0])
+        for setpoint, _info in drain(self._setpoint_sub, Float64, serialized=False):
+            self._on_setpoint(setpoint)
         operation = self.operation
         stamp = self._latest_clock()
         if operation is None or stamp is None:

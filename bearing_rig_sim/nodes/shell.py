@@ -104,13 +104,14 @@ def parameter_values(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
 
 def survives_shutdown(method: F) -> F:
     """Decorate a node's callback method: an exception raised while the node's context is shut
-    down (publishing during Ctrl-C) is dropped; any other propagates."""
+    down (publishing during Ctrl-C, or the KeyboardInterrupt of that Ctrl-C, which rclpy's signal
+    handler raises after shutting the context down) is dropped; any other propagates."""
 
     @functools.wraps(method)
     def wrapper(self: Node, *args: Any, **kwargs: Any) -> Any:
         try:
             return method(self, *args, **kwargs)
-        except Exception:
+        except (Exception, KeyboardInterrupt):
             if self.context.ok():
                 raise
             return None

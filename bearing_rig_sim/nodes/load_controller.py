@@ -20,8 +20,9 @@ Interfaces (README, interface table):
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
 * service ``/rig/axial_load/clutch`` (std_srvs/srv/SetBool): engage (true) or release the clutch;
-* parameter ``axial_load_setpoint_n`` (N): validated by a parameter callback, refused with the
-  reason; it mirrors the set-point in force whichever way it was given;
+* parameter ``axial_load_setpoint_n`` (N): validated by the parameter validation callback (refused
+  with the reason) and applied by the post-set callback once set; it mirrors the set-point in
+  force whichever way it was given;
 * publishes, stamped with the simulation time of the clock tick:
   ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z = the force that reaches the
   bearing, N, reliable, ``force_rate_hz`` of sim time: the simulator's input),
@@ -123,6 +124,7 @@ class LoadControllerNode(ManagedNode):
         self._mirroring = False
         self.operation: AxialLoadOperation | None = None
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.add_post_set_parameters_callback(self._on_parameters_set)
         # The clock is read by the step timer from a queue of its own (see the module
         # documentation): rclpy's time source would wake the executor for every tick.
         if self.get_parameter("use_sim_time").value:
@@ -327,20 +329,29 @@ class LoadControllerNode(ManagedNode):
         return response
 
     def _on_set_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
-        """Validate ``axial_load_setpoint_n`` (any type reaches here: dynamic typing); refuse
-        with the chain's reason."""
+        """Validate ``axial_load_setpoint_n`` (any type reaches here: dynamic typing) without
+        applying it; refuse with the chain's reason. It is applied once set
+        (:meth:`_on_parameters_set`)."""
         for parameter in parameters:
             if parameter.name != SETPOINT_PARAMETER or self._mirroring:
                 continue
+            value = _as_number(parameter.value)
             if self.operation is None:  # not configured: validated at configure
-                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(_as_number(parameter.value))
+                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
                 continue
-            reply = self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
+            reply = self.operation.check_setpoint(value, SetpointSource.PARAMETER)
             if not reply.accepted:
+                self._apply(reply)
                 return SetParametersResult(successful=False, reason=reply.message)
         return SetParametersResult(successful=True)
+
+    def _on_parameters_set(self, parameters: list[Parameter]) -> None:
+        """Apply a set-point given as the parameter, once it is set (validated above)."""
+        for parameter in parameters:
+            if parameter.name == SETPOINT_PARAMETER and not self._mirroring and self.operation is not None:
+                self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the readers' node is never spun

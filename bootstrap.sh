@@ -152,15 +152,37 @@ step_package() {
         stamp_set package "$key"
     fi
     # An editable install leaves out setup.py's data_files. Register the package in the venv's
-    # ament index by hand, its share folder linking back to this checkout (so config/ edits
-    # need no reinstall): get_package_share_directory("bearing_rig_sim") then works as after
-    # colcon build.
+    # ament index by hand, its share folder linking back to this checkout (so config/ and launch/
+    # edits need no reinstall): get_package_share_directory("bearing_rig_sim") and `ros2 launch
+    # bearing_rig_sim rig.launch.py` then work as after colcon build.
     local index="$VENV/share/ament_index/resource_index/packages" share="$VENV/share/bearing_rig_sim"
     mkdir -p "$index" "$share"
     [[ -e "$index/bearing_rig_sim" ]] || : >"$index/bearing_rig_sim"
     ln -sfn "$ROOT/package.xml" "$share/package.xml"
     [[ -d "$share/config" && ! -L "$share/config" ]] && rm -rf "$share/config"
     ln -sfn "$ROOT/config" "$share/config"
+    # ros2 launch looks for the file with os.walk, which does not enter a linked folder: a real
+    # launch/ folder, its files linking back to this checkout.
+    [[ -L "$share/launch" ]] && rm -f "$share/launch"
+    mkdir -p "$share/launch"
+    find "$share/launch" -maxdepth 1 -type l ! -exec test -e {} \; -delete
+    local file
+    for file in "$ROOT"/launch/*.launch.py; do
+        ln -sfn "$file" "$share/launch/$(basename "$file")"
+    done
+    # The node executables where a colcon install has them (lib/bearing_rig_sim/<name>), so the
+    # stock `ros2 run bearing_rig_sim <name>` and `ros2 pkg executables` find them: links to the
+    # console scripts pip put in bin/ (the node entry points of setup.py, by their ROS names).
+    local lib="$VENV/lib/bearing_rig_sim" name
+    mkdir -p "$lib"
+    for name in $("$PY" -c 'from importlib.metadata import entry_points
+for ep in entry_points(group="console_scripts"):
+    if ep.value.startswith("bearing_rig_sim.nodes.") and "-" not in ep.name:
+        print(ep.name)'); do
+        [[ -x "$VENV/bin/$name" ]] || die "console script $VENV/bin/$name missing"
+        ln -sfn "../../bin/$name" "$lib/$name"
+    done
+    [[ -x "$lib/simulator" ]] || die "no node executables under $lib"
 }
 
 setup() {

@@ -27,20 +27,54 @@ from typing import Literal
 QosName = Literal["reliable", "reliable_stream", "sensor_data", "transient_local"]
 """The contract's four QoS profiles (see :data:`QOS_DESCRIPTIONS`)."""
 
-QOS_DESCRIPTIONS: dict[str, str] = {
-    "reliable": "reliable, volatile, depth 10",
-    "reliable_stream": "reliable stream (reliable, depth 5000)",
-    "sensor_data": "sensor data (best effort, depth 100)",
-    "transient_local": "reliable, transient local, depth 10",
+
+@dataclass(frozen=True)
+class QosEntry:
+    """One QoS profile of the rig (keep-last history).
+
+    Attributes:
+        reliability: ``"reliable"`` or ``"best_effort"``.
+        durability: ``"volatile"`` or ``"transient_local"`` (late joiners get the last messages).
+        depth: history depth, messages.
+        description: what it is, as the interface table says it.
+    """
+
+    reliability: Literal["reliable", "best_effort"]
+    durability: Literal["volatile", "transient_local"]
+    depth: int
+    description: str
+
+
+QOS_TABLE: dict[str, QosEntry] = {
+    # -- the contract's profiles: what the publishers offer ---------------------------------------
+    "reliable": QosEntry("reliable", "volatile", 10, "reliable, volatile, depth 10"),
+    "reliable_stream": QosEntry("reliable", "volatile", 5000, "reliable stream (reliable, depth 5000)"),
+    "sensor_data": QosEntry("best_effort", "volatile", 100, "sensor data (best effort, depth 100)"),
+    "transient_local": QosEntry("reliable", "transient_local", 10, "reliable, transient local, depth 10"),
+    # -- the rig's own readers: compatible with the profiles above, deeper ---------------------
+    "pulse_reader": QosEntry("best_effort", "volatile", 10000, "the monitor's and shadow's pulse readers (best effort, depth 10000)"),
+    "clock_reader": QosEntry("best_effort", "volatile", 100, "the load controller's /clock reader (best effort, depth 100)"),
+    "force_reader": QosEntry("best_effort", "volatile", 1000, "the simulator's axial-force reader (best effort, depth 1000)"),
 }
-"""What each profile is, as the interface table says it.
+"""Every QoS profile of the rig, by name: the one table (rclpy profiles are made from it by
+:func:`bearing_rig_sim.nodes.common.qos_profile`).
 
 ``reliable_stream`` is the twin's high-rate streams: published reliably with a deep history, so
 that a reader asking for reliability (the session's recorder) gets every sample even when its
 process is held up for seconds, while readers asking for best effort (the monitor, the live view,
 any sensor-data subscriber) are served as sensor data. The physical bench's counter may publish
 the same topics as plain sensor data; every reader of the rig reads them best effort or records
-whatever comes."""
+whatever comes.
+
+``pulse_reader``: a reader's history drops the oldest sample once ``depth`` are waiting; at 100 a
+monitor held up for a fraction of a second lost bursts of pulses; 10000 is some 20 s of pulses at
+9000 rpm. ``clock_reader``: every tick of the load controller's 10 ms step period (100 ms of a
+1 kHz clock), so the clock guard sees the stamps in a row it needs to confirm a restarted clock.
+``force_reader``: a second of the load controller's force messages, of which the simulator applies
+the latest."""
+
+QOS_DESCRIPTIONS: dict[str, str] = {name: QOS_TABLE[name].description for name in ("reliable", "reliable_stream", "sensor_data", "transient_local")}
+"""What each profile of the contract (:data:`QosName`) is, as the interface table says it."""
 
 
 @dataclass(frozen=True)

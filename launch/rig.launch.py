@@ -2,10 +2,14 @@
 
 Starts the simulator, the load controller and the monitor as managed (lifecycle) nodes and brings
 them up as ``bearing-rig run`` does: configure each in turn (simulator, load controller, monitor),
-then activate each in turn, every step on the previous one's transition event. Then, with a
-``program``, runs it from ``bearing-rig run PROGRAM --attach --no-record`` (the program runner,
-live progress and summary, on these nodes), and with ``record:=true`` records the rig's topics with
-``ros2 bag record`` (MCAP storage) into ``bag_dir``.
+then activate each in turn, every step on the previous one's transition event. Each step of the
+bring-up is taken once: a node cycled by hand afterwards (``ros2 lifecycle set /simulator
+deactivate``, then ``activate``) changes that node alone, and the program and recorder are not
+started again. Then, with a ``program``, runs it with ``python -m bearing_rig_sim.cli run PROGRAM
+--attach --no-record`` (the program runner, live progress and summary, on these nodes; the
+interpreter running the launch, so no ``bearing-rig`` on PATH is needed); when it ends the launch
+shuts down, with exit status 0 when the program passed and 1 otherwise. With ``record:=true`` it
+records the rig's topics with ``ros2 bag record`` (MCAP storage) into ``bag_dir``.
 
 Arguments:
   program:=FILE       test program (YAML); empty (default): the nodes only
@@ -22,10 +26,15 @@ own venv runs ``bearing-rig run`` instead (README).
 
 from __future__ import annotations
 
+import sys
+
 from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument, EmitEvent, ExecuteProcess, RegisterEventHandler
+from launch.actions import DeclareLaunchArgument, EmitEvent, ExecuteProcess, RegisterEventHandler, Shutdown
 from launch.conditions import IfCondition
+from launch.event_handlers import OnProcessExit
 from launch.events import matches_action
+from launch.events.process import ProcessExited
+from launch.launch_context import LaunchContext
 from launch.substitutions import LaunchConfiguration, PythonExpression
 from launch_ros.actions import LifecycleNode
 from launch_ros.event_handlers import OnStateTransition
@@ -46,8 +55,16 @@ def _change(node: LifecycleNode, transition: int) -> EmitEvent:
     return EmitEvent(event=ChangeState(lifecycle_node_matcher=matches_action(node), transition_id=transition))
 
 
-def _on(node: LifecycleNode, goal: str, action: EmitEvent) -> RegisterEventHandler:
-    return RegisterEventHandler(OnStateTransition(target_lifecycle_node=node, goal_state=goal, entities=[action]))
+def _on(node: LifecycleNode, goal: str, action: EmitEvent | ExecuteProcess) -> RegisterEventHandler:
+    """``action`` the first time ``node`` reaches ``goal`` (never again: see the module docstring)."""
+    return RegisterEventHandler(OnStateTransition(target_lifecycle_node=node, goal_state=goal, entities=[action], handle_once=True))
+
+
+def _program_ended(event: ProcessExited, _context: LaunchContext) -> list[Shutdown]:
+    """Shut the launch down when the program runner ends; a failed program fails the launch."""
+    if event.returncode != 0:
+        raise RuntimeError(f"the program ended with exit status {event.returncode}")
+    return [Shutdown(reason="the program ended")]
 
 
 def generate_launch_description() -> LaunchDescription:
@@ -72,7 +89,7 @@ def generate_launch_description() -> LaunchDescription:
     for previous, following in zip(nodes, nodes[1:]):
         steps.append(_on(previous, "active", _change(following, Transition.TRANSITION_ACTIVATE)))
     runner = ExecuteProcess(
-        cmd=["bearing-rig", "run", program, "--attach", "--no-record"],
+        cmd=[sys.executable, "-m", "bearing_rig_sim.cli", "run", program, "--attach", "--no-record"],
         output="screen",
         condition=IfCondition(PythonExpression(["'", program, "' != ''"])),
     )
@@ -91,5 +108,6 @@ def generate_launch_description() -> LaunchDescription:
             *steps,
             _on(nodes[-1], "active", recorder),
             _on(nodes[-1], "active", runner),
+            RegisterEventHandler(OnProcessExit(target_action=runner, on_exit=_program_ended)),
         ]
     )

@@ -246,3 +246,18 @@ def test_a_set_point_the_chain_cannot_reach_is_an_error_after_the_settle_bound(c
     drive(op, bound + 0.01, bound + 1.5, 0.0005)
     assert op.chain.state().bearing_force == pytest.approx(100.0, abs=5.0)
     assert op.health().level is HealthLevel.OK
+
+
+def test_a_checked_set_point_is_not_applied_and_a_refused_one_warns(config: LoadingChainConfig) -> None:
+    """The node's parameter validation asks check_setpoint first and applies only once the
+    parameter is set: checking must change nothing but the refusal's WARN."""
+    op = AxialLoadOperation.from_config(config)
+    assert op.request_setpoint(100.0, SetpointSource.SERVICE).accepted
+    assert op.check_setpoint(250.0, SetpointSource.PARAMETER).accepted
+    assert op.setpoint == 100.0  # checked, not applied
+    assert op.health().level == HealthLevel.OK
+    refused = op.check_setpoint(config.max_setpoint_n + 1.0, SetpointSource.PARAMETER)
+    assert not refused.accepted and "max_setpoint_n" in refused.message and "by parameter" in refused.message
+    assert op.setpoint == 100.0 and op.health().level == HealthLevel.WARN
+    assert op.request_setpoint(250.0, SetpointSource.PARAMETER).accepted  # the accepted one clears the WARN
+    assert op.setpoint == 250.0 and op.health().level == HealthLevel.OK

@@ -28,7 +28,10 @@ from bearing_rig_sim.monitoring import shipped_parameters as monitor_parameters 
 from bearing_rig_sim.nodes.load_controller import LoadControllerNode  # noqa: E402
 from bearing_rig_sim.nodes.monitor import MonitorNode  # noqa: E402
 from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS  # noqa: E402
+from bearing_rig_sim.nodes.shadow import ShadowNode  # noqa: E402
 from bearing_rig_sim.nodes.simulator import SimulatorNode  # noqa: E402
+from bearing_rig_sim.shadow import ShadowSettings  # noqa: E402
+from bearing_rig_sim.shadow import shipped_parameters as shadow_parameters  # noqa: E402
 from bearing_rig_sim.simulation.settings import SimulatorSettings  # noqa: E402
 from bearing_rig_sim.simulation.settings import shipped_parameters as simulator_parameters  # noqa: E402
 
@@ -38,6 +41,7 @@ NODES: dict[str, tuple[Any, Callable[[], dict[str, Any]], Any]] = {
     "simulator": (SimulatorNode, simulator_parameters, SimulatorSettings),
     "load_controller": (LoadControllerNode, load_controller_parameters, LoadControllerSettings),
     "monitor": (MonitorNode, monitor_parameters, MonitorSettings),
+    "shadow": (ShadowNode, shadow_parameters, ShadowSettings),
 }
 
 LIVE = {("load_controller", "axial_load_setpoint_n")}
@@ -96,6 +100,8 @@ def test_a_start_value_out_of_range_is_one_line_naming_the_parameter(ros_graph: 
 DEPENDENT = {
     ("simulator", "initial_speed_rad_s"): "at most the rig file's spindle speed limit",
     ("load_controller", "axial_load_setpoint_n"): "at most the rig file's max_setpoint_n (checked by the chain at configure)",
+    ("shadow", "warn_after_s"): "below error_after_s",
+    ("shadow", "error_after_s"): "above warn_after_s",
 }
 """Bounds that depend on another value: their settings check is relative to it."""
 

@@ -40,7 +40,7 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
 
     node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, qos)
     executor = ros_graph.executor([node])
-    shadow = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.shadow import main; sys.exit(main())")
+    shadow = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.shadow import main; sys.exit(main())", "--autostart")
     assert ros_graph.spin_until(lambda: bool(levels), timeout=60.0, executor=executor), "the shadow node did not come up"
     replay = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "replay", str(bench), "--wait-for-subscribers", "--delay", "20")
     ros_graph.spin_until(lambda: replay.poll() is not None, timeout=60.0, executor=executor)

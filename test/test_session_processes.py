@@ -220,3 +220,37 @@ def test_a_sound_parameter_file_passes(tmp_path: Path) -> None:
         encoding="utf-8",
     )
     check_parameter_file(path)
+
+
+DUMPED = """/load_controller:
+  ros__parameters:
+    axial_load_setpoint_n: 250.0
+    qos_overrides:
+      /parameter_events:
+        publisher:
+          depth: 1000
+          durability: volatile
+          history: keep_last
+          reliability: reliable
+    start_type_description_service: true
+    state_rate_hz: 50.0
+    use_sim_time: true
+"""
+"""What ``ros2 param dump /load_controller`` writes (ros2param's layout: the node's fully qualified
+name, nested ``qos_overrides`` of the parameter-events publisher, and the parameters every Jazzy
+node declares beside the node's own)."""
+
+
+def test_a_file_written_by_ros2_param_dump_passes_and_a_parameter_the_node_lacks_is_still_refused(tmp_path: Path) -> None:
+    from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.session.context import check_parameter_file
+
+    path = tmp_path / "dumped.yaml"
+    path.write_text(DUMPED, encoding="utf-8")
+    check_parameter_file(path)
+    path.write_text(DUMPED + "    kp: 3.0\n", encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"load_controller\.ros__parameters\.kp: load_controller has no such parameter"):
+        check_parameter_file(path)
+    path.write_text(DUMPED.replace("state_rate_hz: 50.0", "state_rate_hz: -1.0"), encoding="utf-8")
+    with pytest.raises(ConfigError, match=r"state_rate_hz"):  # the node's own are still checked
+        check_parameter_file(path)

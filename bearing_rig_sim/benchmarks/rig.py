@@ -122,13 +122,13 @@ class _Probe:
 
     def take(self) -> dict[str, list[tuple[int, bytes]]]:
         """Everything queued: (reception time ns, serialized message) per topic."""
+        from bearing_rig_sim.nodes.common import drain
+
         taken: dict[str, list[tuple[int, bytes]]] = {}
         for name, sub in self.subs.items():
             items = taken.setdefault(name, [])
-            with sub.handle:
-                while (got := sub.handle.take_message(self.types[name], True)) is not None:
-                    raw, info = got
-                    items.append((int(info.get("received_timestamp") or time.time_ns()), raw))
+            for raw, info in drain(sub, self.types[name]):
+                items.append((int(info.get("received_timestamp") or time.time_ns()), raw))
         return taken
 
     def missing(self, seen: dict[str, int]) -> dict[str, str]:

@@ -137,12 +137,9 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
 
 def _take(sub: Any, msgtype: type) -> list[tuple[int, bytes]]:
     """Everything queued on a raw subscription: (reception time ns, bytes)."""
-    out = []
-    with sub.handle:
-        while (got := sub.handle.take_message(msgtype, True)) is not None:
-            raw, info = got
-            out.append((int(info.get("received_timestamp") or time.time_ns()), raw))
-    return out
+    from bearing_rig_sim.nodes.common import drain
+
+    return [(int(info.get("received_timestamp") or time.time_ns()), raw) for raw, info in drain(sub, msgtype)]
 
 
 def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
@@ -164,7 +161,7 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
     expected = shadow_bag(bag, None).counts["windows"]
     env, lease = session_environment(os.environ)
     apply_rig_profile(env, work)
-    shadow = NodeProcess("shadow", node_command(NodeSpec("shadow", "bearing-rig-shadow")), work / "shadow.log")
+    shadow = NodeProcess("shadow", [*node_command(NodeSpec("shadow", "bearing-rig-shadow")), "--autostart"], work / "shadow.log")
     replay = NodeProcess("replay", [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"], work / "replay.log")
     context = rclpy.Context()
     pulses: list[tuple[int, bytes]] = []

@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
 
             view = FoxgloveLiveView(args.foxglove, msg_definition_text)
             sink = LiveReplaySink(sink, view, {name: info.msgtype for name, info in bag.topics.items() if name in topics or name == CLOCK.name})
-            print(f"Foxglove live view: {view.url} (layout to import: config/foxglove/rig.json)", flush=True)
+            print(f"Foxglove live view: {view.urls} (layout to import: config/foxglove/rig.json)", flush=True)
         try:
             if args.wait_for_subscribers:
                 alone = sink.wait_for_subscribers([t for t in topics if t != CLOCK.name], args.delay)

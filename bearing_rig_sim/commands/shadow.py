@@ -86,7 +86,7 @@ def run(args: argparse.Namespace) -> int:
 def _live(args: argparse.Namespace, settings: Any) -> int:
     from bearing_rig_sim.nodes.shadow import main
 
-    argv = ["shadow", *[a for a in args.ros_args if a != "--"]]
+    argv = ["shadow", "--autostart", *[a for a in args.ros_args if a != "--"]]
     extra = []
     if args.params is not None:
         extra += ["--params-file", str(args.params)]

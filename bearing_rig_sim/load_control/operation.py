@@ -224,6 +224,22 @@ class AxialLoadOperation:
             message += f"; interlock fault latched ({self.chain.fault_reason}): takes effect after reset_fault"
         return Reply(True, message)
 
+    def check_setpoint(self, force_n: object, source: SetpointSource | str) -> Reply:
+        """Whether :meth:`request_setpoint` would accept ``force_n`` N, without applying it: for a
+        validation step ahead of the request (a ROS parameter's). A refusal counts as one (the
+        health turns WARN with the reason until the next accepted set-point).
+
+        Returns:
+            Accepted with an empty message, or refused with the reason.
+        """
+        origin = SetpointSource(source).value
+        try:
+            self.chain.check_setpoint(force_n)
+        except SetpointError as exc:
+            self._refusal = f"set-point by {origin} refused: {exc}"
+            return Reply(False, self._refusal)
+        return Reply(True, "")
+
     def _apply_zero_load_rule(self) -> None:
         """Brake de-energised (open loop, 0 V) at a 0 N set-point, closed loop otherwise."""
         self.chain.set_manual_voltage(0.0 if self.chain.setpoint == 0.0 else None)

@@ -13,11 +13,11 @@ import re
 import sys
 from pathlib import Path
 from collections.abc import Callable, Mapping, Sequence
+from typing import Any
 
 import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from rclpy._rclpy_pybind11 import RCLError
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -26,40 +26,36 @@ from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPo
 from bearing_rig_sim.dds_profile import use_rig_profile
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.interfaces import Topic
+from bearing_rig_sim.interfaces import QOS_DESCRIPTIONS, QOS_TABLE, QosEntry, Topic
 
-SENSOR_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST, depth=100, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
-)
+def qos_profile(which: Topic | str | QosEntry) -> QoSProfile:
+    """The rclpy QoS profile of a topic of the contract (its publisher's), of a profile named in
+    :data:`bearing_rig_sim.interfaces.QOS_TABLE`, or of an entry of that table."""
+    if isinstance(which, Topic):
+        which = which.qos
+    entry = QOS_TABLE[which] if isinstance(which, str) else which
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST,
+        depth=entry.depth,
+        reliability=ReliabilityPolicy.RELIABLE if entry.reliability == "reliable" else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if entry.durability == "transient_local" else DurabilityPolicy.VOLATILE,
+    )
+
+
+SENSOR_QOS = qos_profile("sensor_data")
 """Sensor streams (pulses, speeds, load cell, truth): best effort, keep last 100."""
 
-RELIABLE_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
-)
+RELIABLE_QOS = qos_profile("reliable")
 """Commands, set-points, /clock, /diagnostics, the force to the simulator: reliable, depth 10."""
 
-RELIABLE_STREAM_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST, depth=5000, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.VOLATILE
-)
+RELIABLE_STREAM_QOS = qos_profile("reliable_stream")
 """The contract's ``reliable_stream`` profile: the publishers of the simulator's streams
-(``/clock``, pulses, speeds, truth) and of the force on the bearing. Reliable, so that a reader that asks for it (the session's recorder) gets every
-sample: a sample lost in transport (a shared-memory port full while the reader's process was held
-up on a busy host) is sent again. Readers asking for best effort (the interface table's sensor
-data, the monitor) are served as before. A reliable writer drops a sample its reliable readers have
-not acknowledged once ``depth`` newer ones are written: at depth 10 a recorder held up for 10 ms
-lost stretches of ``/clock``; 5000 covers seconds of it."""
+(``/clock``, pulses, speeds, truth) and of the force on the bearing (see ``QOS_TABLE``)."""
 
-PULSE_READER_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST, depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT, durability=DurabilityPolicy.VOLATILE
-)
-"""The monitor's pulse subscriptions: sensor data, but deep. A reader's history drops the oldest
-sample once ``depth`` are waiting; at 100 a monitor held up for a fraction of a second (niced
-below the simulator on a busy host, or a fit at a window's end) lost bursts of pulses and reported
-a FAULT for pulses the bag held. 10000 is some 20 s of pulses at 9000 rpm."""
+PULSE_READER_QOS = qos_profile("pulse_reader")
+"""The monitor's and the shadow node's pulse subscriptions: sensor data, but deep."""
 
-STATUS_QOS = QoSProfile(
-    history=HistoryPolicy.KEEP_LAST, depth=10, reliability=ReliabilityPolicy.RELIABLE, durability=DurabilityPolicy.TRANSIENT_LOCAL
-)
+STATUS_QOS = qos_profile("transient_local")
 """Latched state (slip status, spindle command): reliable, transient local, depth 10."""
 
 OK, WARN, ERROR, STALE = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR, DiagnosticStatus.STALE
@@ -164,14 +160,25 @@ def node_executor(kind: str | None = None) -> Executor:
     return EventsExecutor()
 
 
-def spin_until_shutdown(executor: Executor) -> None:
+def spin_until_shutdown(executor: Executor, logger: Any = None) -> None:
     """Spin ``executor`` until the context shuts down (Ctrl-C, SIGTERM, ``rclpy.shutdown``).
 
     One ``spin_once`` at a time: the events executor's own ``spin()`` in rclpy 7.1.6 neither runs
-    timers nor returns on a signal, its ``spin_once`` does both.
+    timers nor returns on a signal, its ``spin_once`` does both. An exception raised by a
+    callback (service, subscription, timer) never ends the node: it is logged on ``logger`` (at
+    most once a second) and the spin goes on.
     """
     while rclpy.ok():
-        executor.spin_once(timeout_sec=SPIN_SLICE_S)
+        try:
+            executor.spin_once(timeout_sec=SPIN_SLICE_S)
+        except (KeyboardInterrupt, ExternalShutdownException):
+            raise
+        except Exception as exc:
+            if not rclpy.ok():
+                break
+            if logger is not None:
+                text = " ".join(str(exc).split()) or type(exc).__name__
+                logger.error(f"a callback failed, the node carries on: {type(exc).__name__}: {text}", throttle_duration_sec=1.0)
 
 
 def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
@@ -192,7 +199,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
     use_rig_profile()  # the rig's Fast DDS profile unless the user gave one (writer heartbeat)
     try:
         rclpy.init(args=ros_args_with_defaults(node_name, args))
-    except RCLError as exc:  # a malformed --params-file or -p: a user's error, said in one line
+    except RuntimeError as exc:  # rcl refused a malformed --params-file or -p: a user's error, said in one line
         raise RigError(f"ROS arguments refused: {_rcl_message(exc)}") from None
     node = None
     try:
@@ -211,7 +218,7 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
                 print(f"{node_name}: error: {failed}", file=sys.stderr)
                 return 2
         executor.add_node(node)
-        spin_until_shutdown(executor)
+        spin_until_shutdown(executor, node.get_logger())
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
@@ -239,15 +246,24 @@ def _autostart(node: Node) -> str:
     return ""
 
 
-CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {
-    "reliable": RELIABLE_QOS,
-    "reliable_stream": RELIABLE_STREAM_QOS,
-    "sensor_data": SENSOR_QOS,
-    "transient_local": STATUS_QOS,
-}
+def drain(subscription: Any, msgtype: type, serialized: bool = True) -> list[tuple[Any, dict[str, Any]]]:
+    """Take every message queued in ``subscription``'s reader, oldest first, without an executor:
+    ``(message, info)`` pairs, the message as CDR bytes when ``serialized`` (read in place, no
+    message object) else decoded; ``info`` has rmw's ``source_timestamp`` and
+    ``received_timestamp`` (ns).
+
+    The one place the rig takes from a reader by hand (rclpy has no public call for it in
+    Jazzy: the subscription's handle's ``take_message``), for readers whose queue a timer empties
+    at its own pace instead of one callback per message (the load controller's ``/clock``, the
+    simulator's force, the session's recorder).
+    """
+    taken_all: list[tuple[Any, dict[str, Any]]] = []
+    handle = subscription.handle
+    with handle:
+        while (taken := handle.take_message(msgtype, serialized)) is not None:
+            taken_all.append((taken[0], taken[1]))
+    return taken_all
+
+
+CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {name: qos_profile(name) for name in QOS_DESCRIPTIONS}
 """The rclpy profile of each QoS name of the interface contract (:mod:`bearing_rig_sim.interfaces`)."""
-
-
-def qos_profile(topic: Topic) -> QoSProfile:
-    """The rclpy QoS profile the contract gives ``topic``."""
-    return CONTRACT_QOS_PROFILES[topic.qos]

@@ -20,8 +20,9 @@ Interfaces (README, interface table):
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
 * service ``/rig/axial_load/clutch`` (std_srvs/srv/SetBool): engage (true) or release the clutch;
-* parameter ``axial_load_setpoint_n`` (N): validated by a parameter callback, refused with the
-  reason; it mirrors the set-point in force whichever way it was given;
+* parameter ``axial_load_setpoint_n`` (N): validated by the parameter validation callback (refused
+  with the reason) and applied by the post-set callback once set; it mirrors the set-point in
+  force whichever way it was given;
 * publishes, stamped with the simulation time of the clock tick:
   ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z = the force that reaches the
   bearing, N, reliable, ``force_rate_hz`` of sim time: the simulator's input),
@@ -66,7 +67,6 @@ from rclpy.clock import ClockType, ROSClock
 from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.time import Time as RosTime
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
@@ -78,6 +78,7 @@ from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
 from bearing_rig_sim.nodes.common import (
+    drain,
     qos_profile,
     ERROR,
     OK,
@@ -95,7 +96,7 @@ from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
 SETPOINT_PARAMETER = "axial_load_setpoint_n"
 DIAGNOSTIC_NAME = "load_controller: axial load"
-CLOCK_QOS = QoSProfile(depth=100, reliability=ReliabilityPolicy.BEST_EFFORT)
+CLOCK_QOS = qos_profile("clock_reader")
 """The /clock reader's QoS: every tick of a step period kept (100 ms of a 1 kHz clock), so that
 the clock guard sees the stamps in a row it needs to confirm a restarted clock."""
 
@@ -123,6 +124,7 @@ class LoadControllerNode(ManagedNode):
         self._mirroring = False
         self.operation: AxialLoadOperation | None = None
         self.add_on_set_parameters_callback(self._on_set_parameters)
+        self.add_post_set_parameters_callback(self._on_parameters_set)
         # The clock is read by the step timer from a queue of its own (see the module
         # documentation): rclpy's time source would wake the executor for every tick.
         if self.get_parameter("use_sim_time").value:
@@ -195,27 +197,23 @@ class LoadControllerNode(ManagedNode):
         """The latest /clock stamp queued since the last call that the clock guard accepts
         (None when none came): negative and far-jumping stamps are refused and logged."""
         latest = None
-        handle = self._clock_sub.handle
         guard = self.clock_guard
-        with handle:
-            # Taken serialized and read in place (a hundred a wake-up): no message objects.
-            while (taken := handle.take_message(Clock, True)) is not None:
-                sec, nanosec = clock_stamp(taken[0])
-                verdict = guard.check(sec * 1_000_000_000 + nanosec)
-                if verdict.note:
-                    self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
-                if verdict.accepted:
-                    latest = (sec, nanosec)
+        # Taken serialized and read in place (a hundred a wake-up): no message objects.
+        for raw, _info in drain(self._clock_sub, Clock):
+            sec, nanosec = clock_stamp(raw)
+            verdict = guard.check(sec * 1_000_000_000 + nanosec)
+            if verdict.note:
+                self.get_logger().warning(f"{verdict.note} ({guard.refused} refused so far)", throttle_duration_sec=1.0)
+            if verdict.accepted:
+                latest = (sec, nanosec)
         return None if latest is None else Time(sec=latest[0], nanosec=latest[1])
 
     @survives_shutdown
     def _on_step(self) -> None:
         """Apply the set-points that came, step the chain to the latest /clock in force samples
         and publish them."""
-        handle = self._setpoint_sub.handle
-        with handle:
-            while (taken := handle.take_message(Float64, False)) is not None:
-                self._on_setpoint(taken[0])
+        for setpoint, _info in drain(self._setpoint_sub, Float64, serialized=False):
+            self._on_setpoint(setpoint)
         operation = self.operation
         stamp = self._latest_clock()
         if operation is None or stamp is None:
@@ -331,20 +329,29 @@ class LoadControllerNode(ManagedNode):
         return response
 
     def _on_set_parameters(self, parameters: list[Parameter]) -> SetParametersResult:
-        """Validate ``axial_load_setpoint_n`` (any type reaches here: dynamic typing); refuse
-        with the chain's reason."""
+        """Validate ``axial_load_setpoint_n`` (any type reaches here: dynamic typing) without
+        applying it; refuse with the chain's reason. It is applied once set
+        (:meth:`_on_parameters_set`)."""
         for parameter in parameters:
             if parameter.name != SETPOINT_PARAMETER or self._mirroring:
                 continue
+            value = _as_number(parameter.value)
             if self.operation is None:  # not configured: validated at configure
-                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(_as_number(parameter.value))
+                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
                 continue
-            reply = self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
+            reply = self.operation.check_setpoint(value, SetpointSource.PARAMETER)
             if not reply.accepted:
+                self._apply(reply)
                 return SetParametersResult(successful=False, reason=reply.message)
         return SetParametersResult(successful=True)
+
+    def _on_parameters_set(self, parameters: list[Parameter]) -> None:
+        """Apply a set-point given as the parameter, once it is set (validated above)."""
+        for parameter in parameters:
+            if parameter.name == SETPOINT_PARAMETER and not self._mirroring and self.operation is not None:
+                self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the readers' node is never spun

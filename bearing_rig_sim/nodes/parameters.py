@@ -23,7 +23,20 @@ from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
 from bearing_rig_sim.load_control.settings import LoadControllerSettings
 from bearing_rig_sim.settings_model import NodeSettings
 
-__all__ = ["NODE_PARAMETERS", "ParameterSpec", "spec_for"]
+__all__ = ["NODE_PARAMETERS", "STANDARD_PARAMETERS", "STANDARD_PREFIXES", "ParameterSpec", "is_standard", "spec_for"]
+
+STANDARD_PARAMETERS = ("use_sim_time", "start_type_description_service")
+"""Parameters every ROS 2 Jazzy node declares by itself (rclpy and rclcpp alike): ``ros2 param
+dump`` writes them for every node."""
+
+STANDARD_PREFIXES = ("qos_overrides.",)
+"""Prefixes of the parameters a node declares by itself for the QoS of its publishers and
+subscriptions that allow overriding (``qos_overrides./parameter_events.publisher.depth``)."""
+
+
+def is_standard(name: str) -> bool:
+    """Whether ``name`` is one of the parameters every ROS 2 node has (not one of the rig's)."""
+    return name in STANDARD_PARAMETERS or name.startswith(STANDARD_PREFIXES)
 
 
 @dataclass(frozen=True)
@@ -149,10 +162,38 @@ MONITOR = [
     ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
 ]
 
+SHADOW = [
+    *_files(
+        ("bearing_file", "bearing data file (absolute, or relative to the package's config/)"),
+        ("calibration_file", "calibration laid over the bearing data ('' = none; relative to config/)"),
+        ("model", "engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)"),
+        ("recalibrate", "track a calibration parameter online (recursive least squares)"),
+        ("recalibrate_parameter", "the calibration file's parameter tracked ('section.key'; '' = its first one)"),
+    ),
+    ParameterSpec("chunk_s", "engine advance per call (whole engine steps of 40 us)", "s", 4e-5, 0.1),
+    ParameterSpec("window_revolutions", "whole cage revolutions per slip window (the monitor's)", "1", 1, 1000, integer=True),
+    ParameterSpec("min_inner_ring_speed_rad_s", "windows slower than this are not compared", "rad/s", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("calibration_rms_slip_pct", "calibration RMS of the slip (negative: the calibration file's rms_slip_pct)", "%", -1.0, 10.0),
+    ParameterSpec("timing_jitter_std_s", "pulse-timing jitter of the bench's fibre-optic sensors", "s", 0.0, 1e-3),
+    ParameterSpec("band_coverage", "band half-width in combined standard uncertainties", "1", 0.0, 10.0, low_exclusive=True),
+    ParameterSpec("warn_after_s", "a residual outside its band longer than this is a WARN (bench time)", "s", 0.0, 600.0, low_exclusive=True),
+    ParameterSpec("error_after_s", "a residual outside its band longer than this is an ERROR; > warn_after_s", "s", 0.0, 3600.0, low_exclusive=True),
+    ParameterSpec("settle_s", "windows starting sooner than this after an engine (re)start are not compared", "s", 0.0, 10.0),
+    ParameterSpec("max_speed_gap_s", "spindle speed points further apart restart the engine", "s", 0.0, 60.0, low_exclusive=True),
+    ParameterSpec("load_average_s", "averaging time of the load-cell force", "s", 0.0, 10.0, low_exclusive=True),
+    ParameterSpec("load_timeout_s", "no load-cell sample for this long is a dropout", "s", 0.0, 60.0, low_exclusive=True),
+    ParameterSpec("forgetting_factor", "forgetting factor of the recursive least squares, per compared steady window", "1", 0.5, 1.0, low_exclusive=True),
+    ParameterSpec("probe_step_fraction", "initial offset of the probe engine from the calibrated value", "1", 0.0, 0.5, low_exclusive=True),
+    ParameterSpec("steady_speed_fraction", "windows within this fraction of the previous one's spindle speed are steady", "1", 0.0, 0.5),
+    ParameterSpec("status_rate_hz", "checks of the twin per second (wall clock), plus each change of level", "Hz", 0.0, 1000.0, low_exclusive=True),
+    ParameterSpec("diagnostics_rate_hz", f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", "Hz", 0.0, 100.0, low_exclusive=True),
+]
+
 NODE_PARAMETERS: dict[str, dict[str, ParameterSpec]] = {
     "simulator": {p.name: p for p in SIMULATOR},
     "load_controller": {p.name: p for p in LOAD_CONTROLLER},
     "monitor": {p.name: p for p in MONITOR},
+    "shadow": {p.name: p for p in SHADOW},
 }
 """Every parameter of every node (besides rclpy's own ``use_sim_time``), by node name."""
 

@@ -15,6 +15,10 @@ Subscribes the bench's own topics: ``/rig/spindle/pulses`` and ``/rig/cage/pulse
 Time is the pulse stamps (the bench's clock); the node's timers run on the steady clock and give
 the twin the latest stamp extrapolated by the wall time since it arrived, so a silent source is
 noticed. Bad input never stops the node: it shows on ``/diagnostics``.
+
+Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`, like the simulator, the load
+controller and the monitor): unconfigured at start; the twin and its entities are made at
+configure and run while active. ``bearing-rig shadow`` (live) starts it with ``--autostart``.
 """
 
 from __future__ import annotations
@@ -28,14 +32,13 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
-from rclpy.node import Node
 
 from bearing_rig_msgs.msg import FibreOpticPulse, ShadowEstimate, ShadowResidual
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, DIAGNOSTICS, SPINDLE_PULSES, TWIN_ESTIMATE, TWIN_RESIDUAL
 from bearing_rig_sim.nodes.common import PULSE_READER_QOS, diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
-from bearing_rig_sim.nodes.shell import declare_and_read, release_executor, survives_shutdown
+from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.shadow import NODE_NAME, ResidualWindow, ShadowSettings, ShadowTwin, shipped_parameters
 
@@ -59,42 +62,51 @@ def residual_fields(row: ResidualWindow) -> dict[str, Any]:
     }
 
 
-class ShadowNode(Node):
-    """The shadow node (see the module docstring).
+class ShadowNode(ManagedNode):
+    """The shadow node (see the module docstring): a managed node like the rig's other three.
+
+    Its parameters are declared with their descriptors at start; the settings, the twin, the
+    publishers, subscriptions and timers are made at configure (a bad parameter or file fails the
+    transition with the reason), and the twin is fed and published only while active.
 
     Raises:
-        ConfigError: a parameter, the bearing or the calibration file is malformed.
+        RigError: a parameter given at start out of its range.
     """
 
     def __init__(self, **node_options: Any) -> None:
         super().__init__(NODE_NAME, **node_options)
-        values = declare_and_read(self, shipped_parameters())
-        self.settings = ShadowSettings.from_values(values, f"{NODE_NAME} parameters")
+        self._defaults = shipped_parameters()
+        declare_described(self, NODE_NAME, self._defaults)
+        self.twin: ShadowTwin | None = None
+
+    def configure(self) -> None:
+        """Validate the parameters; make the twin, its inputs, outputs and timers."""
+        self.settings = ShadowSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.twin = ShadowTwin(self.settings)
         self._last_stamp = -math.inf
         self._last_wall: float | None = None
         self._last_level: HealthLevel | None = None
         self._received = {"spindle": 0, "cage": 0, "force": 0}
         self._estimate_updates = 0
-        self._residual_pub = self.create_publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
-        self._estimate_pub = self.create_publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
-        self._diag_pub = self.create_publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
+        self._residual_pub = self.publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
+        self._estimate_pub = self.publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         sensor = PULSE_READER_QOS  # best effort: matches a bench counter publishing sensor data, and the twin's reliable streams
-        self.create_subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), sensor)
-        self.create_subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), sensor)
-        self.create_subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, qos_profile(AXIAL_LOAD_FORCE))
+        self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), sensor)
+        self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), sensor)
+        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.create_timer(1.0 / self.settings.status_rate_hz, self._on_check_timer, clock=steady)
-        self.create_timer(1.0 / self.settings.diagnostics_rate_hz, self._publish_diagnostics, clock=steady)
+        self.timer(1.0 / self.settings.status_rate_hz, self._on_check_timer, clock=steady)
+        self.timer(1.0 / self.settings.diagnostics_rate_hz, self._publish_diagnostics, clock=steady)
         cal = self.settings.calibration_file
         self.get_logger().info(
             f"shadowing the bench with {self.settings.bearing_file.name} and calibration {cal.name if cal else 'none'} "
             f"(band +-{self.settings.band_coverage:g} u, u >= {self.settings.calibration_rms_slip_pct:.4f} pp)"
         )
 
-    def close(self) -> None:
-        """Before ``destroy_node``: let the executor release the node's handles."""
-        release_executor(self)
+    def cleanup(self) -> None:
+        """Drop the twin."""
+        self.twin = None
 
     # -- inputs --------------------------------------------------------------------------------
     def _stamp_seen(self, t: float) -> None:
@@ -105,6 +117,7 @@ class ShadowNode(Node):
     @survives_shutdown
     def _on_pulse(self, shaft: str, msg: FibreOpticPulse) -> None:
         try:
+            assert self.twin is not None  # fed only while active
             pulse = Pulse(from_stamp(msg.header.stamp), int(msg.strip_id), int(msg.strip_count), int(msg.revolution), int(msg.pulse_index), msg.sensor_id)
             self._received[shaft] += 1
             self._stamp_seen(pulse.time)
@@ -116,6 +129,7 @@ class ShadowNode(Node):
 
     @survives_shutdown
     def _on_force(self, msg: WrenchStamped) -> None:
+        assert self.twin is not None  # fed only while active
         t = from_stamp(msg.header.stamp)
         self._received["force"] += 1
         self._stamp_seen(t)
@@ -129,6 +143,8 @@ class ShadowNode(Node):
 
     @survives_shutdown
     def _on_check_timer(self) -> None:
+        if self.twin is None:
+            return
         now = self._bench_now()
         if now is not None:
             self._publish_rows(self.twin.check(now))
@@ -137,6 +153,7 @@ class ShadowNode(Node):
 
     # -- outputs -------------------------------------------------------------------------------
     def _publish_rows(self, rows: list[ResidualWindow]) -> None:
+        assert self.twin is not None  # rows come from the twin
         for row in rows:
             msg = ShadowResidual(**residual_fields(row))
             msg.header.stamp = to_stamp(max(row.time, 0.0))
@@ -153,6 +170,8 @@ class ShadowNode(Node):
 
     @survives_shutdown
     def _publish_diagnostics(self) -> None:
+        if self.twin is None:
+            return
         health = self.twin.health(self._bench_now())
         self._last_level = health.level
         counts = self.twin.counts
@@ -174,7 +193,8 @@ class ShadowNode(Node):
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``shadow`` / ``bearing-rig-shadow``: spin the node until Ctrl-C.
+    """Entry point of ``shadow`` / ``bearing-rig-shadow``: spin the node until Ctrl-C. It starts
+    unconfigured (``lifecycle_msgs`` services); ``--autostart`` configures and activates it.
 
     ROS arguments (``--ros-args -p name:=value``, ``--params-file``) set the parameters of
     ``config/shadow.yaml``.

@@ -25,6 +25,12 @@
   being an integer where the file has ``2.0``).
 * :func:`survives_shutdown`: a callback that publishes can be running when Ctrl-C or SIGTERM
   shuts the context down; its "context is invalid" error is swallowed then (and only then).
+* :func:`refuse_unavailable_transitions`: the ``change_state`` service of a lifecycle node answers
+  every request. rclpy in Jazzy raises "Transition is not registered" out of the service callback
+  for a transition the current state does not offer (activate while unconfigured, an unknown id),
+  and the exception ends the node's process; rclpy fixed this later. The node's own
+  ``get_state`` and ``get_available_transitions`` services (reached through ``Node.services``)
+  say what is offered; a request for anything else is answered ``success: false`` and logged.
 * :func:`release_executor`: called from a node's ``close()``. When a callback raised out of
   ``spin``, the executor's wait-set iterator stays suspended holding every entity's handle, and
   ``Node.destroy_node`` then busy-waits for ever for those handles (rclpy in Jazzy). Shutting the
@@ -37,6 +43,8 @@ import functools
 from typing import Any, TypeVar
 from collections.abc import Callable, Mapping
 
+from lifecycle_msgs.msg import TransitionDescription
+from lifecycle_msgs.srv import ChangeState, GetAvailableTransitions, GetState
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterValueException
 from rclpy.lifecycle import LifecycleNode, LifecyclePublisher, LifecycleState, TransitionCallbackReturn
@@ -89,18 +97,6 @@ def declare_described(node: Node, node_name: str, defaults: Mapping[str, Any]) -
             raise RigError(f"{node_name}: parameter {name} refused: {spec.constraints()} ({' '.join(str(exc).split())})") from None
 
 
-def declare_and_read(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
-    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) with dynamic typing
-    and return the values in force: for a plain node whose parameters have no spec in
-    :mod:`bearing_rig_sim.nodes.parameters` yet (the shadow node)."""
-    values: dict[str, Any] = {}
-    for name, default in defaults.items():
-        if name in IMPLICIT:
-            continue
-        values[name] = node.declare_parameter(name, default, ParameterDescriptor(dynamic_typing=True)).value
-    return values
-
-
 def parameter_values(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
     """The values in force of the parameters named in ``defaults`` (and ``use_sim_time``)."""
     return {name: node.get_parameter(name).value for name in defaults if node.has_parameter(name)}
@@ -108,13 +104,14 @@ def parameter_values(node: Node, defaults: Mapping[str, Any]) -> dict[str, Any]:
 
 def survives_shutdown(method: F) -> F:
     """Decorate a node's callback method: an exception raised while the node's context is shut
-    down (publishing during Ctrl-C) is dropped; any other propagates."""
+    down (publishing during Ctrl-C, or the KeyboardInterrupt of that Ctrl-C, which rclpy's signal
+    handler raises after shutting the context down) is dropped; any other propagates."""
 
     @functools.wraps(method)
     def wrapper(self: Node, *args: Any, **kwargs: Any) -> Any:
         try:
             return method(self, *args, **kwargs)
-        except Exception:
+        except (Exception, KeyboardInterrupt):
             if self.context.ok():
                 raise
             return None
@@ -128,6 +125,53 @@ def release_executor(node: Node) -> None:
     executor = node.executor
     if executor is not None:
         executor.shutdown(timeout_sec=0.0)
+
+
+def _lifecycle_service(node: Node, name: str) -> Any:
+    """The node's lifecycle service ``<node>/<name>`` (made by rclpy's ``LifecycleNode``)."""
+    wanted = f"{node.get_fully_qualified_name()}/{name}"
+    for service in node.services:
+        if service.service_name == wanted:
+            return service
+    raise RigError(f"{wanted}: no such service on the node")
+
+
+def offered_transitions(node: Node) -> tuple[str, list[TransitionDescription]]:
+    """The lifecycle node's current state label and the transitions it offers from there."""
+    get_state = _lifecycle_service(node, "get_state")
+    available = _lifecycle_service(node, "get_available_transitions")
+    state = get_state.callback(GetState.Request(), GetState.Response()).current_state.label
+    offered = available.callback(GetAvailableTransitions.Request(), GetAvailableTransitions.Response()).available_transitions
+    return state, list(offered)
+
+
+def refuse_unavailable_transitions(node: Node) -> None:
+    """Answer every ``change_state`` request of lifecycle ``node`` (see the module docstring):
+    a transition its state does not offer, by id or by label, is refused with a logged reason;
+    an exception raised while a transition runs is logged and answered ``success: false``."""
+    change = _lifecycle_service(node, "change_state")
+    perform = change.callback
+    logger = node.get_logger()
+
+    def answer(request: ChangeState.Request, response: ChangeState.Response) -> ChangeState.Response:
+        wanted = request.transition
+        asked = f"{wanted.label!r}" if wanted.label else f"id {wanted.id}"
+        try:
+            state, offered = offered_transitions(node)
+            match = [t for t in offered if (t.transition.label == wanted.label if wanted.label else t.transition.id == wanted.id)]
+            if not match:
+                choices = ", ".join(f"{t.transition.label} ({t.transition.id})" for t in offered) or "none"
+                logger.warning(f"change_state refused: transition {asked} is not available in state {state} (available: {choices})")
+                response.success = False
+                return response
+            result: ChangeState.Response = perform(request, response)
+            return result
+        except Exception as exc:
+            logger.error(f"change_state {asked} failed: {one_line(exc)}")
+            response.success = False
+            return response
+
+    change.callback = answer
 
 
 def one_line(exc: BaseException) -> str:
@@ -145,6 +189,7 @@ class ManagedNode(LifecycleNode):
 
     def __init__(self, node_name: str, **node_options: Any) -> None:
         super().__init__(node_name, **node_options)
+        refuse_unavailable_transitions(self)
         self.active = False
         """True between activate and deactivate: inputs are taken, timers run."""
         self.configure_error = ""

@@ -50,7 +50,6 @@ from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
-from rclpy.qos import HistoryPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
@@ -60,6 +59,7 @@ from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, 
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
+    drain,
     qos_profile,
     RELIABLE_QOS,
     STATUS_QOS,
@@ -83,7 +83,7 @@ NO_REALTIME_FLAG = "--no-realtime"
 
 MAX_UINT32 = 2**32 - 1
 
-FORCE_QOS = QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT)
+FORCE_QOS = qos_profile("force_reader")
 """The force reader: best effort, deep enough for 1 s at 1 kHz. Each loop applies the latest force
 queued, so a sample lost in transport is superseded by the next one a millisecond later; a
 reliable reader here cost the load controller some 3 % of a core in acknowledgements. (The
@@ -345,13 +345,10 @@ class SimulatorNode(ManagedNode):
         The queue is taken serialized and only its last sample is decoded and applied: the ones
         before it would be replaced before the next chunk anyway.
         """
-        handle = self._force_sub.handle
-        latest = None
-        with handle:
-            while (taken := handle.take_message(WrenchStamped, True)) is not None:
-                latest = taken[0]
-        if latest is None:
+        queued = drain(self._force_sub, WrenchStamped)
+        if not queued:
             return
+        latest = queued[-1][0]
         try:
             self.twin.set_axial_load(deserialize_message(latest, WrenchStamped).wrench.force.z)
         except Exception as exc:

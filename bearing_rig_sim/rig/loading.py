@@ -209,6 +209,15 @@ class LoadingChain:
             SetpointError: not a finite number, negative, or above ``max_setpoint_n``; the
                 previous set-point is kept.
         """
+        self.check_setpoint(force_n)
+        self._setpoint = float(force_n)
+
+    def check_setpoint(self, force_n: object) -> None:
+        """Whether :meth:`set_setpoint` would take ``force_n`` N (nothing changes).
+
+        Raises:
+            SetpointError: not a finite number, negative, or above ``max_setpoint_n``.
+        """
         limit = self.config.max_setpoint_n
         keep = f"keeping {self._setpoint:g} N"
         if isinstance(force_n, bool) or not isinstance(force_n, (int, float)):
@@ -219,7 +228,6 @@ class LoadingChain:
             raise SetpointError(f"axial-load set-point must be >= 0 N, got {force_n:g} N; {keep}")
         if force_n > limit:
             raise SetpointError(f"axial-load set-point must be <= {limit:g} N (max_setpoint_n), got {force_n:g} N; {keep}")
-        self._setpoint = float(force_n)
 
     def set_manual_voltage(self, voltage: float | None) -> None:
         """Drive the brake open-loop at ``voltage`` (V), or return to closed loop with None.

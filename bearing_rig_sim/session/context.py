@@ -114,7 +114,9 @@ def check_parameter_file(path: Path) -> None:
     for one of them (by name, ``/ns/name``, or a wildcard ``/**``), every parameter is one the
     node declares (rclpy silently drops the others: a misspelt name would change nothing), and
     each node's values, laid over its shipped ones, pass its settings check (types, units,
-    ranges), as they will at configure.
+    ranges), as they will at configure. The parameters every ROS 2 node declares by itself
+    (``use_sim_time``, ``start_type_description_service``, ``qos_overrides.*``; what ``ros2 param
+    dump`` writes besides the node's own) are not the rig's to check: the node takes them.
 
     Raises:
         ConfigError: naming the file, the block and key, and what is wrong (with the names a
@@ -125,19 +127,19 @@ def check_parameter_file(path: Path) -> None:
     from bearing_rig_sim.config import ConfigError, read_yaml_file
     from bearing_rig_sim.load_control.settings import LoadControllerSettings
     from bearing_rig_sim.monitoring.settings import MonitorSettings, shipped_parameters as monitor_shipped
-    from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS
+    from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS, is_standard
     from bearing_rig_sim.simulation.settings import SimulatorSettings
 
     source = str(path)
     data = read_yaml_file(path)
     if not isinstance(data, dict):
         raise ConfigError(source, "", f"a ROS 2 parameter file maps node names to blocks; its top level is a {type(data).__name__}")
-    nodes = list(NODE_PARAMETERS)
+    nodes = list(NODE_PARAMETER_FILES)
     given: dict[str, dict[str, object]] = {name: {} for name in nodes}
     for key, block in data.items():
         last = str(key).rstrip("/").rsplit("/", 1)[-1]
         wildcard = last in ("*", "**")
-        if not wildcard and last not in NODE_PARAMETERS:
+        if not wildcard and last not in nodes:
             near = difflib.get_close_matches(last, nodes, n=1)
             raise ConfigError(
                 source, str(key), f"no node of a session has this name (its nodes: {', '.join(nodes)}"
@@ -148,6 +150,8 @@ def check_parameter_file(path: Path) -> None:
             raise ConfigError(source, str(key), "must be a mapping with a ros__parameters mapping")
         targets = nodes if wildcard else [last]
         for name, value in _flatten(params).items():
+            if is_standard(name):  # every ROS 2 node has it (``ros2 param dump`` writes it): the node takes it
+                continue
             known = [n for n in targets if name in NODE_PARAMETERS[n] or name == "use_sim_time"]
             if not known:
                 names = sorted({p for n in targets for p in NODE_PARAMETERS[n]})
@@ -165,7 +169,6 @@ def check_parameter_file(path: Path) -> None:
         "monitor": (monitor_shipped, MonitorSettings.from_values),
     }
     for node, values in given.items():
-        values.pop("use_sim_time", None)
         if values:
             defaults, validate = shipped[node]
             validate({**defaults(), **values}, f"{source}: {node}.ros__parameters")

@@ -21,15 +21,11 @@ from collections.abc import Mapping, Sequence
 
 __all__ = [
     "GOAL",
-    "TRANSITION_IDS",
     "Step",
     "TransitionRecord",
     "bring_up",
     "shut_down",
 ]
-
-TRANSITION_IDS = {"configure": 1, "cleanup": 2, "activate": 3, "deactivate": 4}
-"""``lifecycle_msgs/msg/Transition`` ids of the transitions the manager asks for."""
 
 GOAL = {"configure": "inactive", "cleanup": "unconfigured", "activate": "active", "deactivate": "inactive"}
 """The primary state each transition reaches when it succeeds."""

@@ -19,9 +19,17 @@ from rclpy.node import Node
 
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.nodes.common import OK, ERROR, RELIABLE_QOS, diagnostic_array, diagnostic_status, to_stamp
-from bearing_rig_sim.session.lifecycle import GOAL, TRANSITION_IDS, Step, TransitionRecord
+from bearing_rig_sim.session.lifecycle import GOAL, Step, TransitionRecord
 
 __all__ = ["DIAGNOSTIC_PREFIX", "LifecycleManager"]
+
+TRANSITION_IDS = {
+    "configure": Transition.TRANSITION_CONFIGURE,
+    "cleanup": Transition.TRANSITION_CLEANUP,
+    "activate": Transition.TRANSITION_ACTIVATE,
+    "deactivate": Transition.TRANSITION_DEACTIVATE,
+}
+"""The ``lifecycle_msgs/msg/Transition`` id of each transition the manager asks for."""
 
 DIAGNOSTIC_PREFIX = "lifecycle_manager: "
 """``/diagnostics`` status name of a node's lifecycle: the prefix and the node's name."""

@@ -13,6 +13,7 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
+import dataclasses
 import importlib
 from collections import Counter
 from collections.abc import Callable
@@ -22,13 +23,14 @@ from typing import Any
 from bearing_rig_msgs.msg import SpindleCommand
 from rclpy.context import Context
 from rclpy.node import Node
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.interfaces import (
+    QOS_TABLE,
     AXIAL_LOAD_FORCE,
     AXIAL_LOAD_SETPOINT,
     AXIAL_LOAD_STATE,
@@ -43,7 +45,7 @@ from bearing_rig_sim.interfaces import (
     TOPICS,
     TRUTH,
 )
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, to_stamp
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, drain, from_stamp, qos_profile, to_stamp
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 from bearing_rig_sim.simulation.health import stopped_reason
@@ -96,13 +98,8 @@ def reader_qos(topic: RecordedTopic) -> QoSProfile:
     """The recorder's subscription QoS: compatible with the publisher's offered profile, deep;
     reliable for every topic but plain sensor data, so that none of the samples of the
     contract's reliable streams is lost on a busy host."""
-    best_effort = topic.qos == "sensor_data"
-    return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST,
-        depth=RECORDER_DEPTH,
-        reliability=ReliabilityPolicy.BEST_EFFORT if best_effort else ReliabilityPolicy.RELIABLE,
-        durability=DurabilityPolicy.TRANSIENT_LOCAL if topic.qos == "transient_local" else DurabilityPolicy.VOLATILE,
-    )
+    offered = QOS_TABLE[topic.qos]
+    return qos_profile(dataclasses.replace(offered, depth=RECORDER_DEPTH, reliability="best_effort" if topic.qos == "sensor_data" else "reliable"))
 
 
 @dataclass
@@ -279,11 +276,8 @@ class SessionNode(Node):
         before the bag's writing (a chunk being compressed) can hold the session up."""
         batch: list[tuple[int, int, str, bytes, type]] = []
         for topic, msgtype, subscription in self._recorded:
-            handle = subscription.handle
-            with handle:
-                while (taken := handle.take_message(msgtype, True)) is not None:
-                    raw, info = taken
-                    batch.append((info.get("received_timestamp") or 0, len(batch), topic.name, raw, msgtype))
+            for raw, info in drain(subscription, msgtype):
+                batch.append((info.get("received_timestamp") or 0, len(batch), topic.name, raw, msgtype))
         if not batch:
             return 0
         batch.sort(key=lambda item: (item[0], item[1]))

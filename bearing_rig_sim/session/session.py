@@ -288,7 +288,7 @@ class _Session:
             f"bag {self.writer.path}"
         )
         if self.view is not None:
-            self._event(f"Foxglove live view: {self.view.url} (layout to import: config/foxglove/rig.json)")
+            self._event(f"Foxglove live view: {self.view.urls} (layout to import: config/foxglove/rig.json)")
         previous_handlers = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
         context = rclpy.Context()
         executor = None

@@ -202,8 +202,8 @@ class BearingDynamics:
             if self.model == "reduced":
                 limit = reduced_limit(self.vector, state)
                 mechanism = (
-                    f"traction saturation of the ball spin at {rpm:.0f} rpm, {load:g} N: "
-                    f"Q = {state.inner_load:.0f}/{state.outer_load:.0f} N"
+                    f"explicit centrifugal coupling of the contact loads at {rpm:.0f} rpm, {load:g} N: "
+                    f"ball orbit {state.orbit_speed:.0f} rad/s"
                 )
             else:
                 linear, mode = stiff_limit(self.vector, state)

@@ -32,7 +32,11 @@ approach is the centre distance minus (f - 1/2) Dw, the load Q = K delta^1.5 (He
 
   with the ball's orbit and rolling speeds from outer-raceway-control kinematics at its own
   contact angles (Harris and Kotzalas). These speeds are an input of the load distribution only;
-  the dynamic engine computes its cage and ball speeds from the tractions.
+  the dynamic engine computes its cage and ball speeds from the tractions. A ball outside the
+  load zone (the curvature centres closer than A, or no inner contact when resting on the outer
+  raceway under F_c) carries Q_o = F_c at a_o = 0 and no inner load (no gyroscopic moment:
+  nothing holds it by friction; pinched between centres closer than A its two loads would be of
+  the order of F_c, a few newtons at most at the rig's top speed).
 
 The inner ring's balance: F_a = sum Q_i sin a_i, F_x = sum Q_i cos a_i cos psi,
 F_y = sum Q_i cos a_i sin psi, and the two moments. With ``moment=None`` the tilts are held (at
@@ -174,11 +178,21 @@ class QuasiStaticBearing:
             a = math.atan2(a1, a2)
             x = np.array([self.go * math.sin(a), self.go * math.cos(a)])
             return q, q, a, a, 0.0, x
-        x = np.array([self.go * math.sin(math.atan2(a1, a2)), self.go * math.cos(math.atan2(a1, a2))]) if x0 is None else x0.copy()
+        d = math.hypot(a1, a2)
         ai = ao = math.atan2(a1, a2)
+        if x0 is None:  # the static position: on the centre line, the approach split by Hertz
+            q = self.kn * max(d - self.big_a, 0.0) ** 1.5
+            reach = self.go + (q / self.ko) ** (2.0 / 3.0)
+            x0 = np.array([reach * math.sin(ai), reach * math.cos(ai)])
+        x = x0.copy()
         for _ in range(3):  # speeds depend on the angles
             orbit, roll, beta = self._speeds(omega, ai, ao)
             fc = 0.5 * self.mass * self.dm * orbit * orbit
+            # Outside the load zone: the ball rests on the outer raceway under F_c alone (at
+            # a_o = 0; no inner contact to carry a gyroscopic moment by friction).
+            rest = self.go + (fc / self.ko) ** (2.0 / 3.0)
+            if d <= self.big_a or math.hypot(a1, a2 - rest) <= self.gi:
+                return 0.0, fc, math.atan2(a1, a2 - rest), 0.0, orbit, np.array([0.0, rest])
             mg = self.inertia * roll * orbit * math.sin(beta) if gyro else 0.0
 
             def residual(v: np.ndarray, fc: float = fc, mg: float = mg) -> np.ndarray:

@@ -35,9 +35,11 @@ class MonitorSettings:
         slope_span_s: trailing window of the slope against time, s.
         slope_max_span_s: longest stretch of a steady series the slope against time may rest on
             when the trailing window cannot decide, s (>= slope_span_s).
-        slope_span_n: trailing window of the slope against load, N.
-        load_step_n: with the load criterion, the windows are averaged in bins of this width of
-            measured load, one slip point per bin, N.
+        load_step_n: with the load criterion, windows whose measured loads stay within half of
+            this are one hold at one load, N (:mod:`~bearing_rig_sim.monitoring.load_sweep`).
+        sweep_settle_s: a hold's windows count for its load point from this long after its
+            first window, s.
+        sweep_average_s: and are averaged over this long, s.
         min_slope_points: points needed for a slope (>= 3).
         slip_resolution_pct: least scatter of the slip believed, percentage points.
         change_threshold: prediction standard errors for a change in the slip (1).
@@ -62,8 +64,9 @@ class MonitorSettings:
     critical_slope_pct_per_n: float
     slope_span_s: float
     slope_max_span_s: float
-    slope_span_n: float
     load_step_n: float
+    sweep_settle_s: float
+    sweep_average_s: float
     min_slope_points: int
     slip_resolution_pct: float
     change_threshold: float
@@ -104,8 +107,9 @@ class MonitorSettings:
             critical_slope_pct_per_n=s.number("critical_slope_pct_per_n"),
             slope_span_s=s.number("slope_span_s", gt=0.0),
             slope_max_span_s=s.number("slope_max_span_s", gt=0.0),
-            slope_span_n=s.number("slope_span_n", gt=0.0),
             load_step_n=s.number("load_step_n", gt=0.0),
+            sweep_settle_s=s.number("sweep_settle_s", ge=0.0),
+            sweep_average_s=s.number("sweep_average_s", gt=0.0),
             min_slope_points=s.integer("min_slope_points", ge=3),
             slip_resolution_pct=s.number("slip_resolution_pct", gt=0.0),
             change_threshold=s.number("change_threshold", gt=0.0),

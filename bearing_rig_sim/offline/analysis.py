@@ -52,6 +52,7 @@ from typing import Any, cast
 from collections.abc import Callable
 
 
+from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import make_decoder
@@ -75,6 +76,7 @@ from bearing_rig_sim.offline.series import (
     csv_columns,
 )
 from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = "bearing_rig_msgs/msg/FibreOpticPulse"
 PULSE_TOPICS: dict[str, str] = {"spindle": "/rig/spindle/pulses", "cage": "/rig/cage/pulses"}
@@ -198,6 +200,10 @@ class OfflineResult:
     transitions_dropped: int = 0
     segments: list[SegmentSummary] = field(default_factory=list)
     csv_files: list[Path] = field(default_factory=list)
+    sweeps: list[LoadSweepVerdict] = field(default_factory=list)
+    """The offline monitor's load-sweep verdict per spindle speed (``axial_load`` criterion)."""
+    recorded_sweeps: dict[int, str] = field(default_factory=dict)
+    """The recorded statuses' latest load-sweep verdict per speed (rpm rounded to 10 -> text)."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -419,6 +425,7 @@ class OfflineAnalysis:
             self._emit(final.time, final.reason, final.status)
             self.result.final_status = final.status
         self.result.segments = self._segments.finish()
+        self.result.sweeps = list(self.monitor.sweep.verdicts)
 
     # -- context topics ------------------------------------------------------------------------
     def _decoded(self, topic: str, log_time_ns: int, data: bytes) -> tuple[Any, float]:
@@ -447,6 +454,9 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
+        verdict, speed = getattr(message, "sweep_verdict", ""), float(getattr(message, "sweep_speed", _NAN))
+        if verdict and math.isfinite(speed):
+            result.recorded_sweeps[sweep_key(speed)] = verdict
         self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence), float(message.inner_ring_speed))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:

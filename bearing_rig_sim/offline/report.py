@@ -30,6 +30,7 @@ from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
 from bearing_rig_sim.offline.analysis import COMMAND, CONTEXT_TOPICS, PULSE_TOPICS, PULSE_TYPE, TRUTH, OfflineResult
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
+from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")
@@ -241,6 +242,28 @@ def _agreement(segments: Sequence[SegmentSummary]) -> str:
     )
 
 
+def _sweep_section(result: OfflineResult) -> list[str]:
+    """The load sweep by the paper's method, per speed (docs/method.md); [] when the run had none."""
+    if not result.sweeps and not result.recorded_sweeps:
+        return []
+    lines = [
+        "## Load sweep (paper section 4.1)",
+        "",
+        "Per spindle speed: the settled slip of each load point, a Gaussian sum fitted to slip against load "
+        "(1 and 2 terms, the better kept), and the load from which the fitted slope is at or above k1 "
+        "(docs/method.md).",
+        "",
+        "| speed (rpm) | load points (N) | slip (%) | verdict offline | verdict recorded |",
+        "|---|---|---|---|---|",
+    ]
+    for verdict in result.sweeps:
+        key = sweep_key(verdict.inner_ring_speed)
+        loads = ", ".join(f"{x:.0f}" for x in verdict.loads)
+        slips = ", ".join(f"{y:.3f}" for y in verdict.slips)
+        lines.append(f"| {key} | {loads} | {slips} | {verdict.describe()} | {result.recorded_sweeps.get(key, '-')} |")
+    return [*lines, ""]
+
+
 def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Sequence[Path]) -> str:
     """The report's markdown text (see the module documentation)."""
     meta = result.run_metadata
@@ -305,6 +328,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         ]
     else:
         lines += ["No segment: no spindle command, and no constant-speed stretch long enough.", ""]
+    lines += _sweep_section(result)
     lines += ["## Plots", ""]
     lines += [f"![{p.stem}]({p.name})" for p in plots]
     lines += ["", "## Topics", "", "| topic | type | messages | used for |", "|---|---|---|---|"]

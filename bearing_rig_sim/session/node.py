@@ -13,6 +13,8 @@ order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the 
 
 from __future__ import annotations
 
+import math
+
 import importlib
 from collections import Counter
 from collections.abc import Callable
@@ -340,6 +342,8 @@ class SessionNode(Node):
                     cage_speed=msg.cage_speed,
                     window_revolutions=msg.window_revolutions,
                     confidence=msg.confidence,
+                    sweep_speed=getattr(msg, "sweep_speed", math.nan),
+                    sweep_verdict=getattr(msg, "sweep_verdict", ""),
                 )
             )
         elif name == TRUTH.name:

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bearing_rig_sim.analysis.slip import ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring import MonitorSettings, PulseMerger, SlipMonitor, StatusSchedule, shipped_parameters
 from bearing_rig_sim.offline.analysis import analyse_bag
@@ -398,3 +399,48 @@ def test_a_backlog_of_the_two_topics_is_put_back_in_time_order() -> None:
     latest = np.maximum.accumulate(np.array(order))
     spindle_interval = 2.0 * math.pi / (4 * w)
     assert np.max(latest - np.array(order)) <= 2.0 * spindle_interval * 1.01
+
+
+def test_kinematic_slip_removes_the_contact_angle_and_either_slip_can_be_judged() -> None:
+    """A sweep at 900 rpm whose cage runs at the kinematic slip S_k(F) = 5.18 exp(-((F + 4.14)/214)^2) %
+    (Table 5's first term) against the pure-rolling speed at the loaded contact angle a(F). The
+    paper's nominal-angle slip is then 100 (1 - r(a(F)) / r(a0) (1 - S_k/100)), which keeps falling
+    as the load raises the angle (by hand: r = (1 - Dw cos a / dm)/2, a from 18.65 to 18.95 deg
+    between 600 and 700 N, a fall of about 2.9e-4 %/N) and goes negative at high load. With k1 =
+    -1e-4 %/N: judging the nominal slip, no stable state (its slope at 700 N is below k1);
+    judging the kinematic slip, stable from the first load point after the true onset of S_k's
+    slope >= k1 (between 500 and 600 N, from the formula). Both slips are on every status."""
+    base = {**shipped_parameters(), "criterion": "axial_load", "critical_slope_pct_per_n": -1e-4}
+    thrust = ThrustContact.from_config(SETTINGS.bearing_file)
+    kin = SETTINGS.kinematics()
+
+    def load(t: np.ndarray) -> np.ndarray:
+        return np.asarray(SWEEP_LOADS)[np.minimum(np.floor(np.asarray(t) / 3.0).astype(int), 7)]
+
+    def kinematic(f: np.ndarray) -> np.ndarray:
+        return 5.18 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+
+    def ratio(f: float) -> float:
+        return kin.at_contact_angle(thrust.loaded_contact_angle(f)).epicyclic_ratio()
+
+    ratios = np.array([ratio(x) for x in SWEEP_LOADS])
+
+    def nominal(t: np.ndarray) -> np.ndarray:
+        f = load(t)
+        r = ratios[np.searchsorted(SWEEP_LOADS, f)]
+        return 100.0 * (1.0 - r / RATIO * (1.0 - kinematic(f) / 100.0))
+
+    scenario = BenchScenario(24.0, constant(W900), nominal, epicyclic_ratio=RATIO, load_n=load)
+    assert nominal(np.array([22.0]))[0] < -0.2  # 700 N: the nominal slip is negative
+    f = np.linspace(50.0, 700.0, 650_001)
+    slope = -2.0 * 5.18 * (f + 4.14) / 214.0**2 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+    onset = float(f[np.flatnonzero(slope < -1e-4)[-1] + 1])
+    assert 500.0 < onset < 600.0
+    by_nominal = sweep_statuses(MonitorSettings.from_values({**base, "slip_reference": "nominal"}), scenario)[-1][1]
+    by_loaded = sweep_statuses(MonitorSettings.from_values({**base, "slip_reference": "loaded"}), scenario)[-1][1]
+    assert math.isnan(by_nominal.sweep_stable_from) and "below k1" in by_nominal.sweep_verdict
+    assert by_loaded.sweep_stable_from == 600.0, by_loaded.sweep_verdict
+    for status in (by_nominal, by_loaded):
+        assert status.kinematic_slip_rate == pytest.approx(float(kinematic(np.array([700.0]))[0]), abs=0.005)
+        assert status.slip_rate == pytest.approx(float(nominal(np.array([23.0]))[0]), abs=0.005)
+        assert math.degrees(status.loaded_contact_angle) == pytest.approx(18.95, abs=0.01)

@@ -32,7 +32,7 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
-from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.analysis.streaming import TrailingSlope
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
@@ -117,12 +117,16 @@ class MonitorStatus:
 
 @dataclass(frozen=True)
 class MonitorWindow:
-    """A completed window and its slip (NaN below the minimum speed) and mean load (NaN if no
-    load-cell sample fell in it), N."""
+    """A completed window and its slip (the paper's, at the nominal angle; NaN below the minimum
+    speed), mean load (NaN if no load-cell sample fell in it, N), the contact angle of that load
+    (rad) and the kinematic slip against the pure-rolling speed at that angle (%; NaN without a
+    load)."""
 
     window: SlipWindow
     slip_rate: float
     axial_load: float
+    loaded_contact_angle: float = math.nan
+    kinematic_slip_rate: float = math.nan
 
     @property
     def start_time(self) -> float:
@@ -154,6 +158,9 @@ class SlipMonitor:
         self.settings = settings
         self.criterion = settings.criterion
         self._ratio = kinematics.epicyclic_ratio()
+        self.thrust = ThrustContact.from_config(settings.bearing_file)
+        """The loaded contact angle from the measured load (Harris's thrust equilibrium)."""
+        self.loaded = settings.slip_reference == "loaded"
         self.slope = TrailingSlope(
             critical_slope=settings.critical_slope_pct_per_s,
             span=settings.slope_span_s,
@@ -274,11 +281,19 @@ class SlipMonitor:
         self._steady = steady
         self._previous_inner = inner
         slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
-        self._latest = MonitorWindow(window, slip, load)
+        angle = self.thrust.loaded_contact_angle(load)
+        kinematic = math.nan
+        if math.isfinite(angle):
+            ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio()
+            kinematic = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
+        self._latest = MonitorWindow(window, slip, load, angle, kinematic)
+        judged = kinematic if self.loaded else slip
+        if not math.isfinite(judged):  # the loaded slip without a load-cell sample: no point
+            return
         if self.criterion == "time":
-            self._add_point(t1, t1, slip)
+            self._add_point(t1, t1, judged)
         else:
-            verdict = self.sweep.add_window(window.start_time, t1, load, slip, inner)
+            verdict = self.sweep.add_window(window.start_time, t1, load, judged, inner)
             if verdict is not None:
                 self._notes.append((t1, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
@@ -367,6 +382,8 @@ class SlipMonitor:
             duplicates=(books["spindle"].duplicates, books["cage"].duplicates),
             window_start=latest.start_time if latest is not None else None,
             axial_load=latest.axial_load if latest is not None else math.nan,
+            kinematic_slip_rate=latest.kinematic_slip_rate if latest is not None else math.nan,
+            loaded_contact_angle=latest.loaded_contact_angle if latest is not None else math.nan,
             sweep_speed=sweep.inner_ring_speed if sweep is not None else math.nan,
             sweep_stable_from=sweep.stable_from if sweep is not None and sweep.stable_from is not None else math.nan,
             sweep_verdict=sweep.describe() if sweep is not None else "",

@@ -16,6 +16,10 @@ NODE_NAME = "monitor"
 SHIPPED_FILE = "monitor.yaml"
 """The shipped parameter file, under ``config/``."""
 
+SLIP_REFERENCES = ("nominal", "loaded")
+"""Which slip the criterion judges: the paper's, against the pure-rolling cage speed at the
+nominal contact angle, or the kinematic one at the contact angle of the measured axial load."""
+
 CRITERIA = ("time", "axial_load")
 """Abscissae of the slope criterion: slip against time (k2) or against the measured axial load
 (k1), as a test program's ``stability_criterion`` says."""
@@ -30,6 +34,9 @@ class MonitorSettings:
         contact_angle_deg: contact angle of the slip formula, degrees; negative: nominal.
         window_revolutions: whole cage revolutions per slip window (>= 1).
         criterion: "time" or "axial_load".
+        slip_reference: "nominal" (the paper's slip, Eq. 11-12 at ``contact_angle_deg``) or
+            "loaded" (the kinematic slip at the contact angle of the measured axial load,
+            Harris's thrust equilibrium): the slip the criterion judges; both are reported.
         critical_slope_pct_per_s: k2, %/s.
         critical_slope_pct_per_n: k1, %/N.
         slope_span_s: trailing window of the slope against time, s.
@@ -60,6 +67,7 @@ class MonitorSettings:
     contact_angle_deg: float
     window_revolutions: int
     criterion: str
+    slip_reference: str
     critical_slope_pct_per_s: float
     critical_slope_pct_per_n: float
     slope_span_s: float
@@ -98,8 +106,12 @@ class MonitorSettings:
         criterion = s.string("criterion")
         if criterion not in CRITERIA:
             raise s.error("criterion", f"must be one of {', '.join(CRITERIA)}, got {criterion!r}")
+        reference = s.string("slip_reference")
+        if reference not in SLIP_REFERENCES:
+            raise s.error("slip_reference", f"must be one of {', '.join(SLIP_REFERENCES)}, got {reference!r}")
         return cls(
             bearing_file=bearing,
+            slip_reference=reference,
             contact_angle_deg=s.number("contact_angle_deg", lt=90.0),
             window_revolutions=s.integer("window_revolutions", ge=1, le=1000),
             criterion=criterion,

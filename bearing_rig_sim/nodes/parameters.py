@@ -128,6 +128,7 @@ MONITOR = [
     ParameterSpec("contact_angle_deg", "contact angle of the slip formula (negative: the bearing file's nominal)", "deg", -1.0, 89.0),
     ParameterSpec("window_revolutions", "whole cage revolutions per slip window", "1", 1, 1000, integer=True),
     ParameterSpec("criterion", "abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)"),
+    ParameterSpec("slip_reference", "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"),
     ParameterSpec("critical_slope_pct_per_s", "critical slope k2 of the stability criterion (slip against time)", "%/s", -10.0, 0.0),
     ParameterSpec("critical_slope_pct_per_n", "critical slope k1 of the stability criterion (slip against axial load)", "%/N", -1.0, 0.0),
     ParameterSpec("slope_span_s", "trailing window of the slope against time", "s", 0.0, 600.0, low_exclusive=True),

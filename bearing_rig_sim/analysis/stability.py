@@ -255,6 +255,10 @@ give 0.9993-0.9996) ..."""
 SWEEP_MAX_RMSE_PCT: float = 0.1
 """... and its RMSE at most this, percentage points (the paper's Table 4: 0.040-0.045; a fit that
 misses the points by more cannot resolve the flat end of the curve, where k1 is judged) ..."""
+SWEEP_MAX_AMPLITUDE_PCT: float = 100.0
+"""... and every term's amplitude |a_k| at most this, percent (no slip exceeds 100 %: a larger
+term is the flank of an unbounded tail fitted to a steep fall, not a curve the slope of which means
+anything; the paper's Table 5: 5.18 and 2.05 %) ..."""
 SWEEP_FLAT_RMSE_PCT: float = 0.02
 """... or, for a sweep whose slip hardly changes (R^2 is then dominated by the scatter and says
 nothing), when its RMSE is at most this, percentage points."""
@@ -318,8 +322,11 @@ class LoadSweepVerdict:
 
 
 def fit_accepted(fit: GaussianFit) -> bool:
-    """The quality gates of a slip-against-load fit: R^2 >= :data:`SWEEP_MIN_R_SQUARE` and RMSE <=
-    :data:`SWEEP_MAX_RMSE_PCT`, or RMSE <= :data:`SWEEP_FLAT_RMSE_PCT` (a flat sweep)."""
+    """The gates of a slip-against-load fit: every amplitude |a_k| <= :data:`SWEEP_MAX_AMPLITUDE_PCT`,
+    and R^2 >= :data:`SWEEP_MIN_R_SQUARE` with RMSE <= :data:`SWEEP_MAX_RMSE_PCT`, or RMSE <=
+    :data:`SWEEP_FLAT_RMSE_PCT` (a flat sweep)."""
+    if not bool(np.all(np.abs(fit.params[:, 0]) <= SWEEP_MAX_AMPLITUDE_PCT)):
+        return False
     if fit.rmse <= SWEEP_FLAT_RMSE_PCT:
         return True
     return math.isfinite(fit.r_square) and fit.r_square >= SWEEP_MIN_R_SQUARE and fit.rmse <= SWEEP_MAX_RMSE_PCT
@@ -385,8 +392,9 @@ def load_sweep_verdict(
         return verdict(f"no Gaussian fit: {exc}")
     if not fit_accepted(fit):
         return verdict(
-            f"the Gaussian fit fails the quality gates (R^2 {fit.r_square:.4f}, RMSE {fit.rmse:.3g} %: needs R^2 >= "
-            f"{SWEEP_MIN_R_SQUARE} and RMSE <= {SWEEP_MAX_RMSE_PCT} %, or RMSE <= {SWEEP_FLAT_RMSE_PCT} %)",
+            f"the Gaussian fit fails the gates (largest |a| {float(np.max(np.abs(fit.params[:, 0]))):.3g} %, R^2 {fit.r_square:.4f}, "
+            f"RMSE {fit.rmse:.3g} %: needs |a| <= {SWEEP_MAX_AMPLITUDE_PCT:g} % and either R^2 >= {SWEEP_MIN_R_SQUARE} with RMSE <= "
+            f"{SWEEP_MAX_RMSE_PCT} % or RMSE <= {SWEEP_FLAT_RMSE_PCT} %)",
             fit,
         )
     result = stable_onset(fit, float(x[0]), float(x[-1]), critical_slope)

@@ -416,6 +416,22 @@ def link_strain(cage: np.ndarray, k: int, z: int) -> float:
 
 
 @njit(cache=True)
+def implicit_slope(mu: float, dmu: float, s: float) -> float:
+    """Slope (s/m) with which the linearly implicit step treats a traction coefficient mu(s):
+    the larger of the tangent d mu/ds and the secant mu(s)/s through the origin (never < 0).
+
+    With a slope at least the secant, the linearised traction mu(s_n) + k (s - s_n) vanishes
+    between 0 and s_n, so one implicit step cannot carry the sliding speed across zero into the
+    opposite saturation however narrow the traction curve's rising part is (docs/model.md,
+    Integration): the saturated traction acts as a linear damper of coefficient Q mu(s_n)/s_n,
+    integrated implicitly (A-stable)."""
+    k = max(dmu, 0.0)
+    if s * mu > 0.0:
+        k = max(k, mu / s)
+    return k
+
+
+@njit(cache=True)
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
@@ -431,16 +447,20 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     so = -aom * wm + aoa * wa
     mui, dmui, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
     muo, dmuo, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
-    return qi * mui, qo * muo, qi * max(dmui, 0.0), qo * max(dmuo, 0.0), si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
+    kti = qi * implicit_slope(mui, dmui, si)
+    kto = qo * implicit_slope(muo, dmuo, so)
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
 
 
 @njit(cache=True)
 def cage_segment_torque(p: np.ndarray, cage: np.ndarray, k: int, z: int) -> tuple[float, float]:
-    """Rim (stiffness and damping) and land torques on cage segment k, N m, and the land
-    torque's derivative with respect to the segment speed, N m s/rad."""
+    """Rim (stiffness and damping) and land torques on cage segment k, N m, and the slope with
+    which the implicit step treats the land torque (N m s/rad; :func:`implicit_slope`)."""
     km = z - 1 if k == 0 else k - 1
     kp = 0 if k == z - 1 else k + 1
-    tl, dtl = cage_land_torque(p, cage[k, C_OMEGA], z)
+    w = cage[k, C_OMEGA]
+    tl, dtl = cage_land_torque(p, w, z)
+    dtl = implicit_slope(tl, dtl, w)
     tau = p[P_LINK_K] * (link_strain(cage, k, z) - link_strain(cage, km, z))
     tau += p[P_LINK_C] * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
     return tau - tl, dtl
@@ -544,15 +564,18 @@ def step_reduced(
             fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
+            dfd = implicit_slope(fd, dfd, rb * wm)
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
+            omega_roll = wa + cb * wm
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll)
+            kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
             gm = rb * (fi + fo - fd) - rm * fs
             ga = r * (ci * fi - co * fo) - mres
             jmm = rb * (-kti * aim - kto * aom - dfd * rb)
             jma = rb * (-kti * aia + kto * aoa)
-            jam = r * (-ci * kti * aim + co * kto * aom)
-            jaa = r * (-ci * kti * aia - co * kto * aoa)
+            jam = r * (-ci * kti * aim + co * kto * aom) - kres * cb
+            jaa = r * (-ci * kti * aia - co * kto * aoa) - kres
             e = rm * rm * (cu + dt * ku)
             b11 = m * rb * rb - dt * jmm + dt * e
             b12 = -dt * jma

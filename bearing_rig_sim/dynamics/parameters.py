@@ -202,9 +202,9 @@ class BearingParameters:
             cage_land_boundary_torque_scale=res.number("cage_land_boundary_torque_scale", ge=0.0),
             rolling_hysteresis_factor=res.number("rolling_hysteresis_factor", ge=0.0, le=0.5),
             # Plausible ranges only; the engine checks each step against its model's stability
-            # limit over the rig's envelope (dynamics/step_limit.py). Reduced: the traction
-            # saturation limit S_c I_b / (r^2 mu Q) is 1e-5..1e-4 s for spindle-size balls
-            # (4.1e-5 s for H7006C at 1000 N); 1e-3 s cycled to 100 % slip. Stiff: the Hertz
+            # limit over the rig's envelope (dynamics/step_limit.py). Reduced: the stability
+            # limit 1/(mu_max omega_m) is tens of ms; the step is kept short for the accuracy of
+            # transients (pocket and rim contacts are damped, not resolved). Stiff: the Hertz
             # contact mode of a ball of a few mm under tens to hundreds of newtons has periods
             # of 10-30 us, so the explicit limit is a few microseconds (4.8e-6 s for H7006C).
             reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=2e-4),

@@ -17,17 +17,22 @@ centrifugal force), so the limit follows the bearing, its lubricant and the rig.
   Safety fraction 1/2: Hertz stiffness grows as Q^(1/3), so the limit holds for impacts up to
   2^6 = 64 times the largest quasi-static contact load.
 * **Reduced model** (quasi-static normal contacts, linearly implicit Euler on ball orbit, spin
-  and cage). Linearised, the step is A-stable: tractions, pocket, rim and land are implicit. It
-  fails through the traction's saturation: beyond the rising part of mu(s) the tangent slope is
-  nearly zero, the step is explicit there, and the saturated traction of both raceways changes
-  the ball's spin (inertia I_b = 0.4 m r^2, lever r) by r^2 mu (Q_i + Q_o) h / I_b of sliding
-  speed in one step. Once that sweep exceeds the width of the traction curve's rising part the
-  step jumps from one saturated side to the other and locks into a cycle: the slip it then
-  reports is an artefact (up to 100 % and beyond). The allowed sweep is
-  :data:`CRITICAL_SLIDING_SWEEP` (measured; docs/model.md, Integration); the limit is
-  h < S_c I_b / (r^2 (c_i^2 mu_i Q_i + c_o^2 mu_o Q_o)), c = cos(alpha - beta) the lever factor
-  of each contact on the spin, mu the traction law's coefficient at the sliding speed S_c and the
-  contact's load and entrainment speed.
+  and cage). Every velocity-dependent force (raceway tractions, ball drag, rolling-resistance
+  moments, cage land torque) enters the step's Jacobian with a slope at least its secant
+  through zero (:func:`.kernels.implicit_slope`), and the pocket contact and the rim with their
+  tangent stiffness and damping: linearised, the step is A-stable, and a saturated traction
+  cannot carry a sliding speed across zero in one step. What stays explicit over a step is the
+  contact state, solved at its start: the normal loads depend on the ball's orbit speed through
+  the centrifugal force m omega_m^2 r_b. A unit of orbit speed changes it by 2 m omega_m r_b
+  and the outer load by at most that much (the ball's force balance), the outer traction by mu
+  times it, acting on the orbit with lever r_b and on the spin with lever r cos(alpha_o - beta):
+  a rank-one explicit coupling whose only eigenvalue, against the orbit inertia m r_b^2, is
+  lambda = 2 mu omega_m. Explicit Euler keeps it stable for h < 2 / lambda, so the limit is
+  h < 1 / (mu_max omega_m), mu_max the traction law's largest coefficient
+  (:func:`traction_bound`) and omega_m the fastest ball orbit of the envelope. The dependence
+  of the traction on the entrainment speed is frozen too; it is the slide-to-roll ratio times
+  the implicit sliding slope (mu(SRR) with SRR = s/u_e), so below SRR = 1 it cannot
+  destabilise the step (|1 - h b| <= 1 + h a for b <= a). docs/model.md, Integration.
 
 A step above the limit is refused at engine construction (:class:`StepLimitError`, one line
 naming the file key, the value, the limit and the mechanism).
@@ -43,19 +48,11 @@ import numpy as np
 
 from bearing_rig_sim.config import config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.traction import HEADER
 from bearing_rig_sim.errors import RigError
 
 STIFF_SAFETY = 0.5
 """Fraction of the stiff model's linear stability limit allowed (see the module docstring)."""
-
-CRITICAL_SLIDING_SWEEP = 2.0
-"""S_c, m/s: the sliding-speed sweep per step of the saturated traction allowed in the reduced
-model. Measured, not derived: runs of the shipped H7006C from a pure-rolling start
-(docs/model.md, Integration) found the critical step at 12 operating points from 900 rpm/100 N to
-10 000 rpm/1000 N; with S_c = 2.0 m/s the limit over the envelope (5.0e-5 s, set at 1000 N) lies
-below every one of them (the smallest, 6-7e-5 s at 10 000 rpm/500 N), and above the shipped step
-with either shipped lubricant. Point by point the scaling holds within a factor of about 2.5,
-not exactly: the bound is conservative (by 2 for oil-air and the ehl_traction law)."""
 
 SPEED_FRACTIONS = (0.05, 0.1, 0.15, 0.25, 0.5, 0.75, 1.0)
 """Spindle speeds (fractions of the envelope's top speed) at which the limits are evaluated,
@@ -104,7 +101,7 @@ class ContactState:
     """One ball's raceway contacts at an operating point (from the quasi-static solution).
 
     Loads N, lever factors cos(alpha - beta) on the spin (1), entrainment speeds m/s,
-    penetrations m."""
+    penetrations m, the ball's orbit speed rad/s."""
 
     inner_load: float
     outer_load: float
@@ -114,6 +111,7 @@ class ContactState:
     outer_entrainment: float
     inner_penetration: float
     outer_penetration: float
+    orbit_speed: float = 0.0
 
 
 def contact_state(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray) -> ContactState:
@@ -127,18 +125,23 @@ def contact_state(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.nda
     return ContactState(
         float(geo[j, kn.G_QI]), float(geo[j, kn.G_QO]), float(ci), float(co),
         float(abs((ring[kn.R_OMEGA] - wm) * r_ci)), float(abs(wm * r_co)),
-        float(geo[j, kn.G_DI]), float(geo[j, kn.G_DO]),
+        float(geo[j, kn.G_DI]), float(geo[j, kn.G_DO]), float(abs(wm)),
     )
 
 
-def sweep_traction(p: np.ndarray, contact: int, entrainment: float, load: float) -> float:
-    """Traction coefficient of a raceway contact (0 inner, 1 outer) at the sliding speed of the
-    allowed sweep, :data:`CRITICAL_SLIDING_SWEEP`, either way (the larger), at its entrainment
-    speed (m/s) and load (N), from the engine's own traction law."""
-    s = CRITICAL_SLIDING_SWEEP
-    forward = kn.contact_traction(p, contact, s, entrainment, load)[0]
-    backward = kn.contact_traction(p, contact, -s, entrainment, load)[0]
-    return float(max(abs(forward), abs(backward)))
+def traction_bound(p: np.ndarray) -> float:
+    """The largest traction coefficient the engine's law can give (1): the rheology table's
+    largest |mu| (its interpolation is a convex combination of its nodes), the EHL law's
+    mu_max, or the stepped Coulomb law's larger of mu_s and mu_d."""
+    model = p[kn.P_FRIC_MODEL]
+    if model == 2.0:
+        base = int(p[kn.P_TABLE])
+        size = int(p[base]) * int(p[base + 1]) * int(p[base + 2])
+        start = base + HEADER
+        return float(np.max(np.abs(p[start : start + 2 * size])))
+    if model == 1.0:
+        return float(abs(p[kn.P_EHL_MU]))
+    return float(max(abs(p[kn.P_MU_S]), abs(p[kn.P_MU_D])))
 
 
 def symplectic_euler_limit(omega: float, zeta: float) -> float:
@@ -148,15 +151,10 @@ def symplectic_euler_limit(omega: float, zeta: float) -> float:
 
 
 def reduced_limit(p: np.ndarray, c: ContactState) -> float:
-    """Traction-saturation limit of the reduced model's step at one operating point, s
-    (no safety fraction; see the module docstring)."""
-    r, ib = p[kn.P_RBALL], p[kn.P_IBALL]
-    mu_i = sweep_traction(p, 0, c.inner_entrainment, c.inner_load)
-    mu_o = sweep_traction(p, 1, c.outer_entrainment, c.outer_load)
-    torque_per_r = c.inner_lever**2 * mu_i * c.inner_load + c.outer_lever**2 * mu_o * c.outer_load
-    if torque_per_r <= 0.0:
-        return math.inf
-    return CRITICAL_SLIDING_SWEEP * ib / (r * r * torque_per_r)
+    """Limit of the reduced model's step at one operating point, s: the explicit centrifugal
+    coupling of the contact loads, h < 1 / (mu_max omega_m) (module docstring)."""
+    rate = traction_bound(p) * c.orbit_speed
+    return math.inf if rate <= 0.0 else 1.0 / rate
 
 
 def contact_mode(p: np.ndarray, c: ContactState) -> tuple[float, float]:

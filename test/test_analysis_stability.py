@@ -16,6 +16,7 @@ import pytest
 from bearing_rig_sim.analysis import AnalysisError
 from bearing_rig_sim.analysis.gaussian import fit_gaussians
 from bearing_rig_sim.analysis.stability import (
+    load_sweep_verdict,
     K1_AXIAL_LOAD,
     K2_TIME,
     SlipState,
@@ -204,3 +205,44 @@ def test_stable_onset_bad_resolution_and_curve() -> None:
         stable_onset(lambda x: np.full(np.shape(x), np.nan), 0.0, 3.0, K2_TIME)
     with pytest.raises(AnalysisError, match="non-finite slope"):
         classify([0.0, 1.0], lambda x: np.full(np.shape(x), np.nan), K2_TIME)
+
+
+# -- the load sweep by the paper's method -------------------------------------------------------
+SWEEP_LOADS_N = [50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0]
+TABLE5_1000RPM = [(5.18, -4.14, 214.0), (2.05, 530.0, 469.0)]  # docs/paper.md section 10
+
+
+def _table5(f: float) -> float:
+    return sum(a * math.exp(-(((f - b) / c) ** 2)) for a, b, c in TABLE5_1000RPM)
+
+
+def _table5_slope(f: float) -> float:
+    return sum(-2.0 * a * (f - b) / c**2 * math.exp(-(((f - b) / c) ** 2)) for a, b, c in TABLE5_1000RPM)
+
+
+def test_load_sweep_of_the_paper_curve_by_hand() -> None:
+    """The paper's own 1000 rpm curve (Table 5) sampled at the sweep's loads. By hand from the
+    formula: the slope is -5.8e-3 %/N at 300 N, -3.6e-4 at 400 N, and falls again to -2.8e-3 at
+    700 N (the second term's centre is at 530 N). So with k1 read as -5e-6 or -5e-4 %/N the end
+    of the curve is below k1 (no stable state); with -5e-3 %/N it is stable from 400 N."""
+    assert _table5_slope(300.0) == pytest.approx(-5.8e-3, rel=0.05)
+    assert _table5_slope(400.0) == pytest.approx(-3.6e-4, rel=0.1)
+    assert _table5_slope(700.0) == pytest.approx(-2.8e-3, rel=0.05)
+    slips = [_table5(f) for f in SWEEP_LOADS_N]
+    for k in (-5e-6, -5e-4):
+        verdict = load_sweep_verdict(SWEEP_LOADS_N, slips, k)
+        assert verdict.stable_from is None and verdict.fitted and verdict.n_terms == 2
+        assert "below k1" in verdict.reason and verdict.slope_at_end == pytest.approx(_table5_slope(700.0), rel=0.01)
+    verdict = load_sweep_verdict(SWEEP_LOADS_N, slips, -5e-3)
+    assert verdict.stable_from == 400.0 and 300.0 < (verdict.onset or 0.0) < 400.0
+    assert verdict.describe().startswith("stable from 400 N (2-term Gaussian, R^2 1.0000")
+
+
+def test_load_sweep_states_why_there_is_no_verdict() -> None:
+    few = load_sweep_verdict([100.0, 200.0, 300.0], [3.0, 2.0, 1.5])
+    assert few.stable_from is None and not few.fitted and "3 distinct load point(s)" in few.reason
+    rng = np.random.default_rng(3)
+    noise = load_sweep_verdict(SWEEP_LOADS_N, list(2.0 + rng.normal(0.0, 0.5, 8)))
+    assert not noise.fitted and "fails the gates" in noise.reason and noise.describe().startswith("no stable state: ")
+    skid = load_sweep_verdict(SWEEP_LOADS_N, [28.7] + [_table5(f) for f in SWEEP_LOADS_N[1:]], -5e-3)
+    assert skid.loads[0] == 100.0 and "1 load point(s) above 20 % slip (skidding) left out" in skid.describe()

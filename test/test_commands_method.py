@@ -11,7 +11,7 @@ import pytest
 from bearing_rig_sim.cli import main
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingParameters
-from bearing_rig_sim.studies.reproduction import PAPER_TABLE3
+from bearing_rig_sim.studies.paper_data import PAPER_TABLE3
 
 
 def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[str]) -> None:
@@ -73,4 +73,14 @@ def test_reproduce_writes_csvs_figures_and_report_then_reuses_its_cache(tmp_path
     with (tmp_path / "acceleration.csv").open() as fh:
         assert {float(r["acceleration_rad_s2"]) for r in csv.DictReader(fh)} == {20.0, 40.0, 60.0, 80.0}
     assert main(["reproduce", "--out", str(tmp_path), "--quiet"]) == 0
-    assert "reused cached results" in capsys.readouterr().out
+    printed = capsys.readouterr().out
+    assert "reused cached results" in printed
+    # no fit outside the gates: every row of the acceleration table has lambda below 100 % or says why
+    section = report.split("## Constant acceleration", 1)[1].split("###", 1)[0]
+    rows = [line.split(" | ") for line in section.splitlines() if line.startswith("| ") and line[2].isdigit()]
+    assert len(rows) == 4
+    for cells in rows:
+        assert cells[4].startswith("no fit: ") or 0.0 < float(cells[4]) < 100.0
+    for line in printed.splitlines():
+        if "rad/s^2" in line:
+            assert "stable from" in line or "no fit: " in line

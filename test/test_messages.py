@@ -54,6 +54,12 @@ SAMPLES: dict[str, dict[str, Any]] = {
         "confidence": 0.875,
         "window_revolutions": 4_000_000_000,
         "detail": "stable: slope −0.0123 %/s ≥ −0.03 %/s",
+        "axial_load": 200.125,
+        "kinematic_slip_rate": 0.0625,
+        "loaded_contact_angle": 0.3046875,
+        "sweep_speed": 104.71975511965977,
+        "sweep_stable_from": 300.0,
+        "sweep_verdict": "stable from 300 N (2-term Gaussian, R^2 0.9991, RMSE 0.012 %, 8 loads)",
     },
     "SimulatorTruth": {
         "header": {"stamp": {"sec": 7, "nanosec": 123_456_789}, "frame_id": "bearing"},

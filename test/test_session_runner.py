@@ -291,3 +291,24 @@ def test_a_segment_too_short_for_the_load_to_settle_is_not_judged_on_it(tmp_path
     runner.update(0.3)
     outcome = runner.outcomes[-1]
     assert outcome.bearing_force == pytest.approx(30.0) and outcome.conditions_met
+
+
+def test_a_run_up_is_judged_during_the_acceleration_from_its_start(program: TestProgram) -> None:
+    """Paper section 4.2: under constant acceleration the slope of slip against time is judged
+    during the run-up, and its time to stable counts from the run-up's start (Table 7's t = 0),
+    whatever the speed then. The accel segment starts at 10.5 s and reaches 1500 rpm 1.57 s later;
+    a stable status stamped 11.6 s resting on windows from 10.5 + 0.3 s on (evidence from
+    11.6 - (1 + W40)) gives 1.1 s, although the target speed is not reached."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    runner.update(1.5 + 1.0 + 4.0)
+    (accel,) = runner.update(6.5 + 1.0 + 3.0)
+    assert accel.start_time == pytest.approx(10.5) and accel.ramp_end > 11.6
+    runner.observe_status(status(11.2, StatusState.STABLE))  # rests on windows from before the start
+    runner.observe_status(status(10.5 + 1.0 + W40 - 0.01, StatusState.STABLE))  # just before: not yet
+    runner.observe_status(status(11.6 + W40, StatusState.STABLE))
+    run_until(runner, 10.5, accel.deadline + 0.01)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "accel" and outcome.verdict == Verdict.STABLE
+    assert outcome.time_to_stable == pytest.approx(1.1 + W40)

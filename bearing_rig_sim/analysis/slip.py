@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import NamedTuple, overload
 
 import numpy as np
+from scipy.optimize import brentq
 
 from bearing_rig_sim.analysis.inputs import (
     AnalysisError,
@@ -262,3 +263,74 @@ def whole_revolution_slip(
     inner_speed = 2.0 * math.pi * turned / duration
     slip = kinematics.slip_rate(cage_speed, inner_speed) if t1.size else np.empty(0)
     return WindowedSlip(t1, cage_speed, inner_speed, np.asarray(slip, dtype=np.float64))
+
+
+@dataclass(frozen=True)
+class ThrustContact:
+    """The contact angle of a ball bearing under a pure axial load, from Harris's thrust
+    equilibrium (Harris and Kotzalas, *Rolling Bearing Analysis*, Eq. for a thrust-loaded angular
+    contact bearing; physics-targets.md)::
+
+        sin(a) (cos(a0) / cos(a) - 1)^1.5 = F_a / (Z K_n (B Dw)^1.5)
+
+    with a0 the free (nominal) angle, B = f_i + f_o - 1 the total curvature, K_n the combined
+    load-deflection constant of the two raceway contacts (1/K_n^(2/3) = 1/K_i^(2/3) + 1/K_o^(2/3),
+    elliptical Hertz contacts at the free angle; no centrifugal force, so it holds at the rig's
+    speeds as long as the ball's centrifugal force is small against its contact load).
+
+    Attributes:
+        ball_count: Z (>= 1).
+        free_angle: a0, rad.
+        total_curvature: B, 1 (> 0).
+        ball_diameter: Dw, m.
+        combined_constant: K_n, N/m^1.5.
+    """
+
+    ball_count: int
+    free_angle: float
+    total_curvature: float
+    ball_diameter: float
+    combined_constant: float
+
+    @classmethod
+    def from_config(cls, source: Section | str | Path) -> ThrustContact:
+        """From a bearing file: ``geometry`` (ball diameter, pitch diameter, ball count, nominal
+        angle, groove curvature ratios) and ``materials`` (ring and ball moduli, Poisson ratios).
+
+        Raises:
+            ConfigError: naming the file and key of a missing or out-of-range value.
+        """
+        from bearing_rig_sim.dynamics.hertz import raceway_contacts  # the elliptical Hertz solution
+
+        doc = source if isinstance(source, Section) else load_yaml(source)
+        g = doc.section("geometry")
+        dw = g.number("ball_diameter_m", gt=0.0)
+        dm = g.number("pitch_diameter_m", gt=dw)
+        a0 = math.radians(g.number("contact_angle_deg", ge=0.0, lt=90.0))
+        fi = g.number("inner_groove_curvature_ratio", gt=0.5, lt=1.0)
+        fo = g.number("outer_groove_curvature_ratio", gt=0.5, lt=1.0)
+        z = g.integer("ball_count", ge=1)
+        m = doc.section("materials")
+        ball, ring = m.section("ball"), m.section("ring")
+        inner, outer = raceway_contacts(
+            dw, dm, a0, fi, fo,
+            ball.number("youngs_modulus_pa", gt=0.0), ball.number("poisson_ratio", ge=0.0, lt=0.5),
+            ring.number("youngs_modulus_pa", gt=0.0), ring.number("poisson_ratio", ge=0.0, lt=0.5),
+        )
+        k_n = (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5
+        return cls(z, a0, fi + fo - 1.0, dw, k_n)
+
+    def loaded_contact_angle(self, axial_load: float) -> float:
+        """The contact angle (rad) under the axial load ``axial_load`` (N); the free angle at or
+        below zero load, NaN for a non-finite load."""
+        if not math.isfinite(axial_load):
+            return math.nan
+        if axial_load <= 0.0:
+            return self.free_angle
+        rhs = axial_load / (self.ball_count * self.combined_constant * (self.total_curvature * self.ball_diameter) ** 1.5)
+        cos0 = math.cos(self.free_angle)
+
+        def balance(a: float) -> float:
+            return math.sin(a) * max(cos0 / math.cos(a) - 1.0, 0.0) ** 1.5 - rhs
+
+        return float(brentq(balance, self.free_angle, math.radians(89.9), xtol=1e-12))

@@ -28,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import brentq
 
+from bearing_rig_sim.analysis.gaussian import GaussianFit, select_gaussian_fit
 from bearing_rig_sim.analysis.inputs import (
     AnalysisError,
     FloatArray,
@@ -245,3 +246,158 @@ def stable_onset(
         stable_from_start=bool(np.all(stable)),
         stable_intervals=tuple(intervals),
     )
+
+
+# -- the load sweep by the paper's method ----------------------------------------------------------
+SWEEP_MIN_R_SQUARE: float = 0.95
+"""A slip-against-load fit is accepted when its R^2 is at least this (the paper's Table 4 fits
+give 0.9993-0.9996) ..."""
+SWEEP_MAX_RMSE_PCT: float = 0.1
+"""... and its RMSE at most this, percentage points (the paper's Table 4: 0.040-0.045; a fit that
+misses the points by more cannot resolve the flat end of the curve, where k1 is judged) ..."""
+SWEEP_MAX_AMPLITUDE_PCT: float = 100.0
+"""... and every term's amplitude |a_k| at most this, percent (no slip exceeds 100 %: a larger
+term is the flank of an unbounded tail fitted to a steep fall, not a curve the slope of which means
+anything; the paper's Table 5: 5.18 and 2.05 %) ..."""
+SWEEP_FLAT_RMSE_PCT: float = 0.02
+"""... or, for a sweep whose slip hardly changes (R^2 is then dominated by the scatter and says
+nothing), when its RMSE is at most this, percentage points."""
+SKID_SLIP_PCT: float = 20.0
+"""Slip (%) above which a load point is gross skidding rather than rolling with creep: the
+Gaussian-slope method presumes a smooth slip curve, so such points are left out of the fit (and
+said so)."""
+SWEEP_MIN_POINTS: int = 4
+"""Load points needed for a verdict: a 1-term Gaussian has 3 parameters (gaussian.py)."""
+TWO_TERM_POINTS: int = 7
+"""Load points from which the 2-term Gaussian is tried too (6 parameters)."""
+
+
+@dataclass(frozen=True)
+class LoadSweepVerdict:
+    """The paper's verdict on one speed's load sweep (section 4.1; docs/method.md).
+
+    Attributes:
+        inner_ring_speed: mean spindle speed of the sweep's points, rad/s.
+        loads: the load points' measured axial loads, N, increasing.
+        slips: the settled slip of each load point, percent.
+        critical_slope: k1, percent per newton.
+        stable_from: the first load point at or above ``onset``, N (None: no stable state).
+        onset: start of the final stretch where the fitted slope is >= k1, N (None without).
+        n_terms / r_square / rmse / sse: the kept Gaussian fit's (0 / NaN without a fit).
+        slope_at_end: fitted slope at the last load, %/N (NaN without a fit).
+        reason: why there is no "stable from" (empty when there is one).
+        left_out: the points left out of the fit and why (empty when none).
+    """
+
+    inner_ring_speed: float
+    loads: tuple[float, ...]
+    slips: tuple[float, ...]
+    critical_slope: float
+    stable_from: float | None
+    onset: float | None
+    n_terms: int
+    r_square: float
+    rmse: float
+    sse: float
+    slope_at_end: float
+    reason: str
+    left_out: str = ""
+
+    @property
+    def fitted(self) -> bool:
+        """Whether a Gaussian fit passed the quality gates."""
+        return self.n_terms > 0
+
+    def describe(self) -> str:
+        """One line: "stable from 300 N (2-term Gaussian, R^2 0.9991, RMSE 0.012 %, 8 loads)" or
+        "no stable state: <reason>"."""
+        quality = ""
+        if self.fitted:
+            quality = f"{self.n_terms}-term Gaussian, R^2 {self.r_square:.4f}, RMSE {self.rmse:.3g} %, {len(self.loads)} loads"
+            if self.left_out:
+                quality += f"; {self.left_out}"
+        if self.stable_from is not None:
+            return f"stable from {self.stable_from:.0f} N ({quality})"
+        return f"no stable state: {self.reason}" + (f" ({quality})" if quality else "")
+
+
+def fit_accepted(fit: GaussianFit) -> bool:
+    """The gates of a slip-against-load fit: every amplitude |a_k| <= :data:`SWEEP_MAX_AMPLITUDE_PCT`,
+    and R^2 >= :data:`SWEEP_MIN_R_SQUARE` with RMSE <= :data:`SWEEP_MAX_RMSE_PCT`, or RMSE <=
+    :data:`SWEEP_FLAT_RMSE_PCT` (a flat sweep)."""
+    if not bool(np.all(np.abs(fit.params[:, 0]) <= SWEEP_MAX_AMPLITUDE_PCT)):
+        return False
+    if fit.rmse <= SWEEP_FLAT_RMSE_PCT:
+        return True
+    return math.isfinite(fit.r_square) and fit.r_square >= SWEEP_MIN_R_SQUARE and fit.rmse <= SWEEP_MAX_RMSE_PCT
+
+
+def load_sweep_verdict(
+    loads: FloatArray | Sequence[float],
+    slips: FloatArray | Sequence[float],
+    critical_slope: float = K1_AXIAL_LOAD,
+    inner_ring_speed: float = math.nan,
+    skid_slip_pct: float = SKID_SLIP_PCT,
+) -> LoadSweepVerdict:
+    """The paper's method on one speed's load points (docs/paper.md section 7): fit the Gaussian
+    sum to slip against load (1 term, and 2 terms from :data:`TWO_TERM_POINTS` points, the better
+    kept by :func:`~bearing_rig_sim.analysis.gaussian.select_gaussian_fit`), accept it only
+    through the quality gates (:data:`SWEEP_MIN_R_SQUARE` or :data:`SWEEP_FLAT_RMSE_PCT`), and
+    report the first load point from which the fitted slope stays at or above k1 to the last
+    load (:func:`stable_onset`). Never raises on data: a sweep that cannot be judged gets a
+    ``reason``.
+
+    Args:
+        loads: measured axial load of each point, N (sorted here).
+        slips: settled slip of each point, percent.
+        critical_slope: k1, %/N.
+        inner_ring_speed: the sweep's spindle speed, rad/s (carried along).
+        skid_slip_pct: points slipping more are left out (:data:`SKID_SLIP_PCT`), percent.
+    """
+    x = np.asarray(loads, dtype=np.float64)
+    y = np.asarray(slips, dtype=np.float64)
+    keep = np.isfinite(x) & np.isfinite(y)
+    order = np.argsort(x[keep], kind="stable")
+    x, y = x[keep][order], y[keep][order]
+    skid = int(np.count_nonzero(y > skid_slip_pct))
+    x, y = x[y <= skid_slip_pct], y[y <= skid_slip_pct]
+    left_out = f"; {skid} load point(s) above {skid_slip_pct:g} % slip (skidding) left out" if skid else ""
+
+    def verdict(reason: str, fit: GaussianFit | None = None, accepted: bool = False, onset: float | None = None) -> LoadSweepVerdict:
+        stable_from = None
+        if onset is not None:
+            stable_from = float(x[x >= onset - 1e-9 * max(1.0, abs(onset))][0])
+        return LoadSweepVerdict(
+            inner_ring_speed=inner_ring_speed,
+            loads=tuple(x.tolist()),
+            slips=tuple(y.tolist()),
+            critical_slope=critical_slope,
+            stable_from=stable_from,
+            onset=onset,
+            n_terms=fit.n_terms if fit is not None and accepted else 0,
+            r_square=fit.r_square if fit is not None else math.nan,
+            rmse=fit.rmse if fit is not None else math.nan,
+            sse=fit.sse if fit is not None else math.nan,
+            slope_at_end=float(fit.slope(float(x[-1]))) if fit is not None and accepted else math.nan,
+            reason=reason + left_out if reason else "",
+            left_out=left_out.removeprefix("; "),
+        )
+
+    distinct = np.unique(x).size
+    if distinct < SWEEP_MIN_POINTS:
+        return verdict(f"{distinct} distinct load point(s), a Gaussian fit needs {SWEEP_MIN_POINTS}")
+    try:
+        fit, _ = select_gaussian_fit(x, y, max_terms=2 if x.size >= TWO_TERM_POINTS else 1)
+    except AnalysisError as exc:
+        return verdict(f"no Gaussian fit: {exc}")
+    if not fit_accepted(fit):
+        return verdict(
+            f"the Gaussian fit fails the gates (largest |a| {float(np.max(np.abs(fit.params[:, 0]))):.3g} %, R^2 {fit.r_square:.4f}, "
+            f"RMSE {fit.rmse:.3g} %: needs |a| <= {SWEEP_MAX_AMPLITUDE_PCT:g} % and either R^2 >= {SWEEP_MIN_R_SQUARE} with RMSE <= "
+            f"{SWEEP_MAX_RMSE_PCT} % or RMSE <= {SWEEP_FLAT_RMSE_PCT} %)",
+            fit,
+        )
+    result = stable_onset(fit, float(x[0]), float(x[-1]), critical_slope)
+    if result.onset is None:
+        return verdict(f"the fitted slope at {x[-1]:.0f} N is {result.slope_at_end:.3g} %/N, below k1 = {critical_slope:.3g} %/N", fit, True)
+    return verdict("", fit, True, float(result.onset))

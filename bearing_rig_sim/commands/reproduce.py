@@ -37,8 +37,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"{'reused cached results' if out.cached else 'ran the experiments'}; wrote {len(out.files)} files to {out.out_dir}")
     print(f"validation RMS (twin - bench, 4 rows): {out.validation_rms_pct:.3f} pp")
     for rpm, f in out.load_onsets_n.items():
-        print(f"  {rpm:6.0f} rpm: stable from {f'{f:.0f} N' if f is not None else 'not reached in 50-700 N'} (k1 = -5e-6 %/N)")
+        why = out.reasons.get(f"{rpm:.0f} rpm", "not reached in 50-700 N")
+        print(f"  {rpm:6.0f} rpm: {f'stable from {f:.0f} N' if f is not None else why} (k1 = -5e-6 %/N)")
     for a, t in out.acceleration_onsets_s.items():
-        print(f"  {a:4.0f} rad/s^2: stable from {f'{t:.2f} s' if t is not None else 'not reached'} (k2 = -3e-2 %/s)")
+        why = out.reasons.get(f"{a:.0f} rad/s^2", "not reached")
+        print(f"  {a:4.0f} rad/s^2: {f'stable from {t:.2f} s' if t is not None else why} (k2 = -3e-2 %/s)")
     print(f"report: {out.out_dir / 'report.md'}")
     return 0

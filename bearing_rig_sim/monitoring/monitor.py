@@ -32,9 +32,11 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
-from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.analysis.streaming import TrailingSlope
+from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
+from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -44,6 +46,11 @@ MonitorState = SlipState
 
 LOAD_HISTORY = 4096
 """Load-cell samples kept for the windows' mean load (4 s at the load cell's 1 kHz)."""
+
+LOAD_WAIT_S = 2.0
+"""With the load criterion, a window waits for the load cell's samples up to its end (the load
+cell's topic can run behind the pulses') at most this long after its end, rig s; then it is
+judged on the samples at hand."""
 
 
 @dataclass(frozen=True)
@@ -55,7 +62,11 @@ class MonitorStatus:
     losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
     the pulses lost per shaft since the start, ``windows_skipped`` the cage windows skipped and
     ``duplicates`` the exact repeats of a pulse dropped per shaft (spindle, cage).
-    ``confidence`` is P(slope >= k) (0 while no slope is known).
+    ``confidence`` is P(slope >= k) (0 while no slope is known). ``axial_load`` is the latest
+    window's mean measured load (N, NaN without load-cell samples). With the ``axial_load``
+    criterion, ``sweep_speed`` (rad/s), ``sweep_stable_from`` (N) and ``sweep_verdict`` are the
+    latest load-sweep verdict's (:mod:`~bearing_rig_sim.monitoring.load_sweep`; NaN and "" before
+    one).
     """
 
     state: SlipState
@@ -78,6 +89,12 @@ class MonitorStatus:
     windows_skipped: int = 0
     duplicates: tuple[int, int] = (0, 0)
     window_start: float | None = None
+    axial_load: float = math.nan
+    kinematic_slip_rate: float = math.nan
+    loaded_contact_angle: float = math.nan
+    sweep_speed: float = math.nan
+    sweep_stable_from: float = math.nan
+    sweep_verdict: str = ""
 
     def message_fields(self) -> dict[str, object]:
         """The SlipStatus.msg fields of this status (all but the header), for any message class
@@ -94,17 +111,27 @@ class MonitorStatus:
             "confidence": self.confidence,
             "window_revolutions": self.window_revolutions,
             "detail": self.detail,
+            "axial_load": self.axial_load,
+            "kinematic_slip_rate": self.kinematic_slip_rate,
+            "loaded_contact_angle": self.loaded_contact_angle,
+            "sweep_speed": self.sweep_speed,
+            "sweep_stable_from": self.sweep_stable_from,
+            "sweep_verdict": self.sweep_verdict,
         }
 
 
 @dataclass(frozen=True)
 class MonitorWindow:
-    """A completed window and its slip (NaN below the minimum speed) and mean load (NaN if no
-    load-cell sample fell in it), N."""
+    """A completed window and its slip (the paper's, at the nominal angle; NaN below the minimum
+    speed), mean load (NaN if no load-cell sample fell in it, N), the contact angle of that load
+    (rad) and the kinematic slip against the pure-rolling speed at that angle (%; NaN without a
+    load)."""
 
     window: SlipWindow
     slip_rate: float
     axial_load: float
+    loaded_contact_angle: float = math.nan
+    kinematic_slip_rate: float = math.nan
 
     @property
     def start_time(self) -> float:
@@ -136,15 +163,18 @@ class SlipMonitor:
         self.settings = settings
         self.criterion = settings.criterion
         self._ratio = kinematics.epicyclic_ratio()
-        span = settings.slope_span_s if self.criterion == "time" else settings.slope_span_n
+        self.thrust = ThrustContact.from_config(settings.bearing_file)
+        """The loaded contact angle from the measured load (Harris's thrust equilibrium)."""
+        self.loaded = settings.slip_reference == "loaded"
         self.slope = TrailingSlope(
-            critical_slope=settings.critical_slope,
-            span=span,
+            critical_slope=settings.critical_slope_pct_per_s,
+            span=settings.slope_span_s,
             min_points=settings.min_slope_points,
             resolution=settings.slip_resolution_pct,
             change_threshold=settings.change_threshold,
-            max_span=max(settings.slope_max_span_s, settings.slope_span_s) if self.criterion == "time" else None,
+            max_span=max(settings.slope_max_span_s, settings.slope_span_s),
         )
+        self.sweep = LoadSweep(settings.critical_slope_pct_per_n, settings.load_step_n, settings.sweep_settle_s, settings.sweep_average_s)
         self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
         self._loads: deque[tuple[float, float]] = deque(maxlen=LOAD_HISTORY)
@@ -161,7 +191,8 @@ class SlipMonitor:
         self._steady: bool | None = None
         self._previous_inner: float | None = None
         self._last_x: float | None = None
-        self._bin: tuple[float, float, int] = (0.0, 0.0, 0)  # load sum, slip sum, windows
+        self.sweep.reset()
+        self._sweep_pending: deque[SlipWindow] = deque()
         self._now: float | None = None
         self.windows = 0
         """Windows completed since the last reset (1)."""
@@ -189,6 +220,8 @@ class SlipMonitor:
         samples are ignored."""
         if math.isfinite(time) and math.isfinite(force):
             self._loads.append((time, force))
+            if self._sweep_pending and time >= self._sweep_pending[0].end_time:
+                self._feed_sweep(time)
 
     def add_pulse(self, shaft: str, pulse: Pulse) -> bool:
         """Take one pulse of ``shaft`` (``"spindle"`` or ``"cage"``); never raises on bad data.
@@ -210,7 +243,6 @@ class SlipMonitor:
             if kind == "reset":
                 self.slope.reset()
                 self._latest, self._steady, self._previous_inner, self._last_x = None, None, None, None
-                self._bin = (0.0, 0.0, 0)
                 self.windows = 0
                 self._notes.append((when, text))
             elif kind == "invalid":
@@ -226,7 +258,6 @@ class SlipMonitor:
             self._notes.append((time, f"slip series restarted at {time:.6f} s: {why}"))
         self.slope.reset()
         self._last_x = None
-        self._bin = (0.0, 0.0, 0)
 
     def _mean_load(self, t0: float, t1: float) -> float:
         loads = self._loads
@@ -242,7 +273,7 @@ class SlipMonitor:
         st = self.settings
         inner, t1 = window.inner_ring_speed, window.end_time
         self.windows += 1
-        load = self._mean_load(window.start_time, t1) if self.criterion == "axial_load" else math.nan
+        load = self._mean_load(window.start_time, t1)
         if not inner >= st.min_inner_ring_speed_rad_s:
             if self._previous_inner is not None:
                 self._restart_series(t1, f"spindle below {st.min_inner_ring_speed_rad_s:g} rad/s")
@@ -258,23 +289,39 @@ class SlipMonitor:
         self._steady = steady
         self._previous_inner = inner
         slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
-        self._latest = MonitorWindow(window, slip, load)
+        angle = self.thrust.loaded_contact_angle(load)
+        kinematic = math.nan
+        if math.isfinite(angle):
+            ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio()
+            kinematic = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
+        self._latest = MonitorWindow(window, slip, load, angle, kinematic)
+        if self.criterion == "axial_load":
+            self._sweep_pending.append(window)
+            self._feed_sweep(t1)
+            return
+        judged = kinematic if self.loaded else slip
+        if not math.isfinite(judged):  # the loaded slip without a load-cell sample: no point
+            return
         if self.criterion == "time":
-            self._add_point(t1, t1, slip)
-        elif math.isfinite(load):
-            self._add_to_load_bin(t1, load, slip)
+            self._add_point(t1, t1, judged)
 
-    def _add_to_load_bin(self, t1: float, load: float, slip: float) -> None:
-        """Against load, the slip points are bins of load: the windows whose mean load stays
-        within ``load_step_n / 2`` of their bin's mean are averaged, and a bin becomes a point
-        (mean load, mean slip) when the load leaves it, if its load is above the last point's."""
-        total_load, total_slip, count = self._bin
-        if count and abs(load - total_load / count) > 0.5 * self.settings.load_step_n:
-            x, y = total_load / count, total_slip / count
-            if self._last_x is None or x > self._last_x:
-                self._add_point(t1, x, y)
-            total_load, total_slip, count = 0.0, 0.0, 0
-        self._bin = (total_load + load, total_slip + slip, count + 1)
+    def _feed_sweep(self, now: float) -> None:
+        """Give the load sweep the pending windows whose load-cell samples have come (the latest
+        sample at or after their end), or that waited :data:`LOAD_WAIT_S`; ``now`` is the latest
+        rig time seen, s."""
+        latest = self._loads[-1][0] if self._loads else -math.inf
+        while self._sweep_pending and (latest >= self._sweep_pending[0].end_time or now - self._sweep_pending[0].end_time > LOAD_WAIT_S):
+            window = self._sweep_pending.popleft()
+            inner = window.inner_ring_speed
+            load = self._mean_load(window.start_time, window.end_time)
+            slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0
+            if self.loaded:
+                angle = self.thrust.loaded_contact_angle(load)
+                ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio() if math.isfinite(angle) else math.nan
+                slip = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
+            verdict = self.sweep.add_window(window.start_time, window.end_time, load, slip, inner)
+            if verdict is not None:
+                self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
     def _add_point(self, t1: float, x: float, slip: float) -> None:
         try:
@@ -290,6 +337,8 @@ class SlipMonitor:
         if not math.isfinite(now):
             return
         self.counter.check(now)
+        if self._sweep_pending:
+            self._feed_sweep(now)
         hold = self.settings.fault_hold_s
         for held in (self._invalid, self._warnings):
             for key, (when, reason) in list(held.items()):
@@ -313,6 +362,7 @@ class SlipMonitor:
     def status(self) -> MonitorStatus:
         """The current status (never raises)."""
         verdict = self.slope.verdict()
+        sweep = self.sweep.latest if self.criterion == "axial_load" else None
         faults = self.faults()
         notes = tuple(text for _, text in self._notes)
         warnings = tuple(text for _, text in self._warnings.values())
@@ -321,6 +371,8 @@ class SlipMonitor:
             state, detail = SlipState.FAULT, "; ".join(faults)
         elif self.counter.stopped:
             state, detail = SlipState.UNKNOWN, self.counter.stopped
+        elif self.criterion == "axial_load":
+            state, detail = self._sweep_state(latest)
         else:
             state = verdict.state
             detail = verdict.detail if latest is not None else "waiting for whole cage revolutions"
@@ -330,6 +382,12 @@ class SlipMonitor:
             detail = f"{detail}; note: {notes[-1]}"
         inner = latest.inner_ring_speed if latest is not None else math.nan
         books = self.counter.books
+        if self.criterion == "axial_load":  # the fit's verdict is not a probability: 1 stable, 0 else
+            fitted_slope = sweep.slope_at_end if sweep is not None else math.nan
+            confidence = 1.0 if state is SlipState.STABLE else 0.0
+        else:
+            fitted_slope = verdict.slope if verdict.slope is not None else math.nan
+            confidence = verdict.confidence if state in (SlipState.STABLE, SlipState.SLIPPING, SlipState.UNKNOWN) else 0.0
         return MonitorStatus(
             state=state,
             time=latest.end_time if latest is not None else None,
@@ -337,10 +395,10 @@ class SlipMonitor:
             cage_speed=latest.cage_speed if latest is not None else math.nan,
             theoretical_cage_speed=self._ratio * inner,
             slip_rate=latest.slip_rate if latest is not None else math.nan,
-            fitted_slope=verdict.slope if verdict.slope is not None else math.nan,
-            critical_slope=verdict.critical_slope,
+            fitted_slope=fitted_slope,
+            critical_slope=self.settings.critical_slope,
             criterion=self.criterion,
-            confidence=verdict.confidence if state in (SlipState.STABLE, SlipState.SLIPPING, SlipState.UNKNOWN) else 0.0,
+            confidence=confidence,
             window_revolutions=self.settings.window_revolutions,
             detail=detail,
             faults=faults,
@@ -351,4 +409,25 @@ class SlipMonitor:
             windows_skipped=books["cage"].windows_skipped,
             duplicates=(books["spindle"].duplicates, books["cage"].duplicates),
             window_start=latest.start_time if latest is not None else None,
+            axial_load=latest.axial_load if latest is not None else math.nan,
+            kinematic_slip_rate=latest.kinematic_slip_rate if latest is not None else math.nan,
+            loaded_contact_angle=latest.loaded_contact_angle if latest is not None else math.nan,
+            sweep_speed=sweep.inner_ring_speed if sweep is not None else math.nan,
+            sweep_stable_from=sweep.stable_from if sweep is not None and sweep.stable_from is not None else math.nan,
+            sweep_verdict=sweep.describe() if sweep is not None else "",
         )
+
+    def _sweep_state(self, latest: MonitorWindow | None) -> tuple[SlipState, str]:
+        """State against load: the latest load-sweep verdict of the spindle's present speed says
+        STABLE at a load at or above its "stable from", SLIPPING below it (or when the fitted
+        slope never reaches k1), UNKNOWN while the speed has no verdict, or none with a fit."""
+        if latest is None:
+            return SlipState.UNKNOWN, "waiting for whole cage revolutions"
+        sweep = self.sweep.latest
+        inner = latest.inner_ring_speed
+        if sweep is None or not abs(sweep.inner_ring_speed - inner) <= SWEEP_SPEED_TOLERANCE * sweep.inner_ring_speed:
+            return SlipState.UNKNOWN, f"load sweep: {len(self.sweep.points)} settled load point(s) at this speed, a verdict needs 4"
+        if sweep.stable_from is not None:
+            stable = latest.axial_load >= sweep.stable_from - 0.5 * self.settings.load_step_n
+            return (SlipState.STABLE if stable else SlipState.SLIPPING), f"load sweep: {sweep.describe()}"
+        return (SlipState.SLIPPING if sweep.fitted else SlipState.UNKNOWN), f"load sweep: {sweep.describe()}"

@@ -119,14 +119,22 @@ def speed_tolerance(target_speed: float) -> float:
 class TimeToStable:
     """The one "stable after the ramp" rule (module docstring).
 
+    A **run-up** (a constant-acceleration segment, ``run_up_start`` given) is judged as the paper
+    judges it (section 4.2): the slope of slip against time during the acceleration itself, so
+    its time to stable counts from the start of the run-up (the paper's t = 0 of Table 7) to the
+    first stable status on evidence from after that start, at whatever speed it comes.
+
     Args:
         ramp_end: end of the segment's ramp, rig s.
         target_speed: the commanded inner-ring speed, rad/s; None: not checked.
+        run_up_start: start of a run-up, rig s; None for any other segment.
     """
 
-    def __init__(self, ramp_end: float, target_speed: float | None = None) -> None:
-        self.ramp_end = ramp_end
-        self.target_speed = target_speed
+    def __init__(self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None) -> None:
+        self.run_up_start = run_up_start
+        self.ramp_end = ramp_end if run_up_start is None else run_up_start
+        """The origin of the time to stable: the ramp's end, or the run-up's start, rig s."""
+        self.target_speed = target_speed if run_up_start is None else None
         self.stable_at: float | None = None
         """Stamp of the status that made the segment stable, s (None before)."""
 

@@ -16,6 +16,10 @@ NODE_NAME = "monitor"
 SHIPPED_FILE = "monitor.yaml"
 """The shipped parameter file, under ``config/``."""
 
+SLIP_REFERENCES = ("nominal", "loaded")
+"""Which slip the criterion judges: the paper's, against the pure-rolling cage speed at the
+nominal contact angle, or the kinematic one at the contact angle of the measured axial load."""
+
 CRITERIA = ("time", "axial_load")
 """Abscissae of the slope criterion: slip against time (k2) or against the measured axial load
 (k1), as a test program's ``stability_criterion`` says."""
@@ -30,14 +34,19 @@ class MonitorSettings:
         contact_angle_deg: contact angle of the slip formula, degrees; negative: nominal.
         window_revolutions: whole cage revolutions per slip window (>= 1).
         criterion: "time" or "axial_load".
+        slip_reference: "nominal" (the paper's slip, Eq. 11-12 at ``contact_angle_deg``) or
+            "loaded" (the kinematic slip at the contact angle of the measured axial load,
+            Harris's thrust equilibrium): the slip the criterion judges; both are reported.
         critical_slope_pct_per_s: k2, %/s.
         critical_slope_pct_per_n: k1, %/N.
         slope_span_s: trailing window of the slope against time, s.
         slope_max_span_s: longest stretch of a steady series the slope against time may rest on
             when the trailing window cannot decide, s (>= slope_span_s).
-        slope_span_n: trailing window of the slope against load, N.
-        load_step_n: with the load criterion, the windows are averaged in bins of this width of
-            measured load, one slip point per bin, N.
+        load_step_n: with the load criterion, windows whose measured loads stay within half of
+            this are one hold at one load, N (:mod:`~bearing_rig_sim.monitoring.load_sweep`).
+        sweep_settle_s: a hold's windows count for its load point from this long after its
+            first window, s.
+        sweep_average_s: and are averaged over this long, s.
         min_slope_points: points needed for a slope (>= 3).
         slip_resolution_pct: least scatter of the slip believed, percentage points.
         change_threshold: prediction standard errors for a change in the slip (1).
@@ -58,12 +67,14 @@ class MonitorSettings:
     contact_angle_deg: float
     window_revolutions: int
     criterion: str
+    slip_reference: str
     critical_slope_pct_per_s: float
     critical_slope_pct_per_n: float
     slope_span_s: float
     slope_max_span_s: float
-    slope_span_n: float
     load_step_n: float
+    sweep_settle_s: float
+    sweep_average_s: float
     min_slope_points: int
     slip_resolution_pct: float
     change_threshold: float
@@ -95,8 +106,12 @@ class MonitorSettings:
         criterion = s.string("criterion")
         if criterion not in CRITERIA:
             raise s.error("criterion", f"must be one of {', '.join(CRITERIA)}, got {criterion!r}")
+        reference = s.string("slip_reference")
+        if reference not in SLIP_REFERENCES:
+            raise s.error("slip_reference", f"must be one of {', '.join(SLIP_REFERENCES)}, got {reference!r}")
         return cls(
             bearing_file=bearing,
+            slip_reference=reference,
             contact_angle_deg=s.number("contact_angle_deg", lt=90.0),
             window_revolutions=s.integer("window_revolutions", ge=1, le=1000),
             criterion=criterion,
@@ -104,8 +119,9 @@ class MonitorSettings:
             critical_slope_pct_per_n=s.number("critical_slope_pct_per_n"),
             slope_span_s=s.number("slope_span_s", gt=0.0),
             slope_max_span_s=s.number("slope_max_span_s", gt=0.0),
-            slope_span_n=s.number("slope_span_n", gt=0.0),
             load_step_n=s.number("load_step_n", gt=0.0),
+            sweep_settle_s=s.number("sweep_settle_s", ge=0.0),
+            sweep_average_s=s.number("sweep_average_s", gt=0.0),
             min_slope_points=s.integer("min_slope_points", ge=3),
             slip_resolution_pct=s.number("slip_resolution_pct", gt=0.0),
             change_threshold=s.number("change_threshold", gt=0.0),

@@ -3,8 +3,8 @@ around :class:`~bearing_rig_sim.monitoring.SlipMonitor` and the
 :class:`~bearing_rig_sim.monitoring.StatusSchedule` that offline analysis runs too).
 
 Subscribes ``/rig/spindle/pulses`` and ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse,
-sensor data) and, with the ``axial_load`` criterion, ``/rig/axial_load/force`` (the load cell), so
-it runs unchanged on the bench's topics. Publishes:
+sensor data) and ``/rig/axial_load/force`` (the load cell: the load sweep's abscissa and the
+loaded contact angle of the kinematic slip), so it runs unchanged on the bench's topics. Publishes:
 
 * ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): when the
   schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes);
@@ -102,8 +102,8 @@ class MonitorNode(ManagedNode):
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         for shaft, topic in PULSE_TOPICS.items():
             self.subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
-        if self.settings.criterion == "axial_load":
-            self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
+        # the load cell: the load sweep's abscissa and the loaded contact angle of the kinematic slip
+        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)

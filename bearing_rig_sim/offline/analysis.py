@@ -52,6 +52,7 @@ from collections.abc import Callable
 
 
 from bearing_rig_sim import interfaces as contract
+from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
@@ -76,6 +77,7 @@ from bearing_rig_sim.offline.series import (
     csv_columns,
 )
 from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype
 PULSE_TOPICS: dict[str, str] = {shaft: t.name for shaft, t in contract.PULSE_TOPICS.items()}
@@ -180,6 +182,10 @@ class OfflineResult:
     transitions_dropped: int = 0
     segments: list[SegmentSummary] = field(default_factory=list)
     csv_files: list[Path] = field(default_factory=list)
+    sweeps: list[LoadSweepVerdict] = field(default_factory=list)
+    """The offline monitor's load-sweep verdict per spindle speed (``axial_load`` criterion)."""
+    recorded_sweeps: dict[int, str] = field(default_factory=dict)
+    """The recorded statuses' latest load-sweep verdict per speed (rpm rounded to 10 -> text)."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -332,7 +338,7 @@ class OfflineAnalysis:
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
             handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
-            if name == LOAD_CELL and self.settings.criterion == "axial_load":
+            if name == LOAD_CELL:  # the load sweep's abscissa and the kinematic slip's contact angle
                 handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
@@ -401,6 +407,7 @@ class OfflineAnalysis:
             self._emit(final.time, final.reason, final.status)
             self.result.final_status = final.status
         self.result.segments = self._segments.finish()
+        self.result.sweeps = list(self.monitor.sweep.verdicts)
 
     # -- context topics ------------------------------------------------------------------------
     def _decoded(self, topic: str, log_time_ns: int, data: bytes) -> tuple[Any, float]:
@@ -429,6 +436,9 @@ class OfflineAnalysis:
             self._transition(result.recorded_transitions, stamp, state)
         result.final_recorded_state = state
         self._recorded = message
+        verdict, speed = getattr(message, "sweep_verdict", ""), float(getattr(message, "sweep_speed", _NAN))
+        if verdict and math.isfinite(speed):
+            result.recorded_sweeps[sweep_key(speed)] = verdict
         self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence), float(message.inner_ring_speed))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
@@ -497,6 +507,8 @@ class OfflineAnalysis:
             cage_speed=status.cage_speed,
             theoretical_cage_speed=status.theoretical_cage_speed,
             slip_rate=status.slip_rate,
+            kinematic_slip_rate=status.kinematic_slip_rate,
+            loaded_contact_angle=status.loaded_contact_angle,
             fitted_slope=status.fitted_slope,
             confidence=status.confidence,
             windows=status.windows,

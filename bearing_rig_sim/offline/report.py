@@ -6,8 +6,8 @@ analysis itself, as it streams):
 
 * ``speeds.png``: inner ring, cage and epicyclic cage speed (the monitor's windows), with the
   pulse counter's speeds (``/rig/speeds``) and the simulator's truth when the bag has them, rpm;
-* ``slip.png``: slip from the sensors (offline monitor), as recorded (``/rig/slip_status``) and
-  true (``/rig/truth``), %;
+* ``slip.png``: slip from the sensors (offline monitor; the paper's, and the kinematic slip at the
+  loaded contact angle), as recorded (``/rig/slip_status``) and true (``/rig/truth``), %;
 * ``axial_load.png``: set-point, load cell, force on the bearing (and the truth's), N;
 * ``status.png``: the monitor's state offline and as recorded.
 
@@ -43,6 +43,7 @@ from bearing_rig_sim.offline.analysis import (
 )
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
+from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")
@@ -166,6 +167,7 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
             "slip (%)",
             [
                 ("slip_rate", "from the sensors (offline monitor)", 1.0, {"linewidth": 1.4}),
+                ("kinematic_slip_rate", "kinematic, at the loaded contact angle (offline monitor)", 1.0, {"linewidth": 1.0}),
                 ("recorded_slip_rate", f"recorded {STATUS}", 1.0, {"linestyle": "--", "linewidth": 1.0}),
                 ("truth_slip_rate", f"truth ({TRUTH})", 1.0, {"linestyle": ":", "linewidth": 1.0}),
             ],
@@ -254,6 +256,28 @@ def _agreement(segments: Sequence[SegmentSummary]) -> str:
     )
 
 
+def _sweep_section(result: OfflineResult) -> list[str]:
+    """The load sweep by the paper's method, per speed (docs/method.md); [] when the run had none."""
+    if not result.sweeps and not result.recorded_sweeps:
+        return []
+    lines = [
+        "## Load sweep (paper section 4.1)",
+        "",
+        "Per spindle speed: the settled slip of each load point, a Gaussian sum fitted to slip against load "
+        "(1 and 2 terms, the better kept), and the load from which the fitted slope is at or above k1 "
+        "(docs/method.md).",
+        "",
+        "| speed (rpm) | load points (N) | slip (%) | verdict offline | verdict recorded |",
+        "|---|---|---|---|---|",
+    ]
+    for verdict in result.sweeps:
+        key = sweep_key(verdict.inner_ring_speed)
+        loads = ", ".join(f"{x:.0f}" for x in verdict.loads)
+        slips = ", ".join(f"{y:.3f}" for y in verdict.slips)
+        lines.append(f"| {key} | {loads} | {slips} | {verdict.describe()} | {result.recorded_sweeps.get(key, '-')} |")
+    return [*lines, ""]
+
+
 def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Sequence[Path]) -> str:
     """The report's markdown text (see the module documentation)."""
     meta = result.run_metadata
@@ -318,6 +342,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         ]
     else:
         lines += ["No segment: no spindle command, and no constant-speed stretch long enough.", ""]
+    lines += _sweep_section(result)
     lines += ["## Plots", ""]
     lines += [f"![{p.stem}]({p.name})" for p in plots]
     lines += ["", "## Topics", "", "| topic | type | messages | used for |", "|---|---|---|---|"]

@@ -54,7 +54,8 @@ class SegmentSummary:
         slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
             status / simulator truth, %.
         final_state / final_recorded_state: state at the segment's end (recorded: -1 if none).
-        time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one).
+        time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one):
+            from the ramp's end, or for a run-up (constant acceleration) from its start.
         rows: status rows after the ramp end (1).
     """
 
@@ -78,7 +79,7 @@ class SegmentSummary:
 class _Segment:
     """Accumulates one segment's figures from the status rows after its ramp end."""
 
-    def __init__(self, name: str, start: float, ramp_end: float, target: float, settings: MonitorSettings) -> None:
+    def __init__(self, name: str, start: float, ramp_end: float, target: float, settings: MonitorSettings, run_up: bool = False) -> None:
         self.name, self.start, self.ramp_end, self.target = name, start, ramp_end, target
         self.end = start
         self.sums: dict[str, list[float]] = {}
@@ -87,8 +88,9 @@ class _Segment:
         self.final_recorded = -1
         self.settings = settings
         commanded = target if math.isfinite(target) else None  # a stretch found by speed has no command
-        self.stable = TimeToStable(ramp_end, commanded)
-        self.recorded_stable = TimeToStable(ramp_end, commanded)
+        start_of_run_up = start if run_up else None
+        self.stable = TimeToStable(ramp_end, commanded, start_of_run_up)
+        self.recorded_stable = TimeToStable(ramp_end, commanded, start_of_run_up)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):
@@ -193,6 +195,7 @@ class SegmentTracker:
         ``ramp_time`` (s) or at ``acceleration`` (rad/s^2) from the previous target (the first
         time: from ``speed_now``, rad/s)."""
         previous = self._previous_target if math.isfinite(self._previous_target) else speed_now
+        run_up = profile == PROFILE_CONSTANT_ACCELERATION and acceleration > 0.0 and target != previous
         if profile == PROFILE_CONSTANT_ACCELERATION and acceleration > 0.0:
             ramp = abs(target - previous) / acceleration
         else:
@@ -200,7 +203,7 @@ class SegmentTracker:
         self._previous_target = target
         index = len(self.segments) + (self._open is not None)
         self._close()
-        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings)
+        self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings, run_up)
 
     def row(self, row: StatusRow) -> None:
         """One status row, in time order."""

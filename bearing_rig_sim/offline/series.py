@@ -63,6 +63,10 @@ class StatusRow:
     load_cell_force: float = _NAN
     bearing_force: float = _NAN
     truth_axial_load: float = _NAN
+    kinematic_slip_rate: float = _NAN
+    """The monitor's kinematic slip, at the contact angle of the measured load, %."""
+    loaded_contact_angle: float = _NAN
+    """That contact angle, rad."""
 
     @property
     def axial_load(self) -> float:

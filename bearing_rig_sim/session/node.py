@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import dataclasses
 import importlib
+import math
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -334,6 +335,8 @@ class SessionNode(Node):
                     cage_speed=msg.cage_speed,
                     window_revolutions=msg.window_revolutions,
                     confidence=msg.confidence,
+                    sweep_speed=getattr(msg, "sweep_speed", math.nan),
+                    sweep_verdict=getattr(msg, "sweep_verdict", ""),
                 )
             )
         elif name == TRUTH.name:

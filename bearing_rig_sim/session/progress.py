@@ -20,7 +20,7 @@ import math
 from collections import deque
 from dataclasses import dataclass
 from typing import TextIO
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.session.runner import SegmentOutcome, StatusState
@@ -94,14 +94,15 @@ def condition_marks(outcome: SegmentOutcome) -> str:
     return ",".join(marks) or "ok"
 
 
-def format_summary(outcomes: Sequence[SegmentOutcome]) -> str:
+def format_summary(outcomes: Sequence[SegmentOutcome], sweeps: Mapping[int, str] | None = None) -> str:
     """The summary table, one row per segment, columns aligned (numbers right, words left).
 
     ``speed rpm`` is the segment's target speed, ``meas rpm`` the monitor's measured speed after
     the ramp; ``load N`` its set-point, ``F_bearing N`` the mean force on the bearing once settled;
     the slips are the monitor's and the simulator's truth over the same window; ``t_stable s`` the
     time from the ramp end to the stable verdict; ``conditions`` ``ok``, or what was off (the
-    lines under the table say how).
+    lines under the table say how). ``sweeps`` (rpm -> verdict, :attr:`ProgramRunner.sweeps`) adds
+    the load sweep's verdict per speed under the table.
     """
     rows = [
         [
@@ -132,6 +133,9 @@ def format_summary(outcomes: Sequence[SegmentOutcome]) -> str:
     if off:
         out.append("")
         out.extend(f"conditions not met in segment {o.index + 1} {o.name}: {'; '.join(o.conditions)}" for o in off)
+    if sweeps:
+        out += ["", "load sweep by the paper's method (slip against load per speed, Gaussian fit, k1):"]
+        out.extend(f"  {rpm} rpm: {text}" for rpm, text in sweeps.items())
     return "\n".join(out)
 
 

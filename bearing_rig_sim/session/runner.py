@@ -45,9 +45,10 @@ from enum import Enum
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.load_control import settle_band
+from bearing_rig_sim.monitoring.load_sweep import sweep_key
 from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start, speed_tolerance
 from bearing_rig_sim.monitoring.settings import MonitorSettings
-from bearing_rig_sim.rig.program import Segment, SegmentSpeed, TestProgram
+from bearing_rig_sim.rig.program import Segment, SegmentSpeed, SpeedProfileKind, TestProgram
 
 __all__ = [
     "ProgramRunner",
@@ -114,6 +115,10 @@ class SlipObservation:
     """Whole cage revolutions in the slip window."""
     confidence: float = 0.0
     """P(slope >= k) of the monitor's verdict (1)."""
+    sweep_speed: float = math.nan
+    """Spindle speed of the monitor's latest load-sweep verdict, rad/s (NaN: none)."""
+    sweep_verdict: str = ""
+    """That verdict in words ("stable from 300 N (...)" or "no stable state: ...")."""
 
     @property
     def window_duration(self) -> float:
@@ -226,6 +231,9 @@ class ProgramRunner:
         self._finished = False
         self.latest_status: SlipObservation | None = None
         """The last status received, whatever its segment."""
+        self.sweeps: dict[int, str] = {}
+        """The monitor's latest load-sweep verdict per spindle speed (rpm, rounded): the paper's
+        "stable from N" or the reason there is none (:mod:`bearing_rig_sim.monitoring.load_sweep`)."""
 
     # -- state ------------------------------------------------------------------------------------
     @property
@@ -260,7 +268,8 @@ class ProgramRunner:
     def _begin(self, index: int, now: float) -> SegmentPlan:
         segment = self.program.segments[index]
         plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed))
+        run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up))
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -299,7 +308,8 @@ class ProgramRunner:
         plan = data.plan
         decisive = data.stable if data.stable is not None else data.last_status
         if data.stable is not None:
-            time_to_stable: float | None = data.stable.time - plan.ramp_end
+            assert data.rule is not None
+            time_to_stable: float | None = data.stable.time - data.rule.ramp_end
         else:
             time_to_stable = None
         settled = data.force_count > 0
@@ -338,6 +348,8 @@ class ProgramRunner:
     def observe_status(self, status: SlipObservation) -> None:
         """A slip status of the monitor (any order relative to :meth:`update`)."""
         self.latest_status = status
+        if status.sweep_verdict and math.isfinite(status.sweep_speed):
+            self.sweeps[sweep_key(status.sweep_speed)] = status.sweep_verdict
         data = self._data
         if data is None or status.time < data.plan.start_time:
             return

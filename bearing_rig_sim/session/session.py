@@ -585,7 +585,7 @@ class _Session:
             EXIT_FAILED: "summary (failed)",
         }[status]
         self.out.write(f"\n{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n")
-        self.out.write(format_summary(self.runner.outcomes) + "\n")
+        self.out.write(format_summary(self.runner.outcomes, self.runner.sweeps) + "\n")
         counts = self.recorder.counts
         total = sum(counts.values())
         if not self.options.record:

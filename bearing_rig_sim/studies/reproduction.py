@@ -5,7 +5,8 @@ a hash of every input) and hands the raw results to
 :func:`bearing_rig_sim.studies.reproduction_report.write_report`, which applies the paper's method
 (Gaussian fits, slope criterion) and writes into ``out_dir``: one CSV per experiment, one PNG per
 paper figure (5-10 analogues) and ``report.md`` with the paper's numbers beside the twin's.
-This module holds the paper's numbers, the raw-result types and their cache.
+This module runs the experiments and caches their raw results; the paper's numbers are in
+:mod:`bearing_rig_sim.studies.paper_data`, the raw-result types with the report.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ import dataclasses
 import hashlib
 import json
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 from collections.abc import Callable
@@ -23,7 +23,6 @@ import numpy as np
 from tqdm import tqdm
 
 from bearing_rig_sim import __version__
-from bearing_rig_sim.analysis.stability import K1_AXIAL_LOAD
 from bearing_rig_sim.studies.calibration import SteadyState
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.studies.experiments import (
@@ -39,49 +38,11 @@ from bearing_rig_sim.studies.experiments import (
     validation_table,
 )
 
-# -- the paper's numbers (docs/paper.md sections 9-11) ----------------------------------------------------
-PAPER_TABLE3: dict[int, tuple[float, float]] = {900: (3.22, 3.17), 1500: (4.07, 3.95), 2100: (4.64, 4.76), 2700: (5.28, 5.17)}
-"""rpm -> (bench slip %, the paper's simulated slip %), 100 N."""
-PAPER_TABLE4: dict[int, tuple[float, float, float]] = {1: (0.012, 0.9996, 0.045), 2: (0.007, 0.9993, 0.040)}
-"""Slip vs load fit quality: terms -> (SSE, R^2, RMSE)."""
-PAPER_TABLE5_1000RPM: tuple[float, ...] = (5.18, 2.05, -4.14, 530.0, 214.0, 469.0)
-"""2-term parameters at 1000 rpm (a1, a2, b1, b2, c1, c2); other rows are garbled in the source."""
-PAPER_TABLE6: dict[int, tuple[float, float, float]] = {1: (1.16e-4, 0.9997, 0.0048), 2: (1.92e-4, 0.9994, 0.0098)}
-"""Slip vs time fit quality: terms -> (SSE, R^2, RMSE)."""
-PAPER_TABLE7: dict[float, tuple[float, float, float]] = {20.0: (3.5, -1.52, 1.29), 40.0: (1.64, -0.73, 0.9), 60.0: (1.33, -0.49, 0.72), 80.0: (0.76, -0.09, 0.45)}
-"""rad/s^2 -> (lambda %, k s, d s) of y = lambda exp(-((t - k)/d)^2)."""
-
-SKID_SLIP_PCT = 20.0
-"""Slip (%) above which a steady point is gross skidding rather than rolling with creep: the
-Gaussian-slope method presumes a smooth slip curve, so such points are shown but not fitted."""
-K1_FRACTION_READING = K1_AXIAL_LOAD * 100.0
-"""k1 read as slip fraction per newton (-5e-4 %/N): the paper does not state k1's unit; this
-second reading is reported beside the first (docs/paper.md section 7)."""
+from bearing_rig_sim.studies.reproduction_report import Outputs, RawResults, write_report
 
 ACCELERATION_DURATION_S = 3.0
 """Simulated duration of each acceleration run, s (the paper's fits reach the stable state
 within about 2 s)."""
-
-
-@dataclass(frozen=True)
-class RawResults:
-    """The simulated experiments (everything the report is made from)."""
-
-    validation: list[SteadyState]
-    sweep: dict[float, list[SteadyState]]
-    acceleration: list[AccelerationSeries]
-
-
-@dataclass(frozen=True)
-class Outputs:
-    """What :func:`reproduce` wrote and the headline figures."""
-
-    out_dir: Path
-    files: list[Path]
-    validation_rms_pct: float
-    load_onsets_n: dict[float, float | None]
-    acceleration_onsets_s: dict[float, float | None]
-    cached: bool
 
 
 def inputs_key(params: BearingParameters) -> str:
@@ -181,8 +142,6 @@ def reproduce(
     else:
         raw = run_experiments(params, workers, progress)
         save_raw(raw, cache)
-    from bearing_rig_sim.studies.reproduction_report import write_report  # the report imports this module's data
-
     return write_report(raw, out, params, cached)
 
 

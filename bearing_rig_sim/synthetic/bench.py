@@ -202,3 +202,35 @@ def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
         for when, topic, message in messages:
             bag.write_message(topic, int(round(when * 1e9)), message)
     return Path(path)
+
+
+TABLE7: dict[float, tuple[float, float, float]] = {20.0: (3.5, -1.52, 1.29), 40.0: (1.64, -0.73, 0.9), 60.0: (1.33, -0.49, 0.72), 80.0: (0.76, -0.09, 0.45)}
+"""The paper's Table 7 (docs/paper.md section 11): rad/s^2 -> (lambda %, k s, d s) of the slip of a
+run-up from rest, S(t) = lambda exp(-((t - k)/d)^2)."""
+
+
+def table7_run_up(acceleration: float, final_speed: float = 157.08, duration_s: float = 8.0, **options: Any) -> BenchScenario:
+    """A run-up from rest at ``acceleration`` (rad/s^2, one of :data:`TABLE7`) to ``final_speed``
+    (rad/s, then held) whose slip follows the paper's Table 7 curve; ``options`` go to
+    :class:`BenchScenario` (jitter, seed, epicyclic ratio...)."""
+    lam, k, d = TABLE7[acceleration]
+    return BenchScenario(
+        duration_s,
+        lambda t: np.minimum(acceleration * np.asarray(t), final_speed),
+        lambda t: lam * np.exp(-(((np.asarray(t) - k) / d) ** 2)),
+        **options,
+    )
+
+
+def table7_onset(acceleration: float, critical_slope: float) -> float:
+    """Where the slope of the Table 7 curve last rises through ``critical_slope`` (%/s): the true
+    onset of the stable state, s from the run-up's start (closed form: the slope -2 lambda (t - k)/d^2
+    exp(-((t - k)/d)^2) solved by Brent's method past its steepest point, t = k + d / sqrt(2))."""
+    from scipy.optimize import brentq
+
+    lam, k, d = TABLE7[acceleration]
+
+    def margin(t: float) -> float:
+        return -2.0 * lam * (t - k) / d**2 * math.exp(-(((t - k) / d) ** 2)) - critical_slope
+
+    return float(brentq(margin, k + d / math.sqrt(2.0), k + 10.0 * d, xtol=1e-9))

@@ -55,6 +55,9 @@ class Lubricant:
             (oil bath level, grease left in the swept volume after running-in), 1.
         yield_stress, consistency, flow_index: Herschel-Bulkley rheology of a grease
             tau = tau_y + K gamma_dot^n (Pa, Pa s^n, 1); zero for oils.
+        specific_heat: of the lubricant (grease or oil), J/(kg K).
+        yield_stress_temperature_coefficient: c of tau_y(T) = tau_y(T_ref) exp(-c (T - T_ref)),
+            1/K (grease; :meth:`at_temperature`).
         source: file name.
     """
 
@@ -75,6 +78,8 @@ class Lubricant:
     consistency: float
     flow_index: float
     source: str = "<memory>"
+    specific_heat: float = 1900.0
+    yield_stress_temperature_coefficient: float = 0.0
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> Lubricant:
@@ -113,6 +118,11 @@ class Lubricant:
             consistency=grease.number("consistency_pa_sn", gt=0.0, le=1e3) if is_grease else 0.0,
             flow_index=grease.number("flow_index", gt=0.0, le=1.0) if is_grease else 1.0,
             source=doc.source,
+            # [1600, 2400] J/(kg K): mineral and ester oils and their greases at 20-150 degC
+            specific_heat=oil.number("specific_heat_j_kg_k", ge=1600.0, le=2400.0, default=1900.0),
+            yield_stress_temperature_coefficient=(
+                grease.number("yield_stress_temperature_coefficient_1_k", ge=0.0, le=0.05, default=0.0) if is_grease else 0.0
+            ),
         )
 
     # -- base-oil properties at temperature ---------------------------------------------------
@@ -147,6 +157,19 @@ class Lubricant:
         """Roelands pressure-viscosity index Z matching alpha at low pressure:
         alpha = Z (ln eta0 + 9.67) / p0 (Roelands 1966; Hamrock, Schmid and Jacobson, ch. 4)."""
         return self.pressure_viscosity * ROELANDS_P0 / (math.log(self.dynamic_viscosity(temperature_c)) - ROELANDS_LN_ETA_INF)
+
+    def at_temperature(self, temperature_c: float, reference_c: float) -> Lubricant:
+        """The grease's bulk rheology at ``temperature_c`` given its values at ``reference_c``
+        (degC): the consistency K follows the base oil's dynamic viscosity,
+        K(T) = K(T_ref) eta(T) / eta(T_ref) (the sheared grease's plastic viscosity scales with
+        its base oil's), and the yield stress falls as tau_y(T_ref) exp(-c (T - T_ref)) with c
+        :attr:`yield_stress_temperature_coefficient`. An oil is returned unchanged (its viscosity
+        is a function of temperature already)."""
+        if self.kind != "grease" or temperature_c == reference_c:
+            return self
+        ratio = self.dynamic_viscosity(temperature_c) / self.dynamic_viscosity(reference_c)
+        shift = math.exp(-self.yield_stress_temperature_coefficient * (temperature_c - reference_c))
+        return dataclasses.replace(self, consistency=self.consistency * ratio, yield_stress=self.yield_stress * shift)
 
     def replace_rheology(self, **changes: float) -> Lubricant:
         """A copy with some numeric fields changed (calibrated values)."""

@@ -312,7 +312,30 @@ def harris_thrust_angle(axial_load: float, ball_count: int, free_angle: float, b
 
 SKF_ACBB_SINGLE_ROW = {"R1": 5.03e-7, "R2": 1.97, "R3": 1.90e-12, "S1": 1.30e-2, "S2": 0.68, "S3": 1.91e-12, "KZ": 4.4}
 """SKF catalogue geometry constants of single-row angular contact ball bearings (chapter
-"Friction", tables of R1..S3 and K_z); dm in mm, loads in N, n in rpm, moments in N mm."""
+"Friction", tables of R1..S3 and K_z); dm in mm, loads in N, n in rpm, moments in N mm. They are
+published for the 72 B(E) and 73 B(E) series only, whose contact angle is 40 deg
+(:data:`SKF_ACBB_CONTACT_ANGLE_DEG`); SKF's super-precision catalogue (718/719/70 CD, 15 deg)
+publishes none."""
+
+SKF_ACBB_CONTACT_ANGLE_DEG = 40.0
+"""Contact angle of the bearings :data:`SKF_ACBB_SINGLE_ROW` is published for, deg."""
+
+
+def skf_acbb_constants(contact_angle: float) -> dict[str, float]:
+    """The 72 B constants moved to another contact angle (rad) with the catalogue's own
+    contact-angle law, that of its deep groove ball bearings under axial load: there the axial
+    load enters the rolling variable as R2 F_a / sin(alpha) and the sliding variable's
+    F_a^(4/3) term as S2 / sin(alpha)^(1/3) (an axial load F_a gives contact loads
+    F_a / (Z sin alpha), and spin grows with sin alpha). So, from alpha_0 = 40 deg:
+
+        R2(alpha) = R2 sin(alpha_0) / sin(alpha),   S2(alpha) = S2 (sin(alpha_0) / sin(alpha))^(1/3);
+
+    R1, R3, S1, S3 and K_z are kept. At 15 deg: R2 = 4.89, S2 = 0.921 (1.97 and 0.68 at 40 deg)."""
+    c = dict(SKF_ACBB_SINGLE_ROW)
+    ratio = math.sin(math.radians(SKF_ACBB_CONTACT_ANGLE_DEG)) / math.sin(contact_angle)
+    c["R2"] *= ratio
+    c["S2"] *= ratio ** (1.0 / 3.0)
+    return c
 
 
 @dataclass(frozen=True)
@@ -330,7 +353,16 @@ class SkfMoment:
 
 
 def skf_frictional_moment(
-    rpm: float, axial_load: float, bore: float, outside_diameter: float, kinematic_viscosity: float, *, mu_ehl: float = 0.05, mu_bl: float = 0.15, k_rs: float = 6e-8
+    rpm: float,
+    axial_load: float,
+    bore: float,
+    outside_diameter: float,
+    kinematic_viscosity: float,
+    *,
+    mu_ehl: float = 0.05,
+    mu_bl: float = 0.15,
+    k_rs: float = 6e-8,
+    contact_angle: float | None = None,
 ) -> SkfMoment:
     """The SKF model (catalogue chapter "Friction") for a single-row angular contact ball bearing
     under a pure axial load, oil lubricated without drag losses (oil-air or minimal oil):
@@ -342,9 +374,11 @@ def skf_frictional_moment(
         phi_rs = exp(-K_rs nu n (d + D) sqrt(K_z / (2 (D - d)))).
 
     Args: inner-ring speed (rpm), axial load (N), bore d and outside diameter D (m), operating
-    kinematic viscosity (m^2/s); mu_EHL 0.05 (mineral oil), mu_bl 0.15, K_rs 6e-8 (oil-air).
+    kinematic viscosity (m^2/s); mu_EHL 0.05 (mineral oil), mu_bl 0.15, K_rs 6e-8 (oil-air);
+    ``contact_angle`` (rad): the constants moved to it (:func:`skf_acbb_constants`); None: the
+    published 72 B constants (40 deg).
     """
-    c = SKF_ACBB_SINGLE_ROW
+    c = SKF_ACBB_SINGLE_ROW if contact_angle is None else skf_acbb_constants(contact_angle)
     d, big_d = bore * 1e3, outside_diameter * 1e3
     dm = 0.5 * (d + big_d)
     nu = kinematic_viscosity * 1e6

@@ -41,6 +41,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from numba import njit
 
 from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
@@ -153,28 +154,38 @@ class HeatSources:
         return self.inner_contacts + self.outer_contacts + self.drag + self.land + self.rolling_and_pockets
 
 
+@njit(cache=True)
+def _split(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, out: np.ndarray, ring: np.ndarray) -> tuple[float, float, float, float, float]:
+    """(inner contacts, outer contacts, drag, land, total) W, with the engine's kernels."""
+    z = ball.shape[0]
+    omega_i = ring[kn.R_OMEGA]
+    pin = 0.0
+    pout = 0.0
+    drag = 0.0
+    land = 0.0
+    total = 0.0
+    for j in range(z):
+        rb, zb, wm = ball[j, kn.B_R], ball[j, kn.B_Z], ball[j, kn.B_OMEGA]
+        _, nir, niz, _, _, nor, noz, _ = kn.raceway_geometry(p, rb, zb, ring[kn.R_DELTA])
+        r_ci, r_co, _, _, _, _, _, _, _ = kn.ball_kinematics(p, nir, niz, nor, noz, rb)
+        qi, qo = out[j, kn.O_QI], out[j, kn.O_QO]
+        if qi > 0.0:
+            pin += kn.contact_power(p, 0, out[j, kn.O_SI], abs((omega_i - wm) * r_ci), qi)
+        if qo > 0.0:
+            pout += kn.contact_power(p, 1, out[j, kn.O_SO], abs(wm * r_co), qo)
+        fd, _ = kn.ball_drag(p, rb * wm)
+        drag += abs(fd * rb * wm)
+        w = cage[j, kn.C_OMEGA]
+        tl, _ = kn.cage_land_torque(p, w, z)
+        land += abs(tl * w)
+        total += out[j, kn.O_POWER]
+    return pin, pout, drag, land, total + land
+
+
 def heat_sources(engine: BearingDynamics) -> HeatSources:
     """Split the engine's dissipation at its last step (:meth:`BearingDynamics.power_loss`)
     into its terms, with the engine's own kernels (contact power, drag, land torque)."""
-    p, ball, cage, out, ring = engine.vector, engine.ball, engine.cage, engine.out, engine.ring
-    z = ball.shape[0]
-    omega_i = float(ring[kn.R_OMEGA])
-    pin = pout = drag = land = 0.0
-    for j in range(z):
-        rb, zb, wm = float(ball[j, kn.B_R]), float(ball[j, kn.B_Z]), float(ball[j, kn.B_OMEGA])
-        _, nir, niz, _, _, nor, noz, _ = kn.raceway_geometry(p, rb, zb, float(ring[kn.R_DELTA]))
-        r_ci, r_co, _, _, _, _, aom, _, _ = kn.ball_kinematics(p, nir, niz, nor, noz, rb)
-        qi, qo = float(out[j, kn.O_QI]), float(out[j, kn.O_QO])
-        if qi > 0.0:
-            pin += kn.contact_power(p, 0, float(out[j, kn.O_SI]), abs((omega_i - wm) * r_ci), qi)
-        if qo > 0.0:
-            pout += kn.contact_power(p, 1, float(out[j, kn.O_SO]), abs(wm * r_co), qo)
-        fd, _ = kn.ball_drag(p, rb * wm)
-        drag += abs(fd * rb * wm)
-        w = float(cage[j, kn.C_OMEGA])
-        tl, _ = kn.cage_land_torque(p, w, z)
-        land += abs(tl * w)
-    total = float(np.sum(out[:, kn.O_POWER])) + land
+    pin, pout, drag, land, total = _split(engine.vector, engine.ball, engine.cage, engine.out, engine.ring)
     rest = max(total - pin - pout - drag - land, 0.0)
     return HeatSources(pin, pout, drag, land, rest)
 

@@ -73,7 +73,7 @@ class ThermalCoupling:
         initial: start temperature of every node, degC (default: ambient).
     """
 
-    def __init__(self, engine: BearingDynamics, config: ThermalConfig, *, interval: float = 0.1, retune_k: float = 0.25, initial: float | None = None) -> None:
+    def __init__(self, engine: BearingDynamics, config: ThermalConfig, *, interval: float = 0.1, retune_k: float = 0.5, initial: float | None = None) -> None:
         if not math.isfinite(interval) or interval <= 0.0:
             raise ValueError(f"interval must be > 0 s, got {interval!r}")
         self.engine = engine

@@ -87,6 +87,7 @@ LOAD_STATE, LOAD_SETPOINT, LOAD_CELL, BEARING_FORCE = (
     "/rig/axial_load/force",
     "/rig/bearing/axial_force",
 )
+OUTER_RING_TEMPERATURE, HOUSING_TORQUE = "/rig/outer_ring/temperature", "/rig/housing/torque"
 CONTEXT_TOPICS: dict[str, str] = {
     SPEEDS: "sensor_msgs/msg/JointState",
     TRUTH: "bearing_rig_msgs/msg/SimulatorTruth",
@@ -96,6 +97,8 @@ CONTEXT_TOPICS: dict[str, str] = {
     LOAD_SETPOINT: "std_msgs/msg/Float64",
     LOAD_CELL: "geometry_msgs/msg/WrenchStamped",
     BEARING_FORCE: "geometry_msgs/msg/WrenchStamped",
+    OUTER_RING_TEMPERATURE: "sensor_msgs/msg/Temperature",
+    HOUSING_TORQUE: "geometry_msgs/msg/WrenchStamped",
 }
 """Topics read when present, with the type they must carry."""
 
@@ -499,6 +502,10 @@ class OfflineAnalysis:
             values["load_cell_force"] = float(get[LOAD_CELL].wrench.force.z)
         if get.get(BEARING_FORCE) is not None:
             values["bearing_force"] = float(get[BEARING_FORCE].wrench.force.z)
+        if get.get(OUTER_RING_TEMPERATURE) is not None:
+            values["outer_ring_temperature"] = float(get[OUTER_RING_TEMPERATURE].temperature)
+        if get.get(HOUSING_TORQUE) is not None:
+            values["housing_torque"] = float(get[HOUSING_TORQUE].wrench.torque.z)
         if self._recorded is not None:
             values["recorded_state"] = int(self._recorded.state)
             values["recorded_slip_rate"] = float(self._recorded.slip_rate)

@@ -63,6 +63,10 @@ class StatusRow:
     load_cell_force: float = _NAN
     bearing_force: float = _NAN
     truth_axial_load: float = _NAN
+    outer_ring_temperature: float = _NAN
+    """The outer-ring thermocouple, degC."""
+    housing_torque: float = _NAN
+    """The housing torque meter, N m."""
 
     @property
     def axial_load(self) -> float:

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -215,7 +216,7 @@ class RigTwin:
         """The bearing's thermal network, when attached (:meth:`attach_thermal`): it takes the
         engine's heat chunk by chunk and sets the lubricant's temperature."""
 
-    def attach_thermal(self, bearing_file: str | Path | None = None, **options: float) -> ThermalCoupling:
+    def attach_thermal(self, bearing_file: str | Path | None = None, **options: Any) -> ThermalCoupling:
         """Couple the bearing's thermal network (the bearing file's ``thermal:`` section; default
         the shipped H7006C) to the engine from the next chunk on; ``options`` are those of
         :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`."""

@@ -71,15 +71,20 @@ class ThermalCoupling:
         retune_k: lubricant temperature change (K) after which the engine's resistances are
             set to the new temperature.
         initial: start temperature of every node, degC (default: ambient).
+        feedback: set the engine's resistances to the lubricant's temperature (both ways); False
+            leaves the engine as its parameters say and only tracks the temperatures (one way).
     """
 
-    def __init__(self, engine: BearingDynamics, config: ThermalConfig, *, interval: float = 0.1, retune_k: float = 0.5, initial: float | None = None) -> None:
+    def __init__(
+        self, engine: BearingDynamics, config: ThermalConfig, *, interval: float = 0.1, retune_k: float = 0.5, initial: float | None = None, feedback: bool = True
+    ) -> None:
         if not math.isfinite(interval) or interval <= 0.0:
             raise ValueError(f"interval must be > 0 s, got {interval!r}")
         self.engine = engine
         self.config = config
         self.interval = float(interval)
         self.retune_k = float(retune_k)
+        self.feedback = bool(feedback)
         self.params = engine.params
         self._operating = (max(engine.inner_ring_speed, 1.0), engine.axial_load)
         self.network = build_network(self.params, config, *self._operating, initial=initial)
@@ -88,7 +93,8 @@ class ThermalCoupling:
         """The lubricant temperature the engine's resistances are set to, degC."""
         self.sources = HeatSources(0.0, 0.0, 0.0, 0.0, 0.0)
         """The latest heat split, W."""
-        self._retune(self.network.temperature("lubricant"))
+        if self.feedback:
+            self._retune(self.network.temperature("lubricant"))
 
     def temperature(self, node: str) -> float:
         """A node's temperature, degC."""
@@ -114,7 +120,7 @@ class ThermalCoupling:
         self.network.step(self.network.heat_vector(node_heat(self.sources)), self._pending)
         self._pending = 0.0
         t_lub = self.network.temperature("lubricant")
-        if abs(t_lub - self.applied_temperature) >= self.retune_k:
+        if self.feedback and abs(t_lub - self.applied_temperature) >= self.retune_k:
             self._retune(t_lub)
         return True
 

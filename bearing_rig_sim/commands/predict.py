@@ -69,12 +69,34 @@ def run(args: argparse.Namespace) -> int:
     if args.thermal or args.transient is not None:
         return _run_thermal(args, params, loads)
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
+    unc = _uncertainty(args)
     for s in states:
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
+        if unc is not None:
+            _add_interval(row, params, unc, s.inner_ring_speed, s.axial_load, s.slip_pct)
         row.update(s.losses_row(params.composite_roughness))
         _print(row, args.json)
     return 0
+
+
+def _uncertainty(args: argparse.Namespace) -> Any:
+    """The calibration's uncertainty block, when the calibration in use has one."""
+    from bearing_rig_sim.studies.uncertainty import read_uncertainty
+
+    if args.lubricant is not None and args.calibration is None:
+        return None
+    return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+
+
+def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float) -> None:
+    """``slip_pct_low`` / ``slip_pct_high``: the 95 % interval from the parameter and load
+    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`)."""
+    from bearing_rig_sim.studies.uncertainty import slip_interval
+
+    low, high, _ = slip_interval(params, unc, omega, load, slip)
+    row["slip_pct_low"] = round(low, 4)
+    row["slip_pct_high"] = round(high, 4)
 
 
 def _print(row: dict[str, Any], as_json: bool) -> None:
@@ -88,6 +110,8 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
         f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %"
         f"   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm   power {row['power_loss_w']:7.2f} W"
     )
+    if "slip_pct_low" in row:
+        line += f"   slip 95 % [{row['slip_pct_low']:.3f}, {row['slip_pct_high']:.3f}] %"
     if "outer_ring_temperature_c" in row:
         line += f"   outer ring {row['outer_ring_temperature_c']:6.2f} degC"
     print(line)
@@ -97,7 +121,7 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
     from bearing_rig_sim.config import rad_s_to_rpm
     from bearing_rig_sim.studies.calibration import SteadyState
     from bearing_rig_sim.thermal.bearing import ThermalConfig
-    from bearing_rig_sim.thermal.coupling import thermal_steady_state, warm_up
+    from bearing_rig_sim.thermal.coupling import params_at_temperature, thermal_steady_state, warm_up
 
     cfg = ThermalConfig.from_yaml(args.bearing)
     for n, f in zip(args.rpm, loads):
@@ -120,6 +144,9 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
             "land": round(ts.sources.land, 4), "rolling_and_pockets": round(ts.sources.rolling_and_pockets, 4),
         }
         row["time_constants_s"] = [round(t, 1) for t in ts.time_constants[:3]]
+        unc = _uncertainty(args)
+        if unc is not None:
+            _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
         iso = steady_states(params, [(omega, f)], workers=1)[0]
         row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso.slip_pct, 4), "friction_torque_nm": round(iso.friction_torque, 6)}
         _print(row, args.json)

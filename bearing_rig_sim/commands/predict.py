@@ -41,8 +41,14 @@ def register(subparsers: Any) -> None:
 
 def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: Path | None) -> BearingParameters:
     """The bearing file with the calibration laid over it and, with ``lubricant``, that lubricant
-    file in place of the bearing file's (the calibration then only when named explicitly)."""
+    file in place of the bearing file's (the calibration then only when named explicitly). The
+    shipped calibration belongs to the shipped bearing: another bearing file gets it only when
+    named."""
     doc = load_yaml(bearing or config_path("bearings", "h7006c.yaml"))
+    if bearing is not None and calibration is None:
+        if lubricant is not None:
+            doc.section("lubricant").data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
+        return BearingParameters.from_section(doc)
     if lubricant is not None:
         lub = doc.section("lubricant")
         lub.data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
@@ -84,7 +90,7 @@ def _uncertainty(args: argparse.Namespace) -> Any:
     """The calibration's uncertainty block, when the calibration in use has one."""
     from bearing_rig_sim.studies.uncertainty import read_uncertainty
 
-    if args.lubricant is not None and args.calibration is None:
+    if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
         return None
     return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
 

@@ -69,6 +69,7 @@ def test_predict_thermal_is_a_fixed_point_of_heat_and_temperature(capsys: pytest
         assert 22.0 < temps["housing"] < temps["outer_ring"] < temps["balls"]
         assert r["outer_ring_temperature_c"] == temps["outer_ring"]
         assert r["time_constants_s"][0] > 300.0
+        assert abs(r["thermal_residual_k"]) <= 0.2  # converged: heat and temperature agree
     assert rows[1]["outer_ring_temperature_c"] > rows[0]["outer_ring_temperature_c"]
 
 

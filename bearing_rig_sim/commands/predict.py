@@ -150,6 +150,7 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
             "land": round(ts.sources.land, 4), "rolling_and_pockets": round(ts.sources.rolling_and_pockets, 4),
         }
         row["time_constants_s"] = [round(t, 1) for t in ts.time_constants[:3]]
+        row["thermal_residual_k"] = round(ts.residual_k, 3)
         unc = _uncertainty(args)
         if unc is not None:
             _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)

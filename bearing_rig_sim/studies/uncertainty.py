@@ -181,7 +181,7 @@ def check_identifiable(names: Sequence[str], noise_correlation: np.ndarray, cond
 def _slips(params: BearingParameters, points: Sequence[tuple[float, float]]) -> np.ndarray:
     from bearing_rig_sim.studies.calibration import steady_states
 
-    return np.array([s.slip_pct for s in steady_states(params, points, workers=1)])
+    return np.array([s.slip_pct for s in steady_states(params, points)])  # on the Dask cluster when one is set
 
 
 def _shifted(params: BearingParameters, names: Sequence[str], values: Sequence[float], k: int) -> BearingParameters:

@@ -29,6 +29,7 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
+from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.thermal.bearing import HeatSources, ThermalConfig, build_network, heat_sources, node_heat
 from bearing_rig_sim.thermal.network import ThermalNetwork
 
@@ -141,6 +142,8 @@ class ThermalSteadyState:
         temperatures: every node's steady temperature, degC.
         iterations: engine steady solutions used.
         time_constants: the network's time constants there, s (longest first).
+        residual_k: the network's steady lubricant temperature less the one the engine ran at,
+            K (within the tolerance when converged).
     """
 
     point: SteadyPoint
@@ -148,6 +151,13 @@ class ThermalSteadyState:
     temperatures: dict[str, float]
     iterations: int
     time_constants: tuple[float, ...] = field(default=())
+    residual_k: float = 0.0
+
+
+MAX_STEP_K = 40.0
+"""Largest change of the lubricant temperature per secant step of :func:`thermal_steady_state`, K."""
+MAX_LUBRICANT_C = 200.0
+"""Highest lubricant temperature the steady search tries, degC (the lubricant files' range)."""
 
 
 class _HeatAtTemperature:
@@ -162,7 +172,17 @@ class _HeatAtTemperature:
         key = round(float(temperature_c), 3)
         got = self.cache.get(key)
         if got is None:
-            solver = SteadySolver(params_at_temperature(self.params, key))
+            warm = params_at_temperature(self.params, key)
+            for _ in range(4):
+                try:
+                    solver = SteadySolver(warm)
+                    break
+                except StepLimitError:
+                    # the lubricant at this temperature lowers the step's stability limit; the
+                    # steady solution does not depend on the step (dynamics/steady.py): halve it
+                    warm = warm.replace(reduced_time_step=0.5 * warm.reduced_time_step)
+            else:
+                raise StepLimitError(f"no stable step for {self.params.source} with the lubricant at {key:g} degC")
             point = solver.solve(self.speed, self.load)
             got = self.cache[key] = (point, heat_sources(solver.engine))
         return got
@@ -173,7 +193,7 @@ def _steady_temperatures(params: BearingParameters, config: ThermalConfig, speed
     return net.steady(node_heat(sources)), net
 
 
-def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, *, tolerance_k: float = 0.2, max_iter: int = 8) -> ThermalSteadyState:
+def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, *, tolerance_k: float = 0.2, max_iter: int = 10) -> ThermalSteadyState:
     """The steady state where the dissipation at the lubricant temperature T heats the network to
     T: the root of g(T) = T_lub,ss(heat(T)) - T by secant steps from the bearing file's
     temperature (g falls with T: warmer lubricant, less heat)."""
@@ -185,9 +205,14 @@ def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner
         temps, _ = _steady_temperatures(params, config, inner_ring_speed, axial_load, t, src)
         return float(temps[lub_i]) - t
 
-    t0 = params.lubricant_temperature
+    lo, hi = config.ambient - 5.0, MAX_LUBRICANT_C
+
+    def clamp(t: float) -> float:
+        return min(max(t, lo), hi)
+
+    t0 = clamp(params.lubricant_temperature)
     g0 = g(t0)
-    t1 = t0 + g0
+    t1 = clamp(t0 + max(min(g0, MAX_STEP_K), -MAX_STEP_K))
     g1 = g(t1)
     it = 2
     while abs(g1) > tolerance_k and it < max_iter:
@@ -195,12 +220,12 @@ def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner
         if not slope < 0.0:
             slope = -1.0
         t0, g0 = t1, g1
-        t1 = t1 - g1 / slope
+        t1 = clamp(t1 + max(min(-g1 / slope, MAX_STEP_K), -MAX_STEP_K))
         g1 = g(t1)
         it += 1
     point, src = heat(t1)
     temps, net = _steady_temperatures(params, config, inner_ring_speed, axial_load, t1, src)
-    return ThermalSteadyState(point, src, dict(zip(net.names, map(float, temps))), it, tuple(map(float, net.time_constants())))
+    return ThermalSteadyState(point, src, dict(zip(net.names, map(float, temps))), it, tuple(map(float, net.time_constants())), float(g1))
 
 
 def warm_up(params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, duration: float, *, step: float = 1.0, grid: int = 4) -> list[dict[str, float]]:

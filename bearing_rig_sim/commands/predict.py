@@ -7,7 +7,11 @@ temperature, with ``outer_ring_temperature_c``, ``lubricant_temperature_c`` and 
 bearing file's temperature under ``isothermal``. ``--transient S`` prints the warm-up from
 ambient over S seconds instead (one row per ``--transient-step``). ``--lubricant FILE`` replaces
 the bearing file's lubricant (the calibration's lubricant values are laid over it only when
-``--calibration`` is given).
+``--calibration`` is given); the shipped calibration belongs to the shipped bearing, so another
+``--bearing`` gets a calibration only when one is named. When the calibration file has an
+``uncertainty:`` block (``bearing-rig calibrate`` writes it), each point gets ``slip_pct_low`` and
+``slip_pct_high``, its 95 % interval from the parameter and load uncertainty
+(:mod:`bearing_rig_sim.studies.uncertainty`).
 """
 
 from __future__ import annotations

@@ -215,6 +215,24 @@ TWIN_ESTIMATE = Topic(
     "the parameter's",
     "shadow",
 )
+OUTER_RING_TEMPERATURE = Topic(
+    "/rig/outer_ring/temperature",
+    "sensor_msgs/msg/Temperature",
+    "reliable",
+    "10 Hz (sim)",
+    "degC (the message type's unit), variance K^2",
+    "simulator (bench: outer-ring thermocouple)",
+    note="temperature",
+)
+HOUSING_TORQUE = Topic(
+    "/rig/housing/torque",
+    "geometry_msgs/msg/WrenchStamped",
+    "reliable",
+    "100 Hz (sim)",
+    "N m",
+    "simulator (bench: torque meter on the housing)",
+    note="torque.z, the friction torque about the spindle axis",
+)
 DIAGNOSTICS = Topic(
     "/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node"
 )
@@ -233,6 +251,8 @@ TOPICS: tuple[Topic, ...] = (
     SLIP_STATUS,
     TWIN_RESIDUAL,
     TWIN_ESTIMATE,
+    OUTER_RING_TEMPERATURE,
+    HOUSING_TORQUE,
     DIAGNOSTICS,
 )
 """Every topic of the contract, in the table's order. The session records all of them."""

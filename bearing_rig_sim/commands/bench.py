@@ -30,6 +30,7 @@ BENCHMARKS: dict[str, str] = {
     "rig": "bearing_rig_sim.benchmarks.rig",
     "sweep": "bearing_rig_sim.benchmarks.sweep",
     "shadow": "bearing_rig_sim.benchmarks.shadow",
+    "thermal": "bearing_rig_sim.benchmarks.thermal",
 }
 """Benchmark name -> module path (``bearing_rig_sim.benchmarks.<name>``)."""
 

@@ -1,11 +1,24 @@
 """``bearing-rig predict --rpm R [R ...] --load N``: steady cage speed and slip from the calibrated
 engine (one JSON object per line with ``--json``).
 
+With ``--thermal`` each point is the coupled thermal steady state (bearing_rig_sim/thermal,
+docs/thermal.md): slip, ``friction_torque_nm`` and ``power_loss_w`` at the lubricant's steady
+temperature, with ``outer_ring_temperature_c``, ``lubricant_temperature_c`` and the values at the
+bearing file's temperature under ``isothermal``. ``--transient S`` prints the warm-up from
+ambient over S seconds instead (one row per ``--transient-step``). ``--lubricant FILE`` replaces
+the bearing file's lubricant (the calibration's lubricant values are laid over it only when
+``--calibration`` is given); the shipped calibration belongs to the shipped bearing, so another
+``--bearing`` gets a calibration only when one is named. When the calibration file has an
+``uncertainty:`` block (``bearing-rig calibrate`` writes it), each point gets ``slip_pct_low`` and
+``slip_pct_high``, its 95 % interval from the parameter and load uncertainty
+(:mod:`bearing_rig_sim.studies.uncertainty`).
+
 With ``--radial-load`` (and ``--moment``) each point also gets the quasi-static load
 distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max_n``,
 ``ball_load_min_n``, ``loaded_balls``, ``contact_angle_max_load_deg`` and, with the tilt held
 (no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. The slip is still that of the axial load
-(the dynamic engine is axisymmetric); ``cage_whirl_radius_um`` is not computed (no cage whirl)."""
+(the dynamic engine is axisymmetric); ``cage_whirl_radius_um`` is not computed (no cage whirl).
+"""
 
 from __future__ import annotations
 
@@ -15,11 +28,12 @@ import math
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.studies.calibration import steady_states
-from bearing_rig_sim.config import check_number, config_path, rpm_to_rad_s
+from bearing_rig_sim.config import check_number, config_path, load_yaml, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.studies.calibration import steady_states
 
 
 def register(subparsers: Any) -> None:
@@ -31,8 +45,32 @@ def register(subparsers: Any) -> None:
     p.add_argument("--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
     p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: config/calibration/h7006c_table3.yaml)")
+    p.add_argument("--lubricant", type=Path, default=None, help="lubricant file replacing the bearing file's (config/lubricants/)")
+    p.add_argument("--thermal", action="store_true", help="at the thermal steady state (torque, temperatures)")
+    p.add_argument("--transient", type=float, default=None, metavar="S", help="warm-up from ambient over S seconds (one row per step)")
+    p.add_argument("--transient-step", type=float, default=10.0, metavar="S", help="step of the warm-up rows, s (default 10)")
     p.add_argument("--json", action="store_true", help="one JSON object per line")
     p.set_defaults(func=run)
+
+
+def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: Path | None) -> BearingParameters:
+    """The bearing file with the calibration laid over it and, with ``lubricant``, that lubricant
+    file in place of the bearing file's (the calibration then only when named explicitly). The
+    shipped calibration belongs to the shipped bearing: another bearing file gets it only when
+    named."""
+    doc = load_yaml(bearing or config_path("bearings", "h7006c.yaml"))
+    if bearing is not None and calibration is None:
+        if lubricant is not None:
+            doc.section("lubricant").data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
+        return BearingParameters.from_section(doc)
+    if lubricant is not None:
+        lub = doc.section("lubricant")
+        lub.data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
+        if calibration is not None:
+            doc = overlay_calibration(doc, load_yaml(calibration))
+    else:
+        doc = overlay_calibration(doc, load_yaml(calibration or config_path("calibration", "h7006c_table3.yaml")))
+    return BearingParameters.from_section(doc)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -41,30 +79,106 @@ def run(args: argparse.Namespace) -> int:
         raise RigError(f"--load takes one value or one per speed ({len(args.rpm)}), got {len(args.load)}")
     loads = args.load * len(args.rpm) if len(args.load) == 1 else args.load
     for n in args.rpm:
-        check_number(n, "command line", "--rpm", gt=0.0, le=30000.0)
+        check_number(n, "command line", "--rpm", gt=0.0, le=100000.0)
     for f in loads:
         check_number(f, "command line", "--load", ge=1.0, le=20000.0)
+    if args.transient is not None:
+        check_number(args.transient, "command line", "--transient", gt=0.0, le=36000.0)
+        check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)
     radial = _radial_loads(args)
-    params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+    params = load_parameters(args.bearing, args.calibration, args.lubricant)
+    if args.thermal or args.transient is not None:
+        return _run_thermal(args, params, loads)
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
+    unc = _uncertainty(args)
     for k, s in enumerate(states):
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
+        if unc is not None:
+            _add_interval(row, params, unc, s.inner_ring_speed, s.axial_load, s.slip_pct)
         row.update(s.losses_row(params.composite_roughness))
         if radial is not None:
             row.update(load_distribution_row(params, s.inner_ring_speed, s.axial_load, radial[k], args.moment))
-        print(
-            json.dumps(row)
-            if args.json
-            else f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %"
-            f"   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm   power {row['power_loss_w']:7.2f} W"
-            + (
-                f"   Q {row['ball_load_min_n']:.1f}-{row['ball_load_max_n']:.1f} N on {row['loaded_balls']} balls"
-                f" at {row['contact_angle_max_load_deg']:.2f} deg"
-                if "loaded_balls" in row
-                else ""
-            )
+        _print(row, args.json)
+    return 0
+
+
+def _uncertainty(args: argparse.Namespace) -> Any:
+    """The calibration's uncertainty block, when the calibration in use has one."""
+    from bearing_rig_sim.studies.uncertainty import read_uncertainty
+
+    if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
+        return None
+    return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+
+
+def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float) -> None:
+    """``slip_pct_low`` / ``slip_pct_high``: the 95 % interval from the parameter and load
+    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`)."""
+    from bearing_rig_sim.studies.uncertainty import slip_interval
+
+    low, high, _ = slip_interval(params, unc, omega, load, slip)
+    row["slip_pct_low"] = round(low, 4)
+    row["slip_pct_high"] = round(high, 4)
+
+
+def _print(row: dict[str, Any], as_json: bool) -> None:
+    if as_json:
+        print(json.dumps(row))
+        return
+    if "time_s" in row:
+        print(f"{row['time_s']:8.1f} s   outer ring {row['outer_ring_c']:6.2f} degC   lubricant {row['lubricant_c']:6.2f} degC   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm")
+        return
+    line = (
+        f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %"
+        f"   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm   power {row['power_loss_w']:7.2f} W"
+    )
+    if "slip_pct_low" in row:
+        line += f"   slip 95 % [{row['slip_pct_low']:.3f}, {row['slip_pct_high']:.3f}] %"
+    if "loaded_balls" in row:
+        line += (
+            f"   Q {row['ball_load_min_n']:.1f}-{row['ball_load_max_n']:.1f} N on {row['loaded_balls']} balls"
+            f" at {row['contact_angle_max_load_deg']:.2f} deg"
         )
+    if "outer_ring_temperature_c" in row:
+        line += f"   outer ring {row['outer_ring_temperature_c']:6.2f} degC"
+    print(line)
+
+
+def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: list[float]) -> int:
+    from bearing_rig_sim.config import rad_s_to_rpm
+    from bearing_rig_sim.studies.calibration import SteadyState
+    from bearing_rig_sim.thermal.bearing import ThermalConfig
+    from bearing_rig_sim.thermal.coupling import params_at_temperature, thermal_steady_state, warm_up
+
+    cfg = ThermalConfig.from_yaml(args.bearing)
+    for n, f in zip(args.rpm, loads):
+        omega = rpm_to_rad_s(n)
+        if args.transient is not None:
+            for r in warm_up(params, cfg, omega, f, args.transient, step=args.transient_step):
+                _print({"rpm": n, "axial_load_n": f, **r}, args.json)
+            continue
+        ts = thermal_steady_state(params, cfg, omega, f)
+        pt = ts.point
+        s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+        row: dict[str, Any] = dict(s.as_row())
+        row["rpm"] = round(rad_s_to_rpm(omega), 3)
+        row.update(s.losses_row(params.composite_roughness))
+        row["outer_ring_temperature_c"] = round(ts.temperatures["outer_ring"], 2)
+        row["lubricant_temperature_c"] = round(ts.temperatures["lubricant"], 2)
+        row["temperatures_c"] = {k: round(v, 2) for k, v in ts.temperatures.items()}
+        row["heat_w"] = {
+            "inner_contacts": round(ts.sources.inner_contacts, 4), "outer_contacts": round(ts.sources.outer_contacts, 4), "drag": round(ts.sources.drag, 4),
+            "land": round(ts.sources.land, 4), "rolling_and_pockets": round(ts.sources.rolling_and_pockets, 4),
+        }
+        row["time_constants_s"] = [round(t, 1) for t in ts.time_constants[:3]]
+        row["thermal_residual_k"] = round(ts.residual_k, 3)
+        unc = _uncertainty(args)
+        if unc is not None:
+            _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
+        iso = steady_states(params, [(omega, f)], workers=1)[0]
+        row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso.slip_pct, 4), "friction_torque_nm": round(iso.friction_torque, 6)}
+        _print(row, args.json)
     return 0
 
 

@@ -58,6 +58,9 @@ class Lubricant:
             (oil bath level, grease left in the swept volume after running-in), 1.
         yield_stress, consistency, flow_index: Herschel-Bulkley rheology of a grease
             tau = tau_y + K gamma_dot^n (Pa, Pa s^n, 1); zero for oils.
+        specific_heat: of the lubricant (grease or oil), J/(kg K).
+        yield_stress_temperature_coefficient: c of tau_y(T) = tau_y(T_ref) exp(-c (T - T_ref)),
+            1/K (grease; :meth:`at_temperature`).
         source: file name.
     """
 
@@ -78,6 +81,8 @@ class Lubricant:
     consistency: float
     flow_index: float
     source: str = "<memory>"
+    specific_heat: float = 1900.0
+    yield_stress_temperature_coefficient: float = 0.0
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> Lubricant:
@@ -116,6 +121,11 @@ class Lubricant:
             consistency=grease.number("consistency_pa_sn", gt=0.0, le=1e3) if is_grease else 0.0,
             flow_index=grease.number("flow_index", gt=0.0, le=1.0) if is_grease else 1.0,
             source=doc.source,
+            # [1600, 2400] J/(kg K): mineral and ester oils and their greases at 20-150 degC
+            specific_heat=oil.number("specific_heat_j_kg_k", ge=1600.0, le=2400.0, default=1900.0),
+            yield_stress_temperature_coefficient=(
+                grease.number("yield_stress_temperature_coefficient_1_k", ge=0.0, le=0.05, default=0.0) if is_grease else 0.0
+            ),
         )
 
     # -- base-oil properties at temperature ---------------------------------------------------
@@ -150,6 +160,19 @@ class Lubricant:
         """Roelands pressure-viscosity index Z matching alpha at low pressure:
         alpha = Z (ln eta0 + 9.67) / p0 (Roelands 1966; Hamrock, Schmid and Jacobson, ch. 4)."""
         return self.pressure_viscosity * ROELANDS_P0 / (math.log(self.dynamic_viscosity(temperature_c)) - ROELANDS_LN_ETA_INF)
+
+    def at_temperature(self, temperature_c: float, reference_c: float) -> Lubricant:
+        """The grease's bulk rheology at ``temperature_c`` given its values at ``reference_c``
+        (degC): the consistency K follows the base oil's dynamic viscosity,
+        K(T) = K(T_ref) eta(T) / eta(T_ref) (the sheared grease's plastic viscosity scales with
+        its base oil's), and the yield stress falls as tau_y(T_ref) exp(-c (T - T_ref)) with c
+        :attr:`yield_stress_temperature_coefficient`. An oil is returned unchanged (its viscosity
+        is a function of temperature already)."""
+        if self.kind != "grease" or temperature_c == reference_c:
+            return self
+        ratio = self.dynamic_viscosity(temperature_c) / self.dynamic_viscosity(reference_c)
+        shift = math.exp(-self.yield_stress_temperature_coefficient * (temperature_c - reference_c))
+        return dataclasses.replace(self, consistency=self.consistency * ratio, yield_stress=self.yield_stress * shift)
 
     def replace_rheology(self, **changes: float) -> Lubricant:
         """A copy with some numeric fields changed (calibrated values)."""
@@ -295,7 +318,30 @@ def harris_thrust_angle(axial_load: float, ball_count: int, free_angle: float, b
 
 SKF_ACBB_SINGLE_ROW = {"R1": 5.03e-7, "R2": 1.97, "R3": 1.90e-12, "S1": 1.30e-2, "S2": 0.68, "S3": 1.91e-12, "KZ": 4.4}
 """SKF catalogue geometry constants of single-row angular contact ball bearings (chapter
-"Friction", tables of R1..S3 and K_z); dm in mm, loads in N, n in rpm, moments in N mm."""
+"Friction", tables of R1..S3 and K_z); dm in mm, loads in N, n in rpm, moments in N mm. They are
+published for the 72 B(E) and 73 B(E) series only, whose contact angle is 40 deg
+(:data:`SKF_ACBB_CONTACT_ANGLE_DEG`); SKF's super-precision catalogue (718/719/70 CD, 15 deg)
+publishes none."""
+
+SKF_ACBB_CONTACT_ANGLE_DEG = 40.0
+"""Contact angle of the bearings :data:`SKF_ACBB_SINGLE_ROW` is published for, deg."""
+
+
+def skf_acbb_constants(contact_angle: float) -> dict[str, float]:
+    """The 72 B constants moved to another contact angle (rad) with the catalogue's own
+    contact-angle law, that of its deep groove ball bearings under axial load: there the axial
+    load enters the rolling variable as R2 F_a / sin(alpha) and the sliding variable's
+    F_a^(4/3) term as S2 / sin(alpha)^(1/3) (an axial load F_a gives contact loads
+    F_a / (Z sin alpha), and spin grows with sin alpha). So, from alpha_0 = 40 deg:
+
+        R2(alpha) = R2 sin(alpha_0) / sin(alpha),   S2(alpha) = S2 (sin(alpha_0) / sin(alpha))^(1/3);
+
+    R1, R3, S1, S3 and K_z are kept. At 15 deg: R2 = 4.89, S2 = 0.921 (1.97 and 0.68 at 40 deg)."""
+    c = dict(SKF_ACBB_SINGLE_ROW)
+    ratio = math.sin(math.radians(SKF_ACBB_CONTACT_ANGLE_DEG)) / math.sin(contact_angle)
+    c["R2"] *= ratio
+    c["S2"] *= ratio ** (1.0 / 3.0)
+    return c
 
 
 @dataclass(frozen=True)
@@ -313,7 +359,16 @@ class SkfMoment:
 
 
 def skf_frictional_moment(
-    rpm: float, axial_load: float, bore: float, outside_diameter: float, kinematic_viscosity: float, *, mu_ehl: float = 0.05, mu_bl: float = 0.15, k_rs: float = 6e-8
+    rpm: float,
+    axial_load: float,
+    bore: float,
+    outside_diameter: float,
+    kinematic_viscosity: float,
+    *,
+    mu_ehl: float = 0.05,
+    mu_bl: float = 0.15,
+    k_rs: float = 6e-8,
+    contact_angle: float | None = None,
 ) -> SkfMoment:
     """The SKF model (catalogue chapter "Friction") for a single-row angular contact ball bearing
     under a pure axial load, oil lubricated without drag losses (oil-air or minimal oil):
@@ -325,9 +380,11 @@ def skf_frictional_moment(
         phi_rs = exp(-K_rs nu n (d + D) sqrt(K_z / (2 (D - d)))).
 
     Args: inner-ring speed (rpm), axial load (N), bore d and outside diameter D (m), operating
-    kinematic viscosity (m^2/s); mu_EHL 0.05 (mineral oil), mu_bl 0.15, K_rs 6e-8 (oil-air).
+    kinematic viscosity (m^2/s); mu_EHL 0.05 (mineral oil), mu_bl 0.15, K_rs 6e-8 (oil-air);
+    ``contact_angle`` (rad): the constants moved to it (:func:`skf_acbb_constants`); None: the
+    published 72 B constants (40 deg).
     """
-    c = SKF_ACBB_SINGLE_ROW
+    c = SKF_ACBB_SINGLE_ROW if contact_angle is None else skf_acbb_constants(contact_angle)
     d, big_d = bore * 1e3, outside_diameter * 1e3
     dm = 0.5 * (d + big_d)
     nu = kinematic_viscosity * 1e6

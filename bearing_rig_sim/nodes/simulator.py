@@ -12,6 +12,11 @@ Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, his
   pulse-counted angle (rad), effort empty;
 * ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, reliable stream, ``truth_rate_hz`` simulated):
   the engine's ground truth with the achieved real-time factor and the overrun count;
+* ``/rig/outer_ring/temperature`` (sensor_msgs/Temperature, reliable, 10 Hz simulated, degC) and
+  ``/rig/housing/torque`` (geometry_msgs/WrenchStamped, torque.z in N m, reliable, 100 Hz
+  simulated): the bench's outer-ring thermocouple and housing torque meter
+  (:mod:`bearing_rig_sim.thermal.sensors`) on the bearing's thermal network, when the bearing
+  file has a ``thermal:`` section (docs/thermal.md);
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
   on every change of level (see :mod:`bearing_rig_sim.health`).
 
@@ -52,10 +57,13 @@ from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
 from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import JointState
+from sensor_msgs.msg import JointState, Temperature
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SpindleCommand as SpindleCommandMsg
 from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SPEEDS, SPINDLE_COMMAND, SPINDLE_PULSES, TRUTH
+from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE
+from bearing_rig_sim.config import ConfigError
+from bearing_rig_sim.thermal import sensors as bench_sensors
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
@@ -173,6 +181,7 @@ class SimulatorNode(ManagedNode):
         self._speeds_pub = self.publisher(JointState, SPEEDS.name, qos_profile(SPEEDS))
         self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, qos_profile(TRUTH))
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self._configure_bench_sensors(s.bearing_file)
         self._stream_pubs = {
             topic.name: pub
             for topic, pub in (
@@ -287,6 +296,45 @@ class SimulatorNode(ManagedNode):
             self._speeds_pub.publish(msg)
         if out.truth is not None:
             self._truth_pub.publish(self._truth_message(out))
+        if self.twin.thermal is not None:
+            self._publish_bench_sensors(stamp)
+
+    # -- the thermocouple and the torque meter -------------------------------------------------
+    def _configure_bench_sensors(self, bearing_file: Any) -> None:
+        """Couple the bearing's thermal network (one way: the engine keeps its parameters'
+        lubricant temperature, so the session's slip is the calibrated one) and publish the
+        outer-ring thermocouple and the housing torque meter; a bearing file without a
+        ``thermal:`` section has neither."""
+        try:
+            self.twin.attach_thermal(bearing_file, feedback=False)
+        except ConfigError as exc:
+            self.get_logger().info(f"no thermocouple or torque meter: {exc}")
+            return
+        chunk = self.settings.chunk_s
+        self._temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))
+        self._torque_every = max(1, round(1.0 / (bench_sensors.TORQUE_METER_RATE_HZ * chunk)))
+        self._thermocouple = bench_sensors.Thermocouple()
+        self._torque_meter = bench_sensors.TorqueMeter()
+        self._temperature_pub = self.publisher(Temperature, OUTER_RING_TEMPERATURE.name, qos_profile(OUTER_RING_TEMPERATURE))
+        self._torque_pub = self.publisher(WrenchStamped, HOUSING_TORQUE.name, qos_profile(HOUSING_TORQUE))
+
+    def _publish_bench_sensors(self, stamp: Any) -> None:
+        thermal = self.twin.thermal
+        assert thermal is not None
+        chunk = self.settings.chunk_s
+        if self._chunks % self._temperature_every == 0:
+            reading = self._thermocouple.update(thermal.temperature("outer_ring"), self._temperature_every * chunk)
+            msg = Temperature(temperature=reading, variance=bench_sensors.THERMOCOUPLE_NOISE_K**2)
+            msg.header.stamp = stamp
+            msg.header.frame_id = "outer_ring"
+            self._temperature_pub.publish(msg)
+        if self._chunks % self._torque_every == 0:
+            torque = self._torque_meter.update(self.twin.engine.friction_torque(), self._torque_every * chunk)
+            wrench = WrenchStamped()
+            wrench.header.stamp = stamp
+            wrench.header.frame_id = "housing"
+            wrench.wrench.torque.z = torque
+            self._torque_pub.publish(wrench)
 
     def _truth_message(self, out: TickOutput) -> SimulatorTruth:
         t = out.truth

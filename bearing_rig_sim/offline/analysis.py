@@ -87,6 +87,7 @@ SPEEDS, TRUTH, STATUS, COMMAND = (t.name for t in (contract.SPEEDS, contract.TRU
 LOAD_STATE, LOAD_SETPOINT, LOAD_CELL, BEARING_FORCE = (
     t.name for t in (contract.AXIAL_LOAD_STATE, contract.AXIAL_LOAD_SETPOINT, contract.AXIAL_LOAD_FORCE, contract.BEARING_AXIAL_FORCE)
 )
+OUTER_RING_TEMPERATURE, HOUSING_TORQUE = contract.OUTER_RING_TEMPERATURE.name, contract.HOUSING_TORQUE.name
 CONTEXT_TOPICS: dict[str, str] = {
     t.name: t.msgtype
     for t in (
@@ -98,6 +99,8 @@ CONTEXT_TOPICS: dict[str, str] = {
         contract.AXIAL_LOAD_SETPOINT,
         contract.AXIAL_LOAD_FORCE,
         contract.BEARING_AXIAL_FORCE,
+        contract.OUTER_RING_TEMPERATURE,
+        contract.HOUSING_TORQUE,
     )
 }
 """Topics read when present, with the type they must carry."""
@@ -491,6 +494,10 @@ class OfflineAnalysis:
             values["load_cell_force"] = float(get[LOAD_CELL].wrench.force.z)
         if get.get(BEARING_FORCE) is not None:
             values["bearing_force"] = float(get[BEARING_FORCE].wrench.force.z)
+        if get.get(OUTER_RING_TEMPERATURE) is not None:
+            values["outer_ring_temperature"] = float(get[OUTER_RING_TEMPERATURE].temperature)
+        if get.get(HOUSING_TORQUE) is not None:
+            values["housing_torque"] = float(get[HOUSING_TORQUE].wrench.torque.z)
         if self._recorded is not None:
             values["recorded_state"] = int(self._recorded.state)
             values["recorded_slip_rate"] = float(self._recorded.slip_rate)

@@ -1,7 +1,7 @@
 """The offline analysis of a bag as a report: markdown, PNG plots against time, CSV series.
 
 :func:`write_report` turns an :class:`~bearing_rig_sim.offline.analysis.OfflineResult` into
-``report.md`` and four plots in the output folder (the CSV series are written there by the
+``report.md`` and five plots in the output folder (the CSV series are written there by the
 analysis itself, as it streams):
 
 * ``speeds.png``: inner ring, cage and epicyclic cage speed (the monitor's windows), with the
@@ -9,6 +9,8 @@ analysis itself, as it streams):
 * ``slip.png``: slip from the sensors (offline monitor; the paper's, and the kinematic slip at the
   loaded contact angle), as recorded (``/rig/slip_status``) and true (``/rig/truth``), %;
 * ``axial_load.png``: set-point, load cell, force on the bearing (and the truth's), N;
+* ``thermal.png``: the outer-ring thermocouple (``/rig/outer_ring/temperature``, degC) and the
+  housing torque meter (``/rig/housing/torque``, N mm) when the bag has them;
 * ``status.png``: the monitor's state offline and as recorded.
 
 Time on every plot and in the report's tables runs from the first pulse of the bag (s), so bench
@@ -30,10 +32,12 @@ from bearing_rig_sim.config import RPM_TO_RAD_S, ConfigError, parse_yaml
 from bearing_rig_sim.offline.analysis import (
     BEARING_FORCE,
     COMMAND,
+    HOUSING_TORQUE,
     CONTEXT_TOPICS,
     LOAD_CELL,
     LOAD_SETPOINT,
     LOAD_STATE,
+    OUTER_RING_TEMPERATURE,
     PULSE_TOPICS,
     PULSE_TYPE,
     SPEEDS,
@@ -61,6 +65,8 @@ _TOPIC_USE = {
     LOAD_SETPOINT: "axial-load set-point",
     LOAD_CELL: "load cell",
     BEARING_FORCE: "force on the bearing",
+    OUTER_RING_TEMPERATURE: "outer-ring thermocouple (plot)",
+    HOUSING_TORQUE: "housing torque meter (plot)",
 }
 
 
@@ -137,8 +143,26 @@ def _step(transitions: list[tuple[float, int]], t0: float, t_end: float) -> tupl
     return xs, ys
 
 
+def _thermal_plot(result: OfflineResult, out_dir: Path, plt: Any) -> Path:
+    """Outer-ring temperature (left axis) and housing torque (right axis) against time."""
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    try:
+        _shade_segments(ax, result)
+        drawn = _plot_lines(ax, result, [("outer_ring_temperature", "outer-ring thermocouple (degC)", 1.0, {"color": "tab:red", "linewidth": 1.2})])
+        t, torque = _column(result, "housing_torque", 1e3)
+        if t:
+            right = ax.twinx()
+            right.plot(t, torque, color="tab:blue", linewidth=0.8, label="housing torque meter (N mm)")
+            right.set_ylabel("torque (N mm)")
+            right.legend(loc="lower right", fontsize="small")
+            drawn = True
+        return _finish(fig, ax, out_dir / "thermal.png", "Outer-ring temperature and friction torque", "temperature (degC)", drawn, "no thermocouple or torque meter in the bag")
+    finally:
+        plt.close(fig)
+
+
 def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
-    """The four PNG plots of the module documentation; returns their paths."""
+    """The five PNG plots of the module documentation; returns their paths."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -194,6 +218,7 @@ def write_plots(result: OfflineResult, out_dir: Path) -> tuple[Path, ...]:
             paths.append(_finish(fig, ax, out_dir / name, title, ylabel, drawn, missing))
         finally:
             plt.close(fig)
+    paths.append(_thermal_plot(result, out_dir, plt))
     fig, ax = plt.subplots(figsize=(10, 3.5))
     try:
         _shade_segments(ax, result)

@@ -67,6 +67,10 @@ class StatusRow:
     """The monitor's kinematic slip, at the contact angle of the measured load, %."""
     loaded_contact_angle: float = _NAN
     """That contact angle, rad."""
+    outer_ring_temperature: float = _NAN
+    """The outer-ring thermocouple, degC."""
+    housing_torque: float = _NAN
+    """The housing torque meter, N m."""
 
     @property
     def axial_load(self) -> float:

@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,8 @@ from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingPar
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
+from bearing_rig_sim.thermal.bearing import ThermalConfig
+from bearing_rig_sim.thermal.coupling import ThermalCoupling
 
 CHUNK_STEP_TOLERANCE = 1e-6
 """How close (in engine steps) the chunk length must be to a whole number of engine steps (1)."""
@@ -209,6 +212,16 @@ class RigTwin:
         """Engine integration steps since the start (1)."""
         self._acceleration = 0.0
         self._angles = engine.angles()
+        self.thermal: ThermalCoupling | None = None
+        """The bearing's thermal network, when attached (:meth:`attach_thermal`): it takes the
+        engine's heat chunk by chunk and sets the lubricant's temperature."""
+
+    def attach_thermal(self, bearing_file: str | Path | None = None, **options: Any) -> ThermalCoupling:
+        """Couple the bearing's thermal network (the bearing file's ``thermal:`` section; default
+        the shipped H7006C) to the engine from the next chunk on; ``options`` are those of
+        :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`."""
+        self.thermal = ThermalCoupling(self.engine, ThermalConfig.from_yaml(bearing_file), **options)
+        return self.thermal
 
     @classmethod
     def from_files(
@@ -326,6 +339,8 @@ class RigTwin:
             engine.advance(remaining, axial_load=self._load)
         self.step_count += steps
         self._acceleration = accel
+        if self.thermal is not None:
+            self.thermal.advance(t_end - t0)
         self._angles = t1, inner_after, cage_after = engine.angles()
         spindle = self.spindle_sensor.update(t0, inner_before, t1, inner_after)
         cage = self.cage_sensor.update(t0, cage_before, t1, cage_after)

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, ClassVar, Self
-from collections.abc import Iterator, Mapping, Sequence
+from typing import Any
+from collections.abc import Iterator, Sequence
 
 import yaml
 
@@ -325,49 +325,6 @@ def check_number(
 def ros_parameters(doc: Section, node_name: str) -> Section:
     """The ``node_name: ros__parameters:`` block of a ROS 2 parameter file."""
     return doc.section(node_name).section("ros__parameters")
-
-
-class NodeSettingsFile:
-    """What a node's settings class (a frozen dataclass with ``from_section``) reads from ROS 2
-    parameter files: set ``NODE_NAME`` (the node's name, its block in the file) and
-    ``SHIPPED_FILE`` (under ``config/``, the only place the defaults live)."""
-
-    NODE_NAME: ClassVar[str]
-    SHIPPED_FILE: ClassVar[str]
-
-    @classmethod
-    def from_section(cls, s: Section) -> Self:
-        """Validate the parameters in ``s`` (implemented by the settings class)."""
-        raise NotImplementedError
-
-    @classmethod
-    def from_values(cls, values: Mapping[str, Any], source: str | None = None) -> Self:
-        """Validate a flat mapping of parameter values (the node's ROS parameters in force).
-
-        Raises:
-            ConfigError: naming the key and the allowed range.
-        """
-        return cls.from_section(Section(dict(values), source or f"{cls.NODE_NAME} parameters"))
-
-    @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> Self:
-        """Read ``<node>: ros__parameters:`` of a parameter file (default: the shipped one).
-
-        Raises:
-            ConfigError: naming the file and the key.
-        """
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(cls.SHIPPED_FILE)), cls.NODE_NAME))
-
-    @classmethod
-    def shipped_parameters(cls) -> dict[str, Any]:
-        """The raw values of the shipped file (the node's declared defaults), checked valid.
-
-        Raises:
-            ConfigError: the shipped file is missing or malformed.
-        """
-        section = ros_parameters(load_yaml(config_path(cls.SHIPPED_FILE)), cls.NODE_NAME)
-        cls.from_section(section)  # the defaults themselves must be valid
-        return dict(section.data)
 
 
 RPM_TO_RAD_S: float = 2.0 * math.pi / 60.0

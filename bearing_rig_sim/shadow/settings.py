@@ -11,7 +11,7 @@ from pydantic import ValidationInfo, field_validator
 from bearing_rig_sim.config import load_yaml
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
-from bearing_rig_sim.simulation.settings import resolve_config_file
+from bearing_rig_sim.simulation.settings import existing_config_file
 
 NODE_NAME = "shadow"
 """The shadow node's name: the key of its block in a ROS 2 parameter file."""
@@ -21,16 +21,6 @@ SHIPPED_FILE = "shadow.yaml"
 
 MODELS = ("reduced", "stiff")
 """The engine's models (``reduced`` runs in real time)."""
-
-
-def _config_file(raw: object, *, empty_ok: bool) -> Path | None:
-    """A file parameter (absolute or under ``config/``); ``""`` is None where ``empty_ok``."""
-    if not isinstance(raw, str) or (not raw and not empty_ok):
-        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
-    path = resolve_config_file(raw)
-    if path is not None and not path.is_file():
-        raise ValueError(f"file not found: {raw!r} (looked for {path})")
-    return path
 
 
 class ShadowSettings(NodeSettings):
@@ -73,12 +63,12 @@ class ShadowSettings(NodeSettings):
     @field_validator("bearing_file", mode="before")
     @classmethod
     def _bearing_file(cls, raw: object) -> Path | None:
-        return _config_file(raw, empty_ok=False)
+        return existing_config_file(raw)
 
     @field_validator("calibration_file", mode="before")
     @classmethod
     def _calibration_file(cls, raw: object) -> Path | None:
-        return _config_file(raw, empty_ok=True)
+        return existing_config_file(raw, empty_ok=True)
 
     @field_validator("model", mode="before")
     @classmethod

@@ -5,13 +5,17 @@ ball speeds and pocket forces vary around the orbit (docs/model.md, Combined loa
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
+from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters, DynamicsInputError
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
+from bearing_rig_sim.rig.program import RigLimits, load_program
 
 RPM = math.pi / 30.0
 Z = 16
@@ -92,3 +96,35 @@ def test_the_stiff_model_refuses_a_radial_load(params: BearingParameters) -> Non
         engine.advance(engine.time_step, radial_load=100.0)
     with pytest.raises(DynamicsInputError, match="radial_load"):
         BearingDynamics(params).advance(0.001, radial_load=-5.0)
+
+
+PROGRAM = """
+name: side_load
+description: a radial load at speed
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 163, dwell_s: 0.3}
+  - {name: side, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 163, radial_load_n: 500, moment_n_m: 1.5, dwell_s: 1.0}
+"""
+
+
+def test_a_program_asking_for_a_radial_load_the_rig_cannot_give_is_refused(tmp_path: Path) -> None:
+    """The rig file's combined_loading limits (0 N and 0 N m for the paper's axial-only bench):
+    the segment and the limit are named; a rig file that allows them passes the values on."""
+    rig_doc = yaml.safe_load((Path(__file__).parents[1] / "config" / "rig.yaml").read_text())
+    assert rig_doc["combined_loading"] == {"max_radial_setpoint_n": 0.0, "max_moment_setpoint_n_m": 0.0}
+    program = tmp_path / "side.yaml"
+    program.write_text(PROGRAM)
+    axial_only = tmp_path / "rig.yaml"
+    axial_only.write_text(yaml.safe_dump(rig_doc))
+    with pytest.raises(ConfigError, match=r"segments\[1\]\.radial_load_n: segment 'side': 500 N is above the rig's limit of 0 N \(combined_loading\.max_radial_setpoint_n in rig\.yaml\)"):
+        load_program(program, RigLimits.from_rig_file(axial_only))
+    rig_doc["combined_loading"]["max_radial_setpoint_n"] = 800.0
+    axial_only.write_text(yaml.safe_dump(rig_doc))
+    with pytest.raises(ConfigError, match=r"segments\[1\]\.moment_n_m: segment 'side': 1\.5 N m is beyond the rig's limit of 0 N m"):
+        load_program(program, RigLimits.from_rig_file(axial_only))
+    rig_doc["combined_loading"]["max_moment_setpoint_n_m"] = 5.0
+    axial_only.write_text(yaml.safe_dump(rig_doc))
+    side = load_program(program, RigLimits.from_rig_file(axial_only)).segments[1]
+    assert (side.radial_load, side.moment) == (500.0, 1.5)

@@ -278,8 +278,10 @@ def solve_quasi_static(
         worst = 0.0
         for j in range(z):
             rb, zb = ball[j, B_R], ball[j, B_Z]
-            cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
-            shift = dx * cth + dy * sth if radial else 0.0
+            cth = sth = shift = 0.0
+            if radial:
+                cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+                shift = dx * cth + dy * sth
             di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
             sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
             sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
@@ -292,8 +294,9 @@ def solve_quasi_static(
             fz = -qi * niz - qo * noz
             worst = max(worst, abs(fr), abs(fz))
             ga += qi * niz
-            gx += qi * nir * cth
-            gy += qi * nir * sth
+            if radial:
+                gx += qi * nir * cth
+                gy += qi * nir * sth
             if it == max_iter:
                 continue
             hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)

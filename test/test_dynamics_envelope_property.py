@@ -3,7 +3,9 @@
 Hypothesis draws 300 input sequences over the whole envelope of config/rig.yaml (spindle
 speeds 0 to ``spindle.max_speed_rad_s``, accelerations up to ``spindle.max_acceleration_rad_s2``
 either way, axial loads from the engine's 1 N minimum to ``loading_chain.max_setpoint_n``,
-stepped or ramped, at rest and at speed, stops to rest and restarts, in any order). Each
+stepped or ramped, at rest and at speed, stops to rest and restarts, in any order; radial loads
+0 to the same 1000 N: the rig loads only axially, the engine's reduced model takes a radial
+load too, and it must survive it). Each
 sequence starts from an equilibrium at a drawn speed and load, so short simulated horizons
 (at most 0.2 s) reach every part of the envelope. After every 5 ms the state must be one a
 bearing can be in (finite; no ball or cage turning backwards or faster than the inner ring has
@@ -42,12 +44,14 @@ PIECE = 5e-3
 @dataclass(frozen=True)
 class Segment:
     """One input segment: ``duration`` s at ``acceleration`` rad/s^2 (clipped at rest and at
-    the top speed), the axial load going to ``load`` N stepwise or over the segment."""
+    the top speed), the axial load going to ``load`` N stepwise or over the segment, the radial
+    load stepped to ``radial`` N."""
 
     duration: float
     acceleration: float
     load: float
     ramp: bool
+    radial: float = 0.0
 
 
 loads = st.floats(MIN_AXIAL_LOAD, ENVELOPE.max_axial_load)
@@ -59,6 +63,7 @@ segments = st.builds(
     ),
     load=loads,
     ramp=st.booleans(),
+    radial=st.one_of(st.just(0.0), st.floats(0.0, ENVELOPE.max_axial_load)),
 )
 sequences = st.tuples(
     st.one_of(st.just(0.0), st.just(ENVELOPE.max_inner_ring_speed), st.floats(0.0, ENVELOPE.max_inner_ring_speed)),
@@ -82,7 +87,7 @@ def assert_physical(engine: BearingDynamics, peak: float) -> None:
     assert engine.cage_speed <= 0.5 * peak + TOLERANCE, (engine.time, engine.cage_speed, peak)
 
 
-def _advance(engine: BearingDynamics, duration: float, load: float, acceleration: float) -> None:
+def _advance(engine: BearingDynamics, duration: float, load: float, acceleration: float, radial: float) -> None:
     """``duration`` s at ``acceleration``, held within [0, top speed] as the rig's drive does:
     the engine stops integrating where the ring would reverse, then waits at rest."""
     omega = engine.inner_ring_speed
@@ -95,12 +100,12 @@ def _advance(engine: BearingDynamics, duration: float, load: float, acceleration
     n = int(duration_moving / engine.time_step)
     t_end = engine.time + duration
     if n > 0:
-        engine.advance(n * engine.time_step, axial_load=load, inner_ring_acceleration=acceleration)
+        engine.advance(n * engine.time_step, axial_load=load, inner_ring_acceleration=acceleration, radial_load=radial)
     if acceleration < 0.0 and engine.inner_ring_speed < -acceleration * engine.time_step:
         engine.set_inner_ring_speed(0.0)
     rest = int(round((t_end - engine.time) / engine.time_step))
     if rest > 0:
-        engine.advance(rest * engine.time_step, axial_load=load)
+        engine.advance(rest * engine.time_step, axial_load=load, radial_load=radial)
 
 
 @pytest.mark.slow
@@ -115,7 +120,7 @@ def test_no_input_sequence_of_the_envelope_leaves_physical_bounds(engine: Bearin
         start_load = load
         for k in range(pieces):
             load = start_load + (seg.load - start_load) * (k + 1) / pieces if seg.ramp else seg.load
-            _advance(engine, seg.duration / pieces, load, seg.acceleration)
+            _advance(engine, seg.duration / pieces, load, seg.acceleration, seg.radial)
             peak = max(peak, engine.inner_ring_speed)
             assert_physical(engine, peak)
         assert 0.0 <= engine.inner_ring_speed <= ENVELOPE.max_inner_ring_speed * (1.0 + 1e-9)

@@ -1,7 +1,7 @@
 """Benchmark of the dynamics engine: real-time factor per operating point and model.
 
 ``bearing-rig bench dynamics --json`` prints one JSON object per line and operating point with
-keys ``rpm``, ``axial_load_n``, ``model``, ``dt_s``, ``sim_s``, ``wall_s``, ``rtf`` (simulated
+keys ``rpm``, ``axial_load_n``, ``radial_load_n``, ``model``, ``dt_s``, ``sim_s``, ``wall_s``, ``rtf`` (simulated
 seconds per wall-clock second, median of ``--repeats`` runs, compile time excluded),
 ``rtf_min``, ``compile_s`` (first-call JIT compilation or cache load) and ``cage_speed_rad_s``.
 Run on one core: the engine is single-threaded.
@@ -19,6 +19,9 @@ from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 
 POINTS: tuple[tuple[float, float], ...] = ((900, 100), (2700, 100), (5000, 300), (9000, 700), (9000, 50))
 """Operating points (rpm, N) required by issue 3."""
+RADIAL_POINTS: tuple[tuple[float, float, float], ...] = ((900, 163, 500), (5000, 300, 300))
+"""Operating points (rpm, axial N, radial N) under combined load (reduced model only: each
+ball's loads from the ring's radial balance every step)."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -39,11 +42,14 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
         warm = BearingDynamics(params, model=model)
         warm.advance(10 * warm.time_step)
         compile_s = time.perf_counter() - t0
-        for rpm, load in POINTS:
+        points = [(rpm, load, 0.0) for rpm, load in POINTS]
+        if model == "reduced":
+            points += list(RADIAL_POINTS)
+        for rpm, load, radial in points:
             engine = BearingDynamics(params, model=model)
             rtfs = []
             for _ in range(max(1, args.repeats)):
-                engine.initialise(rpm_to_rad_s(rpm), load)
+                engine.initialise(rpm_to_rad_s(rpm), load, radial_load=radial)
                 start = time.perf_counter()
                 avg = engine.advance(sim_s)
                 wall = time.perf_counter() - start
@@ -53,6 +59,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "bench": "dynamics",
                 "rpm": rpm,
                 "axial_load_n": load,
+                "radial_load_n": radial,
                 "model": model,
                 "dt_s": engine.time_step,
                 "sim_s": sim_s,

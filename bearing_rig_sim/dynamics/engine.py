@@ -74,6 +74,7 @@ class Snapshot:
     cage: np.ndarray
     ring: np.ndarray
     axial_load: float
+    radial_load: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -174,6 +175,8 @@ class BearingDynamics:
         self.work = np.zeros((z, kn.NW))
         self.record_every = 0
         self.axial_load = 0.0
+        self.radial_load = 0.0
+        """Radial load on the inner ring along +x, N (reduced model; tilts held)."""
         self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
         self._peak_speed = 0.0
         self.envelope = envelope if envelope is not None else _shipped_envelope()
@@ -214,14 +217,16 @@ class BearingDynamics:
         return StepLimit(self.model, best, why)
 
     # -- set-up --------------------------------------------------------------------------------
-    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0) -> None:
-        """Start from the static equilibrium under ``axial_load`` (N) with the balls and cage at
+    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0, radial_load: float = 0.0) -> None:
+        """Start from the static equilibrium under ``axial_load`` (N; and ``radial_load``, N along
+        +x, reduced model only) with the balls and cage at
         the kinematic (rolling) speeds for ``inner_ring_speed`` (rad/s) at the loaded contact
         angle, each ball touching the driving side of its pocket. The dynamics then find the real
         operating point.
         """
         omega = _finite("inner_ring_speed", inner_ring_speed, 0.0)
         load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+        radial = self._radial(radial_load)
         v, p = self.vector, self.params
         z = p.ball_count
         rm = v[kn.P_RM]
@@ -239,28 +244,36 @@ class BearingDynamics:
         self.ball[:, kn.B_R] = rm
         self.ball[:, kn.B_OMEGA] = omega * p.epicyclic_ratio
         for _ in range(3):  # speeds and loaded angle depend on each other through centrifugal force
-            geo, scratch = self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 4]
+            geo, scratch = self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 6]
             # 1e-11 of the load; under a few newtons that is below the rounding of the contact
             # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there.
-            if kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-11, 200) > 200 and (
-                kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-9, 200) > 200
+            if kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-11, 200, radial) > 200 and (
+                kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-9, 200, radial) > 200
             ):
-                raise DynamicsInputError(f"no static equilibrium found for axial load {load} N at {omega} rad/s")
+                raise DynamicsInputError(f"no static equilibrium found for axial load {load} N, radial load {radial} N at {omega} rad/s")
             self._set_rolling_speeds(omega)
         # Balls just touching the driving side of their pockets (zero force): the cage is
         # carried from the first step instead of crossing the clearance and striking the balls.
         self.cage[:, kn.C_PHI] = theta - v[kn.P_POCKET_CLEAR] / rm
         self.cage[:, kn.C_OMEGA] = np.mean(self.ball[:, kn.B_OMEGA])
         self.axial_load = load
+        self.radial_load = radial
         self.stats[:] = 0.0
         self.out[:] = 0.0
+
+    def _radial(self, radial_load: float) -> float:
+        radial = _finite("radial_load", radial_load, 0.0)
+        if radial > 0.0 and self.model != "reduced":
+            raise DynamicsInputError(f"radial_load needs the reduced model (the {self.model} model is axisymmetric), got {radial_load!r}")
+        return radial
 
     def _set_rolling_speeds(self, omega_i: float) -> None:
         """Ball orbit and spin speeds of pure rolling at both raceways (zero sliding)."""
         v = self.vector
         for j in range(self.params.ball_count):
-            rb, zb = self.ball[j, kn.B_R], self.ball[j, kn.B_Z]
-            _, nir, niz, _, _, nor, noz, _ = kn.raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA])
+            rb, zb, theta = self.ball[j, kn.B_R], self.ball[j, kn.B_Z], self.ball[j, kn.B_THETA]
+            shift = self.ring[kn.R_DX] * math.cos(theta) + self.ring[kn.R_DY] * math.sin(theta)
+            _, nir, niz, _, _, nor, noz, _ = kn.shifted_raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA], shift)
             r_ci, _, _, _, aim, aia, aom, aoa, _ = kn.ball_kinematics(v, nir, niz, nor, noz, rb)
             # s_i = 0 and s_o = 0: a 2x2 linear system in (omega_m, omega_a)
             det = aim * aoa + aia * aom
@@ -273,12 +286,17 @@ class BearingDynamics:
         self._peak_speed = max(self._peak_speed, self.ring[kn.R_OMEGA])
 
     # -- integration ---------------------------------------------------------------------------
-    def advance(self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0) -> ChunkAverage:
+    def advance(
+        self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0, radial_load: float | None = None
+    ) -> ChunkAverage:
         """Integrate for ``duration`` seconds (rounded to whole steps).
 
         Args:
             duration: s, >= 0.
             axial_load: N applied to the inner ring during the interval (default: unchanged).
+            radial_load: N along +x on the inner ring during the interval (default: unchanged;
+                reduced model only): each ball's loads follow from the ring's quasi-static
+                balance at its orbital position, so they vary around the orbit.
             inner_ring_acceleration: rad/s^2, constant during the interval; the speed stops at
                 zero rather than reverse.
 
@@ -288,6 +306,8 @@ class BearingDynamics:
         duration = _finite("duration", duration, 0.0)
         if axial_load is not None:
             self.axial_load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+        if radial_load is not None:
+            self.radial_load = self._radial(radial_load)
         accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
         n = int(round(duration / self.time_step))
         if accel < 0.0:
@@ -295,7 +315,8 @@ class BearingDynamics:
         self.stats[:] = 0.0
         if n > 0:
             self._step(
-                self.vector, self.ball, self.cage, self.ring, self.out, self.stats, self.work, n, self.time_step, self.axial_load, accel, 0
+                self.vector, self.ball, self.cage, self.ring, self.out, self.stats, self.work, n, self.time_step, self.axial_load, accel, 0,
+                self.radial_load,
             )
         self.check_state()
         t = self.stats[kn.S_TIME]
@@ -344,7 +365,7 @@ class BearingDynamics:
     # -- state ---------------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:
         """A copy of the complete state."""
-        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load)
+        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load, self.radial_load)
 
     def restore(self, snap: Snapshot) -> None:
         """Return to a state taken by :meth:`snapshot` (same model and bearing)."""
@@ -354,6 +375,7 @@ class BearingDynamics:
         self.cage[:] = snap.cage
         self.ring[:] = snap.ring
         self.axial_load = snap.axial_load
+        self.radial_load = snap.radial_load
         # A snapshot was taken of an accepted state: its speeds are within the bounds it had.
         carried = max(float(np.max(snap.cage[:, kn.C_OMEGA])), float(np.max(snap.ball[:, kn.B_OMEGA])))
         self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]), carried)

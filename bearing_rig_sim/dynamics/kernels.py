@@ -11,7 +11,8 @@ Conventions (every kernel):
 * ``cage``: shape (Z, NC), one row per cage segment (pocket), columns ``C_*``: angle phi (rad),
   speed Omega (rad/s).
 * ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
-  (m) and axial velocity (m/s), time (s).
+  (m) and axial velocity (m/s), time (s), radial displacement along x and y (m; quasi-static,
+  reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)).
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
 * ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time).
@@ -84,14 +85,15 @@ P_LAND_N = 43  # cage land torque, power-law exponent
 P_FR_IN = 44  # Houpert rolling force of the inner contact at 1 m/s and 1 N, N: F = c u^0.66 Q^0.47
 P_FR_OUT = 45  # same, outer contact
 P_TABLE = 46  # index of the rheology traction table in this vector (0: none; see traction.py)
-P_SIZE = 47
+P_MU_SLOPE_MAX = 47  # steepest slope of the traction law: d mu/d SRR (models 1, 2) or d mu/ds, s/m (model 0)
+P_SIZE = 48
 
 B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
 NB = 7
 C_PHI, C_OMEGA = 0, 1
 NC = 2
-R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME = 0, 1, 2, 3, 4
-NR = 5
+R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
+NR = 7
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 NO = 10
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
@@ -221,7 +223,15 @@ def raceway_geometry(p: np.ndarray, rb: float, zb: float, delta_a: float) -> tup
     Returns (di, nir, niz, dist_i, do, nor, noz, dist_o): penetrations (m), unit vectors from
     each groove curvature centre to the ball centre, and the centre distances (m).
     """
-    dr = rb - p[P_CI_R]
+    return shifted_raceway_geometry(p, rb, zb, delta_a, 0.0)
+
+
+@njit(cache=True)
+def shifted_raceway_geometry(p: np.ndarray, rb: float, zb: float, delta_a: float, shift: float) -> tuple:
+    """:func:`raceway_geometry` with the inner ring displaced ``shift`` (m) radially outward at
+    the ball (its radial displacement projected on the ball's radial direction; the tangential
+    part changes the distances only to second order, as in Jones and Harris)."""
+    dr = rb - p[P_CI_R] - shift
     dz = zb - (p[P_CI_Z] + delta_a)
     dist_i = math.sqrt(dr * dr + dz * dz)
     nir, niz = dr / dist_i, dz / dist_i
@@ -241,29 +251,38 @@ def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> 
 
 @njit(cache=True)
 def solve_quasi_static(
-    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, axial_load: float, tol: float, max_iter: int
+    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, axial_load: float, tol: float, max_iter: int,
+    radial_load: float = 0.0,
 ) -> int:
-    """Newton solution of the normal (radial-axial) equilibrium of every ball and the axial
-    equilibrium of the inner ring under ``axial_load`` (N), with centrifugal force
-    m omega_m^2 r_b; gyroscopic moments neglected. Updates ball B_R, B_Z and ring R_DELTA, and
-    leaves in ``geo`` (Z, NG) the contact loads, normals and penetrations at the solution.
-    ``work`` is scratch of shape (Z, 4).
+    """Newton solution of the normal (radial-axial) equilibrium of every ball and of the inner
+    ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, along +x), with centrifugal
+    force m omega_m^2 r_b; gyroscopic moments neglected; tilts held at zero. Ring unknowns:
+    axial displacement and, with a radial load (or a displacement left by one), the radial
+    displacement (x, y); each ball's 2x2 block is eliminated onto them (a 3x3 Schur system).
+    Updates ball B_R, B_Z and ring R_DELTA, R_DX, R_DY, and leaves in ``geo`` (Z, NG) the contact
+    loads, normals and penetrations at the solution. ``work`` is scratch of shape (Z, 6).
 
     Returns the number of iterations used (max_iter + 1 if not converged).
     """
     z = ball.shape[0]
     m = p[P_MBALL]
     ki, ko = p[P_K_IN], p[P_K_OUT]
-    scale = tol * max(axial_load, 1.0)
+    scale = tol * max(axial_load, abs(radial_load), 1.0)
+    radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
     for it in range(max_iter + 1):
-        delta_a = ring[R_DELTA]
-        g_res = axial_load
-        g_cond = 0.0
-        s_cond = 0.0
+        delta_a, dx, dy = ring[R_DELTA], ring[R_DX], ring[R_DY]
+        ga, gx, gy = axial_load, radial_load, 0.0
+        # Schur system S du = r of the ring's (delta_a, delta_x, delta_y), S symmetric in value
+        s00 = s01 = s02 = s10 = s11 = s12 = s20 = s22 = 0.0
+        r0 = r1 = r2 = 0.0
         worst = 0.0
         for j in range(z):
             rb, zb = ball[j, B_R], ball[j, B_Z]
-            di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
+            cth = sth = shift = 0.0
+            if radial:
+                cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+                shift = dx * cth + dy * sth
+            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
             sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
             sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
             qi = ki * di * sdi if di > 0.0 else 0.0
@@ -274,7 +293,10 @@ def solve_quasi_static(
             fr = -qi * nir - qo * nor + m * w2 * rb
             fz = -qi * niz - qo * noz
             worst = max(worst, abs(fr), abs(fz))
-            g_res += qi * niz
+            ga += qi * niz
+            if radial:
+                gx += qi * nir * cth
+                gy += qi * nir * sth
             if it == max_iter:
                 continue
             hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
@@ -283,24 +305,68 @@ def solve_quasi_static(
             a12 = hirz + horz
             a22 = hizz + hozz
             det = a11 * a22 - a12 * a12
-            # u = J^-1 f and w = J^-1 b with b = -Hi e_z; dG/dx_j = -e_z^T Hi
+            # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
             ux = (a22 * fr - a12 * fz) / det
             uz = (-a12 * fr + a11 * fz) / det
             wx = (-a22 * hirz + a12 * hizz) / det
             wz = (a12 * hirz - a11 * hizz) / det
+            vx = (-a22 * hirr + a12 * hirz) / det
+            vz = (a12 * hirr - a11 * hirz) / det
             work[j, 0], work[j, 1], work[j, 2], work[j, 3] = ux, uz, wx, wz
-            g_cond -= hirz * ux + hizz * uz
-            s_cond += hizz + hirz * wx + hizz * wz
-        if worst < scale and abs(g_res) < scale:
+            # ring rows C = d(ring force)/d(ball): axial -(hirz, hizz), radial -(hirr, hirz) x direction
+            ca_u = -(hirz * ux + hizz * uz)
+            cr_u = -(hirr * ux + hirz * uz)
+            r0 += ca_u
+            s00 += hizz + hirz * wx + hizz * wz
+            if radial:
+                r1 += cr_u * cth
+                r2 += cr_u * sth
+                ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
+                cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
+                cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
+                s01 += ca_v * cth
+                s02 += ca_v * sth
+                s10 += cr_w * cth
+                s20 += cr_w * sth
+                s11 += cr_v * cth * cth
+                s12 += cr_v * cth * sth
+                s22 += cr_v * sth * sth
+                work[j, 4], work[j, 5] = vx, vz
+        if worst < scale and abs(ga) < scale and abs(gx) < scale and abs(gy) < scale:
             return it
         if it == max_iter:
             break
         lim = 2e-6
-        dd = min(max((-g_res + g_cond) / s_cond, -lim), lim)
+        if radial:
+            r0 -= ga
+            r1 -= gx
+            r2 -= gy
+            # Cramer's rule on [[s00, s01, s02], [s10, s11, s12], [s20, s12, s22]]
+            c00 = s11 * s22 - s12 * s12
+            c01 = s12 * s20 - s10 * s22
+            c02 = s10 * s12 - s11 * s20
+            det3 = s00 * c00 + s01 * c01 + s02 * c02
+            dd = (r0 * c00 + s01 * (r2 * s12 - r1 * s22) + s02 * (r1 * s12 - r2 * s11)) / det3
+            ex = (s00 * (r1 * s22 - r2 * s12) + r0 * c01 + s02 * (r2 * s10 - r1 * s20)) / det3
+            ey = (s00 * (s11 * r2 - s12 * r1) + s01 * (r1 * s20 - r2 * s10) + r0 * c02) / det3
+            dd = min(max(dd, -lim), lim)
+            ex = min(max(ex, -lim), lim)
+            ey = min(max(ey, -lim), lim)
+        else:
+            dd = min(max((r0 - ga) / s00, -lim), lim)
+            ex = 0.0
+            ey = 0.0
         ring[R_DELTA] = delta_a + dd
+        ring[R_DX] = dx + ex
+        ring[R_DY] = dy + ey
         for j in range(z):
-            ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd), -lim), lim)
-            ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd), -lim), lim)
+            shift = ex * math.cos(ball[j, B_THETA]) + ey * math.sin(ball[j, B_THETA]) if radial else 0.0
+            if radial:
+                ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd + work[j, 4] * shift), -lim), lim)
+                ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd + work[j, 5] * shift), -lim), lim)
+            else:
+                ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd), -lim), lim)
+                ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd), -lim), lim)
     return max_iter + 1
 
 
@@ -416,9 +482,12 @@ def link_strain(cage: np.ndarray, k: int, z: int) -> float:
 
 
 @njit(cache=True)
-def implicit_slope(mu: float, dmu: float, s: float) -> float:
+def implicit_slope(mu: float, dmu: float, s: float, cap: float = math.inf) -> float:
     """Slope (s/m) with which the linearly implicit step treats a traction coefficient mu(s):
-    the larger of the tangent d mu/ds and the secant mu(s)/s through the origin (never < 0).
+    the larger of the tangent d mu/ds and the secant mu(s)/s through the origin (never < 0),
+    the secant at most ``cap``, the law's steepest slope: a curve through the origin never has
+    a steeper secant, and where an interpolated table is not exactly 0 at s = 0 the secant of
+    a vanishing s would otherwise be unbounded (and the step's 2x2 blocks singular).
 
     With a slope at least the secant, the linearised traction mu(s_n) + k (s - s_n) vanishes
     between 0 and s_n, so one implicit step cannot carry the sliding speed across zero into the
@@ -427,8 +496,17 @@ def implicit_slope(mu: float, dmu: float, s: float) -> float:
     integrated implicitly (A-stable)."""
     k = max(dmu, 0.0)
     if s * mu > 0.0:
-        k = max(k, mu / s)
+        k = max(k, min(mu / s, cap))
     return k
+
+
+@njit(cache=True)
+def slope_cap(p: np.ndarray, entrainment: float) -> float:
+    """The traction law's steepest d mu/ds (s/m) at an entrainment speed (m/s; floored at 1 mm/s
+    as in the laws)."""
+    if p[P_FRIC_MODEL] == 0.0:
+        return p[P_MU_SLOPE_MAX]
+    return p[P_MU_SLOPE_MAX] / max(entrainment, 1e-3)
 
 
 @njit(cache=True)
@@ -445,10 +523,11 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
-    mui, dmui, fri = contact_traction(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    muo, dmuo, fro = contact_traction(p, 1, so, abs(wm * r_co), qo)
-    kti = qi * implicit_slope(mui, dmui, si)
-    kto = qo * implicit_slope(muo, dmuo, so)
+    uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
+    mui, dmui, fri = contact_traction(p, 0, si, uei, qi)
+    muo, dmuo, fro = contact_traction(p, 1, so, ueo, qo)
+    kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
+    kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
     return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
 
 
@@ -527,6 +606,7 @@ def step_reduced(
     axial_load: float,
     inner_acceleration: float,
     record_every: int,
+    radial_load: float = 0.0,
 ) -> int:
     """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
 
@@ -547,7 +627,7 @@ def step_reduced(
     jseg = p[P_JSEG]
     kl, cl = p[P_LINK_K], p[P_LINK_C]
     geo = work[:, 0:NG]
-    qs_work = work[:, NG : NG + 4]
+    qs_work = work[:, NG : NG + 6]  # the quasi-static solve's scratch, free again after it
     tri_work = work[:, NG + 4 : NG + 8]
     w0 = NG + 8  # per-ball elimination data
     worst_iter = 0
@@ -555,7 +635,7 @@ def step_reduced(
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
-        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30)
+        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
@@ -642,6 +722,7 @@ def step_stiff(
     axial_load: float,
     inner_acceleration: float,
     record_every: int,
+    radial_load: float = 0.0,
 ) -> int:
     """Advance the stiff reference model by ``n_steps`` explicit steps of ``dt`` seconds.
 
@@ -650,7 +731,7 @@ def step_stiff(
     applied load, friction and resistances as in the reduced model. Symplectic Euler in the
     canonical polar coordinates (momenta first, then positions), so that with friction and
     damping off the energy error stays bounded. Needs steps well below a microsecond.
-    ``work`` is scratch of shape (Z, NW). Returns 0.
+    ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric). Returns 0.
     """
     z = ball.shape[0]
     rm = p[P_RM]

@@ -39,7 +39,7 @@ from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
-from bearing_rig_sim.dynamics.traction import ContactKinematics, build_table
+from bearing_rig_sim.dynamics.traction import HEADER, SRR_REF, ContactKinematics, build_table
 
 GRAVITY = 9.80665
 """Standard gravity, m/s^2 (CGPM 1901)."""
@@ -514,7 +514,16 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
             v[idx] = p.ehl_rolling_scale * rolling_force(eta0, lub.pressure_viscosity, con.reduced_modulus, rx, con.ellipticity, 1.0, 1.0)
     if p.friction_model == "rheology" and lub is not None:
         v[kn.P_TABLE] = kn.P_SIZE
-        v = np.concatenate([v, traction_table(p)])
+        table = traction_table(p)
+        v = np.concatenate([v, table])
+        # steepest d mu/d SRR of the table: its slope in xi = asinh(SRR/SRR_REF) over SRR_REF
+        n_srr, n_u, n_q, xi_max = int(table[0]), int(table[1]), int(table[2]), table[3]
+        mu = table[HEADER : HEADER + 2 * n_srr * n_u * n_q].reshape(-1, n_srr)
+        v[kn.P_MU_SLOPE_MAX] = float(np.max(np.abs(np.diff(mu, axis=1)))) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
+    elif v[kn.P_FRIC_MODEL] == 1.0:
+        v[kn.P_MU_SLOPE_MAX] = v[kn.P_EHL_MU] / v[kn.P_EHL_SRR]  # d mu/d SRR at SRR = 0
+    else:
+        v[kn.P_MU_SLOPE_MAX] = 1.5 * v[kn.P_MU_S] / v[kn.P_V_S]  # d mu/ds at s = 0, s/m
     geo = DerivedGeometry(
         inner_groove_bottom_diameter=2.0 * (ci_r - ri),
         outer_groove_bottom_diameter=2.0 * (co_r + ro),

@@ -44,7 +44,7 @@ from bearing_rig_sim.rig.spindle import SpindleConfig
 STABILITY_CRITERIA = ("time", "axial_load")
 """Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
 
-SEGMENT_KEYS = ("name", "speed_rpm", "ramp_s", "acceleration_rad_s2", "axial_load_n", "dwell_s", "until_stable", "timeout_s")
+SEGMENT_KEYS = ("name", "speed_rpm", "ramp_s", "acceleration_rad_s2", "axial_load_n", "dwell_s", "until_stable", "timeout_s", "radial_load_n", "moment_n_m")
 PROGRAM_KEYS = ("name", "description", "bearing", "stability_criterion", "initial_speed_rpm", "segments")
 
 
@@ -73,6 +73,10 @@ class Segment:
     """End at the first stable verdict after the ramp (or at ``timeout``)."""
     timeout: float | None
     """With ``until_stable``: longest wait after the ramp, s; None otherwise."""
+    radial_load: float = 0.0
+    """Radial-load set-point during the segment, N (``radial_load_n``, within the rig's limit)."""
+    moment: float = 0.0
+    """Moment on the inner ring across the radial load, N m (``moment_n_m``, within the rig's limit)."""
 
     def speed_profile(self, start_time: float, start_speed: float) -> SegmentSpeed:
         """The segment's speed against time, for a start at ``start_time`` (s) from
@@ -147,6 +151,11 @@ class RigLimits:
     """Largest axial-load set-point of the loading chain, N (``loading_chain.max_setpoint_n``)."""
     source: str = RIG_FILE
     """The rig file the limits come from (for messages)."""
+    max_radial_load_n: float = 0.0
+    """Largest radial-load set-point, N (``combined_loading.max_radial_setpoint_n``; absent: 0,
+    a loading chain that pulls only axially)."""
+    max_moment_n_m: float = 0.0
+    """Largest moment set-point, N m (``combined_loading.max_moment_setpoint_n_m``; absent: 0)."""
 
     @classmethod
     def from_rig_file(cls, path: str | Path | None = None) -> RigLimits:
@@ -158,7 +167,11 @@ class RigLimits:
         spindle = SpindleConfig.from_yaml(path)
         chain = LoadingChainConfig.from_yaml(path)
         name = Path(path).name if path is not None else RIG_FILE
-        return cls(spindle.max_speed_rad_s, spindle.max_acceleration_rad_s2, chain.max_setpoint_n, name)
+        doc = load_yaml(path or config_path("rig.yaml"))
+        combined = doc.section("combined_loading") if "combined_loading" in doc.data else None
+        radial = combined.number("max_radial_setpoint_n", ge=0.0) if combined is not None else 0.0
+        moment = combined.number("max_moment_setpoint_n_m", ge=0.0) if combined is not None else 0.0
+        return cls(spindle.max_speed_rad_s, spindle.max_acceleration_rad_s2, chain.max_setpoint_n, name, radial, moment)
 
 
 def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
@@ -268,6 +281,18 @@ def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
             "axial_load_n",
             f"{load:g} N is above the rig's limit of {rig.max_axial_load_n:g} N ({_limit(rig, 'loading_chain.max_setpoint_n')})",
         )
+    radial = s.number("radial_load_n", ge=0.0, default=0.0)
+    if radial > rig.max_radial_load_n:
+        raise beyond(
+            "radial_load_n",
+            f"{radial:g} N is above the rig's limit of {rig.max_radial_load_n:g} N ({_limit(rig, 'combined_loading.max_radial_setpoint_n')})",
+        )
+    moment = s.number("moment_n_m", default=0.0)
+    if abs(moment) > rig.max_moment_n_m:
+        raise beyond(
+            "moment_n_m",
+            f"{moment:g} N m is beyond the rig's limit of {rig.max_moment_n_m:g} N m ({_limit(rig, 'combined_loading.max_moment_setpoint_n_m')})",
+        )
     until_stable = s.boolean("until_stable", default=False)
     if "until_stable" in s.data and not until_stable:
         raise beyond("until_stable", "must be true when given; use dwell_s for a fixed duration")
@@ -281,4 +306,4 @@ def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
         if "dwell_s" not in s.data:
             raise beyond("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
         dwell, timeout = s.number("dwell_s", gt=0.0, le=MAX_DWELL_S), None
-    return Segment(name, speed, profile, ramp, accel, load, dwell, until_stable, timeout)
+    return Segment(name, speed, profile, ramp, accel, load, dwell, until_stable, timeout, radial, moment)

@@ -154,6 +154,8 @@ class ThermalSteadyState:
     residual_k: float = 0.0
 
 
+WARM_UP_SUBSTEP_S = 0.5
+"""Longest step of :func:`warm_up`'s integration, s (below the bearing bodies' time constants)."""
 MAX_STEP_K = 40.0
 """Largest change of the lubricant temperature per secant step of :func:`thermal_steady_state`, K."""
 MAX_LUBRICANT_C = 200.0
@@ -243,7 +245,8 @@ def warm_up(params: BearingParameters, config: ThermalConfig, inner_ring_speed: 
     t_hi = max(steady.temperatures["lubricant"], config.ambient + 0.5)
     temps = list(np.linspace(config.ambient, t_hi, grid))
     table = [heat(t) for t in temps]
-    net = build_network(params, config, inner_ring_speed, axial_load, lubricant_temperature=config.ambient)
+    # fluid properties of the convection at the steady temperature, where the curve spends most time
+    net = build_network(params, config, inner_ring_speed, axial_load, lubricant_temperature=t_hi, initial=config.ambient)
     names = list(net.names)
     q_grid = np.array([net.heat_vector(node_heat(src)) for _, src in table])
     torque_grid = np.array([pt.torque for pt, _ in table])
@@ -251,9 +254,13 @@ def warm_up(params: BearingParameters, config: ThermalConfig, inner_ring_speed: 
     t = 0.0
     while t < duration - 1e-9:
         h = min(step, duration - t)
-        t_lub = net.temperature("lubricant")
-        q = np.array([np.interp(t_lub, temps, q_grid[:, i]) for i in range(len(names))])
-        net.step(q, h)
+        # the heat follows the lubricant's temperature: sub-steps short beside the bearing's own
+        # time constants (seconds), so the piecewise-constant heat does not overshoot
+        n_sub = max(1, math.ceil(h / WARM_UP_SUBSTEP_S))
+        for _ in range(n_sub):
+            t_lub = net.temperature("lubricant")
+            q = np.array([np.interp(t_lub, temps, q_grid[:, i]) for i in range(len(names))])
+            net.step(q, h / n_sub)
         t += h
         t_lub = net.temperature("lubricant")
         torque = float(np.interp(t_lub, temps, torque_grid))

@@ -49,6 +49,9 @@ setup(
         *config_data_files(),
     ],
     install_requires=["setuptools"],
+    # colcon test runs pytest (not unittest's discovery, which finds none of the suite) for a
+    # package with pytest among its test dependencies.
+    extras_require={"test": ["pytest"]},
     zip_safe=True,
     maintainer="bearing-rig-sim maintainers",
     maintainer_email="bearing-rig-sim@example.org",

@@ -20,8 +20,9 @@ Arguments:
 The nodes read their shipped parameter files (config/<node>.yaml) by themselves; override single
 parameters in the usual launch ways (a wrapping launch file, ``--ros-args`` in ``ros2 run``).
 
-launch and launch_ros are not on PyPI: this file runs on a full ROS 2 install only; the project's
-own venv runs ``bearing-rig run`` instead (README).
+launch and launch_ros are not on PyPI: this file runs on a full ROS 2 install, or from the
+README's set-up with the stock tools of ``../shared/ros2`` (docs/ros.md); ``bearing-rig run`` needs
+neither.
 """
 
 from __future__ import annotations

@@ -175,7 +175,7 @@ class SlipMonitor:
             max_span=max(settings.slope_max_span_s, settings.slope_span_s),
         )
         self.sweep = LoadSweep(settings.critical_slope_pct_per_n, settings.load_step_n, settings.sweep_settle_s, settings.sweep_average_s)
-        self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s)
+        self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s, settings.min_window_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
         self._loads: deque[tuple[float, float]] = deque(maxlen=LOAD_HISTORY)
         self.reset()

@@ -66,7 +66,9 @@ def settings(**changes: object) -> MonitorSettings:
 
 
 def make(**changes: object) -> SlipMonitor:
-    s = settings(**changes)
+    """A monitor with the shipped settings but windows of exactly ``window_revolutions`` (no
+    ``min_window_s``) unless given: these tests count windows by revolutions."""
+    s = settings(**{"min_window_s": 0.0, **changes})
     return SlipMonitor(s.kinematics(), s)
 
 
@@ -429,3 +431,16 @@ def test_a_segment_is_stable_only_at_its_commanded_speed() -> None:
     # without a commanded speed (a stretch found by speed in a bag without a program) no check
     free = TimeToStable(ramp_end=10.0)
     assert free.observe(11.0, 10.5, stable, 0.99)
+
+
+def test_a_window_lasts_at_least_min_window_s_in_whole_revolutions():
+    """At a cage speed of CAGE rad/s one revolution lasts 2 pi / CAGE s; with min_window_s three
+    and a half revolutions long, every window spans the 4 whole revolutions that first last that
+    long (by hand: ceil(3.5) = 4), and the slip is still exact."""
+    period = TWO_PI / CAGE
+    monitor = make(min_window_s=3.5 * period)
+    feed(monitor, train(constant(INNER, 4, 0.0, 40 * period), 4, "spindle"), train(constant(CAGE, 3, 0.0, 40 * period, phase=0.2), 3, "cage"))
+    window = monitor.latest_window
+    assert window is not None and window.window.revolutions == 4
+    assert window.end_time - window.start_time == pytest.approx(4 * period, rel=1e-9)
+    assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)

@@ -196,7 +196,7 @@ def test_offline_verdicts_are_the_monitors(twin_bag: tuple[Path, list[tuple[str,
     assert result.complete and not result.problems
     assert result.pulses == {"spindle": sum(s == "spindle" for s, _p in pulses), "cage": sum(s == "cage" for s, _p in pulses)}
     assert [exact(astuple(w)) for w in got_windows] == [exact(astuple(w)) for w in windows]
-    assert len(windows) > 50
+    assert len(windows) > 30  # two-revolution windows at 1800 rpm (min_window_s 0.1 s)
     # the same state changes at the same instants, from the same kind of event (a check on the
     # status-rate ticks, where refits run, or a closed window); the clean run has no fault
     offline_changes = [(r.time, r.state, r.reason) for a, r in zip(rows, rows[1:]) if r.state != a.state]

@@ -26,7 +26,6 @@ Units: s, rad/s, N; slip and slopes in percent, percent per second or per newton
 
 from __future__ import annotations
 
-import bisect
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -44,13 +43,13 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 MonitorState = SlipState
 """The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""
 
-LOAD_HISTORY = 4096
-"""Load-cell samples kept for the windows' mean load (4 s at the load cell's 1 kHz)."""
+LOAD_HISTORY = 16384
+"""Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
 
-LOAD_WAIT_S = 2.0
+LOAD_WAIT_S = 8.0
 """With the load criterion, a window waits for the load cell's samples up to its end (the load
-cell's topic can run behind the pulses') at most this long after its end, rig s; then it is
-judged on the samples at hand."""
+cell's topic can run seconds behind the pulses' without real time) at most this long after its
+end, rig s; then it is judged on the samples at hand (half the kept history)."""
 
 
 @dataclass(frozen=True)
@@ -175,7 +174,7 @@ class SlipMonitor:
             max_span=max(settings.slope_max_span_s, settings.slope_span_s),
         )
         self.sweep = LoadSweep(settings.critical_slope_pct_per_n, settings.load_step_n, settings.sweep_settle_s, settings.sweep_average_s)
-        self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s)
+        self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s, settings.min_window_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
         self._loads: deque[tuple[float, float]] = deque(maxlen=LOAD_HISTORY)
         self.reset()
@@ -263,11 +262,12 @@ class SlipMonitor:
         loads = self._loads
         if not loads:
             return math.nan
-        times = [t for t, _ in loads]
-        i, j = bisect.bisect_left(times, t0), bisect.bisect_right(times, t1)
-        if j > i:
-            return sum(f for _, f in list(loads)[i:j]) / (j - i)
-        return loads[-1][1] if times[-1] <= t1 and t1 - times[-1] < t1 - t0 else math.nan
+        if loads[-1][0] >= t0 and loads[0][0] <= t1:
+            inside = [f for t, f in loads if t0 <= t <= t1]
+            if inside:
+                return sum(inside) / len(inside)
+        last_time, last_force = loads[-1]
+        return last_force if last_time <= t1 and t1 - last_time < t1 - t0 else math.nan
 
     def _add_window(self, window: SlipWindow) -> None:
         st = self.settings

@@ -91,16 +91,20 @@ STABLE_CONFIDENCE = 0.95
 one-sided 95 % bound the verdict itself uses."""
 
 
-def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int) -> float:
+def evidence_start(
+    stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int, min_window_s: float = 0.0
+) -> float:
     """The earliest time the verdict of a status stamped ``stamp`` (s) can rest on, s.
 
     Its slope is fitted to the slip windows that ended in the last ``slope_span_s`` (at least the
     last ``min_slope_points`` of them), each ``window_revolutions`` cage revolutions long at
-    ``cage_speed`` (rad/s). -inf when the cage speed is unknown.
+    ``cage_speed`` (rad/s), or the fewest whole revolutions that last ``min_window_s`` (s) if
+    more. -inf when the cage speed is unknown.
     """
     if not (math.isfinite(cage_speed) and cage_speed > 0.0 and window_revolutions > 0):
         return -math.inf
-    window = window_revolutions * 2.0 * math.pi / cage_speed
+    revolutions = max(window_revolutions, math.ceil(min_window_s * cage_speed / (2.0 * math.pi)))
+    window = revolutions * 2.0 * math.pi / cage_speed
     return stamp - max(slope_span_s + window, min_slope_points * window)
 
 

@@ -33,6 +33,8 @@ class MonitorSettings:
         bearing_file: bearing data file (geometry for the epicyclic cage speed).
         contact_angle_deg: contact angle of the slip formula, degrees; negative: nominal.
         window_revolutions: whole cage revolutions per slip window (>= 1).
+        min_window_s: a slip window lasts at least this long: more whole revolutions at high
+            speed (0: always ``window_revolutions``), s.
         criterion: "time" or "axial_load".
         slip_reference: "nominal" (the paper's slip, Eq. 11-12 at ``contact_angle_deg``) or
             "loaded" (the kinematic slip at the contact angle of the measured axial load,
@@ -66,6 +68,7 @@ class MonitorSettings:
     bearing_file: Path
     contact_angle_deg: float
     window_revolutions: int
+    min_window_s: float
     criterion: str
     slip_reference: str
     critical_slope_pct_per_s: float
@@ -114,6 +117,7 @@ class MonitorSettings:
             slip_reference=reference,
             contact_angle_deg=s.number("contact_angle_deg", lt=90.0),
             window_revolutions=s.integer("window_revolutions", ge=1, le=1000),
+            min_window_s=s.number("min_window_s", ge=0.0, le=10.0),
             criterion=criterion,
             critical_slope_pct_per_s=s.number("critical_slope_pct_per_s"),
             critical_slope_pct_per_n=s.number("critical_slope_pct_per_n"),

@@ -128,6 +128,8 @@ class SlipWindow:
     end_time: float
     cage_speed: float
     inner_ring_speed: float
+    revolutions: int = 1
+    """Whole cage revolutions in the window."""
 
 
 @dataclass
@@ -167,6 +169,7 @@ class _Shaft:
     times: list[float] = field(default_factory=list)
     angles: list[float] = field(default_factory=list)  # revolutions, spacing-corrected
     window_start: tuple[int, float] | None = None
+    window_grown: bool = False  # the open window reached a revolution too short to close
     recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
     recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
     steady_period: float | None = None  # period of the last whole revolution measured, s
@@ -196,13 +199,18 @@ class SlipWindows:
     Args:
         window_revolutions: whole cage revolutions per window (>= 1).
         rules: when losses are a fault.
+        min_window_s: a window lasts at least this long, s: at ``window_revolutions`` it closes
+            only if it has, else at the first whole revolution after which it has (at high speed
+            a window of more revolutions, whose ends' timing jitter weighs less); 0: always
+            ``window_revolutions``.
         clock_jump_tolerance_s: a pulse further back than this before its shaft's previous one
             is a clock jump (everything restarts); less far back, an out-of-order pulse (that
             shaft restarts), s.
     """
 
-    def __init__(self, window_revolutions: int, rules: LossRules, clock_jump_tolerance_s: float) -> None:
+    def __init__(self, window_revolutions: int, rules: LossRules, clock_jump_tolerance_s: float, min_window_s: float = 0.0) -> None:
         self.window_revolutions = window_revolutions
+        self.min_window_s = min_window_s
         self.rules = rules
         self.clock_jump_tolerance_s = clock_jump_tolerance_s
         self.books = {name: LossBooks() for name in SHAFTS}
@@ -216,7 +224,7 @@ class SlipWindows:
     def reset(self) -> None:
         """Forget every pulse and window (the books and the strips' spacing are kept)."""
         self._shafts = {name: _Shaft(name) for name in SHAFTS}
-        self._pending: deque[tuple[float, float]] = deque()
+        self._pending: deque[tuple[float, float, int]] = deque()  # start, end, revolutions
         self._suspect: set[str] = set()
         self.silent: dict[str, str] = {}
         """Shafts found silent at two consecutive checks, with the reason."""
@@ -379,20 +387,27 @@ class SlipWindows:
 
     def _add_cage_pulse(self, cage: _Shaft, t: float, index: int) -> list[SlipWindow]:
         assert cage.strip_count is not None
-        span = self.window_revolutions * cage.strip_count
+        n = cage.strip_count
+        span = self.window_revolutions * n
         if cage.window_start is None:
-            cage.window_start = (index, t)
+            cage.window_start, cage.window_grown = (index, t), False
             return []
         start_index, start_time = cage.window_start
-        if index - start_index < span:
+        turned = index - start_index
+        if turned < span:
             return []
-        if index - start_index == span:
-            self._pending.append((start_time, t))
+        if turned % n == 0 and (turned == span or cage.window_grown):
+            if t - start_time < self.min_window_s:  # too short yet: grow by whole revolutions
+                cage.window_grown = True
+                return []
+            self._pending.append((start_time, t, turned // n))
             if len(self._pending) > MAX_PENDING_WINDOWS:
                 self._pending.popleft()
+        elif cage.window_grown:
+            return []  # between two revolutions of a growing window (a lost boundary: the next one)
         else:  # the passage closing the window was lost: skip it, start afresh here
             self.books["cage"].windows_skipped += 1
-        cage.window_start = (index, t)
+        cage.window_start, cage.window_grown = (index, t), False
         return self._process_pending()
 
     # -- windows -------------------------------------------------------------------------------
@@ -409,19 +424,19 @@ class SlipWindows:
         spindle = self._shafts["spindle"]
         done: list[SlipWindow] = []
         while self._pending and spindle.times and spindle.times[-1] >= self._pending[0][1]:
-            t0, t1 = self._pending.popleft()
+            t0, t1, revolutions = self._pending.popleft()
             if spindle.times[0] > t0:
                 continue  # the spindle's pulses start after the window: cannot be measured
             duration = t1 - t0
             inner = TWO_PI * (self._spindle_angle(spindle, t1) - self._spindle_angle(spindle, t0)) / duration
-            cage = TWO_PI * self.window_revolutions / duration
-            done.append(SlipWindow(t0, t1, cage, inner))
+            cage = TWO_PI * revolutions / duration
+            done.append(SlipWindow(t0, t1, cage, inner, revolutions))
         self._prune_spindle()
         return done
 
     def _prune_spindle(self) -> None:
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
-        starts = [t0 for t0, _ in self._pending]
+        starts = [t0 for t0, _, _ in self._pending]
         if cage.window_start is not None:
             starts.append(cage.window_start[1])
         keep_from = min(starts) if starts else math.inf

@@ -139,6 +139,7 @@ MONITOR = [
     ParameterSpec("bearing_file", "bearing data file: geometry for the epicyclic cage speed (relative to config/)"),
     ParameterSpec("contact_angle_deg", "contact angle of the slip formula (negative: the bearing file's nominal)", "deg", -1.0, 89.0),
     ParameterSpec("window_revolutions", "whole cage revolutions per slip window", "1", 1, 1000, integer=True),
+    ParameterSpec("min_window_s", "a slip window lasts at least this long (more whole cage revolutions at high speed; 0: never)", "s", 0.0, 10.0),
     ParameterSpec("criterion", "abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)"),
     ParameterSpec("slip_reference", "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"),
     ParameterSpec("critical_slope_pct_per_s", "critical slope k2 of the stability criterion (slip against time)", "%/s", -10.0, 0.0),

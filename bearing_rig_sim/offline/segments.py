@@ -10,7 +10,8 @@
   speed stays within :data:`STRETCH_TOLERANCE` of the stretch's mean, kept when they last at
   least :data:`STRETCH_MIN_DURATION_S`; the ramp end is the stretch's start.
 
-A segment's means are taken over the rows from its ramp end on; its verdicts are the last state
+A segment's means are taken over the rows from its ramp end on whose slip window started after
+it; its verdicts are the last state
 in it; its time to stable follows the one rule the live session summary also uses
 (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`), for the offline statuses and the
 recorded ones alike.
@@ -111,12 +112,14 @@ class _Segment:
         if row.time < self.ramp_end:
             return
         self.rows += 1
+        if math.isfinite(row.window_start) and row.window_start < self.ramp_end:
+            return  # the slip window reaches back into the ramp: not a figure of the segment's speed
         for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
             self._add(key, getattr(row, key))
 
     def evidence(self, stamp: float, cage_speed: float) -> float:
         st = self.settings
-        return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points)
+        return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
 
     def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
         self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)

@@ -357,7 +357,7 @@ class ProgramRunner:
         data.statuses += 1
         assert data.rule is not None
         st = self.monitor_settings
-        evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points)
+        evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
         if data.rule.observe(status.time, evidence, int(status.state), status.confidence, status.inner_ring_speed):
             data.stable = status
 

@@ -163,6 +163,12 @@ def _slip_status_cdr(store: Any) -> bytes:
         confidence=0.9,
         window_revolutions=1,
         detail="",
+        axial_load=100.0,
+        kinematic_slip_rate=3.6,
+        loaded_contact_angle=0.2845,
+        sweep_speed=104.72,
+        sweep_stable_from=300.0,
+        sweep_verdict="stable from 300 N",
     )
     return bytes(store.serialize_cdr(msg, "bearing_rig_msgs/msg/SlipStatus"))
 

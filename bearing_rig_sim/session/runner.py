@@ -14,9 +14,9 @@ Rules (simulation time throughout, s):
   segment's target speed; its ramp ends at ``start + ramp duration``
   (:meth:`~bearing_rig_sim.rig.program.Segment.ramp_duration`).
 * **Commands ahead of time** (:meth:`ProgramRunner.commands_due`): the command of a segment whose
-  start is fixed (every segment before it a dwell segment) is sent up to
-  :data:`COMMAND_LEAD_S` (in real time :data:`REALTIME_COMMAND_LEAD_S`) before that start, stamped with it; the simulator queues it and applies
-  it exactly then. Without real time the simulator runs ahead of the session's clock (it waits
+  start is fixed (every segment before it a dwell segment) is sent up to :data:`COMMAND_LEAD_S`
+  (in real time :data:`REALTIME_COMMAND_LEAD_S`) before that start, stamped with it; the
+  simulator queues it and applies it exactly then. Without real time the simulator runs ahead of the session's clock (it waits
   only for its readers' acknowledgements, not for the session to take the messages: seconds on
   a loaded host), and a command stamped with the session's own, older, clock takes effect when it
   arrives: the spindle's ramp then starts and ends late, the segment's speed is judged against a

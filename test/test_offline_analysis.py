@@ -54,12 +54,15 @@ def write_twin_bag(
     step_at: float | None = 1.5,
     step_rpm: float = 1800.0,
     record_status: bool = False,
+    command_ahead_s: float = 0.0,
 ) -> list[tuple[str, Pulse]]:
     """A bag of the twin at 100 N: ``start_rpm``, then a 0.5 s STEP ramp to ``step_rpm`` at
     ``step_at`` (None: no step); pulses, speeds (1 kHz), truth (100 Hz), the spindle commands,
     and with ``record_status`` the slip status a monitor node would have published (a
-    SlipMonitor fed live: on every change after a window, and every 0.1 s of rig time). Returns
-    the pulses in bag order, as received (times through stamps)."""
+    SlipMonitor fed live: on every change after a window, and every 0.1 s of rig time). With
+    ``command_ahead_s`` the step's command is sent (and recorded) that long before its stamp, as
+    the session sends a dwell segment's successor. Returns the pulses in bag order, as received
+    (times through stamps)."""
     store = rig_typestore()
     types = store.types
     twin = RigTwin.from_files(initial_speed=rpm_to_rad_s(start_rpm), initial_axial_load=100.0)
@@ -94,9 +97,10 @@ def write_twin_bag(
         bag.write_message("/rig/spindle/command", 0, command(0.0, rpm_to_rad_s(start_rpm), 0.0))
         stepped = step_at is None
         while twin.time < seconds:
-            if not stepped and twin.time >= step_at:
-                twin.command_spindle(SpindleCommand(rpm_to_rad_s(step_rpm), ramp_time=0.5))
-                bag.write_message("/rig/spindle/command", int(round(twin.time * 1e9)), command(twin.time, rpm_to_rad_s(step_rpm), 0.5))
+            if not stepped and twin.time >= step_at - command_ahead_s:
+                at = twin.time + command_ahead_s
+                twin.command_spindle(SpindleCommand(rpm_to_rad_s(step_rpm), ramp_time=0.5, time=at if command_ahead_s else None))
+                bag.write_message("/rig/spindle/command", int(round(twin.time * 1e9)), command(at, rpm_to_rad_s(step_rpm), 0.5))
                 stepped = True
             out = twin.tick()
             pulses = sorted([("spindle", p) for p in out.spindle_pulses] + [("cage", p) for p in out.cage_pulses], key=lambda sp: sp[1].time)
@@ -225,6 +229,24 @@ def test_offline_verdicts_are_the_monitors(twin_bag: tuple[Path, list[tuple[str,
     assert sorted(p.name for p in result.csv_files) == sorted([STATUS_CSV, WINDOWS_CSV, SEGMENTS_CSV])
     assert len((tmp_path / STATUS_CSV).read_text().splitlines()) == len(rows) + 1 == result.status_rows + 1
     assert len((tmp_path / WINDOWS_CSV).read_text().splitlines()) == len(windows) + 1
+
+
+def test_a_command_recorded_ahead_of_its_stamp_starts_its_segment_at_the_stamp(
+    twin_bag: tuple[Path, list[tuple[str, Pulse]]], tmp_path: Path
+) -> None:
+    """The session sends a dwell segment's successor up to seconds ahead, and records it when sent:
+    analyze starts the segment where the command takes effect, its stamp, not where it was
+    recorded, so the segments are those of a bag with the command recorded at its stamp."""
+    path = tmp_path / "ahead"
+    write_twin_bag(path, 5.0, command_ahead_s=1.0)
+    on_time, ahead = analyse_bag(twin_bag[0]).segments, analyse_bag(path).segments
+    assert [s.name for s in ahead] == ["n1200", "n1800"]
+    assert ahead[1].start_time == pytest.approx(1.5, abs=1e-3)  # the stamp, not 0.5 s (recorded)
+    for a, b in zip(ahead, on_time):
+        assert (a.start_time, a.ramp_end, a.end_time, a.final_state) == pytest.approx((b.start_time, b.ramp_end, b.end_time, b.final_state), abs=1e-3)
+        assert (a.time_to_stable is None) == (b.time_to_stable is None)
+        if a.time_to_stable is not None:
+            assert a.time_to_stable == pytest.approx(b.time_to_stable, abs=0.01)
 
 
 def test_two_runs_are_identical(twin_bag: tuple[Path, list[tuple[str, Pulse]]], tmp_path: Path) -> None:

@@ -68,22 +68,12 @@ def sweep_lines(text: str) -> dict[int, str]:
     return found
 
 
-LATE_COMMANDS = (
-    "without real time the simulator runs seconds ahead of the session, which stamps a segment's spindle command with "
-    "its own, later, clock: the simulator applies it on arrival, seconds late, so a run-up or a stop is still under way "
-    "when the session judges its speed, and the session exits 3 (conditions not met); measured twice, 1 and 4 segments "
-    "marked. Session/simulator timing, outside the method."
-)
-
-
 def verdict_of(text: str) -> str:
     """"stable from 500 N" or "no stable state" of a load-sweep verdict's text."""
     return text.split(" (")[0] if text.startswith("stable from") else "no stable state"
 
 
-@pytest.mark.parametrize(
-    "name", ["validation", "load_sweep", pytest.param("acceleration", marks=pytest.mark.xfail(reason=LATE_COMMANDS, strict=False))]
-)
+@pytest.mark.parametrize("name", ["validation", "load_sweep", "acceleration"])
 def test_each_shipped_program_runs_to_its_end_and_its_verdicts_agree(ros_graph: Any, tmp_path: Path, name: str) -> None:
     code, text, bag = run_program(ros_graph, tmp_path, name)
     assert code == 0, text[-3000:]
@@ -116,10 +106,13 @@ def test_each_shipped_program_runs_to_its_end_and_its_verdicts_agree(ros_graph: 
         # when the load cell's samples reach each reader: the sweep verdicts above are the verdicts
     # every segment's verdict: the live summary and the recorded statuses agree (the same stream),
     # and analyze's replay of the pulses ends each segment in the same state; a time to stable
-    # the replay finds is the recorded one
+    # the replay finds is the recorded one. A segment that ends at rest is the exception for the
+    # replay: once the pulses stop, the monitor node checks at its own estimate of the rig time
+    # on a wall-clock timer, the replay on its status ticks, so each finds the stop (state
+    # unknown) at another moment of the silence
     for row, segment in zip(rows, result.segments):
         recorded = state_name(segment.final_recorded_state) if segment.final_recorded_state >= 0 else "unknown"
-        if segment.final_recorded_state >= 0:
+        if segment.final_recorded_state >= 0 and segment.target_speed > 0.0:
             assert state_name(segment.final_state) == recorded, segment.name
         if row[VERDICT] == "stable" and row[T_STABLE] != "-" or row[VERDICT] == "timeout":
             assert (row[T_STABLE] != "-") == (segment.recorded_time_to_stable is not None), segment.name

@@ -13,7 +13,7 @@ import pytest
 
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.rig.program import TestProgram, load_program
-from bearing_rig_sim.session.runner import ProgramRunner, SlipObservation, StatusState, Verdict
+from bearing_rig_sim.session.runner import COMMAND_LEAD_S, ProgramRunner, SlipObservation, StatusState, Verdict
 
 PROGRAM = """
 name: short
@@ -312,3 +312,119 @@ def test_a_run_up_is_judged_during_the_acceleration_from_its_start(program: Test
     outcome = runner.outcomes[-1]
     assert outcome.name == "accel" and outcome.verdict == Verdict.STABLE
     assert outcome.time_to_stable == pytest.approx(1.1 + W40)
+
+
+# -- commands ahead of time: the plan is where the spindle is -------------------------------------
+RUN_UPS = """
+name: run_ups
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 200, dwell_s: 1.0}
+  - {name: accel_20, speed_rpm: 1500, acceleration_rad_s2: 20, axial_load_n: 200, dwell_s: 3.0}
+  - {name: stop_20, speed_rpm: 0, ramp_s: 2.0, axial_load_n: 200, dwell_s: 1.0}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 200, until_stable: true, timeout_s: 3.0}
+  - {name: stop, speed_rpm: 0, ramp_s: 1.0, axial_load_n: 200, dwell_s: 1.0}
+"""
+RUN_UP_S = 1500.0 * math.pi / 30.0 / 20.0
+"""0 to 1500 rpm at 20 rad/s^2: 157.08 rad/s / 20 rad/s^2 = 7.854 s."""
+
+
+@pytest.fixture
+def run_ups(tmp_path: Path) -> TestProgram:
+    path = tmp_path / "run_ups.yaml"
+    path.write_text(RUN_UPS, encoding="utf-8")
+    return load_program(path)
+
+
+def test_a_dwell_segments_successor_is_commanded_ahead_stamped_with_its_start(run_ups: TestProgram) -> None:
+    """Without real time the simulator runs ahead of the session's clock: a command stamped when
+    the session notices a segment's end takes effect late, and the spindle does not follow the
+    plan. The end of a dwell segment is known at its start, so the next command goes out up to
+    COMMAND_LEAD_S ahead, stamped with that end, and the next plan starts there, however late the
+    session notices it."""
+    runner = ProgramRunner(run_ups)
+    runner.start(10.0)
+    load_up, accel = runner.commands_due(10.0)
+    assert (load_up.segment.name, load_up.start_time) == ("load_up", 10.0)
+    assert (accel.segment.name, accel.start_time) == ("accel_20", 11.0)  # 10 s + 1 s dwell
+    assert runner.commands_due(10.5) == []  # each command once
+    (started,) = runner.update(11.7)  # the session's clock: 0.7 s after load_up's end
+    assert started is accel and started.start_time == 11.0
+    assert started.ramp_end == pytest.approx(11.0 + RUN_UP_S)
+    stop_due = 11.0 + RUN_UP_S + 3.0 - COMMAND_LEAD_S  # its start less the lead
+    assert runner.commands_due(stop_due - 0.01) == []
+    (stop,) = runner.commands_due(stop_due + 0.01)
+    assert stop.segment.name == "stop_20" and stop.start_time == pytest.approx(11.0 + RUN_UP_S + 3.0)
+    # the stop's successor is due at once (its start, 3 s on, is within the lead), n0900's too:
+    # the segment after an until_stable one is not known ahead
+    (n0900,) = runner.commands_due(stop.start_time - 1.0)
+    assert n0900.segment.name == "n0900" and n0900.start_time == pytest.approx(stop.start_time + 3.0)
+    runner.update(stop.start_time + 0.2)
+    runner.update(n0900.start_time + 0.4)
+    assert runner.current is n0900 and runner.commands_due(n0900.start_time + 3.9) == []
+    runner.update(n0900.deadline + 0.3)  # times out; the next starts when the session notices
+    (last,) = runner.commands_due(n0900.deadline + 0.3)
+    assert last.segment.name == "stop" and last.start_time == pytest.approx(n0900.deadline + 0.3)
+
+
+def stop_status(t: float, rpm: float) -> SlipObservation:
+    return SlipObservation(time=t, state=StatusState.SLIPPING, slip_rate=0.1, inner_ring_speed=rpm_to_rad_s(rpm), cage_speed=20.0, window_revolutions=1)
+
+
+def test_a_stop_is_judged_on_windows_after_its_ramp_only_and_a_turning_spindle_fails_it(run_ups: TestProgram) -> None:
+    """A stopped spindle sends no pulses, so the last window of a stop closes during its ramp at
+    the speed then: that window does not judge the stop. A window closing after the ramp end
+    measures a spindle still turning: the stop's conditions fail (the 446 rpm of a command
+    applied late, or a drive that does not stop)."""
+    for late_rpm, expected in ((None, ()), (446.0, ("speed 446 rpm measured, 0 rpm commanded",))):
+        runner = ProgramRunner(run_ups)
+        runner.start(0.0)
+        runner.update(1.0)
+        runner.update(1.0 + RUN_UP_S + 3.0)
+        stop = runner.current
+        assert stop is not None and stop.segment.name == "stop_20"
+        runner.observe_status(stop_status(stop.ramp_end - 0.3, 1000.0))  # the last window of the ramp
+        if late_rpm is not None:
+            runner.observe_status(stop_status(stop.ramp_end + 0.2, late_rpm))
+        runner.update(stop.deadline)
+        outcome = runner.outcomes[-1]
+        assert outcome.name == "stop_20" and outcome.conditions == expected
+
+
+def test_what_is_stamped_after_a_dwell_segments_end_belongs_to_the_next(run_ups: TestProgram) -> None:
+    """The simulator, its next command queued, is in the next segment before the session notices
+    the end of the running one: a status stamped after that end judges the next segment, not the
+    running one (a run-up's windows at 1458 rpm made a stop "1458 rpm measured")."""
+    runner = ProgramRunner(run_ups)
+    runner.start(0.0)
+    runner.update(1.0)
+    runner.update(1.0 + RUN_UP_S + 3.0)
+    stop = runner.current
+    assert stop is not None and stop.segment.name == "stop_20"
+    # stop_20 ends at stop.deadline; the session has not noticed yet when these arrive
+    runner.observe_status(stop_status(stop.deadline - 0.5, 0.0))
+    runner.observe_status(stop_status(stop.deadline + 0.5, 1458.0))
+    runner.observe_load(stop.deadline + 0.5, 200.0)
+    runner.update(stop.deadline + 0.6)
+    ended = runner.outcomes[-1]
+    assert ended.name == "stop_20" and ended.verdict is Verdict.SLIPPING and ended.measured_speed == 0.0 and ended.conditions_met
+    runner.update(stop.deadline + 1.0)  # n0900 ramps 1 s: the status at +0.5 is in it, before the ramp end
+    runner.observe_status(stop_status(stop.deadline + 1.5, 900.0))
+    runner.update(stop.deadline + 4.0)
+    n0900 = runner.outcomes[-1]
+    assert n0900.name == "n0900" and n0900.measured_speed == pytest.approx(rpm_to_rad_s(900.0)) and n0900.conditions_met
+
+
+def test_a_run_up_stable_during_its_acceleration_is_judged_on_the_speed_it_holds(run_ups: TestProgram) -> None:
+    """A run-up's verdict comes during the acceleration (paper section 4.2); its speed is judged
+    on the segment's last status, at the end of the hold: 1500 rpm met, 1400 rpm not."""
+    for held_rpm, met in ((1500.0, True), (1400.0, False)):
+        runner = ProgramRunner(run_ups)
+        runner.start(0.0)
+        (accel,) = runner.update(1.0)
+        runner.observe_status(SlipObservation(**{**status(accel.start_time + 2.0, StatusState.STABLE).__dict__, "inner_ring_speed": 40.0}))
+        runner.observe_status(stop_status(accel.deadline - 0.1, held_rpm))
+        runner.update(accel.deadline)
+        outcome = runner.outcomes[-1]
+        assert outcome.name == "accel_20" and outcome.time_to_stable == pytest.approx(2.0) and outcome.conditions_met is met

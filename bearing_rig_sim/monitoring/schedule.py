@@ -73,6 +73,15 @@ class StatusSchedule:
             self._tick += 1
         self.clock = max(self.clock, t)
 
+    def advance_to(self, t: float) -> list[ScheduledStatus]:
+        """The ticks due up to the rig time ``t`` (s) without a pulse: those the next pulse would
+        bring, brought now (offline, where something other than a pulse marks the time, such as
+        the start of a program segment); none before the first pulse."""
+        out: list[ScheduledStatus] = []
+        if self._origin is not None and math.isfinite(t) and t > self.clock:
+            self._advance(t, out)
+        return out
+
     def idle(self, now: float) -> ScheduledStatus:
         """No pulse for a while: check at the rig time ``now`` (s) and report."""
         self.monitor.check(now)

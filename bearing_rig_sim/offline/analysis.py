@@ -28,7 +28,9 @@ bench records the same contract, and bags without the simulator's truth are anal
 * ``/rig/speeds``: ``sensor_msgs/msg/JointState`` (``velocity`` of ``inner_ring`` and ``cage``);
 * ``/rig/truth``: ``bearing_rig_msgs/msg/SimulatorTruth`` (twin only);
 * ``/rig/slip_status``: ``bearing_rig_msgs/msg/SlipStatus`` (the monitor's recorded verdicts);
-* ``/rig/spindle/command``: ``bearing_rig_msgs/msg/SpindleCommand`` (program segments);
+* ``/rig/spindle/command``: ``bearing_rig_msgs/msg/SpindleCommand`` (program segments; a
+  command is recorded when sent, which may be ahead of its stamp, the time it takes effect: it
+  starts its segment when the bag's timeline reaches that stamp);
 * ``/rig/axial_load/state`` (``bearing_rig_msgs/msg/AxialLoadState``),
   ``/rig/axial_load/setpoint`` (``std_msgs/msg/Float64``), ``/rig/axial_load/force`` and
   ``/rig/bearing/axial_force`` (``geometry_msgs/msg/WrenchStamped``, ``force.z``).
@@ -288,6 +290,8 @@ class OfflineAnalysis:
         self._segments = SegmentTracker(
             self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings
         )
+        self._commands_ahead: list[tuple[float, Any]] = []
+        """Spindle commands read before their stamp: (stamp s, message), in order."""
         self._sinks: list[CsvWriter] = []
         self._csv_dir = csv_dir
         if csv_dir is not None:
@@ -345,6 +349,11 @@ class OfflineAnalysis:
                 handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
+                while self._commands_ahead and self._commands_ahead[0][0] <= log_time_ns * 1e-9:
+                    start, command = self._commands_ahead.pop(0)
+                    for scheduled in self.schedule.advance_to(start):  # the ticks of the ending segment
+                        self._emit(scheduled.time, scheduled.reason, scheduled.status)
+                    self._start_segment(start, command)
                 handlers[topic](log_time_ns, cast(bytes, data))  # raw=True: the CDR bytes
             self._finish()
         finally:
@@ -445,9 +454,18 @@ class OfflineAnalysis:
         self._segments.recorded(stamp, float(message.cage_speed), state, float(message.confidence), float(message.inner_ring_speed))
 
     def _on_command(self, log_time_ns: int, data: bytes) -> None:
+        """A spindle command; one stamped ahead of the bag's timeline (sent ahead of its start by
+        the session) waits until the timeline reaches its stamp. One never reached (an
+        interrupted run) started no segment."""
         command, start = self._decoded(COMMAND, log_time_ns, data)
         if command is None:
             return
+        if start > log_time_ns * 1e-9:
+            self._commands_ahead.append((start, command))
+            return
+        self._start_segment(start, command)
+
+    def _start_segment(self, start: float, command: Any) -> None:
         window = self.monitor.latest_window
         self._segments.command(
             start,

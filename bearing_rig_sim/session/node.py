@@ -179,8 +179,9 @@ class SessionNode(Node):
         self.tap.destroy_node()
 
     # -- commands ---------------------------------------------------------------------------------
-    def send(self, plan: SegmentPlan) -> None:
-        """Command a segment: the spindle's speed profile and the axial-load set-point."""
+    def send_command(self, plan: SegmentPlan) -> None:
+        """The segment's spindle command, stamped with the segment's start: sent ahead of that
+        time, it waits in the simulator's queue until then (:meth:`ProgramRunner.commands_due`)."""
         command = SpindleCommand()
         command.header.stamp = to_stamp(plan.start_time)
         command.header.frame_id = plan.segment.name
@@ -188,10 +189,14 @@ class SessionNode(Node):
         command.profile = plan.segment.profile.message_code
         command.ramp_time = plan.segment.ramp_time
         command.acceleration = plan.segment.acceleration
-        setpoint = Float64(data=plan.segment.axial_load)
         self._own[SPINDLE_COMMAND.name][repr(command)] += 1
-        self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._spindle.publish(command)
+
+    def send_setpoint(self, plan: SegmentPlan) -> None:
+        """The segment's axial-load set-point (no stamp: it is in force from its arrival, so it is
+        sent when the segment starts)."""
+        setpoint = Float64(data=plan.segment.axial_load)
+        self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._setpoint.publish(setpoint)
 
     # -- readiness --------------------------------------------------------------------------------

@@ -14,7 +14,11 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
    bag's timeline in 2038;
 2. else (``std_msgs/Float64`` set-points), or when the stamp is zero (not set) or more than
    :data:`PLAUSIBLE_SPAN_NS` away from the last ``/clock`` (a wall-clock stamp from some other
-   publisher), the time of the last ``/clock`` received before it;
+   publisher), the time of the last ``/clock`` received before it; so too a spindle command
+   stamped ahead of that ``/clock``: its stamp is when it is to take effect (the session sends
+   the next segment's command ahead), and logged there it would drag the timeline of every
+   message received meanwhile up to it (rule 3); it is logged when received, its header keeps
+   the stamp (``analyze`` starts the segment there);
 3. strictly increasing over the bag: messages taken together (one drain of the subscriptions) are
    ordered by that time (ties keep their arrival order), and a time not after the previous one
    becomes previous + 1 ns. A stamp earlier than the last message written (a pulse interpolated
@@ -29,7 +33,7 @@ from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.clock_guard import ClockGuard
-from bearing_rig_sim.interfaces import CLOCK, TOPICS, Topic
+from bearing_rig_sim.interfaces import CLOCK, SPINDLE_COMMAND, TOPICS, Topic
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",
@@ -92,6 +96,8 @@ class LogTimeRule:
                     self.clock_count += 1
             return self.last_clock_ns
         if stamp is None or stamp <= 0 or abs(stamp - self.last_clock_ns) > self.plausible_span_ns:
+            return self.last_clock_ns
+        if topic.name == SPINDLE_COMMAND.name and stamp > self.last_clock_ns:
             return self.last_clock_ns
         return stamp
 

@@ -7,10 +7,22 @@ the commands it returns.
 
 Rules (simulation time throughout, s):
 
-* A segment starts when the runner notices the previous one ended (the first at
-  :meth:`ProgramRunner.start`); its speed profile starts there from the previous segment's
-  target speed; its ramp ends at ``start + ramp duration``
+* A segment starts where its spindle command is stamped to take effect: the first at
+  :meth:`ProgramRunner.start`; one after a ``dwell_s`` segment at that segment's end
+  (``ramp end + dwell``, known from its start on); one after an ``until_stable`` segment when the
+  runner notices the previous one ended. Its speed profile starts there from the previous
+  segment's target speed; its ramp ends at ``start + ramp duration``
   (:meth:`~bearing_rig_sim.rig.program.Segment.ramp_duration`).
+* **Commands ahead of time** (:meth:`ProgramRunner.commands_due`): the command of a segment whose
+  start is fixed (every segment before it a dwell segment) is sent up to :data:`COMMAND_LEAD_S`
+  (in real time :data:`REALTIME_COMMAND_LEAD_S`) before that start, stamped with it; the
+  simulator queues it and applies it exactly then. Without real time the simulator runs ahead of the session's clock (it waits
+  only for its readers' acknowledgements, not for the session to take the messages: seconds on
+  a loaded host), and a command stamped with the session's own, older, clock takes effect when it
+  arrives: the spindle's ramp then starts and ends late, the segment's speed is judged against a
+  plan the spindle does not follow (a stop still turning at its "ramp end"), and a run-up's time
+  to stable counts from a start that was not the spindle's. Stamped ahead, the plan, the
+  spindle and the recorded command (``analyze`` times segments by its stamp) agree.
 * ``dwell_s``: the segment ends at ``ramp end + dwell``. Its verdict is the monitor's last state
   within the segment (stable, slipping, fault; unknown when no status came).
 * ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
@@ -25,8 +37,14 @@ Rules (simulation time throughout, s):
   two are compared over the same stretch of time. Bearing force: mean of the load controller's
   bearing force once the load has settled (after the ramp end and at least
   :data:`LOAD_SETTLE_S` after the load controller's state first shows the segment's set-point).
-  Measured speed: the monitor's inner-ring speed in the deciding status (else the segment's last),
-  when it is stamped after the ramp end.
+  Measured speed: the monitor's inner-ring speed in the segment's last status, when it is stamped
+  after the ramp end: the speed held at the end, not that of the status that decided the verdict
+  (a run-up is judged stable during its acceleration). A window closes only at a spindle pulse
+  at or after its end, so a stop that stopped has none after its ramp (its last window closes
+  during the ramp, and is not judged), and a stop whose spindle still turns is measured turning.
+* Observations stamped at or after the end of a dwell segment belong to the next segment (the
+  simulator may be there already, its command having been sent ahead): they are kept until the
+  runner starts it.
 * Conditions: a segment whose measured speed or bearing force is off the commanded one by more
   than the tolerance (:func:`speed_tolerance`, :func:`~bearing_rig_sim.load_control.settle_band`),
   or during which a command, a set-point or the load controller's set-point came from outside
@@ -39,8 +57,10 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from enum import Enum
+from typing import Any
 
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.config import rad_s_to_rpm
@@ -61,6 +81,18 @@ __all__ = [
 
 TRUTH_HISTORY = 6000
 """True-slip samples kept (60 s at the simulator's 100 Hz): enough for any status window."""
+
+COMMAND_LEAD_S = 9.0
+"""How long before a segment's fixed start its spindle command is sent without real time, s of
+sim time: more than the simulator runs ahead of the session on a loaded host (1.4 s in the runs
+that failed before commands were sent ahead; 4 s once, with the session held up and a
+stretch of the recording lost), and under the simulator's ``max_command_lead_s`` (10 s), which
+it counts from its own clock, later than the session's. In the acceleration program a run-up's
+command goes out 6-9 s ahead (from the start of the run-up before the stop that precedes it)."""
+
+REALTIME_COMMAND_LEAD_S = 1.0
+"""The same in real time, s: the rig's clock is the wall clock's, and a command queued in the
+drive outlives an interrupted session by at most this."""
 
 LOAD_SETTLE_S = 0.5
 """Sim time after a segment's start before its load is judged, s: the loading chain's stated
@@ -179,7 +211,7 @@ class SegmentOutcome:
     bearing_force: float | None
     """Mean axial force on the bearing once settled (see the module documentation), N."""
     measured_speed: float | None = None
-    """Mean inner-ring speed the monitor measured after the ramp end, rad/s."""
+    """Inner-ring speed of the segment's last status, when stamped after the ramp end, rad/s."""
     conditions: tuple[str, ...] = ()
     """What was off: speed or load not as commanded, disturbances from outside; empty when the
     segment ran under its own conditions."""
@@ -220,8 +252,10 @@ class ProgramRunner:
         if runner.finished: ...                 # runner.outcomes holds one row per segment
     """
 
-    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None) -> None:
+    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None, command_lead_s: float = COMMAND_LEAD_S) -> None:
         self.program = program
+        self.command_lead_s = command_lead_s
+        """How long before a segment's fixed start its command is sent, s (:meth:`commands_due`)."""
         self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
         """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
         self.outcomes: list[SegmentOutcome] = []
@@ -229,6 +263,12 @@ class ProgramRunner:
         self._truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_HISTORY)
         self._start_speeds = program.start_speeds()
         self._finished = False
+        self._ahead: dict[int, SegmentPlan] = {}
+        """Plans of segments not started yet whose start is fixed (see :meth:`commands_due`)."""
+        self._commanded = -1
+        """Highest segment index whose command :meth:`commands_due` gave."""
+        self._early: list[tuple[Callable[..., None], tuple[Any, ...]]] = []
+        """Observations stamped after the running segment's end, for the next one (in order)."""
         self.latest_status: SlipObservation | None = None
         """The last status received, whatever its segment."""
         self.sweeps: dict[int, str] = {}
@@ -265,11 +305,18 @@ class ProgramRunner:
             raise RuntimeError("the program runner was started already")
         return self._begin(0, now)
 
-    def _begin(self, index: int, now: float) -> SegmentPlan:
+    def _plan(self, index: int, start: float) -> SegmentPlan:
         segment = self.program.segments[index]
-        plan = SegmentPlan(index, segment, segment.speed_profile(now, self._start_speeds[index]))
+        return SegmentPlan(index, segment, segment.speed_profile(start, self._start_speeds[index]))
+
+    def _begin(self, index: int, start: float) -> SegmentPlan:
+        """Start segment ``index`` at ``start`` (s of sim time), or as planned ahead."""
+        plan = self._ahead.pop(index, None) or self._plan(index, start)
         run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
         self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up))
+        early, self._early = self._early, []
+        for observe, args in early:  # stamped within this segment, or beyond it (kept again)
+            observe(*args)
         return plan
 
     def update(self, now: float) -> list[SegmentPlan]:
@@ -292,9 +339,34 @@ class ProgramRunner:
             return []
         self._end(verdict, now)
         if plan.index + 1 < self.segment_count:
-            return [self._begin(plan.index + 1, now)]
+            # after a dwell segment the next one starts at its end, where its command is stamped
+            return [self._begin(plan.index + 1, plan.deadline if plan.segment.dwell is not None else now)]
         self._finished = True
         return []
+
+    def commands_due(self, now: float) -> list[SegmentPlan]:
+        """The plans whose spindle command is to be sent at ``now`` (s of sim time), each once, in
+        order: the running segment's (unless given before), and that of each following segment
+        whose start is fixed, the end of a dwell segment, and at most :attr:`command_lead_s`
+        ahead of ``now``. Each command is stamped with its plan's start
+        (:attr:`SegmentPlan.start_time`). An ``until_stable`` segment's end is not known ahead, so
+        the segment after it is commanded when it starts."""
+        plan = self.current
+        if plan is None:
+            return []
+        due = []
+        if self._commanded < plan.index:
+            due.append(plan)
+            self._commanded = plan.index
+        while plan.segment.dwell is not None and plan.index + 1 < self.segment_count and plan.deadline - now <= self.command_lead_s:
+            following = self._ahead.get(plan.index + 1)
+            if following is None:
+                following = self._ahead[plan.index + 1] = self._plan(plan.index + 1, plan.deadline)
+            if self._commanded < following.index:
+                due.append(following)
+                self._commanded = following.index
+            plan = following
+        return due
 
     def interrupt(self, now: float) -> SegmentOutcome | None:
         """Stop: the running segment ends as "interrupted" (returned), the program as finished."""
@@ -319,10 +391,9 @@ class ProgramRunner:
             force = data.force_sum_all / data.force_count_all
         else:
             force = None
+        last = data.last_status
         measured_speed = (
-            decisive.inner_ring_speed
-            if decisive is not None and decisive.time >= plan.ramp_end and math.isfinite(decisive.inner_ring_speed)
-            else None
+            last.inner_ring_speed if last is not None and last.time >= plan.ramp_end and math.isfinite(last.inner_ring_speed) else None
         )
         outcome = SegmentOutcome(
             index=plan.index,
@@ -351,7 +422,7 @@ class ProgramRunner:
         if status.sweep_verdict and math.isfinite(status.sweep_speed):
             self.sweeps[sweep_key(status.sweep_speed)] = status.sweep_verdict
         data = self._data
-        if data is None or status.time < data.plan.start_time:
+        if data is None or status.time < data.plan.start_time or self._ahead_of_segment(status.time, self.observe_status, status):
             return
         data.last_status = status
         data.statuses += 1
@@ -360,6 +431,17 @@ class ProgramRunner:
         evidence = evidence_start(status.time, status.cage_speed, status.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
         if data.rule.observe(status.time, evidence, int(status.state), status.confidence, status.inner_ring_speed):
             data.stable = status
+
+    def _ahead_of_segment(self, time: float, observe: Callable[..., None], *args: Any) -> bool:
+        """Whether an observation stamped ``time`` (s of sim time) belongs to a later segment: one
+        at or after the end of the running dwell segment, whose successor's command was sent ahead
+        (:meth:`commands_due`), so the simulator, running ahead of the session, may already be in
+        it. It is kept and given to the next segment when that starts (True); False otherwise."""
+        data = self._data
+        if data is None or data.plan.segment.dwell is None or time < data.plan.deadline:
+            return False
+        self._early.append((observe, args))
+        return True
 
     def observe_truth(self, time: float, slip_rate: float) -> None:
         """The simulator's true slip rate (%) at ``time`` (s of sim time)."""
@@ -370,6 +452,8 @@ class ProgramRunner:
         """The axial force on the bearing (N) at ``time`` (s of sim time)."""
         data = self._data
         if data is None or time < data.plan.start_time or not math.isfinite(bearing_force):
+            return
+        if self._ahead_of_segment(time, self.observe_load, time, bearing_force):
             return
         data.force_sum_all += bearing_force
         data.force_count_all += 1
@@ -385,7 +469,7 @@ class ProgramRunner:
         time, the previous one, or the load controller's initial 0 N, still in force); any other
         once the segment's was seen was set from outside."""
         data = self._data
-        if data is None or time < data.plan.start_time:
+        if data is None or time < data.plan.start_time or self._ahead_of_segment(time, self.observe_axial_setpoint, time, setpoint):
             return
         own = data.plan.segment.axial_load
         if setpoint == own:

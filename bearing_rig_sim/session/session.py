@@ -65,7 +65,7 @@ from bearing_rig_sim.session.processes import (
 )
 from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, RealTimeFactor, format_progress, format_summary
 from bearing_rig_sim.session.recorder import SessionRecorder
-from bearing_rig_sim.session.runner import ProgramRunner, SegmentOutcome, SegmentPlan
+from bearing_rig_sim.session.runner import COMMAND_LEAD_S, REALTIME_COMMAND_LEAD_S, ProgramRunner, SegmentOutcome, SegmentPlan
 
 __all__ = ["EXIT_CONDITIONS", "EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
 
@@ -247,7 +247,8 @@ class _Session:
         self.out = out
         self.err = err
         self.printer = ProgressPrinter(out, quiet=options.quiet)
-        self.runner = ProgramRunner(program)
+        lead = REALTIME_COMMAND_LEAD_S if options.realtime else COMMAND_LEAD_S  # without real time the simulator runs ahead
+        self.runner = ProgramRunner(program, command_lead_s=lead)
         self.view = view
         if view is not None:
             from bearing_rig_sim.live.foxglove import TeeWriter
@@ -370,6 +371,7 @@ class _Session:
             if not missing:
                 self.phase = _Phase.RUNNING
                 self._start_segment(self.runner.start(now))
+                self._send_commands(now)
             elif time.monotonic() > self.deadline:
                 name, what = next(iter(missing.items()))
                 child = next(c for c in self.children if c.name == name)
@@ -387,6 +389,7 @@ class _Session:
             self._segment_ended(outcome)
         for plan in started:
             self._start_segment(plan)
+        self._send_commands(now)
         if self.runner.finished:
             off = [o.name for o in self.runner.outcomes if o.conditions]
             if off:
@@ -474,9 +477,16 @@ class _Session:
             manager.poll()
             node.drain()
 
+    def _send_commands(self, now: float) -> None:
+        """Send the spindle commands due (the running segment's and those of the next segments
+        whose start is fixed, ahead of time: :meth:`ProgramRunner.commands_due`)."""
+        assert self.node is not None
+        for plan in self.runner.commands_due(now):
+            self.node.send_command(plan)
+
     def _start_segment(self, plan: SegmentPlan) -> None:
         assert self.node is not None
-        self.node.send(plan)
+        self.node.send_setpoint(plan)
         seg = plan.segment
         hold = f"until stable (at most {seg.timeout:g} s)" if seg.until_stable else f"dwell {seg.dwell:g} s"
         self._event(

@@ -28,9 +28,9 @@ pytest.importorskip("foxglove_websocket")
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
 CLIENT = Path(__file__).resolve().parent / "foxglove_client"
-COUNTS = {"/rig/slip_status": 20, "/rig/speeds": 3000}
+COUNTS = {"/rig/slip_status": 20, "/rig/speeds": 3000, "/rig/outer_ring/temperature": 10, "/rig/housing/torque": 100}
 """Messages decoded per topic: 2 s of slip status (10 Hz), 3 s of speeds (1 kHz: the spindle is
-at speed 0.5 s after the start)."""
+at speed 0.5 s after the start), 1 s of the thermocouple (10 Hz) and of the torque meter (100 Hz)."""
 TOPICS = tuple(COUNTS)
 SPEED_RAD_S = 1500.0 * 2.0 * 3.141592653589793 / 60.0
 """The program's spindle speed, 1500 rpm, in rad/s."""
@@ -86,6 +86,14 @@ def test_foxglove_published_client_decodes_a_live_session_on_both_subprotocols(r
             statuses = by_topic["/rig/slip_status"]
             assert {d["schemaName"] for d in statuses} == {"bearing_rig_msgs/msg/SlipStatus"}
             assert all(d["message"]["criterion"] == "time" and d["message"]["state"] in (0, 1, 2, 3) for d in statuses), statuses[-1]
+            temperatures = by_topic["/rig/outer_ring/temperature"]
+            assert {d["schemaName"] for d in temperatures} == {"sensor_msgs/msg/Temperature"}
+            # a thermocouple on a bearing that starts at the room's temperature and warms slowly
+            assert all(10.0 < d["message"]["temperature"] < 60.0 for d in temperatures), temperatures[-1]
+            torques = by_topic["/rig/housing/torque"]
+            assert {d["schemaName"] for d in torques} == {"geometry_msgs/msg/WrenchStamped"}
+            # friction torque about the axis of a 30 mm bore bearing: well under 1 N m, never huge
+            assert all(abs(d["message"]["wrench"]["torque"]["z"]) < 1.0 for d in torques), torques[-1]
             stamps = [int(d["logTimeNs"]) for d in speeds]
             assert stamps == sorted(stamps) and stamps[-1] > stamps[0], "log times on the rig's clock, increasing"
     finally:

@@ -238,6 +238,25 @@ class RosGraph:
             executor.spin_once(timeout_sec=min(0.05, remaining))
         return True
 
+    def call(self, client: Any, request: Any, executor: Any, timeout: float, resend_after: float | None = None) -> Any:
+        """The answer of ``client``'s service to ``request``, spinning ``executor``; None when none
+        came within ``timeout`` s.
+
+        With ``resend_after``, for a request that may be repeated without effect (a ``get_state``),
+        the request is sent again every ``resend_after`` s: Fast DDS may drop the answer to a
+        request sent just after discovery, before the server's reply writer has matched the
+        client's reader (``service_is_ready`` only says the request side has matched).
+        """
+        deadline = time.monotonic() + timeout
+        while True:
+            future = client.call_async(request)
+            wait = deadline - time.monotonic() if resend_after is None else min(resend_after, deadline - time.monotonic())
+            if self.spin_until(future.done, timeout=max(wait, 0.0), executor=executor):
+                return future.result()
+            client.remove_pending_request(future)
+            if time.monotonic() >= deadline:
+                return None
+
     # -- other processes ---------------------------------------------------------------------
     def spawn_python(self, *args: str, cwd: str | Path | None = None) -> subprocess.Popen[str]:
         """Start ``python args...`` (this interpreter) in this graph's environment.

@@ -63,16 +63,10 @@ class Lifecycle:
         )
         assert ready, f"no lifecycle services of /{target}"
 
-    def _call(self, client: Any, request: Any, resend_after: float = WAIT) -> Any:
-        """The answer to ``request``; a request that may be repeated without effect (get_state)
-        is sent again every ``resend_after`` s until ``WAIT``: DDS may drop the answer to a
-        request sent just after discovery, before the server's reply writer matched the client."""
-        for _ in range(max(1, round(WAIT / resend_after))):
-            future = client.call_async(request)
-            if self.graph.spin_until(future.done, timeout=resend_after, executor=self.executor):
-                return future.result()
-            client.remove_pending_request(future)
-        raise AssertionError(f"no answer to {request} within {WAIT:g} s")
+    def _call(self, client: Any, request: Any, resend_after: float | None = None) -> Any:
+        answer = self.graph.call(client, request, self.executor, WAIT, resend_after)
+        assert answer is not None, f"no answer to {request} within {WAIT:g} s"
+        return answer
 
     def state(self) -> str:
         return str(self._call(self.get_state, GetState.Request(), resend_after=5.0).current_state.label)

@@ -46,13 +46,14 @@ class LifecycleClient:
     def spin_until(self, condition: Any, timeout: float = WAIT) -> bool:
         return self.graph.spin_until(condition, timeout=timeout, executor=self.executor)
 
-    def call(self, client: Any, request: Any) -> Any:
-        future = client.call_async(request)
-        assert self.spin_until(future.done), "no answer"
-        return future.result()
+    def call(self, client: Any, request: Any, resend_after: float | None = None) -> Any:
+        answer = self.graph.call(client, request, self.executor, WAIT, resend_after)
+        assert answer is not None, "no answer"
+        return answer
 
     def state(self) -> str:
-        return self.call(self.get_state_client, GetState.Request()).current_state.label
+        # get_state changes nothing: sent again when DDS drops the answer to the first request
+        return self.call(self.get_state_client, GetState.Request(), resend_after=5.0).current_state.label
 
     def change(self, transition_id: int) -> bool:
         return self.call(self.change_client, ChangeState.Request(transition=Transition(id=transition_id))).success

@@ -48,6 +48,10 @@ MANAGED = ("simulator", "load_controller", "monitor")
 """The nodes ``rig.launch.py`` starts and brings up."""
 WAIT = 120.0
 """Longest wait for one answer or state, s (a first configure compiles the engine's kernels)."""
+ATTEMPT_S = 30.0
+"""A repeatable ``ros2`` verb that has not ended by then is started again (see ``Ros2.run``)."""
+REPEATABLE = frozenset({("param", "describe"), ("param", "get"), ("param", "dump"), ("param", "set"), ("param", "load"), ("lifecycle", "get"), ("topic", "echo")})
+"""Verbs whose repetition changes nothing: they read, or set a parameter to the same value."""
 
 
 @dataclass(frozen=True)
@@ -115,12 +119,24 @@ class Ros2:
 
     def run(self, *argv: str, timeout: float = WAIT) -> subprocess.CompletedProcess[str]:
         """``ros2 argv...`` to its end; again while it has not discovered the node it names yet
-        (``--no-daemon`` verbs discover the graph afresh each time, for ``--spin-time``)."""
+        (``--no-daemon`` verbs discover the graph afresh each time, for ``--spin-time``).
+
+        A verb whose repetition changes nothing (:data:`REPEATABLE`) is also started again when it
+        hangs for ``ATTEMPT_S``: a fresh ``--no-daemon`` process asks a node's service just after
+        discovering it, and Fast DDS may drop the answer before the node's reply writer has
+        matched (``ros2 param`` then waits for ever)."""
         deadline = time.monotonic() + timeout
+        repeatable = tuple(argv[:2]) in REPEATABLE
         while True:
-            result = subprocess.run(
-                [self.ros2, *argv], env=self.env, cwd=REPO_ROOT, capture_output=True, text=True, timeout=timeout, preexec_fn=_prepare_child
-            )
+            attempt = min(ATTEMPT_S, timeout) if repeatable else timeout
+            try:
+                result = subprocess.run(
+                    [self.ros2, *argv], env=self.env, cwd=REPO_ROOT, capture_output=True, text=True, timeout=attempt, preexec_fn=_prepare_child
+                )
+            except subprocess.TimeoutExpired:
+                if not repeatable or time.monotonic() + attempt > deadline:
+                    raise
+                continue
             said = result.stdout + result.stderr
             undiscovered = "Node not found" in said or "does not appear to be published yet" in said
             if not undiscovered or time.monotonic() > deadline:

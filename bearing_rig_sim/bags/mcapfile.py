@@ -11,9 +11,8 @@ bytes are lost. The same index serves both cases, so reading and repairing share
 
 from __future__ import annotations
 
-import heapq
+import contextlib
 import io
-import itertools
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,7 +28,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, merge_in_time
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
 """What the mcap library raises on bytes that are not the records they should be (a CRC mismatch
@@ -104,10 +103,11 @@ def _one_record(stream: BinaryIO, offset: int) -> McapRecord:
     return next(iter(StreamReader(stream, skip_magic=True, emit_chunks=True).records))
 
 
-def _open_chunk(chunk: Chunk) -> list[McapRecord]:
-    """The records of a chunk, decompressed and checksummed by the mcap library."""
+@contextlib.contextmanager
+def _opening_chunk() -> Iterator[None]:
+    """Turn whatever decompressing or checksumming a chunk raises into :class:`DamagedRecord`."""
     try:
-        return breakup_chunk(chunk, validate_crc=True)
+        yield
     except Exception as exc:  # zstandard, lz4 and mcap raise their own classes
         raise DamagedRecord(f"chunk does not decompress or fails its checksum ({exc})") from None
 
@@ -116,10 +116,11 @@ _RECORD_HEAD = struct.Struct("<BQ")  # opcode, length (MCAP spec, "Records")
 _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publish time ("Message")
 
 
-def _chunk_messages(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageTuple]:
-    """The wanted message records of a decompressed chunk. ``breakup_chunk`` builds a record
-    object for every message (2 us each: an hour of the rig's traffic took 13 s to read instead
-    of 3 s); this loop slices out only the messages ``keep`` accepts."""
+def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageTuple]:
+    """The wanted message records of a run of records (a decompressed chunk, or messages written
+    outside chunks). ``breakup_chunk`` builds a record object for every message (2 us each: an
+    hour of the rig's traffic took 13 s to read instead of 3 s); this loop slices out only the
+    messages ``keep`` accepts."""
     out = []
     position, end = 0, len(data)
     head, message = _RECORD_HEAD.unpack_from, _MESSAGE_HEAD.unpack_from
@@ -143,31 +144,21 @@ def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, in
         DamagedRecord: the chunk is truncated, corrupt or does not decompress.
     """
     try:
+        stream.seek(ref.offset)
         if ref.loose:
-            stream.seek(ref.offset)
-            records = _records(io.BytesIO(stream.read(ref.stop - ref.offset)))
-            messages = [(r.log_time, r.channel_id, r.publish_time, r.data) for r in records if isinstance(r, Message) and keep(r.channel_id, r.log_time)]
+            data = stream.read(ref.stop - ref.offset)
         else:
             chunk = _one_record(stream, ref.offset)
             if not isinstance(chunk, Chunk):
                 raise DamagedRecord(f"no chunk record at offset {ref.offset}")
-            try:
-                data, size = get_chunk_data_stream(chunk, validate_crc=True)
-                messages = _chunk_messages(data.read(size), keep)
-            except Exception as exc:  # zstandard, lz4 and mcap raise their own classes
-                raise DamagedRecord(f"chunk does not decompress or fails its checksum ({exc})") from None
+            with _opening_chunk():
+                stream_of_data, size = get_chunk_data_stream(chunk, validate_crc=True)
+                data = stream_of_data.read(size)
+        messages = _messages_in(data, keep)
     except _UNREADABLE as exc:
         raise DamagedRecord(f"unreadable at offset {ref.offset} ({exc or type(exc).__name__})") from None
     messages.sort(key=lambda m: m[0])
     return messages
-
-
-def _records(stream: BinaryIO) -> Iterator[McapRecord]:
-    """Records from the current position up to the end of ``stream``."""
-    try:
-        yield from StreamReader(stream, skip_magic=True, emit_chunks=True).records
-    except EndOfFile:
-        return
 
 
 def _record_head(head: bytes) -> tuple[str, str]:
@@ -233,56 +224,47 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
     """Fill ``index`` from the records after the header: a damaged chunk is skipped, the scan
     stops at the first record that cannot be read (cut by the end of the file)."""
     name = index.path.name
-    start = stream.tell()
+    start = run_start = stream.tell()
     schemas: dict[int, Schema] = {}
-    loose: list[tuple[int, int, int]] = []  # (offset after the record, channel, log time) of messages outside chunks
-    run_start = start
+    loose: list[tuple[int, int]] = []  # (channel, log time) of the current run of messages outside chunks
 
-    def close_loose_run() -> None:
-        if loose:
-            times = [t for _end, _c, t in loose]
-            index.chunks.append(ChunkRef(run_start, loose[-1][0], min(times), max(times), frozenset(c for _e, c, _t in loose), loose=True))
-            loose.clear()
+    def add_group(offset: int, stop: int, messages: list[tuple[int, int]], is_loose: bool) -> None:
+        if messages:
+            times = [t for _c, t in messages]
+            index.chunks.append(ChunkRef(offset, stop, min(times), max(times), frozenset(c for c, _t in messages), is_loose))
+
+    def note(record: McapRecord) -> None:
+        if isinstance(record, Message):
+            index.count(record.channel_id, record.log_time)
+        elif isinstance(record, Schema):
+            schemas[record.id] = record
+            index.add_schema(record)
+        elif isinstance(record, Channel):
+            index.add_channel(record, schemas)
+        elif isinstance(record, Metadata):
+            index.metadata.setdefault(record.name, {}).update(record.metadata)
 
     try:
         for record in records:
             end = stream.tell()
             if isinstance(record, Message):
-                if not loose:
-                    run_start = start
-                loose.append((end, record.channel_id, record.log_time))
-                index.count(record.channel_id, record.log_time)
+                run_start = run_start if loose else start
+                loose.append((record.channel_id, record.log_time))
             else:
-                close_loose_run()
+                add_group(run_start, start, loose, True)
+                loose = []
+            inner: list[McapRecord] = [record]
             if isinstance(record, Chunk):
+                index.compression = index.compression or record.compression
                 try:
-                    inner = _open_chunk(record)
+                    with _opening_chunk():
+                        inner = breakup_chunk(record, validate_crc=True)
                 except DamagedRecord as exc:
                     index.problems.append(f"{name}: chunk record at offset {start} is damaged ({exc}); skipped")
                     inner = []
-                times = []
-                channels = set()
-                for item in inner:
-                    if isinstance(item, Message):
-                        times.append(item.log_time)
-                        channels.add(item.channel_id)
-                        index.count(item.channel_id, item.log_time)
-                    elif isinstance(item, Schema):
-                        schemas[item.id] = item
-                        index.add_schema(item)
-                    elif isinstance(item, Channel):
-                        index.add_channel(item, schemas)
-                if not index.chunks and not index.compression:
-                    index.compression = record.compression
-                if times:
-                    index.chunks.append(ChunkRef(start, end, min(times), max(times), frozenset(channels)))
-            elif isinstance(record, Schema):
-                schemas[record.id] = record
-                index.add_schema(record)
-            elif isinstance(record, Channel):
-                index.add_channel(record, schemas)
-            elif isinstance(record, Metadata):
-                index.metadata.setdefault(record.name, {}).update(record.metadata)
+                add_group(start, end, [(m.channel_id, m.log_time) for m in inner if isinstance(m, Message)], False)
+            for item in inner:
+                note(item)
             start = end
             if isinstance(record, (DataEnd, Footer)):
                 break
@@ -294,7 +276,7 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
             kind, size = _record_head(stream.read(9))
             state = "cut by the end of the file" if isinstance(exc, (EndOfFile, struct.error)) else f"damaged ({exc})"
             index.problems.append(f"{name}: {kind} record at offset {start} is {state} ({index.file_size - start}{size} bytes present)")
-    close_loose_run()
+    add_group(run_start, start, loose, True)
     index.readable_bytes = start
 
 
@@ -362,19 +344,14 @@ def check_chunks(index: McapIndex) -> list[str]:
     return problems
 
 
-def _lazy_chunk(
-    stream: BinaryIO, ref: ChunkRef, order: int, keep: Callable[[int, int], bool], report: ProblemSink, label: str
-) -> Iterator[tuple[int, int, int, int, bytes]]:
-    """A chunk's wanted messages as (log_time, order, channel, publish, data); the first item is a
-    marker at the chunk's start time, so a merge can hold many chunks without reading them."""
-    yield (ref.start_ns, order, -1, 0, b"")
+def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool], report: ProblemSink, label: str) -> Iterator[MessageTuple]:
+    """A chunk's wanted messages; the first item is a marker (channel -1) at the chunk's start
+    time, so a merge can hold many chunks without reading them."""
+    yield (ref.start_ns, -1, 0, b"")
     try:
-        messages = read_chunk_messages(stream, ref, keep)
+        yield from read_chunk_messages(stream, ref, keep)
     except DamagedRecord as exc:
-        report(f"{label}: {exc}; its messages are skipped")
-        return
-    for log_time, channel_id, publish_time, data in messages:
-        yield (log_time, order, channel_id, publish_time, data)
+        report(f"{label}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
 
 
 def iter_file_messages(
@@ -414,12 +391,8 @@ def iter_file_messages(
         report(f"{index.path}: cannot open ({exc.strerror or exc})")
         return
     try:
-        in_order = all(b.start_ns >= a.end_ns for a, b in zip(refs, refs[1:]))
-        chunks = [_lazy_chunk(stream, r, i, keep, report, f"{index.path.name}: chunk at offset {r.offset}") for i, r in enumerate(refs)]
-        source = itertools.chain.from_iterable(chunks) if in_order else heapq.merge(*chunks)
-        for log_time, _order, channel_id, publish_time, data in source:
-            if channel_id >= 0:
-                yield log_time, channel_id, publish_time, data
+        chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
+        yield from (m for m in merge_in_time(chunks) if m[1] >= 0)
     finally:
         stream.close()
 

@@ -1,27 +1,20 @@
-"""Quality-of-service profiles a recorded topic was offered with.
+"""The quality of service a recorded topic was offered with (rosbag2 ``offered_qos_profiles``), so
+that a replay can offer the same again.
 
-A bag stores, per topic, the QoS its publisher offered (rosbag2 ``offered_qos_profiles``), so that
-a replay can offer the same again. The named profiles are the ones of the interface contract
-(``docs/interfaces.md``, :data:`bearing_rig_sim.interfaces.QOS_DESCRIPTIONS`):
-
-* ``"reliable"``: reliable, volatile, keep last 10 (commands, states, diagnostics);
-* ``"reliable_stream"``: reliable, volatile, keep last 5000 (the twin's streams: ``/clock``,
-  pulses, speeds, truth, the force on the bearing);
-* ``"sensor_data"``: best effort, volatile, keep last 100 (load cell);
-* ``"transient_local"``: reliable, transient local, keep last 10 (latched: spindle command, slip
-  status).
-
-Deadline, lifespan and liveliness lease are stored as 0 s, the middleware's "default" (none).
+The named profiles are the contract's (:data:`bearing_rig_sim.interfaces.QOS_TABLE`, names
+:data:`~bearing_rig_sim.interfaces.QosName`); deadline, lifespan and liveliness lease are stored
+as 0 s, the middleware's "default" (none).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, get_args
 
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 
 from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim.interfaces import QOS_TABLE, QosName
 
 Reliability = Literal["reliable", "best_effort"]
 Durability = Literal["volatile", "transient_local"]
@@ -37,6 +30,9 @@ class QosSpec:
         durability: ``"volatile"`` or ``"transient_local"`` (late joiners get the last messages).
         depth: history depth (messages), >= 1 for ``keep_last``.
         history: ``"keep_last"`` or ``"keep_all"``.
+
+    Raises:
+        BagError: a value outside those.
     """
 
     reliability: Reliability = "reliable"
@@ -45,12 +41,9 @@ class QosSpec:
     history: History = "keep_last"
 
     def __post_init__(self) -> None:
-        if self.reliability not in ("reliable", "best_effort"):
-            raise BagError(f"QoS reliability must be 'reliable' or 'best_effort', got {self.reliability!r}")
-        if self.durability not in ("volatile", "transient_local"):
-            raise BagError(f"QoS durability must be 'volatile' or 'transient_local', got {self.durability!r}")
-        if self.history not in ("keep_last", "keep_all"):
-            raise BagError(f"QoS history must be 'keep_last' or 'keep_all', got {self.history!r}")
+        for name, allowed in (("reliability", Reliability), ("durability", Durability), ("history", History)):
+            if getattr(self, name) not in get_args(allowed):
+                raise BagError(f"QoS {name} must be {' or '.join(map(repr, get_args(allowed)))}, got {getattr(self, name)!r}")
         if not isinstance(self.depth, int) or self.depth < 0 or (self.history == "keep_last" and self.depth < 1):
             raise BagError(f"QoS depth must be an integer >= 1 with keep_last, got {self.depth!r}")
 
@@ -73,24 +66,15 @@ class QosSpec:
     def from_rosbags(cls, qos: Qos) -> QosSpec | None:
         """The profile stored in a bag, or None when it uses values this project does not offer
         (system default, best available, unknown)."""
+        names = (qos.reliability.name.lower(), qos.durability.name.lower(), int(qos.depth), qos.history.name.lower())
         try:
-            return cls(
-                reliability=qos.reliability.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
-                durability=qos.durability.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
-                depth=int(qos.depth),
-                history=qos.history.name.lower(),  # type: ignore[arg-type]  # an enum name checked by QosSpec itself
-            )
+            return cls(*names)  # type: ignore[arg-type]  # enum names, checked by QosSpec itself
         except BagError:
             return None
 
 
-QOS_PROFILES: dict[str, QosSpec] = {
-    "reliable": QosSpec("reliable", "volatile", 10),
-    "reliable_stream": QosSpec("reliable", "volatile", 5000),
-    "sensor_data": QosSpec("best_effort", "volatile", 100),
-    "transient_local": QosSpec("reliable", "transient_local", 10),
-}
-"""The named profiles of the interface contract."""
+QOS_PROFILES: dict[str, QosSpec] = {name: QosSpec(QOS_TABLE[name].reliability, QOS_TABLE[name].durability, QOS_TABLE[name].depth) for name in get_args(QosName)}
+"""The contract's named profiles, as stored in a bag."""
 
 
 def qos_spec(qos: str | QosSpec) -> QosSpec:

@@ -21,14 +21,12 @@ Fast-CDR leaves after a message (bags from ``ros2 bag record``) is ignored.
 
 from __future__ import annotations
 
-import heapq
-import itertools
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
 from typing import Literal, NamedTuple
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Iterable, Iterator
 
 from rosbags.interfaces.typing import Constdefs, Fielddefs, Typesdict
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -39,7 +37,7 @@ from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
-from bearing_rig_sim.bags.storage import FileIndex, StorageFormat
+from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, StorageFormat, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, dependencies, rig_typestore
 from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
@@ -158,7 +156,6 @@ class BagReader:
             for problem in index.problems:
                 self._report(problem)
         self._store = self._build_typestore()
-        self._decoders: dict[str, Callable[[bytes], object]] = {}
         self._channel_topics: list[dict[int, str]] = []
         self._topics = self._collect_topics()
         self._check_layout()
@@ -347,50 +344,31 @@ class BagReader:
                 f"(stale metadata after an interrupted recording? `bearing-rig bag repair {self.path}` rewrites it)"
             )
 
-    def _decoder(self, msgtype: str) -> Callable[[bytes], object]:
-        decoder = self._decoders.get(msgtype)
-        if decoder is None:
-            decoder = self._decoders[msgtype] = make_decoder(self._store, msgtype)
-        return decoder
-
     def _iterate(self, selected: set[str], start_ns: int | None, stop_ns: int | None, raw: bool) -> Iterator[BagMessage]:
+        def named(messages: Iterator[MessageTuple], topic_of: dict[int, str]) -> Iterator[tuple[int, str, bytes]]:
+            return ((t, topic_of[cid], data) for t, cid, _publish, data in messages)
+
         streams = []
-        routes: list[dict[int, tuple[str, str, Callable[[bytes], object] | None]]] = []
         for index, topic_of in zip(self._indexes, self._channel_topics):
-            wanted = [cid for cid, name in topic_of.items() if name in selected]
-            if not wanted or not index.message_count:
-                continue
-            tagged = len(routes)
-            routes.append(
-                {
-                    cid: (
-                        topic_of[cid],
-                        self._topics[topic_of[cid]].msgtype,
-                        None if raw else self._decoder(self._topics[topic_of[cid]].msgtype),
-                    )
-                    for cid in wanted
-                }
-            )
-            messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
-            streams.append((index.start_ns, index.end_ns, ((t, tagged, cid, data) for t, cid, _pub, data in messages)))
-        streams.sort(key=lambda s: s[0])
-        in_order = all(b[0] > a[1] for a, b in zip(streams, streams[1:]))
-        generators = [s[2] for s in streams]
-        source = itertools.chain.from_iterable(generators) if in_order else heapq.merge(*generators, key=lambda m: (m[0], m[1]))
+            wanted = {cid: name for cid, name in topic_of.items() if name in selected}
+            if wanted and index.message_count:
+                messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
+                streams.append((index.start_ns, index.end_ns, named(messages, wanted)))
+        types = {name: self._topics[name].msgtype for name in selected}
+        decoders = {} if raw else {name: make_decoder(self._store, msgtype) for name, msgtype in types.items()}
         failed: dict[str, int] = {}
-        for log_time, tagged, channel_id, data in source:
-            name, msgtype, decode = routes[tagged][channel_id]
-            if decode is None:
-                yield BagMessage(name, log_time, msgtype, data)
+        for log_time, name, data in merge_in_time(streams):
+            if raw:
+                yield BagMessage(name, log_time, types[name], data)
                 continue
             try:
-                message = decode(data)
+                message = decoders[name](data)
             except BagError as exc:
                 failed[name] = failed.get(name, 0) + 1
                 if failed[name] == 1:
                     self._report(f"{self.path.name}: topic {name}: {exc}; such messages are skipped")
                 continue
-            yield BagMessage(name, log_time, msgtype, message)
+            yield BagMessage(name, log_time, types[name], message)
         for name, count in failed.items():
             if count > 1:
                 self._report(f"{self.path.name}: topic {name}: {count} messages could not be decoded in all")

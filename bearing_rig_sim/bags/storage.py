@@ -11,10 +11,12 @@ MCAP's alone (:mod:`.repair`).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator, Mapping
+import heapq
+import itertools
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Protocol
+from typing import Any, Protocol, TypeVar
 
 ProblemSink = Callable[[str], None]
 """Receives a one-line description of each problem met while reading."""
@@ -77,6 +79,21 @@ class FileIndex:
             self.end_ns = max(self.end_ns, log_time)
         self.message_count += 1
         self.channel_counts[channel_id] = self.channel_counts.get(channel_id, 0) + 1
+
+
+Item = TypeVar("Item", bound=tuple[Any, ...])
+
+
+def merge_in_time(streams: Sequence[tuple[int, int, Iterable[Item]]]) -> Iterator[Item]:
+    """The items of several streams, each given as (earliest, latest log time, items in log-time
+    order) with the log time first in every item, in log-time order; equal times keep the order
+    of the streams sorted by their earliest time. Streams that follow each other in time are
+    chained (each is read when the one before is done), others merged on a heap."""
+    ordered = sorted(streams, key=lambda s: s[0])
+    items = [s[2] for s in ordered]
+    if all(b[0] >= a[1] for a, b in zip(ordered, ordered[1:])):
+        return itertools.chain.from_iterable(items)
+    return heapq.merge(*items, key=lambda item: item[0])
 
 
 class StorageFormat(Protocol):

@@ -156,9 +156,16 @@ class BagReader:
             for problem in index.problems:
                 self._report(problem)
         self._store = self._build_typestore()
+        self._found = layout_from_indexes(self._indexes, self.layout, self._report)
+        """What the files hold, as a ``metadata.yaml`` would state it."""
         self._channel_topics: list[dict[int, str]] = []
         self._topics = self._collect_topics()
-        self._check_layout()
+        if self.layout is not None and self.layout.message_count != self.message_count:
+            self._report(
+                f"{self.path / 'metadata.yaml'}: states {self.layout.message_count} messages but the files hold "
+                f"{self.message_count} readable ones (stale metadata after an interrupted recording? "
+                f"`bearing-rig bag repair {self.path}` rewrites it)"
+            )
 
     # -- public API -------------------------------------------------------------------------
 
@@ -175,22 +182,22 @@ class BagReader:
     @property
     def message_count(self) -> int:
         """Messages readable in all files (all topics, decodable or not)."""
-        return sum(i.message_count for i in self._indexes)
+        return self._found.message_count
 
     @property
     def start_ns(self) -> int:
         """Log time of the earliest message (ns); 0 for an empty bag."""
-        return min((i.start_ns for i in self._indexes if i.message_count), default=0)
+        return self._found.start_ns
 
     @property
     def end_ns(self) -> int:
         """Log time of the latest message (ns); 0 for an empty bag."""
-        return max((i.end_ns for i in self._indexes if i.message_count), default=0)
+        return self._found.start_ns + self._found.duration_ns
 
     @property
     def duration_ns(self) -> int:
         """``end_ns - start_ns``."""
-        return self.end_ns - self.start_ns
+        return self._found.duration_ns
 
     @property
     def run_metadata(self) -> dict[str, str]:
@@ -308,8 +315,7 @@ class BagReader:
         return store
 
     def _collect_topics(self) -> dict[str, TopicInfo]:
-        found = layout_from_indexes(self._indexes, self.layout, self._report)
-        types = {t.name: t.msgtype for t in found.topics}
+        types = {t.name: t.msgtype for t in self._found.topics}
         for index in self._indexes:
             self._channel_topics.append(
                 {
@@ -319,7 +325,7 @@ class BagReader:
                 }
             )
         topics = {}
-        for entry in sorted(found.topics, key=lambda t: t.name):
+        for entry in sorted(self._found.topics, key=lambda t: t.name):
             cdr = entry.serialization_format == "cdr"
             decodable = cdr and bool(entry.msgtype) and entry.msgtype in self._store.fielddefs
             if not decodable:
@@ -332,17 +338,6 @@ class BagReader:
             qos = QosSpec.from_rosbags(entry.qos[0]) if entry.qos else None
             topics[entry.name] = TopicInfo(entry.name, entry.msgtype, entry.message_count, qos, entry.type_hash, decodable)
         return topics
-
-    def _check_layout(self) -> None:
-        if self.layout is None:
-            return
-        stated = self.layout.message_count
-        held = self.message_count
-        if stated != held:
-            self._report(
-                f"{self.path / 'metadata.yaml'}: states {stated} messages but the files hold {held} readable ones "
-                f"(stale metadata after an interrupted recording? `bearing-rig bag repair {self.path}` rewrites it)"
-            )
 
     def _iterate(self, selected: set[str], start_ns: int | None, stop_ns: int | None, raw: bool) -> Iterator[BagMessage]:
         def named(messages: Iterator[MessageTuple], topic_of: dict[int, str]) -> Iterator[tuple[int, str, bytes]]:

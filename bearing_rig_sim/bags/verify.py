@@ -1,34 +1,25 @@
 """A full check of a bag's contents: every chunk decompressed and checksummed, the timeline looked at.
 
-Opening a bag reads its index only (fast, and enough to list topics and counts); a chunk whose
-bytes were damaged after the recording (a bad disk, a truncated copy) still looks fine there.
-:func:`verify_bag` reads every chunk once:
-
-* **Chunks**: each is read through the bag's storage format (:mod:`.storage`; for MCAP
-  decompressed and its CRC-32 compared); a chunk that fails is named, and the messages the index
-  promised but no chunk delivered are counted as unreadable.
-* **Timeline**: the log times of all readable messages are grouped into stretches with no gap
-  longer than :data:`TIMELINE_GAP_NS`; a healthy recording is one stretch. Every stretch but the
-  largest is reported as log-time outliers (a stamp from another clock, a ``/clock`` far in the
-  future that became the recording's time).
-
-Memory stays bounded: messages come in log-time order and only the stretches are kept.
+Opening a bag reads its index only; a chunk damaged after the recording (a bad disk, a truncated
+copy) still looks fine there. :func:`verify_indexes` reads every message once, through the bag's
+storage format: a chunk that fails is named, and the messages the index promised but no chunk
+delivered are counted as unreadable. The log times are grouped into stretches with no gap longer
+than :data:`TIMELINE_GAP_NS`; a healthy recording is one stretch, every other one is reported as
+log-time outliers (a stamp from another clock, a ``/clock`` far in the future that became the
+recording's time). Memory stays bounded: messages come in log-time order, only stretches are kept.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
-from collections.abc import Callable, Iterator
+from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
+from bearing_rig_sim.clock_guard import DEFAULT_MAX_STEP_NS
 
-from bearing_rig_sim.bags.storage import FileIndex, MessageTuple
-
-__all__ = ["TIMELINE_GAP_NS", "BagCheck", "Stretch", "verify_indexes"]
-
-TIMELINE_GAP_NS = 10_000_000_000
-"""A gap of more than 10 s between two consecutive log times splits the timeline. The rig's
-recordings carry /clock at 1 kHz; the session's recorder treats a stamp 10 s from the clock as
-not sim time, with the same bound."""
+TIMELINE_GAP_NS = DEFAULT_MAX_STEP_NS
+"""A gap of more than this (10 s) between two consecutive log times splits the timeline: the
+largest step the clock guard accepts as the same clock."""
 
 
 @dataclass
@@ -42,16 +33,19 @@ class Stretch:
 
 @dataclass
 class BagCheck:
-    """What :func:`verify_indexes` found."""
+    """What :func:`verify_indexes` found.
+
+    Attributes:
+        damaged: one line per chunk that failed to decompress or whose checksum did not match.
+        messages_read: messages delivered by the chunks.
+        messages_indexed: messages the files' indexes (statistics) count.
+        stretches: the timeline's stretches, in time order.
+    """
 
     damaged: list[str] = field(default_factory=list)
-    """One line per chunk that failed to decompress or whose checksum did not match."""
     messages_read: int = 0
-    """Messages delivered by the chunks."""
     messages_indexed: int = 0
-    """Messages the files' indexes (statistics) count."""
     stretches: list[Stretch] = field(default_factory=list)
-    """The timeline's stretches, in time order."""
 
     @property
     def messages_unreadable(self) -> int:
@@ -61,9 +55,7 @@ class BagCheck:
     @property
     def outliers(self) -> list[Stretch]:
         """Every stretch but the one with the most messages."""
-        if len(self.stretches) < 2:
-            return []
-        main = max(self.stretches, key=lambda s: s.count)
+        main = max(self.stretches, key=lambda s: s.count, default=None)
         return [s for s in self.stretches if s is not main]
 
     def problems(self) -> list[str]:
@@ -71,51 +63,31 @@ class BagCheck:
         lines = list(self.damaged)
         if self.messages_unreadable:
             share = 100.0 * self.messages_unreadable / self.messages_indexed
+            lines.append(f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that cannot be read")
+        main = max(self.stretches, key=lambda s: s.count, default=None)
+        for s in self.outliers:
+            assert main is not None  # there are outliers only beside a main stretch
+            after = s.start_ns > main.end_ns
+            distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
             lines.append(
-                f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that "
-                "cannot be read"
+                f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
+                f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
+                f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
             )
-        if self.outliers:
-            main = max(self.stretches, key=lambda s: s.count)
-            for s in self.outliers:
-                side = "after" if s.start_ns > main.end_ns else "before"
-                distance = (s.start_ns - main.end_ns) if side == "after" else (main.start_ns - s.end_ns)
-                lines.append(
-                    f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
-                    f"{distance * 1e-9:.3f} s {side} the main timeline ({main.start_ns * 1e-9:.3f}-"
-                    f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
-                )
         return lines
-
-
-def _merge(stretches: list[Stretch]) -> list[Stretch]:
-    """Stretches that overlap or lie within the gap of each other, joined; in time order."""
-    merged: list[Stretch] = []
-    for s in sorted(stretches, key=lambda s: s.start_ns):
-        if merged and s.start_ns - merged[-1].end_ns <= TIMELINE_GAP_NS:
-            last = merged[-1]
-            last.end_ns = max(last.end_ns, s.end_ns)
-            last.count += s.count
-        else:
-            merged.append(Stretch(s.start_ns, s.end_ns, s.count))
-    return merged
 
 
 def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
     """Read every message of the indexed files with their storage format's ``messages`` (see
     the module documentation)."""
-    check = BagCheck()
-    pieces: list[Stretch] = []
-    for index in indexes:
-        check.messages_indexed += index.message_count
-        current: Stretch | None = None
-        for log_time, _channel, _publish, _data in messages(index, report=check.damaged.append):
-            check.messages_read += 1
-            if current is not None and log_time - current.end_ns <= TIMELINE_GAP_NS:
-                current.end_ns = max(current.end_ns, log_time)
-                current.count += 1
-            else:
-                current = Stretch(log_time, log_time, 1)
-                pieces.append(current)
-    check.stretches = _merge(pieces)
+    check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
+    streams = [(i.start_ns, i.end_ns, messages(i, report=check.damaged.append)) for i in indexes]
+    for log_time, _channel, _publish, _data in merge_in_time(streams):
+        check.messages_read += 1
+        last = check.stretches[-1] if check.stretches else None
+        if last is not None and log_time - last.end_ns <= TIMELINE_GAP_NS:
+            last.end_ns = max(last.end_ns, log_time)
+            last.count += 1
+        else:
+            check.stretches.append(Stretch(log_time, log_time, 1))
     return check

@@ -1,4 +1,5 @@
-"""The recorder: a rosbag2 (format version 9) bag directory with MCAP storage.
+"""The recorder: a rosbag2 (format version 9) bag directory with MCAP storage (what it holds:
+``docs/bags.md``).
 
 ::
 
@@ -6,22 +7,15 @@
         bag.add_topic("/rig/speeds", "sensor_msgs/msg/JointState", "sensor_data")
         bag.write("/rig/speeds", sim_time_ns, raw_cdr_bytes)
 
-What a bag holds: ``metadata.yaml`` and ``<name>_0.mcap`` (then ``_1``, ``_2``... when split by
-size), with one ``ros2msg`` schema per type (the full definition, dependencies included), one
-``cdr`` channel per topic carrying its offered QoS profile and RIHS01 type hash, zstd-compressed
-chunks, and the run context (configuration, calibration, test program, project version) in an
-MCAP metadata record named ``bearing_rig_sim`` and in ``metadata.yaml``'s ``custom_data``.
+Time: ``log_time`` is the simulation time in ns, strictly increasing over the whole bag (as
+Foxglove's timeline and a faithful replay need): a message whose time is not greater than the
+previous one is **nudged** to the previous time + 1 ns (:attr:`BagWriter.nudged_count`); its
+``publish_time`` keeps the time it was given.
 
-Time: ``log_time`` is the simulation time in nanoseconds and is strictly increasing over the
-whole bag, as Foxglove's timeline and a faithful replay need. Topics published at the same
-simulation instant (``/clock``, ``/rig/speeds``...) would collide, so a message whose time is not
-greater than the previous one is **nudged** to the previous time + 1 ns; its ``publish_time``
-keeps the time it was given. :attr:`BagWriter.nudged_count` counts such messages.
-
-Robustness: chunks go to the operating system as soon as they are complete, and
-``metadata.yaml`` is written when the bag opens and whenever topics or files change, so a killed
-recording leaves every complete chunk readable (:func:`~bearing_rig_sim.bags.repair.repair_bag`
-restores the index). Leaving the ``with`` block for any reason, Ctrl-C included, finalises the bag.
+Robustness: chunks reach the operating system as soon as they are complete and ``metadata.yaml``
+is rewritten whenever topics or files change, so a killed recording leaves every complete chunk
+readable (:func:`~bearing_rig_sim.bags.repair.repair_bag` restores the index). Leaving the
+``with`` block for any reason, Ctrl-C included, finalises the bag.
 """
 
 from __future__ import annotations
@@ -91,21 +85,9 @@ def register_topic(mcap: McapWriter, schema_ids: dict[str, int], topic: TopicEnt
     return mcap.register_channel(topic.name, topic.serialization_format, schema_id, metadata)
 
 
-def normalise_msgtype(msgtype: str) -> str:
-    """``pkg/Name`` or ``pkg/msg/Name`` -> ``pkg/msg/Name``."""
-    parts = msgtype.split("/")
-    if len(parts) == 2:
-        return f"{parts[0]}/msg/{parts[1]}"
-    return msgtype
-
-
 class CountingSink:
-    """Unbuffered output file that knows how many bytes were written.
-
-    Each write goes straight to the operating system, so every chunk the MCAP writer has finished
-    survives a kill of the recording process; :attr:`position` lets the writer split files by
-    size without a system call.
-    """
+    """Unbuffered output file that counts the bytes written: every chunk the MCAP writer finishes
+    survives a kill of the recording process, and files are split by size without a system call."""
 
     def __init__(self, path: Path) -> None:
         try:
@@ -120,12 +102,10 @@ class CountingSink:
     def write(self, data: bytes | bytearray | memoryview) -> int:
         """Write everything (looping over partial writes); returns the byte count."""
         view = memoryview(data)
-        total = len(view)
         while view:
-            written = self._file.write(view)
-            view = view[written:]
-        self.position += total
-        return total
+            view = view[self._file.write(view) :]
+        self.position += len(data)
+        return len(data)
 
     def tell(self) -> int:
         """Bytes written so far."""
@@ -148,6 +128,10 @@ class _Topic:
     normalise: Callable[[CdrBytes], CdrBytes]
     channel_id: int = 0
     count: int = 0
+
+    def entry(self) -> TopicEntry:
+        """The topic as ``metadata.yaml`` states it."""
+        return TopicEntry(self.name, self.msgtype, [self.qos.to_rosbags()], self.type_hash, self.count)
 
 
 class BagWriter:
@@ -258,7 +242,8 @@ class BagWriter:
         self._check_open()
         if not isinstance(name, str) or not name.startswith("/") or len(name) < 2:
             raise BagError(f"topic name must be fully qualified (start with '/'), got {name!r}")
-        msgtype = normalise_msgtype(msgtype)
+        if msgtype.count("/") == 1:  # pkg/Name
+            msgtype = msgtype.replace("/", "/msg/")
         spec = qos_spec(qos)
         if msgtype not in self._typestore.fielddefs:
             raise BagError(f"topic {name}: unknown message type {msgtype!r} (not a ROS 2 Jazzy or bearing_rig_msgs type)")
@@ -293,10 +278,7 @@ class BagWriter:
             BagError: bag closed, unknown topic, bad time, or bytes that are not a message of
                 the topic's type.
         """
-        entry = self._topics.get(topic)
-        if entry is None:
-            self._check_open()
-            raise BagError(f"topic {topic!r} was not added to the bag (call add_topic first)")
+        entry = self._topic(topic)
         if not isinstance(data, (bytes, bytearray, memoryview)):
             raise BagError(f"topic {topic}: data must be serialized bytes, got {type(data).__name__}")
         try:
@@ -311,10 +293,7 @@ class BagWriter:
         Raises:
             BagError: as :meth:`write`, or the message is not of the topic's type.
         """
-        entry = self._topics.get(topic)
-        if entry is None:
-            self._check_open()
-            raise BagError(f"topic {topic!r} was not added to the bag (call add_topic first)")
+        entry = self._topic(topic)
         msgtype = getattr(message, "__msgtype__", None)
         if msgtype != entry.msgtype:
             raise BagError(f"topic {topic} carries {entry.msgtype}, got a {msgtype or type(message).__name__}")
@@ -370,6 +349,13 @@ class BagWriter:
         if self._mcap is None:
             raise BagError(f"{self._path}: the bag is closed")
 
+    def _topic(self, name: str) -> _Topic:
+        entry = self._topics.get(name)
+        if entry is None:
+            self._check_open()
+            raise BagError(f"topic {name!r} was not added to the bag (call add_topic first)")
+        return entry
+
     def _append(self, entry: _Topic, log_time_ns: int, data: CdrBytes) -> None:
         mcap = self._mcap
         if mcap is None:
@@ -414,8 +400,7 @@ class BagWriter:
 
     def _register(self, topic: _Topic) -> None:
         assert self._mcap is not None
-        entry = TopicEntry(topic.name, topic.msgtype, [topic.qos.to_rosbags()], topic.type_hash)
-        topic.channel_id = register_topic(self._mcap, self._schema_ids, entry, self._typestore)
+        topic.channel_id = register_topic(self._mcap, self._schema_ids, topic.entry(), self._typestore)
 
     def _finish_file(self) -> None:
         assert self._mcap is not None and self._sink is not None
@@ -427,13 +412,7 @@ class BagWriter:
             self._sink.close()
 
     def _write_layout(self) -> None:
-        layout = BagLayout(
-            topics=[
-                TopicEntry(t.name, t.msgtype, [t.qos.to_rosbags()], t.type_hash, t.count) for t in self._topics.values()
-            ],
-            files=list(self._files),
-            custom_data=dict(self._run_context),
-        )
+        layout = BagLayout([t.entry() for t in self._topics.values()], list(self._files), dict(self._run_context))
         try:
             write_layout(self._path, layout)
         except OSError as exc:

@@ -1,10 +1,9 @@
-"""The rosbag2 bag directory: ``metadata.yaml`` (format version 9) and the MCAP file names.
+"""The rosbag2 bag directory: ``metadata.yaml`` (format version 9) and the storage file names.
 
-A bag is a directory ``<name>/`` holding ``metadata.yaml`` and one or more storage files
-``<name>_0.mcap``, ``<name>_1.mcap``... (split by size). ``metadata.yaml`` lists the files, every
-topic with its type, serialization format (``cdr``), offered QoS profiles and RIHS01 type hash,
-message counts and the time range; ``custom_data`` holds string key/value pairs (the project puts
-its run context there too).
+A bag is a directory ``<name>/`` holding ``metadata.yaml`` and the storage files ``<name>_0.mcap``,
+``<name>_1.mcap``... (split by size); ``metadata.yaml`` lists the files and every topic with its
+type, serialization format, offered QoS profiles, RIHS01 type hash and message count, the time
+range and ``custom_data`` (string pairs: the project puts its run context there too).
 """
 
 from __future__ import annotations
@@ -72,8 +71,6 @@ class BagLayout:
     storage_identifier: str = "mcap"
     version: int = BAG_VERSION
     ros_distro: str = ROS_DISTRO
-    compression_mode: str = ""
-    compression_format: str = ""
     stated_message_count: int | None = None
     """The top-level ``message_count`` of a ``metadata.yaml`` that was read (None when built)."""
 
@@ -86,16 +83,17 @@ class BagLayout:
     @property
     def start_ns(self) -> int:
         """Earliest message time (ns); 0 for an empty bag."""
-        used = [f for f in self.files if f.message_count]
-        return min((f.start_ns for f in used), default=0)
+        return min((f.start_ns for f in self.files if f.message_count), default=0)
+
+    @property
+    def end_ns(self) -> int:
+        """Latest message time (ns); 0 for an empty bag."""
+        return max((f.start_ns + f.duration_ns for f in self.files if f.message_count), default=0)
 
     @property
     def duration_ns(self) -> int:
         """Time from the earliest to the latest message (ns)."""
-        used = [f for f in self.files if f.message_count]
-        if not used:
-            return 0
-        return max(f.start_ns + f.duration_ns for f in used) - self.start_ns
+        return self.end_ns - self.start_ns
 
 
 def storage_file_name(bag_dir: Path, index: int) -> str:
@@ -154,8 +152,8 @@ def layout_to_dict(layout: BagLayout) -> dict[str, Any]:
                 }
                 for t in layout.topics
             ],
-            "compression_format": layout.compression_format,
-            "compression_mode": layout.compression_mode,
+            "compression_format": "",
+            "compression_mode": "",
             "relative_file_paths": [f.path for f in layout.files],
             "files": [
                 {
@@ -170,11 +168,6 @@ def layout_to_dict(layout: BagLayout) -> dict[str, Any]:
             "ros_distro": layout.ros_distro,
         }
     }
-
-
-def same_layout(a: BagLayout, b: BagLayout) -> bool:
-    """True when both would write the same ``metadata.yaml``."""
-    return layout_to_dict(a) == layout_to_dict(b)
 
 
 def write_layout(bag_dir: Path, layout: BagLayout) -> None:
@@ -229,44 +222,32 @@ def read_layout(bag_dir: Path) -> BagLayout:
             "compression instead, or decompress with `ros2 bag convert`)"
         )
     paths = _get(info, "relative_file_paths", source, list, where)
-    file_info = {str(PurePath(str(f.get("path", ""))).name): f for f in info.get("files") or [] if isinstance(f, dict)}
+    file_info = {PurePath(str(f.get("path", ""))).name: f for f in info.get("files") or [] if isinstance(f, dict)}
+
+    def ns(entry: dict[str, Any], key: str, unit: str) -> int:
+        return int((entry.get(key) or {}).get(unit, 0) or 0)
+
     files = []
-    for raw in paths:
-        name = PurePath(str(raw)).name
+    for name in (PurePath(str(raw)).name for raw in paths):
         entry = file_info.get(name, {})
-        files.append(
-            FileEntry(
-                path=name,
-                start_ns=int((entry.get("starting_time") or {}).get("nanoseconds_since_epoch", 0) or 0),
-                duration_ns=int((entry.get("duration") or {}).get("nanoseconds", 0) or 0),
-                message_count=int(entry.get("message_count", 0) or 0),
-            )
-        )
+        files.append(FileEntry(name, ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds"), int(entry.get("message_count", 0) or 0)))
     topics = []
     for index, item in enumerate(_get(info, "topics_with_message_count", source, list, where)):
         at = f"{where}topics_with_message_count[{index}]."
         meta = _get(item, "topic_metadata", source, dict, at)
         name = _get(meta, "name", source, str, at + "topic_metadata.")
-        topics.append(
-            TopicEntry(
-                name=name,
-                msgtype=_get(meta, "type", source, str, at + "topic_metadata."),
-                qos=parse_qos_profiles(meta.get("offered_qos_profiles"), f"{source}: topic {name}"),
-                type_hash=str(meta.get("type_description_hash") or ""),
-                message_count=int(item.get("message_count", 0) or 0),
-                serialization_format=str(meta.get("serialization_format") or "cdr"),
-            )
-        )
+        msgtype = _get(meta, "type", source, str, at + "topic_metadata.")
+        qos = parse_qos_profiles(meta.get("offered_qos_profiles"), f"{source}: topic {name}")
+        count = int(item.get("message_count", 0) or 0)
+        topics.append(TopicEntry(name, msgtype, qos, str(meta.get("type_description_hash") or ""), count, str(meta.get("serialization_format") or "cdr")))
     custom = info.get("custom_data") or {}
     return BagLayout(
-        topics=topics,
-        files=files,
-        custom_data={str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {},
+        topics,
+        files,
+        {str(k): str(v) for k, v in custom.items()} if isinstance(custom, dict) else {},
         storage_identifier=storage,
         version=version,
         ros_distro=str(info.get("ros_distro") or ""),
-        compression_mode="",
-        compression_format="",
         stated_message_count=int(info.get("message_count") or 0),
     )
 

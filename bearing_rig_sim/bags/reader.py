@@ -192,7 +192,7 @@ class BagReader:
     @property
     def end_ns(self) -> int:
         """Log time of the latest message (ns); 0 for an empty bag."""
-        return self._found.start_ns + self._found.duration_ns
+        return self._found.end_ns
 
     @property
     def duration_ns(self) -> int:

@@ -27,8 +27,8 @@ from bearing_rig_sim.bags.layout import (
     METADATA_FILE,
     BagLayout,
     layout_from_indexes,
+    layout_to_dict,
     read_layout,
-    same_layout,
     storage_file_index,
     write_layout,
 )
@@ -216,7 +216,7 @@ def repair_bag(path: str | Path) -> RepairReport:
     layout = layout_from_indexes(indexes, previous, problems.append, type_hash)
     if problems and report.files:
         report.files[0].problems.extend(problems)
-    if previous is None or not same_layout(previous, layout):
+    if previous is None or layout_to_dict(previous) != layout_to_dict(layout):
         old = bag_dir / METADATA_FILE
         if old.exists():
             report.metadata_backup = _backup_path(old)

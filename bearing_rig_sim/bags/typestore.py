@@ -27,10 +27,8 @@ SCHEMA_SEPARATOR = "=" * 80
 
 
 def msg_folder() -> Path:
-    """Folder holding the ``bearing_rig_msgs`` ``.msg`` files.
-
-    The source tree's ``msg_defs/msg`` first, then the installed ``share/bearing_rig_msgs/msg``
-    found through the ament index.
+    """Folder holding the ``bearing_rig_msgs`` ``.msg`` files: the source tree's ``msg_defs/msg``,
+    else the installed ``share/bearing_rig_msgs/msg`` (through the ament index).
 
     Raises:
         BagError: neither exists.
@@ -46,34 +44,23 @@ def msg_folder() -> Path:
             return installed
     except Exception:  # ament index absent or package not installed
         pass
-    raise BagError(
-        f"cannot find the {RIG_MSG_PACKAGE} message definitions: neither {local} nor an installed "
-        f"share/{RIG_MSG_PACKAGE}/msg exists"
-    )
+    raise BagError(f"cannot find the {RIG_MSG_PACKAGE} message definitions: neither {local} nor an installed share/{RIG_MSG_PACKAGE}/msg exists")
 
 
 @functools.cache
 def rig_message_texts() -> dict[str, str]:
     """``{"bearing_rig_msgs/msg/<Name>": <.msg file text>}`` for every custom message."""
-    folder = msg_folder()
-    return {
-        f"{RIG_MSG_PACKAGE}/msg/{path.stem}": path.read_text(encoding="utf-8")
-        for path in sorted(folder.glob("*.msg"))
-    }
+    return {f"{RIG_MSG_PACKAGE}/msg/{path.stem}": path.read_text(encoding="utf-8") for path in sorted(msg_folder().glob("*.msg"))}
 
 
 @functools.cache
 def rig_typestore() -> Typestore:
-    """ROS 2 Jazzy's types plus the ``bearing_rig_msgs`` types (cached, shared).
+    """ROS 2 Jazzy's types plus the ``bearing_rig_msgs`` types (cached and shared: treat it as
+    read-only).
 
-    Treat the result as read-only: register extra types into a store of your own
-    (:func:`new_rig_typestore`).
+    Raises:
+        BagError: a ``.msg`` file does not parse.
     """
-    return new_rig_typestore()
-
-
-def new_rig_typestore() -> Typestore:
-    """A fresh, unshared store with the same types as :func:`rig_typestore`."""
     store = get_typestore(Stores.ROS2_JAZZY)
     types: Typesdict = {}
     for name, text in rig_message_texts().items():

@@ -11,7 +11,7 @@ subscriptions) sizes its buffer with the worst-case alignment of every empty seq
 elements (``float64[]``...), so such a message carries 4 to 12 bytes of padding after its last
 field. rosbags' ``deserialize_cdr`` refuses more than 3 bytes after the end ("CDR message size
 mismatch"). The length a message really occupies is therefore found by walking its bytes along
-the type's field definitions (:func:`encoded_length`: lengths and alignment only, a few
+the type's field definitions (:func:`length_function`: lengths and alignment only, a few
 microseconds); the recorder stores messages of types with sequences cut to that length, and the
 reader decodes the cut bytes with rosbags' public ``Typestore.deserialize_cdr``. Bags written by
 other tools (``ros2 bag record`` on the physical bench) keep the padding and decode all the same.
@@ -126,10 +126,10 @@ def little_endian(msgtype: str, data: CdrBytes | bytearray) -> bool:
     return header == LITTLE_ENDIAN
 
 
-def _length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], int] | None:
-    """A function giving the bytes a message of ``msgtype`` occupies, header included (raises
-    :class:`BagError` for bytes that end before the message does or are not CDR); None when the
-    type holds a field the walk does not know."""
+def length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], int] | None:
+    """A function giving the bytes a message of ``msgtype`` really occupies, header included
+    (<= ``len(data)``; it raises :class:`BagError` for bytes that end before the message does or
+    are not CDR); None when the type holds a field the walk does not know (``wstring``)."""
     try:
         walk = _walker(typestore, Nodetype.NAME, msgtype)
     except KeyError:
@@ -147,34 +147,18 @@ def _length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes],
     return length
 
 
-def encoded_length(typestore: Typestore, msgtype: str, data: CdrBytes) -> int:
-    """Bytes the message really occupies, header included (<= ``len(data)``).
-
-    Raises:
-        BagError: the bytes end before the message does, or are not CDR.
-    """
-    length = _length_function(typestore, msgtype)
-    if length is None:
-        raise BagError(f"{msgtype}: a field type the CDR walk does not know (wstring?)")
-    return length(data)
-
-
 def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], CdrBytes]:
     """A function returning serialized messages of ``msgtype`` as the recorder stores them:
     trailing padding trimmed for a type with sequences; as received for a type without (its
     Fast-CDR size is exact), once its encapsulation header is checked.
 
     The function raises :class:`BagError` for bytes that are not a (complete) message."""
-    length = _length_function(typestore, msgtype) if has_sequences(typestore, msgtype) else None
-    if length is None:
-
-        def check(data: CdrBytes) -> CdrBytes:
-            little_endian(msgtype, data)
-            return data
-
-        return check
+    length = length_function(typestore, msgtype) if has_sequences(typestore, msgtype) else None
 
     def normalise(data: CdrBytes) -> CdrBytes:
+        if length is None:
+            little_endian(msgtype, data)
+            return data
         end = length(data)
         return data[:end] if end < len(data) else data
 
@@ -185,7 +169,7 @@ def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], obj
     """A function decoding serialized messages of ``msgtype`` into rosbags message objects with
     rosbags' ``deserialize_cdr``; bytes after the end of the message (Fast-CDR padding) are
     ignored. A malformed or truncated message raises :class:`BagError`."""
-    length = _length_function(typestore, msgtype)
+    length = length_function(typestore, msgtype)
     deserialize = typestore.deserialize_cdr
 
     def decode(data: CdrBytes) -> object:

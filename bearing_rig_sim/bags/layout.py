@@ -276,7 +276,8 @@ def layout_from_indexes(
     Topics come from the files' channels (type from the schema, QoS and type hash from the
     channel metadata), completed by ``previous`` (the existing ``metadata.yaml``, if any) for
     topics without messages or values the files lack; ``type_hash_of`` fills hashes still
-    missing. Counts and times come from the file indexes. A channel whose type contradicts an
+    missing. Counts and times come from the file indexes; the run context from the first MCAP
+    metadata record :data:`RUN_METADATA_RECORD`, else ``previous``'s ``custom_data``. A channel whose type contradicts an
     earlier one of the same topic is reported and left out.
     """
     topics: dict[str, TopicEntry] = {}
@@ -321,9 +322,9 @@ def layout_from_indexes(
         )
         for index in indexes
     ]
-    custom: dict[str, str] = dict(previous.custom_data) if previous is not None else {}
-    if not custom:
-        custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), {})
+    custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), None)
+    if custom is None:
+        custom = dict(previous.custom_data) if previous is not None else {}
     return BagLayout(
         topics=list(topics.values()),
         files=files,

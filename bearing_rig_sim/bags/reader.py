@@ -34,7 +34,7 @@ from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
-from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, channel_msgtype, layout_from_indexes, read_layout
+from bearing_rig_sim.bags.layout import BagLayout, channel_msgtype, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, StorageFormat, merge_in_time
@@ -204,10 +204,7 @@ class BagReader:
         """The run context (configuration, calibration, test program, project version...): the
         MCAP metadata record ``bearing_rig_sim``, else ``metadata.yaml``'s ``custom_data``;
         empty when the bag has neither."""
-        for index in self._indexes:
-            if RUN_METADATA_RECORD in index.metadata:
-                return dict(index.metadata[RUN_METADATA_RECORD])
-        return dict(self.layout.custom_data) if self.layout is not None else {}
+        return dict(self._found.custom_data)
 
     def verify(self) -> BagCheck:
         """Read every chunk: checksums, unreadable messages, log-time outliers (see

@@ -7,16 +7,11 @@
         for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]):
             ...
 
-Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk
-(memory does not grow with the bag's length). Types are decoded with the definitions the bag
-carries (so an old bag keeps decoding after a message changes), falling back to ROS 2 Jazzy's
-and ``bearing_rig_msgs``' own.
-
-Damage is reported, not fatal: an MCAP file whose recording was killed (no summary) is read up to
-its last complete chunk, a corrupt chunk is skipped, a topic whose type is unknown is left out; each
-problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
-:attr:`BagReader.problems`. ``strict=True`` turns them into :class:`BagError`. Padding that
-Fast-CDR leaves after a message (bags from ``ros2 bag record``) is ignored.
+Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk.
+Types are decoded with the definitions the bag carries (an old bag keeps decoding after a message
+changes), else with ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (what is
+still read: ``docs/bags.md``): each problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning`
+and a line in :attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
 """
 
 from __future__ import annotations

@@ -276,9 +276,9 @@ def layout_from_indexes(
     Topics come from the files' channels (type from the schema, QoS and type hash from the
     channel metadata), completed by ``previous`` (the existing ``metadata.yaml``, if any) for
     topics without messages or values the files lack; ``type_hash_of`` fills hashes still
-    missing. Counts and times come from the file indexes; the run context from the first MCAP
-    metadata record :data:`RUN_METADATA_RECORD`, else ``previous``'s ``custom_data``. A channel whose type contradicts an
-    earlier one of the same topic is reported and left out.
+    missing. A channel whose type contradicts an earlier one of the same topic is reported and
+    left out. Counts and times come from the file indexes; the run context from the first MCAP
+    metadata record :data:`RUN_METADATA_RECORD`, else ``previous``'s ``custom_data``.
     """
     topics: dict[str, TopicEntry] = {}
     for index in indexes:

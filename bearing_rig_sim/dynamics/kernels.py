@@ -797,10 +797,18 @@ def step_reduced(
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
-        omega_c = 0.0
-        for k in range(z):
-            omega_c += cage[k, C_OMEGA]
-        fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
+        # the cage centre moves once something pushes it off the axis: a radial load or a state
+        # left off it; a centred cage under a purely axial load is an exact equilibrium (the
+        # pockets' forces cancel, the film has none) and skips the centre's terms
+        centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
+        if centre:
+            omega_c = 0.0
+            for k in range(z):
+                omega_c += cage[k, C_OMEGA]
+            fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
+        else:
+            ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
         land_f = ring[R_LAND_F]
         # the cage centre's 2x2 block: m_c - dt (dt K + C) - sum (g/r_m) n t^T, and its right side
         m11 = mc - dt * (dt * kxx + cxx)
@@ -816,7 +824,9 @@ def step_reduced(
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
-            cph, sph = math.cos(cage[j, C_PHI]), math.sin(cage[j, C_PHI])
+            cph = sph = 0.0
+            if centre:
+                cph, sph = math.cos(cage[j, C_PHI]), math.sin(cage[j, C_PHI])
             # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
             gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
             rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
@@ -849,25 +859,26 @@ def step_reduced(
             work[j, w0 + 4] = e
             work[j, w0 + 5] = ku * rate
             work[j, w0 + 6] = fs
-            # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1) <= 0,
-            # the force's direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
-            g = dt * rm * ee * (dt * e * i11 - 1.0)
-            nx = -sph + mup * sroll * cph
-            ny = cph + mup * sroll * sph
             work[j, w0 + 20] = -sph
             work[j, w0 + 21] = cph
-            work[j, w0 + 22] = g
-            work[j, w0 + 23] = nx
-            work[j, w0 + 24] = ny
-            work[j, w0 + 25] = g * -sph
-            work[j, w0 + 26] = g * cph
-            m11 -= g / rm * nx * -sph
-            m12 -= g / rm * nx * cph
-            m21 -= g / rm * ny * -sph
-            m22 -= g / rm * ny * cph
-            fp = fs + dt * ku * rate + ee * rm * x2
-            rcx += nx * fp
-            rcy += ny * fp
+            if centre:
+                # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1)
+                # <= 0, its direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
+                g = dt * rm * ee * (dt * e * i11 - 1.0)
+                nx = -sph + mup * sroll * cph
+                ny = cph + mup * sroll * sph
+                work[j, w0 + 22] = g
+                work[j, w0 + 23] = nx
+                work[j, w0 + 24] = ny
+                work[j, w0 + 25] = g * -sph
+                work[j, w0 + 26] = g * cph
+                m11 -= g / rm * nx * -sph
+                m12 -= g / rm * nx * cph
+                m21 -= g / rm * ny * -sph
+                m22 -= g / rm * ny * cph
+                fp = fs + dt * ku * rate + ee * rm * x2
+                rcx += nx * fp
+                rcy += ny * fp
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
                 out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
@@ -887,30 +898,33 @@ def step_reduced(
                 + dt * rm * work[k, w0 + 5]
             ) + dt * e * work[k, w0 + 2]
         cyclic_tridiagonal(diag, -dt * lc, rhs, d_omega, tri_work)
-        # the segments' response to the cage centre's velocity change: A Y = g t
-        yx = work[:, w0 + 27]
-        yy = work[:, w0 + 28]
-        cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 25], yx, tri_work)
-        cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 26], yy, tri_work)
-        for k in range(z):
-            g = work[k, w0 + 22]
-            nx, ny = work[k, w0 + 23], work[k, w0 + 24]
-            m11 -= g * nx * yx[k]
-            m12 -= g * nx * yy[k]
-            m21 -= g * ny * yx[k]
-            m22 -= g * ny * yy[k]
-            rcx += g / dt * nx * d_omega[k]
-            rcy += g / dt * ny * d_omega[k]
-        det2 = m11 * m22 - m12 * m21
-        dvx = dt * (m22 * rcx - m12 * rcy) / det2
-        dvy = dt * (m11 * rcy - m21 * rcx) / det2
-        ring[R_CVX] = cvx + dvx
-        ring[R_CVY] = cvy + dvy
-        ring[R_CX] = cx + dt * ring[R_CVX]
-        ring[R_CY] = cy + dt * ring[R_CVY]
+        dvx = dvy = 0.0
+        if centre:
+            # the segments' response to the cage centre's velocity change: A Y = g t
+            yx = work[:, w0 + 27]
+            yy = work[:, w0 + 28]
+            cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 25], yx, tri_work)
+            cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 26], yy, tri_work)
+            for k in range(z):
+                g = work[k, w0 + 22]
+                nx, ny = work[k, w0 + 23], work[k, w0 + 24]
+                m11 -= g * nx * yx[k]
+                m12 -= g * nx * yy[k]
+                m21 -= g * ny * yx[k]
+                m22 -= g * ny * yy[k]
+                rcx += g / dt * nx * d_omega[k]
+                rcy += g / dt * ny * d_omega[k]
+            det2 = m11 * m22 - m12 * m21
+            dvx = dt * (m22 * rcx - m12 * rcy) / det2
+            dvy = dt * (m11 * rcy - m21 * rcx) / det2
+            ring[R_CVX] = cvx + dvx
+            ring[R_CVY] = cvy + dvy
+            ring[R_CX] = cx + dt * ring[R_CVX]
+            ring[R_CY] = cy + dt * ring[R_CVY]
+            for j in range(z):
+                d_omega[j] += yx[j] * dvx + yy[j] * dvy
         cage_sum = 0.0
         for j in range(z):
-            d_omega[j] += yx[j] * dvx + yy[j] * dvy
             # the pocket's closing speed seen by the ball: r_m d Omega + t . d v (over r_m)
             coup = dt * work[j, w0 + 4] * (d_omega[j] + (work[j, w0 + 20] * dvx + work[j, w0 + 21] * dvy) / rm)
             ball[j, B_OMEGA] += work[j, w0 + 2] + work[j, w0 + 0] * coup

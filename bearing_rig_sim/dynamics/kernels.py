@@ -474,6 +474,44 @@ def cyclic_tridiagonal(diag: np.ndarray, off: float, rhs: np.ndarray, out: np.nd
 
 
 @njit(cache=True)
+def cyclic_tridiagonal_pair(diag: np.ndarray, off: float, rhs_a: np.ndarray, rhs_b: np.ndarray, out_a: np.ndarray, out_b: np.ndarray, work: np.ndarray) -> None:
+    """:func:`cyclic_tridiagonal` for two right-hand sides sharing one factorisation; ``work``
+    is scratch of shape (n, 5)."""
+    n = diag.shape[0]
+    gamma = -diag[0]
+    for i in range(n):
+        work[i, 0] = diag[i]
+        work[i, 2] = rhs_a[i]
+        work[i, 3] = 0.0
+        work[i, 4] = rhs_b[i]
+    work[0, 0] -= gamma
+    work[n - 1, 0] -= off * off / gamma
+    work[0, 3] = gamma
+    work[n - 1, 3] = off
+    inv = 1.0 / work[0, 0]
+    work[0, 1] = off * inv
+    work[0, 2] *= inv
+    work[0, 3] *= inv
+    work[0, 4] *= inv
+    for i in range(1, n):
+        inv = 1.0 / (work[i, 0] - off * work[i - 1, 1])
+        work[i, 1] = off * inv
+        work[i, 2] = (work[i, 2] - off * work[i - 1, 2]) * inv
+        work[i, 3] = (work[i, 3] - off * work[i - 1, 3]) * inv
+        work[i, 4] = (work[i, 4] - off * work[i - 1, 4]) * inv
+    for i in range(n - 2, -1, -1):
+        work[i, 2] -= work[i, 1] * work[i + 1, 2]
+        work[i, 3] -= work[i, 1] * work[i + 1, 3]
+        work[i, 4] -= work[i, 1] * work[i + 1, 4]
+    den = 1.0 + work[0, 3] + off * work[n - 1, 3] / gamma
+    fact_a = (work[0, 2] + off * work[n - 1, 2] / gamma) / den
+    fact_b = (work[0, 4] + off * work[n - 1, 4] / gamma) / den
+    for i in range(n):
+        out_a[i] = work[i, 2] - fact_a * work[i, 3]
+        out_b[i] = work[i, 4] - fact_b * work[i, 3]
+
+
+@njit(cache=True)
 def cage_land_torque(p: np.ndarray, omega: float, z: int, factor: float = 1.0, normal: float = 0.0) -> tuple[float, float]:
     """Land friction torque on one cage segment (N m, resisting) and its derivative.
 
@@ -721,6 +759,26 @@ def finish_step(ring: np.ndarray, stats: np.ndarray, omega_i_old: float, omega_i
 
 
 @njit(cache=True)
+def pocket_directions(cage: np.ndarray, tx: np.ndarray, ty: np.ndarray, pitch_c: float, pitch_s: float) -> None:
+    """Circumferential directions t_k = (-sin phi_k, cos phi_k) of the cage's pockets into
+    ``tx``, ``ty``: segment 0's by the library, the others by rotating it through the pitch
+    2 pi/Z (``pitch_c``, ``pitch_s`` its cosine and sine) and the segment's small offset d from
+    its nominal place (series to d^4, exact to 1e-16 for |d| < 1e-3 rad; the library beyond)."""
+    z = cage.shape[0]
+    c, s = math.cos(cage[0, C_PHI]), math.sin(cage[0, C_PHI])
+    for k in range(z):
+        d = cage[k, C_PHI] - cage[0, C_PHI] - 2.0 * math.pi * k / z
+        if abs(d) < 1e-3:
+            d2 = d * d
+            cd, sd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0), d * (1.0 - d2 / 6.0)
+            ck, sk = c * cd - s * sd, s * cd + c * sd
+        else:
+            ck, sk = math.cos(cage[k, C_PHI]), math.sin(cage[k, C_PHI])
+        tx[k], ty[k] = -sk, ck
+        c, s = c * pitch_c - s * pitch_s, s * pitch_c + c * pitch_s
+
+
+@njit(cache=True)
 def cage_centre_forces(p: np.ndarray, ring: np.ndarray, omega_c: float) -> tuple:
     """Land force on the cage centre (plus gravity with a horizontal spindle) and its Jacobians,
     for the implicit step: (F_x, F_y, N, Kxx, Kxy, Kyx, Kyy, Cxx, Cxy, Cyx, Cyy), N, N/m, N s/m
@@ -790,6 +848,7 @@ def step_reduced(
     w0 = NG + 8  # per-ball elimination data
     worst_iter = 0
     lc = cl + dt * kl
+    pitch_c, pitch_s = math.cos(2.0 * math.pi / z), math.sin(2.0 * math.pi / z)
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
@@ -807,8 +866,11 @@ def step_reduced(
             for k in range(z):
                 omega_c += cage[k, C_OMEGA]
             fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
+            pocket_directions(cage, work[:, w0 + 20], work[:, w0 + 21], pitch_c, pitch_s)
         else:
             ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
+            work[:, w0 + 20] = 0.0
+            work[:, w0 + 21] = 0.0
         land_f = ring[R_LAND_F]
         # the cage centre's 2x2 block: m_c - dt (dt K + C) - sum (g/r_m) n t^T, and its right side
         m11 = mc - dt * (dt * kxx + cxx)
@@ -824,9 +886,7 @@ def step_reduced(
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
-            cph = sph = 0.0
-            if centre:
-                cph, sph = math.cos(cage[j, C_PHI]), math.sin(cage[j, C_PHI])
+            cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
             # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
             gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
             rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
@@ -859,8 +919,6 @@ def step_reduced(
             work[j, w0 + 4] = e
             work[j, w0 + 5] = ku * rate
             work[j, w0 + 6] = fs
-            work[j, w0 + 20] = -sph
-            work[j, w0 + 21] = cph
             if centre:
                 # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1)
                 # <= 0, its direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
@@ -903,8 +961,7 @@ def step_reduced(
             # the segments' response to the cage centre's velocity change: A Y = g t
             yx = work[:, w0 + 27]
             yy = work[:, w0 + 28]
-            cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 25], yx, tri_work)
-            cyclic_tridiagonal(diag, -dt * lc, work[:, w0 + 26], yy, tri_work)
+            cyclic_tridiagonal_pair(diag, -dt * lc, work[:, w0 + 25], work[:, w0 + 26], yx, yy, work[:, NG : NG + 5])
             for k in range(z):
                 g = work[k, w0 + 22]
                 nx, ny = work[k, w0 + 23], work[k, w0 + 24]

@@ -35,7 +35,11 @@ def test_the_full_model_equals_the_axisymmetric_one_under_pure_axial_load(params
     """The engine with its ring's radial DOFs active (started under a 300 N radial load that is
     then removed, so the ring's radial balance is solved every step) against the engine that
     never had a radial load: the same cage speed within 0.01 percentage points of slip (issue
-    23), once the radial displacement has gone back to zero."""
+    23), once the radial displacement has gone back to (almost) zero. The cage, pushed off
+    centre by the pockets under the radial load, keeps whirling for a while after it is removed
+    (its orbit decays slowly: the land film's radial force grows as eps^2), and the ball-speed
+    variation of that orbit moves the ring by nanometres (< 1e-8 m against microns under the
+    load)."""
     plain = BearingDynamics(params)
     plain.initialise(2700 * RPM, 200.0)
     full = BearingDynamics(params)
@@ -43,7 +47,7 @@ def test_the_full_model_equals_the_axisymmetric_one_under_pure_axial_load(params
     full.advance(0.05)
     full.advance(0.25, radial_load=0.0)
     plain.advance(0.3)
-    assert abs(full.ring[kn.R_DX]) < 1e-9 and abs(full.ring[kn.R_DY]) < 1e-9
+    assert abs(full.ring[kn.R_DX]) < 1e-8 and abs(full.ring[kn.R_DY]) < 1e-8
     assert full.ring[kn.R_DX] != 0.0 or full.ring[kn.R_DY] != 0.0  # the radial path stayed active
     assert _slip(params, full, 0.1) == pytest.approx(_slip(params, plain, 0.1), abs=0.01)
 

@@ -82,6 +82,7 @@ SAMPLES: dict[str, dict[str, Any]] = {
         "overruns": 3_000_000_000,
         "friction_torque": 0.0152,
         "power_loss": 42.75,
+        "cage_whirl_radius_um": 37.5,
     },
     "AxialLoadState": {
         "header": {"stamp": {"sec": 99, "nanosec": 1}, "frame_id": "load_cell"},

@@ -124,7 +124,7 @@ def write_twin_bag(
             if round(out.time * 1000) % 10 == 0:
                 truth = out.truth
                 values = {f: getattr(truth, f) for f in ("inner_ring_speed", "inner_ring_acceleration", "cage_speed", "theoretical_cage_speed", "slip_rate", "axial_load", "inner_contact_load_mean", "inner_contact_load_max", "outer_contact_load_mean", "outer_contact_load_max", "pocket_load_max", "inner_contact_angle", "outer_contact_angle", "inner_ring_axial_displacement", "friction_torque", "power_loss")}
-                message = types["bearing_rig_msgs/msg/SimulatorTruth"](header=header(out.time), **values, real_time_factor=1.0, step_count=truth.step_count, overruns=0)
+                message = types["bearing_rig_msgs/msg/SimulatorTruth"](header=header(out.time), **values, real_time_factor=1.0, step_count=truth.step_count, overruns=0, cage_whirl_radius_um=truth.cage_whirl_radius * 1e6)
                 bag.write_message("/rig/truth", now, message)
             if record_status and round(out.time * 1000) % 100 == 0:
                 live.check(out.time)

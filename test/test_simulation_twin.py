@@ -19,6 +19,7 @@ import yaml
 from bearing_rig_sim.analysis.slip import BearingKinematics, whole_revolution_slip
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters
+from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
@@ -124,7 +125,21 @@ def test_truth_summary_fields(params):
     assert math.radians(10) < t.inner_contact_angle < math.radians(25)
     assert t.inner_ring_axial_displacement > 0.0
     assert t.inner_ring_acceleration == pytest.approx(0.0, abs=1e-6)
+    assert t.cage_whirl_radius == 0.0  # axial load only: the cage stays on the axis
     assert twin.tick(with_truth=False).truth is None
+
+
+def test_truth_carries_the_cage_whirl_radius(params):
+    """A cage knocked off the axis (40 um, 20 mm/s outward): the truth's whirl radius is the
+    engine's cage-centre distance at the chunk's end, non-zero and within the land clearance."""
+    twin = make_twin(params, initial_speed=1200 * RPM, initial_axial_load=150.0)
+    twin.engine.ring[kn.R_CX] = 40e-6
+    twin.engine.ring[kn.R_CVX] = 0.02
+    out = twin.tick()
+    assert out.truth is not None
+    radius = out.truth.cage_whirl_radius
+    assert radius == math.hypot(twin.engine.ring[kn.R_CX], twin.engine.ring[kn.R_CY])
+    assert 0.0 < radius < params.land_clearance
 
 
 def test_sensor_slip_agrees_with_ground_truth_over_whole_revolution_windows(params):

@@ -51,6 +51,12 @@ zero (ball orbit at rest under 1000 N) and 0.05 rad/s above the inner ring's pea
 step leaves the bounds by orders of magnitude within a few steps."""
 
 
+CAGE_CENTRE_BOUND = 1.5
+"""The cage centre may leave the axis by at most this many land clearances: at one clearance it
+touches its land, whose contact (stiffness of the order of 1e7 N/m) lets it in by microns
+under the few newtons the pockets give; half a clearance further means a diverged step."""
+
+
 class DynamicsInputError(RigError):
     """An input of the dynamics engine is not finite or out of its range."""
 
@@ -93,6 +99,9 @@ class Observation:
         pocket_loads: per ball, signed (> 0: ball pushes the cage forward), N.
         inner_ring_axial_displacement: m.
         axial_load: applied axial load, N.
+        cage_whirl_radius: distance of the cage centre from the bearing axis, m (reduced model;
+            0 for the concentric stiff model).
+        cage_centre: the cage centre's (x, y) displacement, m (x along the radial load).
     """
 
     time: float
@@ -108,6 +117,8 @@ class Observation:
     pocket_loads: np.ndarray
     inner_ring_axial_displacement: float
     axial_load: float
+    cage_whirl_radius: float = 0.0
+    cage_centre: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -341,9 +352,15 @@ class BearingDynamics:
         rel, absolute = SPEED_TOLERANCE
         lo, hi = -absolute, self._peak_speed * (1.0 + rel) + absolute
         fault = kn.speed_outlier(self.ball, self.cage, self.ring, lo, hi)  # one compiled pass per chunk
-        if fault == 0:
-            return
         t = self.time
+        if fault == 0:
+            bound = CAGE_CENTRE_BOUND * self.params.land_clearance
+            if self.cage_whirl_radius > bound:
+                raise DynamicsDivergedError(
+                    f"dynamics diverged at t = {t:.6g} s: cage centre {self.cage_whirl_radius * 1e6:.6g} um from the axis, "
+                    f"beyond {CAGE_CENTRE_BOUND:g} x the land clearance {self.params.land_clearance * 1e6:g} um ({self._step_hint()})"
+                )
+            return
         if fault == 1:
             raise DynamicsDivergedError(f"dynamics diverged at t = {t:.6g} s: non-finite state ({self._step_hint()})")
         name, speeds = ("cage speed", self.cage[:, kn.C_OMEGA]) if fault == 2 else ("ball orbit speed", self.ball[:, kn.B_OMEGA])
@@ -391,6 +408,11 @@ class BearingDynamics:
         return float(self.ring[kn.R_OMEGA])
 
     @property
+    def cage_whirl_radius(self) -> float:
+        """Distance of the cage centre from the bearing axis, m (its orbit is the cage whirl)."""
+        return math.hypot(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY]))
+
+    @property
     def cage_speed(self) -> float:
         """Mean cage-segment speed, rad/s."""
         return float(np.mean(self.cage[:, kn.C_OMEGA]))
@@ -405,9 +427,10 @@ class BearingDynamics:
         land. With the outer ring fixed it equals the friction torque times the inner-ring speed."""
         v, z = self.vector, self.params.ball_count
         land = 0.0
+        factor, normal = float(self.ring[kn.R_LAND_F]) or 1.0, float(self.ring[kn.R_LAND_N])
         for k in range(z):
             w = float(self.cage[k, kn.C_OMEGA])
-            tl, _ = kn.cage_land_torque(v, w, z)
+            tl, _ = kn.cage_land_torque(v, w, z, factor, normal)
             land += abs(tl * w)
         return float(np.sum(self.out[:, kn.O_POWER])) + land
 
@@ -465,5 +488,7 @@ class BearingDynamics:
             pocket_loads=o[:, kn.O_FP].copy(),
             inner_ring_axial_displacement=float(self.ring[kn.R_DELTA]),
             axial_load=self.axial_load,
+            cage_whirl_radius=self.cage_whirl_radius,
+            cage_centre=(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY])),
         )
 

@@ -12,7 +12,10 @@ Conventions (every kernel):
   speed Omega (rad/s).
 * ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
   (m) and axial velocity (m/s), time (s), radial displacement along x and y (m; quasi-static,
-  reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)).
+  reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)); the cage
+  centre's displacement (m) and velocity (m/s) along x and y (dynamic, reduced model only), the
+  cage-land contact force (N) and the eccentricity factor of the land's viscous torque (1) of
+  the last step.
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
 * ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time).
@@ -86,14 +89,25 @@ P_FR_IN = 44  # Houpert rolling force of the inner contact at 1 m/s and 1 N, N: 
 P_FR_OUT = 45  # same, outer contact
 P_TABLE = 46  # index of the rheology traction table in this vector (0: none; see traction.py)
 P_MU_SLOPE_MAX = 47  # steepest slope of the traction law: d mu/d SRR (models 1, 2) or d mu/ds, s/m (model 0)
-P_SIZE = 48
+P_CAGE_MASS = 48  # cage mass, kg (its centre's two in-plane translations, reduced model)
+P_LAND_R = 49  # land (cage outer) radius, m
+P_LAND_CLEAR = 50  # radial land clearance c, m
+P_LAND_OCV = 51  # Ocvirk geometry factor of all lands, sum R L_land^3 / c^2, m^2
+P_LAND_ETA = 52  # land film: Newtonian viscosity (oil x fill x scale), Pa s (0 for a grease)
+P_LAND_TAUY = 53  # land film: grease yield stress x fill x scale, Pa
+P_LAND_CONS = 54  # land film: grease consistency x fill x scale, Pa s^n (flow index P_LAND_N)
+P_LAND_K = 55  # cage-land contact stiffness (conformal line contact, linearised), N/m
+P_LAND_MU = 56  # cage-land contact friction coefficient, 1
+P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
+P_SIZE = 58
 
 B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
 NB = 7
 C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
-NR = 7
+R_CX, R_CY, R_CVX, R_CVY, R_LAND_N, R_LAND_F = 7, 8, 9, 10, 11, 12
+NR = 13
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 NO = 10
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
@@ -460,18 +474,169 @@ def cyclic_tridiagonal(diag: np.ndarray, off: float, rhs: np.ndarray, out: np.nd
 
 
 @njit(cache=True)
-def cage_land_torque(p: np.ndarray, omega: float, z: int) -> tuple[float, float]:
-    """Land friction torque on one cage segment (N m, resisting) and its derivative."""
+def cyclic_tridiagonal_pair(diag: np.ndarray, off: float, rhs_a: np.ndarray, rhs_b: np.ndarray, out_a: np.ndarray, out_b: np.ndarray, work: np.ndarray) -> None:
+    """:func:`cyclic_tridiagonal` for two right-hand sides sharing one factorisation; ``work``
+    is scratch of shape (n, 5)."""
+    n = diag.shape[0]
+    gamma = -diag[0]
+    for i in range(n):
+        work[i, 0] = diag[i]
+        work[i, 2] = rhs_a[i]
+        work[i, 3] = 0.0
+        work[i, 4] = rhs_b[i]
+    work[0, 0] -= gamma
+    work[n - 1, 0] -= off * off / gamma
+    work[0, 3] = gamma
+    work[n - 1, 3] = off
+    inv = 1.0 / work[0, 0]
+    work[0, 1] = off * inv
+    work[0, 2] *= inv
+    work[0, 3] *= inv
+    work[0, 4] *= inv
+    for i in range(1, n):
+        inv = 1.0 / (work[i, 0] - off * work[i - 1, 1])
+        work[i, 1] = off * inv
+        work[i, 2] = (work[i, 2] - off * work[i - 1, 2]) * inv
+        work[i, 3] = (work[i, 3] - off * work[i - 1, 3]) * inv
+        work[i, 4] = (work[i, 4] - off * work[i - 1, 4]) * inv
+    for i in range(n - 2, -1, -1):
+        work[i, 2] -= work[i, 1] * work[i + 1, 2]
+        work[i, 3] -= work[i, 1] * work[i + 1, 3]
+        work[i, 4] -= work[i, 1] * work[i + 1, 4]
+    den = 1.0 + work[0, 3] + off * work[n - 1, 3] / gamma
+    fact_a = (work[0, 2] + off * work[n - 1, 2] / gamma) / den
+    fact_b = (work[0, 4] + off * work[n - 1, 4] / gamma) / den
+    for i in range(n):
+        out_a[i] = work[i, 2] - fact_a * work[i, 3]
+        out_b[i] = work[i, 4] - fact_b * work[i, 3]
+
+
+@njit(cache=True)
+def cage_land_torque(p: np.ndarray, omega: float, z: int, factor: float = 1.0, normal: float = 0.0) -> tuple[float, float]:
+    """Land friction torque on one cage segment (N m, resisting) and its derivative.
+
+    ``factor`` multiplies the film's rate-dependent shear (the eccentric film's Couette shear,
+    :func:`land_shear_factor`; 1 for a centred cage) and ``normal`` (N) is the cage-land contact
+    force, which adds the boundary friction mu_land N R_land of the contact."""
     y = omega / SPIN_SIGN_SPEED
     q = 1.0 / math.sqrt(1.0 + y * y)
-    t = (p[P_LAND_COULOMB] * y * q + p[P_LAND_VISC] * omega) / z
-    dt = (p[P_LAND_COULOMB] * q * q * q / SPIN_SIGN_SPEED + p[P_LAND_VISC]) / z
+    coulomb = p[P_LAND_COULOMB] + p[P_LAND_MU] * normal * p[P_LAND_R]
+    t = (coulomb * y * q + factor * p[P_LAND_VISC] * omega) / z
+    dt = (coulomb * q * q * q / SPIN_SIGN_SPEED + factor * p[P_LAND_VISC]) / z
     if p[P_LAND_POW] > 0.0:
         a = max(abs(omega), SPIN_SIGN_SPEED)
         an = math.sqrt(a) if p[P_LAND_N] == 0.5 else a ** p[P_LAND_N]
-        t += p[P_LAND_POW] * an * y * q / z
-        dt += p[P_LAND_POW] * p[P_LAND_N] * an / a / z
+        t += factor * p[P_LAND_POW] * an * y * q / z
+        dt += factor * p[P_LAND_POW] * p[P_LAND_N] * an / a / z
     return t, dt
+
+
+LAND_EPS_MAX = 0.95
+"""Eccentricity ratio at which the land film's force stops growing: Ocvirk's forces diverge as
+eps -> 1 and the short-bearing theory no longer holds in a film of a few per cent of the
+clearance; beyond it the cage-land contact (at eps = 1) takes over."""
+LAND_SIGN_SPEED = 1e-3
+"""rad/s, smoothing of the sign of eps (Omega - 2 psi_dot), which decides the half of the land
+that carries pressure (pi film)."""
+LAND_SLIDE_SPEED = 0.01
+"""m/s, smoothing of the sign of the sliding speed at the cage-land contact."""
+LAND_MIN_SHEAR_SPEED = 1.0
+"""rad/s, cage speed below which the land's apparent (grease) viscosity is that of 1 rad/s."""
+
+
+@njit(cache=True)
+def land_viscosity(p: np.ndarray, omega: float) -> float:
+    """Viscosity (Pa s) of the land film at cage speed ``omega`` (rad/s): the oil's, or the
+    grease's apparent viscosity tau_y/g + K g^(n-1) at the film's shear rate g = R |omega| / c
+    (the same wall stress as the land torque), the fill and scale included."""
+    eta = p[P_LAND_ETA]
+    if p[P_LAND_TAUY] > 0.0 or p[P_LAND_CONS] > 0.0:
+        g = p[P_LAND_R] * max(abs(omega), LAND_MIN_SHEAR_SPEED) / p[P_LAND_CLEAR]
+        gn = math.sqrt(g) if p[P_LAND_N] == 0.5 else g ** p[P_LAND_N]
+        eta += (p[P_LAND_TAUY] + p[P_LAND_CONS] * gn) / g
+    return eta
+
+
+@njit(cache=True)
+def ocvirk_force(eta: float, geometry: float, eps: float, eps_omega: float, eps_dot: float) -> tuple[float, float]:
+    """Short-journal-bearing (Ocvirk) film force on the journal, pi film, with whirl and squeeze.
+
+    Args:
+        eta: viscosity, Pa s.
+        geometry: R L^3 / c^2 summed over the lands, m^2 (R journal radius, L land width, c
+            radial clearance).
+        eps: eccentricity ratio e/c, 0 <= eps < 1.
+        eps_omega: eps (Omega - 2 psi_dot), rad/s: Omega the journal's speed, psi_dot the whirl
+            speed of its centre (the wedge term of Reynolds' equation).
+        eps_dot: d eps/dt, 1/s (the squeeze term).
+
+    Returns:
+        (F_r, F_t), N: along the eccentricity (outward, > 0 pushes the journal further out) and
+        perpendicular to it in the direction of rotation. For a journal turning at Omega about a
+        fixed centre (U = R Omega): F_r = -(eta U L^3/c^2) eps^2/(1 - eps^2)^2,
+        F_t = (pi eta U L^3/(4 c^2)) eps/(1 - eps^2)^1.5; the squeeze adds
+        -(eta R L^3/c^2) pi (1 + 2 eps^2) eps_dot / (2 (1 - eps^2)^2.5) and
+        2 (eta R L^3/c^2) eps eps_dot/(1 - eps^2)^2 (the half carrying pressure is the one
+        ahead of the minimum film for eps_omega > 0 and behind it for eps_omega < 0).
+    """
+    one = 1.0 - eps * eps
+    a = eta * geometry
+    sg = eps_omega / math.sqrt(eps_omega * eps_omega + LAND_SIGN_SPEED * LAND_SIGN_SPEED)
+    fr = -a * (eps * eps_omega * sg / (one * one) + 0.5 * math.pi * (1.0 + 2.0 * eps * eps) * eps_dot / (one * one * math.sqrt(one)))
+    ft = a * (0.25 * math.pi * eps_omega / (one * math.sqrt(one)) + 2.0 * eps * eps_dot * sg / (one * one))
+    return fr, ft
+
+
+@njit(cache=True)
+def land_force(p: np.ndarray, x: float, y: float, vx: float, vy: float, omega: float) -> tuple[float, float, float]:
+    """Force of the guiding land on the cage centre at (x, y) (m, from the bearing axis) moving at
+    (vx, vy) (m/s), the cage turning at ``omega`` (rad/s): the Ocvirk film
+    (:func:`ocvirk_force`, eps capped at :data:`LAND_EPS_MAX`) plus, once the eccentricity
+    reaches the clearance, a Hunt-Crossley contact k d (1 + 1.5 a_e d_dot) with Coulomb friction
+    mu_land N against the sliding of the cage's surface. Returns (F_x, F_y, N) in N."""
+    c = p[P_LAND_CLEAR]
+    e = math.sqrt(x * x + y * y)
+    if e > 1e-12 * c:
+        rx, ry = x / e, y / e
+        ratio = 1.0 / c
+    else:
+        v = math.sqrt(vx * vx + vy * vy)
+        rx, ry = (vx / v, vy / v) if v > 0.0 else (1.0, 0.0)
+        ratio = 1.0 / c
+    eps = e / c
+    if eps > LAND_EPS_MAX:
+        eps = LAND_EPS_MAX
+        ratio = LAND_EPS_MAX / e
+    vr = vx * rx + vy * ry
+    vt = vy * rx - vx * ry
+    fr, ft = ocvirk_force(land_viscosity(p, omega), p[P_LAND_OCV], eps, eps * omega - 2.0 * ratio * vt, vr / c)
+    normal = 0.0
+    if e > c:
+        d = e - c
+        normal = max(p[P_LAND_K] * d * (1.0 + 1.5 * p[P_HC_A] * vr), 0.0)
+        fr -= normal
+        slide = (omega * p[P_LAND_R] + vt) / LAND_SLIDE_SPEED
+        ft -= p[P_LAND_MU] * normal * slide / math.sqrt(1.0 + slide * slide)
+    return fr * rx - ft * ry, fr * ry + ft * rx, normal
+
+
+@njit(cache=True)
+def land_shear_factor(p: np.ndarray, eps: float) -> float:
+    """Mean over the land of (c/h)^n, h = c (1 - eps cos theta): how much an eccentric film
+    shears more than a centred one for a wall stress growing as the shear rate^n (n = 1 for an
+    oil: 1/sqrt(1 - eps^2), Petroff's torque of the eccentric journal). Trapezoidal rule with
+    32 points over the period (17 by symmetry; relative error 3e-5 at eps = 0.95), eps capped
+    at :data:`LAND_EPS_MAX`."""
+    if eps <= 0.0:
+        return 1.0
+    eps = min(eps, LAND_EPS_MAX)
+    n = p[P_LAND_N]
+    total = 0.0
+    for i in range(17):
+        w = 1.0 - eps * math.cos(math.pi * i / 16.0)
+        f = 1.0 / math.sqrt(w) if n == 0.5 else w ** (-n)
+        total += 0.5 * f if i == 0 or i == 16 else f
+    return total / 16.0
 
 
 @njit(cache=True)
@@ -532,13 +697,14 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
 
 
 @njit(cache=True)
-def cage_segment_torque(p: np.ndarray, cage: np.ndarray, k: int, z: int) -> tuple[float, float]:
+def cage_segment_torque(p: np.ndarray, cage: np.ndarray, k: int, z: int, factor: float = 1.0, normal: float = 0.0) -> tuple[float, float]:
     """Rim (stiffness and damping) and land torques on cage segment k, N m, and the slope with
-    which the implicit step treats the land torque (N m s/rad; :func:`implicit_slope`)."""
+    which the implicit step treats the land torque (N m s/rad; :func:`implicit_slope`);
+    ``factor`` and ``normal`` as in :func:`cage_land_torque`."""
     km = z - 1 if k == 0 else k - 1
     kp = 0 if k == z - 1 else k + 1
     w = cage[k, C_OMEGA]
-    tl, dtl = cage_land_torque(p, w, z)
+    tl, dtl = cage_land_torque(p, w, z, factor, normal)
     dtl = implicit_slope(tl, dtl, w)
     tau = p[P_LINK_K] * (link_strain(cage, k, z) - link_strain(cage, km, z))
     tau += p[P_LINK_C] * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
@@ -593,6 +759,50 @@ def finish_step(ring: np.ndarray, stats: np.ndarray, omega_i_old: float, omega_i
 
 
 @njit(cache=True)
+def pocket_directions(cage: np.ndarray, tx: np.ndarray, ty: np.ndarray, pitch_c: float, pitch_s: float) -> None:
+    """Circumferential directions t_k = (-sin phi_k, cos phi_k) of the cage's pockets into
+    ``tx``, ``ty``: segment 0's by the library, the others by rotating it through the pitch
+    2 pi/Z (``pitch_c``, ``pitch_s`` its cosine and sine) and the segment's small offset d from
+    its nominal place (series to d^4, exact to 1e-16 for |d| < 1e-3 rad; the library beyond)."""
+    z = cage.shape[0]
+    c, s = math.cos(cage[0, C_PHI]), math.sin(cage[0, C_PHI])
+    for k in range(z):
+        d = cage[k, C_PHI] - cage[0, C_PHI] - 2.0 * math.pi * k / z
+        if abs(d) < 1e-3:
+            d2 = d * d
+            cd, sd = 1.0 - 0.5 * d2 * (1.0 - d2 / 12.0), d * (1.0 - d2 / 6.0)
+            ck, sk = c * cd - s * sd, s * cd + c * sd
+        else:
+            ck, sk = math.cos(cage[k, C_PHI]), math.sin(cage[k, C_PHI])
+        tx[k], ty[k] = -sk, ck
+        c, s = c * pitch_c - s * pitch_s, s * pitch_c + c * pitch_s
+
+
+@njit(cache=True)
+def cage_centre_forces(p: np.ndarray, ring: np.ndarray, omega_c: float) -> tuple:
+    """Land force on the cage centre (plus gravity with a horizontal spindle) and its Jacobians,
+    for the implicit step: (F_x, F_y, N, Kxx, Kxy, Kyx, Kyy, Cxx, Cxy, Cyx, Cyy), N, N/m, N s/m
+    (K = dF/dx, C = dF/dv by forward differences: the film force is linear in the velocity at a
+    given position, so its tangent is its secant). Stores the contact force and the land
+    torque's eccentricity factor in ``ring``."""
+    x, y, vx, vy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
+    fx, fy, normal = land_force(p, x, y, vx, vy, omega_c)
+    hx = 1e-4 * p[P_LAND_CLEAR]
+    hv = 1e-5
+    f1x, f1y, _ = land_force(p, x + hx, y, vx, vy, omega_c)
+    f2x, f2y, _ = land_force(p, x, y + hx, vx, vy, omega_c)
+    f3x, f3y, _ = land_force(p, x, y, vx + hv, vy, omega_c)
+    f4x, f4y, _ = land_force(p, x, y, vx, vy + hv, omega_c)
+    ring[R_LAND_N] = normal
+    ring[R_LAND_F] = land_shear_factor(p, math.sqrt(x * x + y * y) / p[P_LAND_CLEAR])
+    return (
+        fx, fy + p[P_CAGE_GRAV_Y], normal,
+        (f1x - fx) / hx, (f2x - fx) / hx, (f1y - fy) / hx, (f2y - fy) / hx,
+        (f3x - fx) / hv, (f4x - fx) / hv, (f3y - fy) / hv, (f4y - fy) / hv,
+    )
+
+
+@njit(cache=True)
 def step_reduced(
     p: np.ndarray,
     ball: np.ndarray,
@@ -610,12 +820,16 @@ def step_reduced(
 ) -> int:
     """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
 
-    Normal contacts are quasi-static (solved every step); ball orbit and spin, and the cage
-    segments, are integrated with a linearly implicit Euler step that treats the stiff traction,
-    pocket and rim couplings implicitly (block elimination onto a cyclic tridiagonal system).
-    The inner ring turns at the prescribed speed, changing at ``inner_acceleration`` (rad/s^2).
-    ``work`` is scratch of shape (Z, NW). Diagnostics go to ``out`` on the last step and every
-    ``record_every`` steps.
+    Normal contacts are quasi-static (solved every step); ball orbit and spin, the cage
+    segments and the cage centre's two translations are integrated with a linearly implicit
+    Euler step that treats the stiff traction, pocket, rim and land-film couplings implicitly
+    (block elimination onto a cyclic tridiagonal system of the segments bordered by the cage
+    centre's 2x2 block). The pocket gap of ball j is u = r_m (theta_j - phi_j) - e . t_j (e the
+    cage centre, t_j the pocket's circumferential direction): the pockets push the cage centre
+    along t_j, and pocket friction along the pocket's radial direction (the ball's surface
+    moves radially there). The inner ring turns at the prescribed speed, changing at
+    ``inner_acceleration`` (rad/s^2). ``work`` is scratch of shape (Z, NW). Diagnostics go to
+    ``out`` on the last step and every ``record_every`` steps.
 
     Returns the largest number of quasi-static Newton iterations used.
     """
@@ -625,6 +839,8 @@ def step_reduced(
     m = p[P_MBALL]
     ib = p[P_IBALL]
     jseg = p[P_JSEG]
+    mc = p[P_CAGE_MASS]
+    mup = p[P_MU_POCKET]
     kl, cl = p[P_LINK_K], p[P_LINK_C]
     geo = work[:, 0:NG]
     qs_work = work[:, NG : NG + 6]  # the quasi-static solve's scratch, free again after it
@@ -632,12 +848,38 @@ def step_reduced(
     w0 = NG + 8  # per-ball elimination data
     worst_iter = 0
     lc = cl + dt * kl
+    pitch_c, pitch_s = math.cos(2.0 * math.pi / z), math.sin(2.0 * math.pi / z)
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
         it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
+        # the cage centre moves once something pushes it off the axis: a radial load, its weight
+        # (horizontal spindle) or a state left off it; a centred cage under a purely axial load
+        # is an exact equilibrium (the pockets' forces cancel, the film has none) and skips the
+        # centre's terms
+        centre = radial_load != 0.0 or p[P_CAGE_GRAV_Y] != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
+        if centre:
+            omega_c = 0.0
+            for k in range(z):
+                omega_c += cage[k, C_OMEGA]
+            fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
+            pocket_directions(cage, work[:, w0 + 20], work[:, w0 + 21], pitch_c, pitch_s)
+        else:
+            ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
+            work[:, w0 + 20] = 0.0
+            work[:, w0 + 21] = 0.0
+        land_f = ring[R_LAND_F]
+        # the cage centre's 2x2 block: m_c - dt (dt K + C) - sum (g/r_m) n t^T, and its right side
+        m11 = mc - dt * (dt * kxx + cxx)
+        m12 = -dt * (dt * kxy + cxy)
+        m21 = -dt * (dt * kyx + cyx)
+        m22 = mc - dt * (dt * kyy + cyy)
+        rcx = fcx + dt * (kxx * cvx + kxy * cvy)
+        rcy = fcy + dt * (kyx * cvx + kyy * cvy)
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
@@ -645,10 +887,14 @@ def step_reduced(
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
-            rel = wm - cage[j, C_OMEGA]
-            fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
+            cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
+            # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
+            gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
+            rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
+            fs, ku, cu = pocket_force(p, gap, rate)
             omega_roll = wa + cb * wm
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll)
+            sroll = smooth_sign(omega_roll)
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sroll
             kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
             gm = rb * (fi + fo - fd) - rm * fs
             ga = r * (ci * fi - co * fo) - mres
@@ -656,22 +902,42 @@ def step_reduced(
             jma = rb * (-kti * aia + kto * aoa)
             jam = r * (-ci * kti * aim + co * kto * aom) - kres * cb
             jaa = r * (-ci * kti * aia - co * kto * aoa) - kres
-            e = rm * rm * (cu + dt * ku)
+            ee = cu + dt * ku
+            e = rm * rm * ee
             b11 = m * rb * rb - dt * jmm + dt * e
             b12 = -dt * jma
             b21 = -dt * jam
             b22 = ib - dt * jaa
             det = b11 * b22 - b12 * b21
             i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
-            r1 = dt * (gm - dt * rm * rm * ku * rel)
+            r1 = dt * (gm - dt * rm * ku * rate)
             r2 = dt * ga
+            x2 = i11 * r1 + i12 * r2
             work[j, w0 + 0] = i11
             work[j, w0 + 1] = i21
-            work[j, w0 + 2] = i11 * r1 + i12 * r2
+            work[j, w0 + 2] = x2
             work[j, w0 + 3] = i21 * r1 + i22 * r2
             work[j, w0 + 4] = e
-            work[j, w0 + 5] = ku
+            work[j, w0 + 5] = ku * rate
             work[j, w0 + 6] = fs
+            if centre:
+                # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1)
+                # <= 0, its direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
+                g = dt * rm * ee * (dt * e * i11 - 1.0)
+                nx = -sph + mup * sroll * cph
+                ny = cph + mup * sroll * sph
+                work[j, w0 + 22] = g
+                work[j, w0 + 23] = nx
+                work[j, w0 + 24] = ny
+                work[j, w0 + 25] = g * -sph
+                work[j, w0 + 26] = g * cph
+                m11 -= g / rm * nx * -sph
+                m12 -= g / rm * nx * cph
+                m21 -= g / rm * ny * -sph
+                m22 -= g / rm * ny * cph
+                fp = fs + dt * ku * rate + ee * rm * x2
+                rcx += nx * fp
+                rcy += ny * fp
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
                 out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
@@ -681,19 +947,44 @@ def step_reduced(
         for k in range(z):
             km = z - 1 if k == 0 else k - 1
             kp = 0 if k == z - 1 else k + 1
-            tau, dtl = cage_segment_torque(p, cage, k, z)
+            tau, dtl = cage_segment_torque(p, cage, k, z, land_f, land_n)
             e = work[k, w0 + 4]
             gc = rm * work[k, w0 + 6] + tau
             diag[k] = jseg + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
             rhs[k] = dt * (
                 gc
                 + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
-                + dt * rm * rm * work[k, w0 + 5] * (ball[k, B_OMEGA] - cage[k, C_OMEGA])
+                + dt * rm * work[k, w0 + 5]
             ) + dt * e * work[k, w0 + 2]
         cyclic_tridiagonal(diag, -dt * lc, rhs, d_omega, tri_work)
+        dvx = dvy = 0.0
+        if centre:
+            # the segments' response to the cage centre's velocity change: A Y = g t
+            yx = work[:, w0 + 27]
+            yy = work[:, w0 + 28]
+            cyclic_tridiagonal_pair(diag, -dt * lc, work[:, w0 + 25], work[:, w0 + 26], yx, yy, work[:, NG : NG + 5])
+            for k in range(z):
+                g = work[k, w0 + 22]
+                nx, ny = work[k, w0 + 23], work[k, w0 + 24]
+                m11 -= g * nx * yx[k]
+                m12 -= g * nx * yy[k]
+                m21 -= g * ny * yx[k]
+                m22 -= g * ny * yy[k]
+                rcx += g / dt * nx * d_omega[k]
+                rcy += g / dt * ny * d_omega[k]
+            det2 = m11 * m22 - m12 * m21
+            dvx = dt * (m22 * rcx - m12 * rcy) / det2
+            dvy = dt * (m11 * rcy - m21 * rcx) / det2
+            ring[R_CVX] = cvx + dvx
+            ring[R_CVY] = cvy + dvy
+            ring[R_CX] = cx + dt * ring[R_CVX]
+            ring[R_CY] = cy + dt * ring[R_CVY]
+            for j in range(z):
+                d_omega[j] += yx[j] * dvx + yy[j] * dvy
         cage_sum = 0.0
         for j in range(z):
-            coup = dt * work[j, w0 + 4] * d_omega[j]
+            # the pocket's closing speed seen by the ball: r_m d Omega + t . d v (over r_m)
+            coup = dt * work[j, w0 + 4] * (d_omega[j] + (work[j, w0 + 20] * dvx + work[j, w0 + 21] * dvy) / rm)
             ball[j, B_OMEGA] += work[j, w0 + 2] + work[j, w0 + 0] * coup
             ball[j, B_SPIN] += work[j, w0 + 3] + work[j, w0 + 1] * coup
             cage[j, C_OMEGA] += d_omega[j]
@@ -704,8 +995,8 @@ def step_reduced(
     return worst_iter
 
 
-NW = NG + 8 + 10
-"""Columns of the reduced model's scratch array."""
+NW = NG + 8 + 29
+"""Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling)."""
 
 
 @njit(cache=True)

@@ -17,7 +17,11 @@ lubrication mode of the lubricant file selects the drag and land laws:
   apparent viscosity at v/Dw.
 * Cage land friction (outer-land guided cage): a Petroff short-journal film
   T_v = s_v 2 pi eta r^3 w omega_c / c (oil) or 2 pi r^2 w fill (tau_y + K (r omega_c/c)^n)
-  (grease), plus boundary friction T_b = s_b mu m_c g r with a horizontal spindle (smoothed sign).
+  (grease), times the eccentric film's shear factor, plus boundary friction T_b = s_b mu m_c g r
+  with a horizontal spindle (smoothed sign) and mu N r when the cage touches its land.
+* Cage land force (reduced model, the cage centre dynamic): Ocvirk's short journal bearing with
+  whirl and squeeze on each land, viscosity that of the land torque (the grease's apparent
+  viscosity at the land's shear rate), plus a Hunt-Crossley contact at the clearance.
 * Houpert's EHL rolling force at each raceway contact, as a moment on the ball's rolling.
 * Ball-pocket friction: mu_p times the pocket normal force, on the ball's spin.
 * Elastic-hysteresis rolling resistance at each raceway contact (Harris and Kotzalas ch. 7):
@@ -51,8 +55,9 @@ class BearingParameters:
 
     Geometry: ``ball_diameter`` Dw (m), ``pitch_diameter`` dm (m), ``contact_angle`` free
     contact angle (rad), ``ball_count`` Z, groove curvature ratios f_i, f_o (1), cage inner and
-    outer diameter, width and pocket diameter (m), land radial clearance and wetted width (m),
-    cage material loss factor (1).
+    outer diameter, width and pocket diameter (m), land radial clearance and wetted width (m;
+    :data:`LAND_CLEARANCE_RANGE`, :data:`LAND_WIDTH_RANGE`), ``land_count`` (1 or 2 lands sharing
+    the width), cage material loss factor (1).
     Materials: densities (kg/m^3), Young's moduli (Pa), Poisson ratios (1).
     Contact: Hunt-Crossley coefficient a_e (s/m) and exponent n (1); full-damping penetration (m).
     Friction: model name, mu_s, v_s (m/s), mu_d, v_d (m/s), EHL mu_max and SRR0, pocket mu.
@@ -120,6 +125,7 @@ class BearingParameters:
     ehl_rolling_scale: float = 1.0
     composite_roughness: float = 0.0
     spindle_axis: str = "horizontal"
+    land_count: int = 1
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -166,8 +172,8 @@ class BearingParameters:
             cage_outer_diameter=c_out,
             cage_width=c.number("width_m", gt=pocket, lt=0.2),
             pocket_diameter=pocket,
-            land_clearance=c.number("land_radial_clearance_m", gt=0.0, lt=0.005),
-            land_width=c.number("land_width_m", gt=0.0, lt=0.05),
+            land_clearance=c.number("land_radial_clearance_m", ge=LAND_CLEARANCE_RANGE[0], le=LAND_CLEARANCE_RANGE[1]),
+            land_width=c.number("land_width_m", ge=LAND_WIDTH_RANGE[0], le=LAND_WIDTH_RANGE[1]),
             cage_loss_factor=c.number("material_loss_factor", ge=0.0, le=1.0),
             ring_density=ring.number("density_kg_m3", gt=0.0),
             ring_modulus=ring.number("youngs_modulus_pa", gt=0.0),
@@ -215,6 +221,7 @@ class BearingParameters:
             ehl_rolling_scale=res.number("ehl_rolling_scale", ge=0.0, default=1.0),
             composite_roughness=g.number("composite_roughness_rq_m", ge=0.0, lt=1e-5, default=0.0),
             spindle_axis=doc.section("installation", default={}).choice("spindle_axis", SPINDLE_AXES, default="horizontal"),
+            land_count=c.integer("land_count", ge=1, le=2, default=1),
             source=doc.source,
         )
         if friction_model == "rheology" and lubricant is None:
@@ -260,6 +267,13 @@ class BearingParameters:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
 
+
+LAND_CLEARANCE_RANGE = (1e-5, 1e-3)
+"""Plausible radial land clearance of a land-guided cage, m: 0.1-0.5 % of the land diameter
+for machined cages (Harris and Kotzalas, cage design; SKF super-precision catalogue), widened
+to 10 um - 1 mm for small and large bearings."""
+LAND_WIDTH_RANGE = (2e-4, 0.02)
+"""Plausible total wetted width of the guiding land(s), m (a fraction of the bearing width)."""
 
 SPINDLE_AXES = ("horizontal", "vertical")
 """Orientation of the bearing axis: with a horizontal axis the cage's weight presses it on its
@@ -460,6 +474,18 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_weight_on_land * r_land
     b_in = inner.semi_axes(1.0)[1]
     b_out = outer.semi_axes(1.0)[1]
+    # Land film (Ocvirk short journal bearing, kernels.land_force): the same fluid and fill as
+    # the land torque; land_count lands of width land_width / land_count each.
+    land_scale = p.cage_land_viscous_scale * fill
+    each = p.land_width / p.land_count
+    land_ocv = p.land_count * r_land * each**3 / p.land_clearance**2
+    if lub is not None and lub.kind == "grease":
+        land_eta, land_tauy, land_cons = 0.0, land_scale * lub.yield_stress, land_scale * lub.consistency
+    else:
+        land_eta, land_tauy, land_cons = land_scale * p.oil_viscosity, 0.0, 0.0
+    # Cage on its land at eps = 1: two conforming cylinders (cage OD in the land bore, nearly equal
+    # radii), linearised line-contact stiffness (pi/4) E* L (Johnson, Contact Mechanics, 5.3).
+    e_star = 1.0 / ((1.0 - p.cage_poisson**2) / p.cage_modulus + (1.0 - p.ring_poisson**2) / p.ring_modulus)
 
     v = np.zeros(kn.P_SIZE)
     v[kn.P_Z] = z
@@ -505,6 +531,16 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_DRAG_N] = drag_n
     v[kn.P_LAND_POW] = land_pow
     v[kn.P_LAND_N] = land_n
+    v[kn.P_CAGE_MASS] = cage_mass
+    v[kn.P_LAND_R] = r_land
+    v[kn.P_LAND_CLEAR] = p.land_clearance
+    v[kn.P_LAND_OCV] = land_ocv
+    v[kn.P_LAND_ETA] = land_eta
+    v[kn.P_LAND_TAUY] = land_tauy
+    v[kn.P_LAND_CONS] = land_cons
+    v[kn.P_LAND_K] = 0.25 * math.pi * e_star * p.land_width
+    v[kn.P_LAND_MU] = p.cage_land_friction
+    v[kn.P_CAGE_GRAV_Y] = -cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     gamma = dw * math.cos(a0) / dm
     rx_in, rx_out = rball * (1.0 - gamma), rball * (1.0 + gamma)
     if lub is not None:

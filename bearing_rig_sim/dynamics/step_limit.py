@@ -19,8 +19,9 @@ centrifugal force), so the limit follows the bearing, its lubricant and the rig.
 * **Reduced model** (quasi-static normal contacts, linearly implicit Euler on ball orbit, spin
   and cage). Every velocity-dependent force (raceway tractions, ball drag, rolling-resistance
   moments, cage land torque) enters the step's Jacobian with a slope at least its secant
-  through zero (:func:`.kernels.implicit_slope`), and the pocket contact and the rim with their
-  tangent stiffness and damping: linearised, the step is A-stable, and a saturated traction
+  through zero (:func:`.kernels.implicit_slope`), and the pocket contact, the rim and the cage
+  centre's land film and contact (time constants down to a microsecond) with their tangent
+  stiffness and damping: linearised, the step is A-stable, and a saturated traction
   cannot carry a sliding speed across zero in one step. What stays explicit over a step is the
   contact state, solved at its start: the normal loads depend on the ball's orbit speed through
   the centrifugal force m omega_m^2 r_b. A unit of orbit speed changes it by 2 m omega_m r_b

@@ -359,6 +359,7 @@ class SimulatorNode(ManagedNode):
             overruns=min(self.pacer.overruns, MAX_UINT32),
             friction_torque=t.friction_torque,
             power_loss=t.power_loss,
+            cage_whirl_radius_um=t.cage_whirl_radius * 1e6,
         )
         msg.header.stamp = to_stamp(t.time)
         msg.header.frame_id = "bearing"

@@ -82,6 +82,7 @@ class TruthSummary:
     ``slip_rate`` is NaN while the inner ring is at rest (the slip rate is undefined there).
     Contact angles are means over the balls with a non-zero contact load (NaN if none).
     Friction torque N m and power loss W: the engine's dissipation at the chunk's last step.
+    ``cage_whirl_radius``: distance of the cage centre from the bearing axis, m.
     """
 
     time: float
@@ -102,6 +103,7 @@ class TruthSummary:
     step_count: int
     friction_torque: float = 0.0
     power_loss: float = 0.0
+    cage_whirl_radius: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -396,4 +398,5 @@ class RigTwin:
             step_count=self.step_count,
             friction_torque=self.engine.friction_torque(),
             power_loss=self.engine.power_loss(),
+            cage_whirl_radius=obs.cage_whirl_radius,
         )

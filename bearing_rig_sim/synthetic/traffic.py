@@ -205,6 +205,7 @@ def rig_traffic(
                 overruns=0,
                 friction_torque=0.01,
                 power_loss=3.0,
+                cage_whirl_radius_um=0.0,
             )
             yield TRUTH_TOPIC, time_ns, bytes(store.serialize_cdr(truth, "bearing_rig_msgs/msg/SimulatorTruth"))
         pulses = []

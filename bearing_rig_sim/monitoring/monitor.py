@@ -31,6 +31,7 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
+from bearing_rig_sim.analysis.phase import PhaseSlope
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.analysis.streaming import TrailingSlope
@@ -42,6 +43,12 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 
 MonitorState = SlipState
 """The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""
+
+PHASE_WHITE_SHARE = 0.5
+"""The cage's phase decides the slope against time on its own standard error when at least this
+share of its variance is the pulses' own white noise (timing jitter); below it the slip itself
+wanders (or the parabola misfits), and the standard error is taken as at least that of the whole
+windows' line, whose scatter is pooled over 64 windows (1)."""
 
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
@@ -173,6 +180,9 @@ class SlipMonitor:
             change_threshold=settings.change_threshold,
             max_span=max(settings.slope_max_span_s, settings.slope_span_s),
         )
+        self.phase: PhaseSlope | None = None
+        """The slope against time from the cage's phase (time criterion, nominal slip); built at
+        the first cage pulse, which gives the strip count."""
         self.sweep = LoadSweep(settings.critical_slope_pct_per_n, settings.load_step_n, settings.sweep_settle_s, settings.sweep_average_s)
         self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s, settings.min_window_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
@@ -184,6 +194,7 @@ class SlipMonitor:
         """Forget every pulse, window, slope and fault (state unknown); ``reason`` becomes a note."""
         self.counter.reset()
         self.slope.reset()
+        self._reset_phase()
         self._latest: MonitorWindow | None = None
         self._invalid: dict[str, tuple[float | None, str]] = {}
         self._warnings: dict[str, tuple[float | None, str]] = {}
@@ -230,12 +241,37 @@ class SlipMonitor:
         """
         done = self.counter.add_pulse(shaft, pulse)
         self._take_events()
+        self._take_phase(shaft, pulse)
         t = pulse.time
         if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
             self._now = float(t) if self._now is None else max(self._now, float(t))
         for window in done:
             self._add_window(window)
         return bool(done)
+
+    def _reset_phase(self, since: float = -math.inf) -> None:
+        """Forget the cage's phase; count its pulses from ``since`` (s) on."""
+        if self.phase is not None:
+            self.phase.reset()
+        self._phase_from = since
+        self._phase_epoch = self.counter.epoch
+
+    def _take_phase(self, shaft: str, pulse: Pulse) -> None:
+        """Give the phase slope the cage pulses whose spindle angle is now known."""
+        points, self.counter.phase = self.counter.phase, []
+        st = self.settings
+        if self.criterion != "time" or self.loaded:
+            return
+        if self.phase is None and shaft == "cage" and isinstance(pulse.strip_count, int) and pulse.strip_count >= 1:
+            span = st.slope_span_s
+            self.phase = PhaseSlope(self._ratio, span, pulse.strip_count, st.slip_resolution_pct)
+        if self.phase is None:
+            return
+        if self.counter.epoch != self._phase_epoch:
+            self._reset_phase()
+        for t, index, strip, angle in points:
+            if t > self._phase_from:
+                self.phase.add(t, index, strip, angle)
 
     def _take_events(self) -> None:
         for kind, when, text in self.counter.events:
@@ -256,6 +292,7 @@ class SlipMonitor:
         if self.slope.n_points or self.slope.state is not SlipState.UNKNOWN:
             self._notes.append((time, f"slip series restarted at {time:.6f} s: {why}"))
         self.slope.reset()
+        self._reset_phase(time)
         self._last_x = None
 
     def _mean_load(self, t0: float, t1: float) -> float:
@@ -277,6 +314,7 @@ class SlipMonitor:
         if not inner >= st.min_inner_ring_speed_rad_s:
             if self._previous_inner is not None:
                 self._restart_series(t1, f"spindle below {st.min_inner_ring_speed_rad_s:g} rad/s")
+            self._reset_phase(t1)
             self._previous_inner, self._steady = None, None
             self._latest = MonitorWindow(window, math.nan, load)
             return
@@ -324,8 +362,14 @@ class SlipMonitor:
                 self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
     def _add_point(self, t1: float, x: float, slip: float) -> None:
+        external: tuple[float, float, int, bool] | None = None
+        if self.phase is not None and self.criterion == "time":
+            change = self.slope.verdict().change_at
+            estimate = self.phase.estimate(t1, since=change)
+            if estimate is not None:
+                external = (estimate.slope, estimate.standard_error, estimate.dof, estimate.white_share < PHASE_WHITE_SHARE)
         try:
-            if self.slope.add(x, slip):
+            if self.slope.add(x, slip, external):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))
             self._last_x = x
         except AnalysisError as exc:  # cannot happen with ordered points; never crash

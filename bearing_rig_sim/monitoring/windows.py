@@ -226,12 +226,20 @@ class SlipWindows:
         malformed pulse, discarded), "gap" (lost pulses), "note" (an out-of-order pulse or a
         restart) or "reset" (a clock jump: the caller resets what it derived)."""
         self._spacing: dict[int, float] = {}
+        self.phase: list[tuple[float, int, int, float]] = []
+        """Cage pulses with the spindle's angle at their time, since the caller last cleared
+        it: (time s, cage pulse_index, cage strip, spindle angle rad); the series restarts
+        (:attr:`epoch` changes) when either shaft's counting does."""
+        self.epoch = 0
+        """Count of restarts of either shaft's counting (1)."""
         self.reset()
 
     def reset(self) -> None:
         """Forget every pulse and window (the books and the strips' spacing are kept)."""
         self._shafts = {name: _Shaft(name) for name in SHAFTS}
         self._pending: deque[tuple[float, float, int]] = deque()  # start, end, revolutions
+        self._phase_pending: deque[tuple[float, int, int]] = deque()  # cage pulses: time, index, strip
+        self.epoch = getattr(self, "epoch", 0) + 1
         self._suspect: set[str] = set()
         self.silent: dict[str, str] = {}
         """Shafts found silent at two consecutive checks, with the reason."""
@@ -352,6 +360,8 @@ class SlipWindows:
 
     def _restart_shaft(self, shaft: str) -> None:
         self._shafts[shaft] = _Shaft(shaft)
+        self._phase_pending.clear()
+        self.epoch += 1
         self.silent.pop(shaft, None)
         self._suspect.discard(shaft)
 
@@ -400,8 +410,11 @@ class SlipWindows:
             self._spacing[strip] = sample if old is None else old + (sample - old) / SPACING_AVERAGE_REVOLUTIONS
 
     def _add_cage_pulse(self, cage: _Shaft, t: float, index: int) -> list[SlipWindow]:
-        assert cage.strip_count is not None
+        assert cage.strip_count is not None and cage.offset is not None
         n = cage.strip_count
+        self._phase_pending.append((t, index, (index + cage.offset) % n))
+        if len(self._phase_pending) > MAX_PENDING_WINDOWS:
+            self._phase_pending.popleft()
         span = self.window_revolutions * n
         if cage.window_start is None:
             cage.window_start, cage.window_grown = (index, t), False
@@ -454,12 +467,18 @@ class SlipWindows:
             inner = TWO_PI * (self._spindle_angle(spindle, t1) - self._spindle_angle(spindle, t0)) / duration
             cage = TWO_PI * revolutions / duration
             done.append(SlipWindow(t0, t1, cage, inner, revolutions))
+        while self._phase_pending and spindle.times and spindle.times[-1] >= self._phase_pending[0][0]:
+            t, index, strip = self._phase_pending.popleft()
+            if spindle.times[0] <= t:
+                self.phase.append((t, index, strip, TWO_PI * self._spindle_angle(spindle, t)))
         self._prune_spindle()
         return done
 
     def _prune_spindle(self) -> None:
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
         starts = [t0 for t0, _, _ in self._pending]
+        if self._phase_pending:
+            starts.append(self._phase_pending[0][0])
         if cage.window_start is not None:
             starts.append(cage.window_start[1])
         keep_from = min(starts) if starts else math.inf

@@ -18,11 +18,13 @@ the spindle's own angle. The line fit of window slips over the same second avera
 same way (a parabola's curvature is the mean slope of its derivative), so the verdicts mean the
 same, with a standard error several times smaller (every pulse, no differencing).
 
-**Standard error** from the fit's residuals, ``sigma^2 (X^T X)^-1``, with ``sigma`` never below
-the angle a window slip of ``resolution`` percent means, and inflated by ``(1 + rho) / (1 -
-rho)`` for residuals correlated from pulse to pulse (``rho`` their lag-1 autocorrelation: a slip
-that scatters from moment to moment makes the phase wander, and the plain formula would believe
-the wandering line too much); the degrees of freedom shrink by the same factor.
+**Standard error** of ``c2`` under two noises told apart by the residuals' variogram at a lag of
+one pulse and of an eighth of the stretch: white on each pulse's angle (timing jitter; never
+below the angle a window slip of ``resolution`` percent means) and a random walk of the phase (a
+slip that scatters from moment to moment makes the phase wander; the plain formula would believe
+the wandering line too much). :attr:`PhaseEstimate.white_share` says which dominates; the
+degrees of freedom are the fit's for the white part and about one per cage revolution for the
+walk.
 
 Units: s, rad; slip in percent, slopes in percent per second.
 """
@@ -150,12 +152,15 @@ class PhaseSlope:
         residual = y - x @ coef
         # two noises: white on each pulse's angle (timing jitter, w2 rad^2) and a wandering
         # phase (a slip that scatters from moment to moment: a random walk of q rad^2/s); the
-        # residuals' successive differences tell them apart (Var = 2 w2 + q dt, lag-1
-        # covariance -w2)
-        d = np.diff(residual)
-        dt = np.diff(t)
-        w2 = max(-float(np.mean(d[:-1] * d[1:])), self.angle_floor**2)
-        q = max((float(np.mean(d * d)) - 2.0 * w2) / float(np.mean(dt)), 0.0)
+        # residuals' variogram tells them apart: E (r_(k+L) - r_k)^2 = 2 w2 + q (t_(k+L) - t_k),
+        # at lags 1 and L (an eighth of the pulses: short-range correlation, such as two cage
+        # pulses read on the same spindle pulses, does not pass for a random walk)
+        lag = max(2, n // 8)
+        near, far = residual[1:] - residual[:-1], residual[lag:] - residual[:-lag]
+        near_dt, far_dt = float(np.mean(np.diff(t))), float(np.mean(t[lag:] - t[:-lag]))
+        gamma_near, gamma_far = float(np.mean(near * near)), float(np.mean(far * far))
+        q = max((gamma_far - gamma_near) / (far_dt - near_dt), 0.0)
+        w2 = max(0.5 * (gamma_far - q * far_dt), self.angle_floor**2)
         normal = np.linalg.inv(x.T @ x)
         row = (normal @ x.T)[2]  # c2 = row . y
         # Var(c2) = w2 |row|^2 + q sum_k (e_k - e_(k-1)) (sum_(j >= k) row_j)^2, the random walk's

@@ -50,6 +50,10 @@ share of its variance is the pulses' own white noise (timing jitter); below it t
 wanders (or the parabola misfits), and the standard error is taken as at least that of the whole
 windows' line, whose scatter is pooled over 64 windows (1)."""
 
+PHASE_MIN_PULSES = 20
+"""... and it has at least this many cage pulses: on fewer, a wandering phase cannot be told from
+jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1)."""
+
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
 
@@ -367,7 +371,8 @@ class SlipMonitor:
             change = self.slope.verdict().change_at
             estimate = self.phase.estimate(t1, since=change)
             if estimate is not None:
-                external = (estimate.slope, estimate.standard_error, estimate.dof, estimate.white_share < PHASE_WHITE_SHARE)
+                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES
+                external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)
         try:
             if self.slope.add(x, slip, external):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))

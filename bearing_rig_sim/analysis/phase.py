@@ -114,19 +114,21 @@ class PhaseSlope:
             return 0.0
         return 2.0 * math.pi * (p[-1][1] - p[0][1]) / self.strips / (p[-1][0] - p[0][0])
 
-    def estimate(self, end: float, since: float | None = None) -> PhaseEstimate | None:
-        """The slope over the pulses of the last ``span`` up to ``end`` (s), or back to
+    def estimate(self, end: float, since: float | None = None, span: float | None = None) -> PhaseEstimate | None:
+        """The slope over the pulses of the last ``span`` (s; default the one given at
+        construction, at most ``max_span``) up to ``end`` (s), or back to
         :data:`MIN_PHASE_REVOLUTIONS` cage revolutions if the span holds fewer, none before
         ``since`` (s: a change in the slip); None with too few pulses for the fit (three more
         than its parameters)."""
         start = -math.inf if since is None else since
+        stretch = self.span if span is None else min(span, self.max_span)
         rows = [p for p in self._points if start <= p[0] <= end]
         if len(rows) < 2:
             return None
         last_index = rows[-1][1]
         first = len(rows) - 1
         need = MIN_PHASE_REVOLUTIONS * self.strips
-        while first > 0 and (end - rows[first - 1][0] <= self.span or last_index - rows[first][1] < need):
+        while first > 0 and (end - rows[first - 1][0] <= stretch or last_index - rows[first][1] < need):
             first -= 1
         rows = rows[first:]
         if last_index - rows[0][1] < need:

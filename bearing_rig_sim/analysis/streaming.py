@@ -131,8 +131,8 @@ class TrailingSlope:
     if it is clear by the same rule. It never reaches back before the data that made the current
     decision (the first point of the window that last decided), before a change, or before the
     last :meth:`forget_scatter` (a speed change), so it can only confirm the held state from
-    newer points or overturn it with points taken after it, and only towards the side of k the
-    trailing slope itself is on, so a plateau cannot flap.
+    newer points or overturn it with points taken after it, and it gives a new verdict only on the
+    side of k the trailing slope itself is on, so a plateau cannot flap.
 
     Args:
         critical_slope: k, %/unit of x.
@@ -393,8 +393,8 @@ class TrailingSlope:
         by_longer = self._clear(line)
         if by_longer is SlipState.UNKNOWN or (decided is not SlipState.UNKNOWN and by_longer is not decided):
             return
-        if held is not SlipState.UNKNOWN and by_longer is not held and self._line is not None:
-            # an overturn only where the trailing slope itself points (its older points may be
+        if by_longer is not held and self._line is not None:
+            # a new verdict only where the trailing slope itself points (the older points may be
             # from before a steep stretch ended, which the trailing window has left behind)
             if (self._line[0] >= self.critical_slope) != (by_longer is SlipState.STABLE):
                 return

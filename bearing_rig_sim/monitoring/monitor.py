@@ -31,10 +31,10 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
-from bearing_rig_sim.analysis.phase import PhaseSlope
+from bearing_rig_sim.analysis.phase import PhaseEstimate, PhaseSlope
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
-from bearing_rig_sim.analysis.streaming import TrailingSlope
+from bearing_rig_sim.analysis.streaming import TrailingSlope, t_quantile_95
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
 from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
@@ -160,6 +160,14 @@ class MonitorWindow:
         return self.window.cage_speed
 
 
+def _clear(estimate: PhaseEstimate | None, critical_slope: float) -> bool:
+    """Whether a phase slope is clear of k by its one-sided 95 % bound, on the side its value is."""
+    if estimate is None:
+        return False
+    bound = t_quantile_95(estimate.dof) * estimate.standard_error
+    return estimate.slope - bound >= critical_slope or estimate.slope + bound < critical_slope
+
+
 class SlipMonitor:
     """Online cage slip and its stability from the two pulse streams (module docstring).
 
@@ -203,6 +211,7 @@ class SlipMonitor:
         self._invalid: dict[str, tuple[float | None, str]] = {}
         self._warnings: dict[str, tuple[float | None, str]] = {}
         self._steady: bool | None = None
+        self._steady_since: float | None = None
         self._previous_inner: float | None = None
         self._last_x: float | None = None
         self.sweep.reset()
@@ -268,7 +277,7 @@ class SlipMonitor:
             return
         if self.phase is None and shaft == "cage" and isinstance(pulse.strip_count, int) and pulse.strip_count >= 1:
             span = st.slope_span_s
-            self.phase = PhaseSlope(self._ratio, span, pulse.strip_count, st.slip_resolution_pct)
+            self.phase = PhaseSlope(self._ratio, span, pulse.strip_count, st.slip_resolution_pct, max(st.slope_max_span_s, span))
         if self.phase is None:
             return
         if self.counter.epoch != self._phase_epoch:
@@ -328,6 +337,10 @@ class SlipMonitor:
             change = f"steady at {inner:.6g} rad/s" if steady else f"changing, {previous:.6g} -> {inner:.6g} rad/s"
             self.slope.forget_scatter()
             self._notes.append((t1, f"spindle speed {change}: slip scatter estimated afresh"))
+        if not steady:
+            self._steady_since = None
+        elif self._steady_since is None:  # steady from the previous window on
+            self._steady_since = self._latest.start_time if self._latest is not None else window.start_time
         self._steady = steady
         self._previous_inner = inner
         slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
@@ -370,6 +383,12 @@ class SlipMonitor:
         if self.phase is not None and self.criterion == "time":
             change = self.slope.verdict().change_at
             estimate = self.phase.estimate(t1, since=change)
+            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN and not _clear(estimate, self.settings.critical_slope):
+                # no verdict yet at a steady speed: the phase since the speed settled decides
+                since = self._steady_since if change is None else max(change, self._steady_since)
+                longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
+                if longer is not None and _clear(longer, self.settings.critical_slope):
+                    estimate = longer
             if estimate is not None:
                 alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES
                 external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)

@@ -52,7 +52,12 @@ windows' line, whose scatter is pooled over 64 windows (1)."""
 
 PHASE_MIN_PULSES = 20
 """... and it has at least this many cage pulses: on fewer, a wandering phase cannot be told from
-jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1)."""
+jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1) ..."""
+
+PHASE_FULL_SPAN = 0.95
+"""... over at least this fraction of ``slope_span_s`` (1): at the start of a hold the first
+spindle spacing estimate is one revolution's, as scattered as the jitter, and shorter stretches
+of 50 us jitter at 900 rpm made false SLIPPING verdicts."""
 
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
@@ -390,7 +395,8 @@ class SlipMonitor:
                 if longer is not None and _clear(longer, self.settings.critical_slope):
                     estimate = longer
             if estimate is not None:
-                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES
+                full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
+                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
                 external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)
         try:
             if self.slope.add(x, slip, external):

@@ -82,7 +82,7 @@ STOP_SILENCE_PERIODS = 4.0
 ``loss_min_timeout_s``): the rig has stopped (1). No fault hangs on it, so it may be decided
 sooner than a sensor loss."""
 
-STEADY_ANGLE_TOLERANCE_REV = 1e-3
+STEADY_ANGLE_TOLERANCE_REV = 4e-3
 """Three spindle revolutions measure the strips' spacing when the parabola of angle against time
 through their first three strip-0 passages predicts the fourth's angle within this, revolutions:
 a constant speed or acceleration passes (3 us of jitter moves the prediction by 2e-4 revolution at

@@ -388,11 +388,12 @@ class SlipMonitor:
         if self.phase is not None and self.criterion == "time":
             change = self.slope.verdict().change_at
             estimate = self.phase.estimate(t1, since=change)
-            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN and not _clear(estimate, self.settings.critical_slope):
-                # no verdict yet at a steady speed: the phase since the speed settled decides
+            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
+                # no verdict yet at a steady speed: the phase since the speed settled (the more
+                # data, the surer a first verdict, which no hysteresis protects)
                 since = self._steady_since if change is None else max(change, self._steady_since)
                 longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
-                if longer is not None and _clear(longer, self.settings.critical_slope):
+                if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
                     estimate = longer
             if estimate is not None:
                 full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s

@@ -19,7 +19,16 @@ from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import SlipMonitor
 from bearing_rig_sim.monitoring.schedule import StatusSchedule
 from bearing_rig_sim.monitoring.settings import MonitorSettings
-from bearing_rig_sim.synthetic.bench import TABLE7, BenchScenario, bench_pulses, table7_onset, table7_run_up
+from bearing_rig_sim.synthetic.bench import TABLE7, BenchScenario, Profile, bench_pulses, table7_onset, table7_run_up
+
+
+def constant(value: float) -> Profile:
+    """A profile of constant ``value`` (rad/s or percent)."""
+
+    def profile(t: np.ndarray) -> np.ndarray:
+        return np.full_like(t, value)
+
+    return profile
 
 
 def statuses(settings: MonitorSettings, scenario: BenchScenario) -> tuple[np.ndarray, np.ndarray]:
@@ -69,7 +78,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         w = rpm * math.pi / 30.0
         firsts, notes = [], set()
         for seed in range(args.seeds):
-            scenario = BenchScenario(10.0, lambda t, w=w: np.full_like(t, w), lambda t: np.full_like(t, 2.0), epicyclic_ratio=ratio, jitter_s=50e-6, seed=seed)
+            scenario = BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=ratio, jitter_s=50e-6, seed=seed)
             times, states = statuses(settings, scenario)
             at, kept = first_stable(times, states)
             firsts.append(at)

@@ -11,7 +11,10 @@ kinematics, so it runs unchanged on the real bench's topics.
 * **Verdict**: the paper's slope criterion on the slip series, against time (k2) or against the
   measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
   slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,
-  and a change in the slip itself (whatever caused it) restarts the slope's window.
+  and a change in the slip itself (whatever caused it) restarts the slope's window. Against time
+  (nominal slip), the slope and its standard error come from the cage's phase over every pulse
+  (:class:`~bearing_rig_sim.analysis.phase.PhaseSlope`, :data:`PHASE_WHITE_SHARE`), far less
+  scattered than a line through whole windows' slips (docs/method.md, run-ups).
 * **Speed changes**: at the start and the end of one (a window's mean spindle speed more than
   ``restart_speed_change_fraction`` from the previous window's, or back within it) the slip's
   scatter is estimated afresh; the verdict is kept, its trailing window forgets the ramp within

@@ -355,6 +355,23 @@ def test_strip_spacing_is_measured_from_the_pulses() -> None:
         assert measured[strip] == pytest.approx(value, abs=3e-5)
 
 
+@pytest.mark.parametrize("acceleration", [20.0, 80.0])
+def test_strip_spacing_is_measured_during_a_run_up(acceleration: float) -> None:
+    """A run-up from rest at constant acceleration (no steady revolution before 2 s): the
+    spindle's strip spacing errors of the generator (mean removed) are found from the pulses of
+    its first 2 s to within a few 1e-5 revolution, so the run-up's windows do not carry them
+    (uncorrected, 1e-3 revolution moves a one-revolution window's slip by up to 0.06 %)."""
+    scenario = BenchScenario(2.0, lambda t: acceleration * np.asarray(t), constant(1.0), epicyclic_ratio=RATIO)
+    monitor = SlipMonitor(SETTINGS.kinematics(), SETTINGS)
+    for shaft, pulse in bench_pulses(scenario):
+        monitor.add_pulse(shaft, pulse)
+    errors = np.array(scenario.spacing_error_rev["spindle"])
+    measured = monitor.counter.spacing()
+    assert set(measured) == set(range(4))
+    for strip, value in enumerate(errors - errors.mean()):
+        assert measured[strip] == pytest.approx(float(value), abs=3e-5)
+
+
 def _backlogged(pulses: list, start: float, end: float) -> list:
     """The arrival order after a subscriber held up from ``start`` to ``end`` (s from the epoch
     offset): the backlog of each topic comes one message per topic in turn, as an executor
@@ -446,36 +463,59 @@ def test_kinematic_slip_removes_the_contact_angle_and_either_slip_can_be_judged(
         assert math.degrees(status.loaded_contact_angle) == pytest.approx(18.95, abs=0.01)
 
 
+ONSET_DELAY_S = 1.5
+"""Issue 25: a stable verdict within 1.5 s after the true onset (the Table 7 curve's slope rising
+through k2, from the formula: 1.67, 1.41, 1.23, 0.97 s at 20-80 rad/s^2)."""
+
+
+@pytest.mark.parametrize("seed", [0, 4, 5])
 @pytest.mark.parametrize("acceleration", [20.0, 40.0, 60.0, 80.0])
-def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float) -> None:
+def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float, seed: int) -> None:
     """Run-ups from rest at the paper's accelerations with the slip of its Table 7 curves (3 us of
-    jitter): no FAULT; a stable verdict after the true onset (where the curve's slope rises through
-    k2: 1.67, 1.41, 1.23, 0.97 s, from the formula) and kept to the end. The verdict comes 2.0 to
-    2.7 s after the onset (the issue asks for 1.5 s: a slope needs min_slope_points whole cage
-    revolutions, and the cage turns about 2 revolutions in the first 1.7 s at 20 rad/s^2); the
-    bound here is 3 s."""
-    scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, seed=5)
+    jitter): no FAULT; no stable verdict before the true onset, one within ONSET_DELAY_S after it,
+    kept to the end. (Measured 0.5-1.4 s; before the cage's phase decided the slope and the
+    spindle's strips were measured in the run-up, 2.0-2.7 s: the bound here was 3 s.)"""
+    scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, seed=seed)
     onset = table7_onset(acceleration, K2)
     out = run(scenario)
     assert SlipState.FAULT not in out.states
     stable = out.times[out.states == SlipState.STABLE]
-    assert stable.size and onset <= stable[0] <= onset + 3.0
+    assert stable.size and onset <= stable[0] <= onset + ONSET_DELAY_S
     assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
 
 
-@pytest.mark.parametrize("rpm", [900.0, 1500.0, 3000.0, 9000.0])
-def test_a_hold_with_50_us_of_jitter_is_stable_and_its_median_slip_true(rpm: float) -> None:
+@pytest.mark.parametrize(("acceleration", "changes"), [(20.0, {"lost_fraction": 0.005, "seed": 1}), (60.0, {"bursts": (Burst("cage", 1.8, 8),)}), (40.0, {"jitter_s": 10e-6, "seed": 2})])
+def test_run_ups_with_sensor_imperfections_are_judged_stable_after_the_onset(acceleration: float, changes: dict) -> None:
+    """The same run-ups with 0.5 % of the pulses lost, a burst of 8 lost cage pulses (2 revolutions)
+    just after the onset, or 10 us of jitter: no FAULT, never stable before the onset, stable
+    within 2 s after it (the burst costs the phase its stretch; 10 us of jitter at 20-40 rad/s^2
+    took up to 1.8 s in 10 seeds) and kept."""
+    scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, **changes)
+    onset = table7_onset(acceleration, K2)
+    out = run(scenario)
+    assert SlipState.FAULT not in out.states
+    stable = out.times[out.states == SlipState.STABLE]
+    assert stable.size and onset <= stable[0] <= onset + 2.0
+    assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
+
+
+@pytest.mark.parametrize(("rpm", "first_stable_s"), [(900.0, 2.0), (1500.0, 1.5), (3000.0, 1.5), (9000.0, 1.5)])
+def test_a_hold_with_50_us_of_jitter_is_stable_and_its_median_slip_true(rpm: float, first_stable_s: float) -> None:
     """A 10 s hold at constant 2 % slip with 50 us of timing jitter on every pulse: no FAULT, a
     stable verdict that is kept, and the median slip of the statuses within 0.02 pp of the truth
     (windows of at least min_window_s = 0.1 s: at 9000 rpm a one-revolution window's slip
     scatters by about 0.45 % under this jitter, a 0.1 s one by 0.07 %). The verdict comes within
-    4 s (the issue asks 1.5 s: at 3000-9000 rpm it takes about 3 s)."""
+    1.5 s (issue 25) from 1500 rpm up. At 900 rpm the data hardly allow it: the cage's phase over
+    T seconds (26 pulses a second, each 50 us = 2e-3 rad off, the spindle's angle as much again)
+    leaves the slope a standard error of about 0.034 T^-2.5 %/s, and its 95 % bound clears
+    k2 = -0.03 %/s from a true slope of 0 only from T = 1.25 s (12 seeds: 1.0-2.4 s, median 1.3 s);
+    the bound there is 2 s. (Before the phase fit: 3-4 s.)"""
     w = rpm * math.pi / 30.0
     scenario = BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=RATIO, jitter_s=50e-6, seed=3)
     out = run(scenario)
     assert SlipState.FAULT not in out.states
     stable = out.times[out.states == SlipState.STABLE]
-    assert stable.size and stable[0] <= 4.0
+    assert stable.size and stable[0] <= first_stable_s
     assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
     slips = [s.slip_rate for s in out.statuses if math.isfinite(s.slip_rate)]
     assert abs(float(np.median(slips)) - 2.0) <= 0.02

@@ -30,6 +30,13 @@ from bearing_rig_sim.analysis.stability import SlipState
 
 
 @functools.lru_cache(maxsize=256)
+def t_quantile_overturn(dof: int) -> float:
+    """One-sided Student's t quantile at 1 - :data:`OVERTURN_AT_ONCE_P` with ``dof`` (>= 1)
+    degrees of freedom (``scipy.stats.t.ppf``; cached)."""
+    return float(student_t.ppf(1.0 - OVERTURN_AT_ONCE_P, dof))
+
+
+@functools.lru_cache(maxsize=256)
 def t_quantile_95(dof: int) -> float:
     """One-sided 95 % quantile of Student's t with ``dof`` (>= 1) degrees of freedom
     (``scipy.stats.t.ppf``; cached, as the monitor asks for the same few at every point)."""
@@ -73,6 +80,13 @@ again in between (1). The slope is re-tested at every slip point (6-19 a second)
 windows, so a single 5 % test overturned a verdict on a plateau by chance 2-9 times in 30 s once
 the points scattered by about 0.06 %; with this rule, not once in the same trials."""
 
+OVERTURN_AT_ONCE_P = 1e-4
+"""... unless the opposite verdict is beyond doubt: its one-sided bound at 1 - this (Student's t,
+about 4 standard errors at 60 degrees of freedom, 6.4 at 8) is on the other side of k, which
+chance does not give on a plateau (1). A run-up's slope crosses k2 and runs on to zero within
+half a second (Table 7: from -0.03 to -0.005 %/s in 0.3 s at 60 rad/s^2): its clean windows
+reach this bound at once, where waiting out half the span added 0.5 s to each time to stable."""
+
 SCATTER_POINTS = 64
 """Second differences kept for the scatter of the slip points (1)."""
 
@@ -97,7 +111,8 @@ class TrailingSlope:
     becomes STABLE when ``slope - q se >= k``, SLIPPING when ``slope + q se < k``, and otherwise
     stays what it was (UNKNOWN at the start of a series). Since the test is repeated at every
     point, a held verdict is overturned only once the opposite one has been reached over
-    :data:`OVERTURN_CONFIRM` of the span (not after a detected change in the slip:
+    :data:`OVERTURN_CONFIRM` of the span, or at once when beyond doubt
+    (:data:`OVERTURN_AT_ONCE_P`) (not after a detected change in the slip:
     the held verdict's points are gone, and the new ones decide afresh), or at once when the
     longer stretch (below) reaches the same opposite verdict. A verdict thus changes only when the data puts the
     slope clearly on the other side of k, so noise on a plateau cannot flap it.
@@ -116,7 +131,8 @@ class TrailingSlope:
     if it is clear by the same rule. It never reaches back before the data that made the current
     decision (the first point of the window that last decided), before a change, or before the
     last :meth:`forget_scatter` (a speed change), so it can only confirm the held state from
-    newer points or overturn it with points taken after it, and a plateau cannot flap.
+    newer points or overturn it with points taken after it, and it gives a new verdict only on the
+    side of k the trailing slope itself is on, so a plateau cannot flap.
 
     Args:
         critical_slope: k, %/unit of x.
@@ -196,8 +212,16 @@ class TrailingSlope:
         """The current decision."""
         return self._state
 
-    def add(self, x: float, slip_pct: float) -> bool:
+    def add(self, x: float, slip_pct: float, external: tuple[float, float, int] | tuple[float, float, int, bool] | None = None) -> bool:
         """Add one point (x increasing); returns whether a change in the slip was detected.
+
+        ``external``: (slope, standard error, degrees of freedom) of the slip over the trailing
+        window estimated from finer data than the points (the cage's phase,
+        :class:`~bearing_rig_sim.analysis.phase.PhaseSlope`), which then decides in place of the
+        points' line (with fewer than ``min_points`` points too); the points still serve the
+        change detection and the longer stretch. A fourth element True: that standard error is
+        not to be trusted below the points' own line's (its data wander: the larger of the two
+        is used, and the smaller degrees of freedom; none with fewer than 3 points).
 
         Raises:
             AnalysisError: a non-finite value or an x not after the previous one (the point is
@@ -223,7 +247,7 @@ class TrailingSlope:
             self._hy.append(yv)
             while u - self._hx[0] > self.max_span:
                 del self._hx[0], self._hy[0]
-        self._fit()
+        self._fit(external)
         self._decide()
         self._verdict = self._make_verdict()
         return changed
@@ -233,6 +257,8 @@ class TrailingSlope:
         if line is None:
             return False
         slope, _se, xbar, ybar, sxx, n = line
+        if not sxx > 0.0:
+            return False
         sigma = self._sigma
         predicted = ybar + slope * (u - xbar)
         spread = sigma * math.sqrt(1.0 + 1.0 / n + (u - xbar) ** 2 / sxx)
@@ -293,20 +319,32 @@ class TrailingSlope:
         sse = sum((y - ybar - slope * d) ** 2 for d, y in zip(dx, ys))
         return slope, xbar, ybar, sxx, math.sqrt(sse / (n - 2)) if n > 2 else 0.0
 
-    def _fit(self) -> None:
+    def _fit(self, external: tuple[float, float, int] | tuple[float, float, int, bool] | None = None) -> None:
         n = len(self._x)
-        fit = self._least_squares(self._x, self._y) if n >= self.min_points else None
-        if fit is None:
+        fit = self._least_squares(self._x, self._y) if n >= (3 if external is not None else self.min_points) else None
+        if external is not None and all(math.isfinite(v) for v in external[:3]) and external[1] > 0.0:
+            slope, se, dof, checked = external[0], external[1], max(1, int(external[2])), len(external) > 3 and bool(external[3])
+            if fit is not None:
+                self._sigma, points_dof = self._scatter(fit[4])
+                if checked:  # no better than the points' own line
+                    se, dof = max(se, self._sigma / math.sqrt(fit[3])), min(dof, points_dof)
+            if fit is not None or not checked:
+                xbar, ybar, sxx = (fit[1], fit[2], fit[3]) if fit is not None else (self._x[-1], self._y[-1], 0.0)
+                self._dof = dof
+                self._line = (slope, se, xbar, ybar, sxx, n)
+                return
+        if fit is None or n < self.min_points:
             self._line = None
             return
         slope, xbar, ybar, sxx, scatter = fit
         self._sigma, self._dof = self._scatter(scatter)
         self._line = (slope, self._sigma / math.sqrt(sxx), xbar, ybar, sxx, n)
 
-    def _clear(self, line: tuple[float, float, float, float, float, int]) -> SlipState:
-        """The state a line decides by the one-sided 95 % bound (UNKNOWN: neither side)."""
+    def _clear(self, line: tuple[float, float, float, float, float, int], strict: bool = False) -> SlipState:
+        """The state a line decides by the one-sided 95 % bound (UNKNOWN: neither side); with
+        ``strict``, by the bound at 1 - :data:`OVERTURN_AT_ONCE_P`."""
         slope, se, *_rest = line
-        q = t_quantile_95(self._dof)
+        q = t_quantile_overturn(self._dof) if strict else t_quantile_95(self._dof)
         k = self.critical_slope
         if slope - q * se >= k:
             return SlipState.STABLE
@@ -343,7 +381,7 @@ class TrailingSlope:
             # an overturn of the held verdict: reached over OVERTURN_CONFIRM of the span first
             since = self._overturn[1] if self._overturn is not None and self._overturn[0] is decided else self._x[-1]
             self._overturn = (decided, since)
-            if self._x[-1] - since >= OVERTURN_CONFIRM * self.span:
+            if self._x[-1] - since >= OVERTURN_CONFIRM * self.span or self._clear(self._line, strict=True) is decided:
                 self._state, self._anchor, self._overturn = decided, self._x[0], None
                 return
         # the trailing window cannot decide, or its overturn is not confirmed yet: the longer
@@ -355,6 +393,11 @@ class TrailingSlope:
         by_longer = self._clear(line)
         if by_longer is SlipState.UNKNOWN or (decided is not SlipState.UNKNOWN and by_longer is not decided):
             return
+        if by_longer is not held and self._line is not None:
+            # a new verdict only where the trailing slope itself points (the older points may be
+            # from before a steep stretch ended, which the trailing window has left behind)
+            if (self._line[0] >= self.critical_slope) != (by_longer is SlipState.STABLE):
+                return
         if by_longer is not held or self._anchor is None:
             self._anchor = self._hx[-line[5]]  # the first of its points
             self._overturn = None
@@ -367,7 +410,8 @@ class TrailingSlope:
         if self._line is None or self._used is None:
             detail = f"collecting slip points: {n} of the {self.min_points} needed for a slope"
             if self._state is not SlipState.UNKNOWN:
-                detail += f" (holding {self._state.label} since a change at x = {self._change_at:.6g})"
+                since = f" since a change at x = {self._change_at:.6g}" if self._change_at is not None else ""
+                detail += f" (holding {self._state.label}{since})"
             return SlopeVerdict(self._state, None, None, k, 0.0, n, span, self._change_at, detail)
         line, span = self._used
         slope, se, n = line[0], line[1], line[5]

@@ -11,7 +11,10 @@ kinematics, so it runs unchanged on the real bench's topics.
 * **Verdict**: the paper's slope criterion on the slip series, against time (k2) or against the
   measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
   slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,
-  and a change in the slip itself (whatever caused it) restarts the slope's window.
+  and a change in the slip itself (whatever caused it) restarts the slope's window. Against time
+  (nominal slip), the slope and its standard error come from the cage's phase over every pulse
+  (:class:`~bearing_rig_sim.analysis.phase.PhaseSlope`, :data:`PHASE_WHITE_SHARE`), far less
+  scattered than a line through whole windows' slips (docs/method.md, run-ups).
 * **Speed changes**: at the start and the end of one (a window's mean spindle speed more than
   ``restart_speed_change_fraction`` from the previous window's, or back within it) the slip's
   scatter is estimated afresh; the verdict is kept, its trailing window forgets the ramp within
@@ -31,9 +34,10 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
+from bearing_rig_sim.analysis.phase import PhaseEstimate, PhaseSlope
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
-from bearing_rig_sim.analysis.streaming import TrailingSlope
+from bearing_rig_sim.analysis.streaming import TrailingSlope, t_quantile_95
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
 from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
@@ -42,6 +46,21 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 
 MonitorState = SlipState
 """The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""
+
+PHASE_WHITE_SHARE = 0.5
+"""The cage's phase decides the slope against time on its own standard error when at least this
+share of its variance is the pulses' own white noise (timing jitter); below it the slip itself
+wanders (or the parabola misfits), and the standard error is taken as at least that of the whole
+windows' line, whose scatter is pooled over 64 windows (1)."""
+
+PHASE_MIN_PULSES = 20
+"""... and it has at least this many cage pulses: on fewer, a wandering phase cannot be told from
+jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1) ..."""
+
+PHASE_FULL_SPAN = 0.95
+"""... over at least this fraction of ``slope_span_s`` (1): at the start of a hold the first
+spindle spacing estimate is one revolution's, as scattered as the jitter, and shorter stretches
+of 50 us jitter at 900 rpm made false SLIPPING verdicts."""
 
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
@@ -149,6 +168,14 @@ class MonitorWindow:
         return self.window.cage_speed
 
 
+def _clear(estimate: PhaseEstimate | None, critical_slope: float) -> bool:
+    """Whether a phase slope is clear of k by its one-sided 95 % bound, on the side its value is."""
+    if estimate is None:
+        return False
+    bound = t_quantile_95(estimate.dof) * estimate.standard_error
+    return estimate.slope - bound >= critical_slope or estimate.slope + bound < critical_slope
+
+
 class SlipMonitor:
     """Online cage slip and its stability from the two pulse streams (module docstring).
 
@@ -173,6 +200,9 @@ class SlipMonitor:
             change_threshold=settings.change_threshold,
             max_span=max(settings.slope_max_span_s, settings.slope_span_s),
         )
+        self.phase: PhaseSlope | None = None
+        """The slope against time from the cage's phase (time criterion, nominal slip); built at
+        the first cage pulse, which gives the strip count."""
         self.sweep = LoadSweep(settings.critical_slope_pct_per_n, settings.load_step_n, settings.sweep_settle_s, settings.sweep_average_s)
         self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s, settings.min_window_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
@@ -184,10 +214,12 @@ class SlipMonitor:
         """Forget every pulse, window, slope and fault (state unknown); ``reason`` becomes a note."""
         self.counter.reset()
         self.slope.reset()
+        self._reset_phase()
         self._latest: MonitorWindow | None = None
         self._invalid: dict[str, tuple[float | None, str]] = {}
         self._warnings: dict[str, tuple[float | None, str]] = {}
         self._steady: bool | None = None
+        self._steady_since: float | None = None
         self._previous_inner: float | None = None
         self._last_x: float | None = None
         self.sweep.reset()
@@ -230,12 +262,37 @@ class SlipMonitor:
         """
         done = self.counter.add_pulse(shaft, pulse)
         self._take_events()
+        self._take_phase(shaft, pulse)
         t = pulse.time
         if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
             self._now = float(t) if self._now is None else max(self._now, float(t))
         for window in done:
             self._add_window(window)
         return bool(done)
+
+    def _reset_phase(self, since: float = -math.inf) -> None:
+        """Forget the cage's phase; count its pulses from ``since`` (s) on."""
+        if self.phase is not None:
+            self.phase.reset()
+        self._phase_from = since
+        self._phase_epoch = self.counter.epoch
+
+    def _take_phase(self, shaft: str, pulse: Pulse) -> None:
+        """Give the phase slope the cage pulses whose spindle angle is now known."""
+        points, self.counter.phase = self.counter.phase, []
+        st = self.settings
+        if self.criterion != "time" or self.loaded:
+            return
+        if self.phase is None and shaft == "cage" and isinstance(pulse.strip_count, int) and pulse.strip_count >= 1:
+            span = st.slope_span_s
+            self.phase = PhaseSlope(self._ratio, span, pulse.strip_count, st.slip_resolution_pct, max(st.slope_max_span_s, span))
+        if self.phase is None:
+            return
+        if self.counter.epoch != self._phase_epoch:
+            self._reset_phase()
+        for t, index, strip, angle in points:
+            if t > self._phase_from:
+                self.phase.add(t, index, strip, angle)
 
     def _take_events(self) -> None:
         for kind, when, text in self.counter.events:
@@ -256,6 +313,7 @@ class SlipMonitor:
         if self.slope.n_points or self.slope.state is not SlipState.UNKNOWN:
             self._notes.append((time, f"slip series restarted at {time:.6f} s: {why}"))
         self.slope.reset()
+        self._reset_phase(time)
         self._last_x = None
 
     def _mean_load(self, t0: float, t1: float) -> float:
@@ -277,6 +335,7 @@ class SlipMonitor:
         if not inner >= st.min_inner_ring_speed_rad_s:
             if self._previous_inner is not None:
                 self._restart_series(t1, f"spindle below {st.min_inner_ring_speed_rad_s:g} rad/s")
+            self._reset_phase(t1)
             self._previous_inner, self._steady = None, None
             self._latest = MonitorWindow(window, math.nan, load)
             return
@@ -286,6 +345,10 @@ class SlipMonitor:
             change = f"steady at {inner:.6g} rad/s" if steady else f"changing, {previous:.6g} -> {inner:.6g} rad/s"
             self.slope.forget_scatter()
             self._notes.append((t1, f"spindle speed {change}: slip scatter estimated afresh"))
+        if not steady:
+            self._steady_since = None
+        elif self._steady_since is None:  # steady from the previous window on
+            self._steady_since = self._latest.start_time if self._latest is not None else window.start_time
         self._steady = steady
         self._previous_inner = inner
         slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0  # Eq. 11, as BearingKinematics.slip_rate
@@ -324,8 +387,23 @@ class SlipMonitor:
                 self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
     def _add_point(self, t1: float, x: float, slip: float) -> None:
+        external: tuple[float, float, int, bool] | None = None
+        if self.phase is not None and self.criterion == "time":
+            change = self.slope.verdict().change_at
+            estimate = self.phase.estimate(t1, since=change)
+            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
+                # no verdict yet at a steady speed: the phase since the speed settled (the more
+                # data, the surer a first verdict, which no hysteresis protects)
+                since = self._steady_since if change is None else max(change, self._steady_since)
+                longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
+                if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
+                    estimate = longer
+            if estimate is not None:
+                full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
+                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
+                external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)
         try:
-            if self.slope.add(x, slip):
+            if self.slope.add(x, slip, external):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))
             self._last_x = x
         except AnalysisError as exc:  # cannot happen with ordered points; never crash

@@ -15,18 +15,25 @@ spacing. If that closing passage is lost, the window is skipped (counted in
 :attr:`LossBooks.windows_skipped`) and the next window starts at the next cage pulse received.
 
 **Time-aligned spindle speed.** The spindle's angle is known at each of its pulses (its index,
-corrected for the strip's own spacing error, below) and interpolated linearly between them at
-the cage window's two ends; the mean inner-ring speed is the difference over the same interval,
-so a changing speed gives no apparent slip from windows that do not line up. A window waits for
-the first spindle pulse at or after its end (a gap in the spindle's pulses widens the
-interpolation bracket and costs nothing else).
+corrected for the strip's own spacing error, below) and interpolated at the cage window's two
+ends by the parabola through the pulse before the end and the two that bracket it (exact under
+a constant acceleration, where a straight line between pulses 4 ms apart errs by some 1e-4
+revolution at 60 rad/s^2, 0.01 % of a window's slip); the mean inner-ring speed is the
+difference over the same interval, so a changing speed gives no apparent slip from windows
+that do not line up. A window waits for the first spindle pulse at or after its end (a gap in
+the spindle's pulses widens the interpolation bracket and costs nothing else).
 
 **Strip spacing errors** of the spindle do not bias the interpolated angle: each strip's offset
 from its nominal position (a fraction of a revolution) is measured from the pulses themselves,
-over whole revolutions with every pulse received whose period differs from the one before by
-less than :data:`STEADY_PERIOD_CHANGE` (at a steady speed a time fraction is an angle fraction),
-averaged over :data:`SPACING_AVERAGE_REVOLUTIONS`, and added to the strip's nominal angle.
-Until then the nominal positions are used.
+over three whole revolutions with every pulse received whose strip-0 passages lie on one
+parabola of angle against time (a constant speed or a constant acceleration: the parabola
+through the first three predicts the fourth within :data:`STEADY_ANGLE_TOLERANCE_REV`), from the
+middle revolution's pulse times read on the cubic through the four passages, averaged over
+:data:`SPACING_AVERAGE_REVOLUTIONS`, and added to the strip's nominal angle (of every spindle
+pulse kept, also those received before). Until then the nominal positions are used. Measured in a
+run-up too, not only at a steady speed: on a bench's strips (offsets of 1e-3 revolution) the
+nominal positions move a one-revolution window's slip by up to 0.06 %, which hid a run-up's
+slope against k2 for seconds.
 
 **Losses** (:class:`LossBooks`, per shaft): pulses lost, isolated gaps, windows skipped. An
 isolated loss is a warning. It is a fault only when sustained, by one of two rules stated in
@@ -75,11 +82,12 @@ STOP_SILENCE_PERIODS = 4.0
 ``loss_min_timeout_s``): the rig has stopped (1). No fault hangs on it, so it may be decided
 sooner than a sensor loss."""
 
-STEADY_PERIOD_CHANGE = 0.002
-"""A spindle revolution whose period is within this fraction of the previous one's is steady
-enough to measure the strips' spacing from (1): at 20 rad/s^2 and 900 rpm a revolution's period
-changes by 1.4 %, so ramps are excluded; jitter of microseconds changes a 67 ms period by
-about 0.003 %."""
+STEADY_ANGLE_TOLERANCE_REV = 4e-3
+"""Three spindle revolutions measure the strips' spacing when the parabola of angle against time
+through their first three strip-0 passages predicts the fourth's angle within this, revolutions:
+a constant speed or acceleration passes (3 us of jitter moves the prediction by 2e-4 revolution at
+900 rpm), the corner where a run-up reaches its speed (about 8e-3 revolution at 60 rad/s^2) does
+not."""
 
 ESTABLISHED_REVOLUTIONS = 2
 """Pulses of this many revolutions since a shaft's restart make it a running shaft (1). Until
@@ -167,12 +175,11 @@ class _Shaft:
     previous_period: float | None = None
     pulses: int = 0
     times: list[float] = field(default_factory=list)
-    angles: list[float] = field(default_factory=list)  # revolutions, spacing-corrected
+    indices: list[int] = field(default_factory=list)  # pulse_index of each of times
     window_start: tuple[int, float] | None = None
     window_grown: bool = False  # the open window reached a revolution too short to close
     recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
     recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
-    steady_period: float | None = None  # period of the last whole revolution measured, s
     other_pulses_at_last: int = 0  # the other shaft's pulses received when this one last pulsed
 
     def established(self) -> bool:
@@ -219,12 +226,20 @@ class SlipWindows:
         malformed pulse, discarded), "gap" (lost pulses), "note" (an out-of-order pulse or a
         restart) or "reset" (a clock jump: the caller resets what it derived)."""
         self._spacing: dict[int, float] = {}
+        self.phase: list[tuple[float, int, int, float]] = []
+        """Cage pulses with the spindle's angle at their time, since the caller last cleared
+        it: (time s, cage pulse_index, cage strip, spindle angle rad); the series restarts
+        (:attr:`epoch` changes) when either shaft's counting does."""
+        self.epoch = 0
+        """Count of restarts of either shaft's counting (1)."""
         self.reset()
 
     def reset(self) -> None:
         """Forget every pulse and window (the books and the strips' spacing are kept)."""
         self._shafts = {name: _Shaft(name) for name in SHAFTS}
         self._pending: deque[tuple[float, float, int]] = deque()  # start, end, revolutions
+        self._phase_pending: deque[tuple[float, int, int]] = deque()  # cage pulses: time, index, strip
+        self.epoch = getattr(self, "epoch", 0) + 1
         self._suspect: set[str] = set()
         self.silent: dict[str, str] = {}
         """Shafts found silent at two consecutive checks, with the reason."""
@@ -345,6 +360,8 @@ class SlipWindows:
 
     def _restart_shaft(self, shaft: str) -> None:
         self._shafts[shaft] = _Shaft(shaft)
+        self._phase_pending.clear()
+        self.epoch += 1
         self.silent.pop(shaft, None)
         self._suspect.discard(shaft)
 
@@ -353,41 +370,51 @@ class SlipWindows:
         n = s.strip_count
         strip = (index + s.offset) % n
         s.recent.append((index, t))
-        if len(s.recent) > n + 1:
+        if len(s.recent) > 3 * n + 1:
             s.recent.popleft()
         if strip == 0 and n > 1:
             self._measure_spacing(s, n)
         s.times.append(t)
-        s.angles.append(index / n + self._spacing.get(strip, 0.0))
+        s.indices.append(index)
 
     def _measure_spacing(self, s: _Shaft, n: int) -> None:
-        """Update the strips' spacing errors from the revolution that ends at this strip-0 pulse.
+        """Update the strips' spacing errors from the three revolutions that end at this strip-0
+        pulse (module docstring).
 
-        Over one whole revolution with every pulse received, pulse m's time fraction of the
-        revolution minus its nominal fraction is e(strip m) - e(0); with the errors' mean taken
-        as zero (only differences matter), each strip's error follows.
+        The strip-0 passages at times T0..T3 are at angles 0..3 revolutions (strip 0's own error
+        is a common offset); on a constant speed or acceleration the angle is a parabola in
+        time, so the cubic through the four gives the angle of the middle revolution's pulses,
+        and pulse m's angle minus its nominal one is e(strip m) - e(0). With the errors' mean
+        taken as zero (only differences matter), each strip's error follows.
         """
-        first_index, first_time = s.recent[0]
-        last_index, last_time = s.recent[-1]
-        if len(s.recent) != n + 1 or last_index - first_index != n:
-            s.steady_period = None
+        recent = list(s.recent)
+        if len(recent) != 3 * n + 1 or recent[-1][0] - recent[0][0] != 3 * n:
             return
-        period = last_time - first_time
-        previous, s.steady_period = s.steady_period, period
-        if previous is None or abs(period - previous) > STEADY_PERIOD_CHANGE * previous:
+        first_index = recent[0][0]
+        t0, t1, t2, t3 = (recent[k * n][1] for k in range(4))
+        if not t0 < t1 < t2 < t3:
             return
-        d = [(time - first_time) / period - (index - first_index) / n for index, time in list(s.recent)[1:]]
+        # the parabola through the first three passages, at the fourth: 3 revolutions if the
+        # acceleration is constant
+        predicted = _lagrange((t0, t1, t2), (0.0, 1.0, 2.0), t3)
+        if not abs(predicted - 3.0) <= STEADY_ANGLE_TOLERANCE_REV:
+            return
+        middle = recent[n + 1 : 2 * n + 1]
+        d = [_lagrange((t0, t1, t2, t3), (0.0, 1.0, 2.0, 3.0), time) - (index - first_index) / n for index, time in middle]
         mean = sum(d) / n
         assert s.offset is not None
-        for (index, _), dm in zip(list(s.recent)[1:], d):
+        for (index, _), dm in zip(middle, d):
             strip = (index + s.offset) % n
             sample = dm - mean
             old = self._spacing.get(strip)
             self._spacing[strip] = sample if old is None else old + (sample - old) / SPACING_AVERAGE_REVOLUTIONS
 
     def _add_cage_pulse(self, cage: _Shaft, t: float, index: int) -> list[SlipWindow]:
-        assert cage.strip_count is not None
+        assert cage.strip_count is not None and cage.offset is not None
         n = cage.strip_count
+        self._phase_pending.append((t, index, (index + cage.offset) % n))
+        if len(self._phase_pending) > MAX_PENDING_WINDOWS:
+            self._phase_pending.popleft()
         span = self.window_revolutions * n
         if cage.window_start is None:
             cage.window_start, cage.window_grown = (index, t), False
@@ -412,13 +439,22 @@ class SlipWindows:
 
     # -- windows -------------------------------------------------------------------------------
     def _spindle_angle(self, spindle: _Shaft, t: float) -> float:
-        """Spindle revolutions at ``t`` (index units / strips, spacing-corrected), interpolated."""
-        k = bisect.bisect_right(spindle.times, t) - 1
-        if k >= len(spindle.times) - 1:
-            return spindle.angles[-1]
-        t0, t1 = spindle.times[k], spindle.times[k + 1]
-        a0, a1 = spindle.angles[k], spindle.angles[k + 1]
-        return a0 + (t - t0) / (t1 - t0) * (a1 - a0)
+        """Spindle revolutions at ``t`` (index units / strips, spacing-corrected), on the parabola
+        through the pulse before the bracket of ``t`` and the bracket's two (a line with only two
+        pulses; the last pulse's angle at or after it)."""
+        times = spindle.times
+        k = bisect.bisect_right(times, t) - 1
+        if k >= len(times) - 1:
+            return self._angle(spindle, len(times) - 1)
+        first = max(0, min(k - 1, len(times) - 3))
+        picks = range(first, min(first + 3, len(times)))
+        return _lagrange(tuple(times[j] for j in picks), tuple(self._angle(spindle, j) for j in picks), t)
+
+    def _angle(self, spindle: _Shaft, j: int) -> float:
+        """Angle of the spindle's kept pulse ``j``, revolutions, with its strip's spacing error."""
+        assert spindle.strip_count is not None and spindle.offset is not None
+        index = spindle.indices[j]
+        return index / spindle.strip_count + self._spacing.get((index + spindle.offset) % spindle.strip_count, 0.0)
 
     def _process_pending(self) -> list[SlipWindow]:
         spindle = self._shafts["spindle"]
@@ -431,20 +467,26 @@ class SlipWindows:
             inner = TWO_PI * (self._spindle_angle(spindle, t1) - self._spindle_angle(spindle, t0)) / duration
             cage = TWO_PI * revolutions / duration
             done.append(SlipWindow(t0, t1, cage, inner, revolutions))
+        while self._phase_pending and spindle.times and spindle.times[-1] >= self._phase_pending[0][0]:
+            t, index, strip = self._phase_pending.popleft()
+            if spindle.times[0] <= t:
+                self.phase.append((t, index, strip, TWO_PI * self._spindle_angle(spindle, t)))
         self._prune_spindle()
         return done
 
     def _prune_spindle(self) -> None:
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
         starts = [t0 for t0, _, _ in self._pending]
+        if self._phase_pending:
+            starts.append(self._phase_pending[0][0])
         if cage.window_start is not None:
             starts.append(cage.window_start[1])
         keep_from = min(starts) if starts else math.inf
-        k = bisect.bisect_right(spindle.times, keep_from) - 1
+        k = bisect.bisect_right(spindle.times, keep_from) - 2  # one more before: the parabola's
         k = min(k, len(spindle.times) - 1)
         if k > 0:
             del spindle.times[:k]
-            del spindle.angles[:k]
+            del spindle.indices[:k]
 
     # -- time-based checks ---------------------------------------------------------------------
     def check(self, now: float) -> None:
@@ -494,6 +536,18 @@ def unstamped(stamp: float, received: float) -> bool:
     """Whether a pulse stamped ``stamp`` (s) and received at ``received`` (s, the receiver's
     clock or the bag's log time) was not stamped, so that its reception time must stand in."""
     return stamp == 0.0 and received > UNSTAMPED_AFTER_S
+
+
+def _lagrange(xs: tuple[float, ...], ys: tuple[float, ...], x: float) -> float:
+    """The polynomial through the points (xs, ys) (distinct xs, 1 to 4 of them) at ``x``."""
+    total = 0.0
+    for i, (xi, yi) in enumerate(zip(xs, ys)):
+        weight = 1.0
+        for j, xj in enumerate(xs):
+            if j != i:
+                weight *= (x - xj) / (xi - xj)
+        total += weight * yi
+    return total
 
 
 def _malformed(pulse: Pulse) -> str:

@@ -15,7 +15,8 @@ Conventions (every kernel):
   reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)).
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
-* ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time).
+* ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time,
+  drive work: the drive torque x inner-ring speed x dt, J).
 
 Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
 direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
@@ -35,7 +36,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.traction import table_lookup, table_power
+from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_power, table_power
 
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
@@ -95,9 +96,11 @@ NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
 NR = 7
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
-NO = 10
+O_DRIVE = 10  # torque the drive applies to the inner ring against ball j's inner traction, N m
+NO = 11
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
-NS = 3
+S_DRIVE = 3  # drive work, J
+NS = 4
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
 
@@ -156,6 +159,18 @@ def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, 
         return mu, slope / ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
     return mu, dmu, 0.0
+
+
+@njit(cache=True)
+def contact_traction_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
+    """:func:`contact_traction` and :func:`contact_power` together (one table lookup): traction
+    coefficient, d mu/ds (s/m), Houpert rolling force (N) and dissipated power (W)."""
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        mu, slope, rolling, pw = table_lookup_power(p, int(p[P_TABLE]), contact, s / ue, ue, load)
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue
+    mu, dmu = traction_coefficient(p, s, entrainment)
+    return mu, dmu, 0.0, abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -513,10 +528,12 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
-    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll):
-    traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for
-    the implicit step), sliding velocities (m/s), the lever arms of :func:`ball_kinematics` and
-    the sum of the two contacts' Houpert rolling forces (N; model 2 only, else 0).
+    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
+    po, fri): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at
+    >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
+    :func:`ball_kinematics`, the sum of the two contacts' Houpert rolling forces (N; model 2
+    only, else 0), the two contacts' dissipated power (W, :func:`contact_power`) and the inner
+    contact's rolling force (N).
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
@@ -524,11 +541,11 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
     uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
-    mui, dmui, fri = contact_traction(p, 0, si, uei, qi)
-    muo, dmuo, fro = contact_traction(p, 1, so, ueo, qo)
+    mui, dmui, fri, pi = contact_traction_power(p, 0, si, uei, qi)
+    muo, dmuo, fro, po = contact_traction_power(p, 1, so, ueo, qo)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
-    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri
 
 
 @njit(cache=True)
@@ -554,12 +571,57 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 
 
 @njit(cache=True)
-def ball_power(p: np.ndarray, wm: float, rb: float, omega_i: float, qi: float, qo: float, si: float, so: float, r_ci: float, r_co: float, mres: float, omega_roll: float, fd: float) -> float:
-    """Power (W) dissipated at ball j: both raceway contacts (sliding, spin and Heathcote
-    losses), the rolling-resistance and pocket moments on its rolling, and its drag."""
-    pi = contact_power(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    po = contact_power(p, 1, so, abs(wm * r_co), qo)
-    return pi + po + abs(mres * omega_roll) + abs(fd * rb * wm)
+def contact_moments(
+    p: np.ndarray, omega_i: float, wa: float, omega_roll: float, fi: float, fo: float, si: float, so: float, pi: float, po: float, fri: float, di: float,
+) -> tuple[float, float, float]:
+    """The raceway contacts' moments besides their rolling-direction traction (docs/thermal.md,
+    Energy), from the contacts' tractions F (N), sliding velocities s (m/s), dissipated powers
+    P (W, :func:`contact_power`), the inner contact's Houpert rolling force (N, model 2) and
+    penetration (m):
+
+    * ``t_inner`` (N m, about the bearing axis, on the inner ring): the inner contact's loss
+      beyond traction x sliding (the rheology table's spin and Heathcote losses) taken from the
+      ring that turns through the contact: (P_i - F_i s_i) / omega_i. Under outer-raceway
+      control the spin at the inner contact is the ring's own rotation about the contact
+      normal, so the spin moment does its work on the ring;
+    * ``m_outer`` (N m, resisting the ball's rotation about its rolling axis): the outer
+      contact's loss beyond traction x sliding (Heathcote's differential slip; no spin there)
+      taken from the ball, the outer ring being fixed: (P_o - F_o s_o) / omega_a;
+    * ``m_ring`` (N m, about the ball's rolling axis): the inner contact's share of the rolling
+      resistance the ball feels (elastic hysteresis and Houpert's EHL rolling force, as in
+      :func:`spin_resistance`), whose reaction acts on the inner ring; its component along the
+      bearing axis, m_ring cos(beta), is part of the drive torque.
+
+    The first two are smoothed to zero below 1 rad/s of the speed they divide by. Models 0 and
+    1 have no loss beyond traction x sliding: (0, 0, m_ring)."""
+    r = p[P_RBALL]
+    dip = max(di, 0.0)
+    m_ring = p[P_HYST_IN] * dip * dip
+    t_inner = 0.0
+    m_outer = 0.0
+    if p[P_FRIC_MODEL] == 2.0:
+        m_ring += r * fri
+        wi2 = max(omega_i, SPIN_SIGN_SPEED)
+        t_inner = (pi - fi * si) * omega_i / (wi2 * wi2)
+        wa2 = max(abs(wa), SPIN_SIGN_SPEED)
+        m_outer = (po - fo * so) * wa / (wa2 * wa2)
+    elif p[P_FR_IN] > 0.0:
+        m_ring += r * (r * abs(omega_roll)) ** 0.66 * p[P_FR_IN] * (p[P_K_IN] * dip * math.sqrt(dip)) ** 0.47
+    return t_inner, m_outer, m_ring * smooth_sign(omega_roll)
+
+
+@njit(cache=True)
+def ball_power(
+    wm: float, wa: float, rb: float, omega_i: float, fi: float, fo: float, si: float, so: float, mres: float, fd: float, t_inner: float, m_ring: float, cb: float,
+) -> float:
+    """Power (W) dissipated at ball j, each term the work its force or moment takes from the
+    drive or the bodies in the equations of motion (so that drive work = heat + kinetic and
+    stored energy): traction x sliding at both contacts, the inner contact's spin and Heathcote
+    moment on the ring (t_inner omega_i), the moments resisting the ball's rotation (rolling
+    resistance, pocket friction and the outer contact's Heathcote moment, all in ``mres``) at
+    its spin omega_a plus the inner ring's share through its rotation (m_ring cos(beta)
+    omega_i), and the drag."""
+    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i + fd * rb * wm
 
 
 @njit(cache=True)
@@ -638,17 +700,21 @@ def step_reduced(
         it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        drive = 0.0
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            drive += fi * r_ci
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
             omega_roll = wa + cb * wm
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll)
+            t_inner, m_outer, m_ring = contact_moments(p, omega_i, wa, omega_roll, fi, fo, si, so, pi, po, fri, geo[j, G_DI])
+            drive += t_inner + m_ring * cb
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll) + m_outer
             kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
             gm = rb * (fi + fo - fd) - rm * fs
             ga = r * (ci * fi - co * fo) - mres
@@ -672,9 +738,12 @@ def step_reduced(
             work[j, w0 + 4] = e
             work[j, w0 + 5] = ku
             work[j, w0 + 6] = fs
+            work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
+            work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, cb)
+                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         diag = work[:, w0 + 7]
         rhs = work[:, w0 + 8]
         d_omega = work[:, w0 + 9]
@@ -694,17 +763,26 @@ def step_reduced(
         cage_sum = 0.0
         for j in range(z):
             coup = dt * work[j, w0 + 4] * d_omega[j]
-            ball[j, B_OMEGA] += work[j, w0 + 2] + work[j, w0 + 0] * coup
-            ball[j, B_SPIN] += work[j, w0 + 3] + work[j, w0 + 1] * coup
+            d_wm = work[j, w0 + 2] + work[j, w0 + 0] * coup
+            d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
+            ball[j, B_OMEGA] += d_wm
+            ball[j, B_SPIN] += d_wa
+            # the drive torque of the traction the step applied: Q mu at the start plus its
+            # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
+            d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
+            drive -= d_drive
+            if keep:
+                out[j, O_DRIVE] -= d_drive
             cage[j, C_OMEGA] += d_omega[j]
             ball[j, B_THETA] += dt * ball[j, B_OMEGA]
             cage[j, C_PHI] += dt * cage[j, C_OMEGA]
             cage_sum += cage[j, C_OMEGA]
+        stats[S_DRIVE] += drive * omega_i * dt
         finish_step(ring, stats, omega_i_old, omega_i, cage_sum / z, dt)
     return worst_iter
 
 
-NW = NG + 8 + 10
+NW = NG + 8 + 12
 """Columns of the reduced model's scratch array."""
 
 
@@ -745,17 +823,21 @@ def step_stiff(
         omega_i = omega_i_old + inner_acceleration * dt
         delta_a, vdelta = ring[R_DELTA], ring[R_VDELTA]
         ring_force = axial_load
+        drive = 0.0
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
             rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            drive += fi * r_ci
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
-            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
+            t_inner, m_outer, m_ring = contact_moments(p, omega_i, wa, wa + cb * wm, fi, fo, si, so, pi, po, fri, di)
+            drive += t_inner + m_ring * cb
+            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
             # momenta at the current positions (p_theta first: p_r's update needs it)
             ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
             wnew = ptheta / (m * rb * rb)
@@ -772,7 +854,9 @@ def step_stiff(
             torque[j] = rm * fs
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, cb)
+                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
+        stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)
             torque[k] += tau

@@ -572,56 +572,97 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
 
 @njit(cache=True)
 def contact_moments(
-    p: np.ndarray, omega_i: float, wa: float, omega_roll: float, fi: float, fo: float, si: float, so: float, pi: float, po: float, fri: float, di: float,
-) -> tuple[float, float, float]:
-    """The raceway contacts' moments besides their rolling-direction traction (docs/thermal.md,
+    p: np.ndarray,
+    omega_i: float,
+    wa: float,
+    omega_roll: float,
+    rb: float,
+    r_ci: float,
+    r_co: float,
+    fi: float,
+    fo: float,
+    si: float,
+    so: float,
+    pi: float,
+    po: float,
+    fri: float,
+    fro: float,
+    qi: float,
+    qo: float,
+    di: float,
+) -> tuple[float, float, float, float]:
+    """The raceway contacts' actions besides their rolling-direction traction (docs/thermal.md,
     Energy), from the contacts' tractions F (N), sliding velocities s (m/s), dissipated powers
-    P (W, :func:`contact_power`), the inner contact's Houpert rolling force (N, model 2) and
-    penetration (m):
+    P (W, :func:`contact_power`), Houpert rolling forces (N; model 2, from the table lookup),
+    loads (N) and the inner penetration (m). Returns (t_inner, m_outer, m_ring, t_orbit):
 
-    * ``t_inner`` (N m, about the bearing axis, on the inner ring): the inner contact's loss
-      beyond traction x sliding (the rheology table's spin and Heathcote losses) taken from the
-      ring that turns through the contact: (P_i - F_i s_i) / omega_i. Under outer-raceway
-      control the spin at the inner contact is the ring's own rotation about the contact
-      normal, so the spin moment does its work on the ring;
+    * ``t_inner`` (N m, about the bearing axis, resisting the inner ring): the inner contact's
+      loss beyond traction x sliding (the rheology table's spin and Heathcote losses), taken
+      from the ring that turns through the contact, (P_i - F_i s_i) / omega_i (under
+      outer-raceway control the spin there is the ring's own rotation about the contact
+      normal), plus the moment F_R,i r_ci of the EHL rolling force on the ring's surface;
     * ``m_outer`` (N m, resisting the ball's rotation about its rolling axis): the outer
       contact's loss beyond traction x sliding (Heathcote's differential slip; no spin there)
       taken from the ball, the outer ring being fixed: (P_o - F_o s_o) / omega_a;
-    * ``m_ring`` (N m, about the ball's rolling axis): the inner contact's share of the rolling
-      resistance the ball feels (elastic hysteresis and Houpert's EHL rolling force, as in
-      :func:`spin_resistance`), whose reaction acts on the inner ring; its component along the
-      bearing axis, m_ring cos(beta), is part of the drive torque.
+    * ``m_ring`` (N m, about the ball's rolling axis): the inner contact's elastic-hysteresis
+      moment (as in :func:`spin_resistance`), whose reaction acts on the inner ring; its
+      component along the bearing axis, m_ring cos(beta), is part of the drive torque;
+    * ``t_orbit`` (N m, on the ball's orbit): the EHL rolling forces of both contacts, which act
+      on each surface against its motion through the contact (the moment they make on the ball
+      is in :func:`spin_resistance` / the rolling force of the stepper), with the inlet
+      pressure's force through the ball centre, F_H = 2 F_R (2 R_x / D_w) = 2 F_R r_c / r_b,
+      forward at the inner contact and backward at the outer (Harris and Kotzalas, *Advanced
+      Concepts*, ch. 5, hydrodynamic rolling and pressure forces; Gupta's ADORE). A contact
+      then loses 2 F_R u_e in pure rolling, F_R u_e on each surface.
 
     The first two are smoothed to zero below 1 rad/s of the speed they divide by. Models 0 and
-    1 have no loss beyond traction x sliding: (0, 0, m_ring)."""
+    1 have no loss beyond traction x sliding; their Houpert force takes u_e = R |omega_roll|
+    as in :func:`spin_resistance`."""
     r = p[P_RBALL]
     dip = max(di, 0.0)
     m_ring = p[P_HYST_IN] * dip * dip
     t_inner = 0.0
     m_outer = 0.0
     if p[P_FRIC_MODEL] == 2.0:
-        m_ring += r * fri
         wi2 = max(omega_i, SPIN_SIGN_SPEED)
         t_inner = (pi - fi * si) * omega_i / (wi2 * wi2)
         wa2 = max(abs(wa), SPIN_SIGN_SPEED)
         m_outer = (po - fo * so) * wa / (wa2 * wa2)
-    elif p[P_FR_IN] > 0.0:
-        m_ring += r * (r * abs(omega_roll)) ** 0.66 * p[P_FR_IN] * (p[P_K_IN] * dip * math.sqrt(dip)) ** 0.47
-    return t_inner, m_outer, m_ring * smooth_sign(omega_roll)
+    elif p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0:
+        u066 = (r * abs(omega_roll)) ** 0.66
+        fri = p[P_FR_IN] * u066 * qi**0.47 if qi > 0.0 else 0.0
+        fro = p[P_FR_OUT] * u066 * qo**0.47 if qo > 0.0 else 0.0
+    sg = smooth_sign(omega_roll)
+    t_inner += fri * r_ci * sg
+    t_orbit = (fri * (2.0 * r_ci - rb) - fro * (2.0 * r_co - rb)) * sg
+    return t_inner, m_outer, m_ring * sg, t_orbit
 
 
 @njit(cache=True)
 def ball_power(
-    wm: float, wa: float, rb: float, omega_i: float, fi: float, fo: float, si: float, so: float, mres: float, fd: float, t_inner: float, m_ring: float, cb: float,
+    wm: float,
+    wa: float,
+    rb: float,
+    omega_i: float,
+    fi: float,
+    fo: float,
+    si: float,
+    so: float,
+    mres: float,
+    fd: float,
+    t_inner: float,
+    m_ring: float,
+    t_orbit: float,
+    cb: float,
 ) -> float:
     """Power (W) dissipated at ball j, each term the work its force or moment takes from the
     drive or the bodies in the equations of motion (so that drive work = heat + kinetic and
-    stored energy): traction x sliding at both contacts, the inner contact's spin and Heathcote
-    moment on the ring (t_inner omega_i), the moments resisting the ball's rotation (rolling
-    resistance, pocket friction and the outer contact's Heathcote moment, all in ``mres``) at
-    its spin omega_a plus the inner ring's share through its rotation (m_ring cos(beta)
-    omega_i), and the drag."""
-    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i + fd * rb * wm
+    stored energy; :func:`contact_moments`): traction x sliding at both contacts, the inner
+    contact's moments on the ring (t_inner omega_i), the moments resisting the ball's rotation
+    (rolling resistance, pocket friction, the outer contact's Heathcote moment: ``mres``) at its
+    spin omega_a plus the inner ring's share of the hysteresis through its rotation
+    (m_ring cos(beta) omega_i), the EHL forces on its orbit, and the drag."""
+    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm
 
 
 @njit(cache=True)
@@ -712,11 +753,13 @@ def step_reduced(
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
             omega_roll = wa + cb * wm
-            t_inner, m_outer, m_ring = contact_moments(p, omega_i, wa, omega_roll, fi, fo, si, so, pi, po, fri, geo[j, G_DI])
+            t_inner, m_outer, m_ring, t_orbit = contact_moments(
+                p, omega_i, wa, omega_roll, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
+            )
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll) + m_outer
             kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
-            gm = rb * (fi + fo - fd) - rm * fs
+            gm = rb * (fi + fo - fd) - rm * fs + t_orbit
             ga = r * (ci * fi - co * fo) - mres
             jmm = rb * (-kti * aim - kto * aom - dfd * rb)
             jma = rb * (-kti * aia + kto * aoa)
@@ -742,7 +785,7 @@ def step_reduced(
             work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, cb)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
                 out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         diag = work[:, w0 + 7]
         rhs = work[:, w0 + 8]
@@ -835,11 +878,13 @@ def step_stiff(
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
-            t_inner, m_outer, m_ring = contact_moments(p, omega_i, wa, wa + cb * wm, fi, fo, si, so, pi, po, fri, di)
+            t_inner, m_outer, m_ring, t_orbit = contact_moments(
+                p, omega_i, wa, wa + cb * wm, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, di
+            )
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
             # momenta at the current positions (p_theta first: p_r's update needs it)
-            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
+            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit)
             wnew = ptheta / (m * rb * rb)
             vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
             vz_new = vz + dt * (-qi * niz - qo * noz) / m
@@ -854,7 +899,7 @@ def step_stiff(
             torque[j] = rm * fs
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, cb)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
                 out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):

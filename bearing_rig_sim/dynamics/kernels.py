@@ -161,7 +161,7 @@ def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, 
     return mu, dmu, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_traction_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
     """:func:`contact_traction` and :func:`contact_power` together (one table lookup): traction
     coefficient, d mu/ds (s/m), Houpert rolling force (N) and dissipated power (W)."""
@@ -524,7 +524,7 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
     return p[P_MU_SLOPE_MAX] / max(entrainment, 1e-3)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
@@ -570,12 +570,13 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
     out[j, O_FP], out[j, O_SI], out[j, O_SO], out[j, O_FI], out[j, O_FO] = fs, si, so, fi, fo
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def contact_moments(
     p: np.ndarray,
-    omega_i: float,
+    inner_scale: float,
     wa: float,
     omega_roll: float,
+    sg: float,
     rb: float,
     r_ci: float,
     r_co: float,
@@ -594,7 +595,9 @@ def contact_moments(
     """The raceway contacts' actions besides their rolling-direction traction (docs/thermal.md,
     Energy), from the contacts' tractions F (N), sliding velocities s (m/s), dissipated powers
     P (W, :func:`contact_power`), Houpert rolling forces (N; model 2, from the table lookup),
-    loads (N) and the inner penetration (m). Returns (t_inner, m_outer, m_ring, t_orbit):
+    loads (N) and the inner penetration (m); ``inner_scale`` is :func:`inner_speed_scale` of the
+    inner ring's speed and ``sg`` :func:`smooth_sign` of the rolling speed omega_roll. Returns
+    (t_inner, m_outer, m_ring, t_orbit):
 
     * ``t_inner`` (N m, about the bearing axis, resisting the inner ring): the inner contact's
       loss beyond traction x sliding (the rheology table's spin and Heathcote losses), taken
@@ -624,18 +627,24 @@ def contact_moments(
     t_inner = 0.0
     m_outer = 0.0
     if p[P_FRIC_MODEL] == 2.0:
-        wi2 = max(omega_i, SPIN_SIGN_SPEED)
-        t_inner = (pi - fi * si) * omega_i / (wi2 * wi2)
+        t_inner = (pi - fi * si) * inner_scale
         wa2 = max(abs(wa), SPIN_SIGN_SPEED)
         m_outer = (po - fo * so) * wa / (wa2 * wa2)
     elif p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0:
         u066 = (r * abs(omega_roll)) ** 0.66
         fri = p[P_FR_IN] * u066 * qi**0.47 if qi > 0.0 else 0.0
         fro = p[P_FR_OUT] * u066 * qo**0.47 if qo > 0.0 else 0.0
-    sg = smooth_sign(omega_roll)
     t_inner += fri * r_ci * sg
     t_orbit = (fri * (2.0 * r_ci - rb) - fro * (2.0 * r_co - rb)) * sg
     return t_inner, m_outer, m_ring * sg, t_orbit
+
+
+@njit(cache=True)
+def inner_speed_scale(omega_i: float) -> float:
+    """1 / omega_i (s/rad) for :func:`contact_moments`, smoothed to omega_i / (1 rad/s)^2 below
+    1 rad/s (a loss divided by the speed it is drawn through, without a pole at rest)."""
+    w = max(omega_i, SPIN_SIGN_SPEED)
+    return omega_i / (w * w)
 
 
 @njit(cache=True)
@@ -742,6 +751,7 @@ def step_reduced(
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         drive = 0.0
+        inner_scale = inner_speed_scale(omega_i)
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
@@ -753,11 +763,12 @@ def step_reduced(
             rel = wm - cage[j, C_OMEGA]
             fs, ku, cu = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * rel)
             omega_roll = wa + cb * wm
+            sg = smooth_sign(omega_roll)
             t_inner, m_outer, m_ring, t_orbit = contact_moments(
-                p, omega_i, wa, omega_roll, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
+                p, inner_scale, wa, omega_roll, sg, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
             )
             drive += t_inner + m_ring * cb
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * smooth_sign(omega_roll) + m_outer
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sg + m_outer
             kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
             gm = rb * (fi + fo - fd) - rm * fs + t_orbit
             ga = r * (ci * fi - co * fo) - mres
@@ -879,7 +890,7 @@ def step_stiff(
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
             t_inner, m_outer, m_ring, t_orbit = contact_moments(
-                p, omega_i, wa, wa + cb * wm, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, di
+                p, inner_speed_scale(omega_i), wa, wa + cb * wm, smooth_sign(wa + cb * wm), rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, di
             )
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer

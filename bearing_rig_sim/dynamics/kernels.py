@@ -320,6 +320,14 @@ def solve_quasi_static(
             a12 = hirz + horz
             a22 = hizz + hozz
             det = a11 * a22 - a12 * a12
+            if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
+                # both contacts barely touching along parallel normals at rest (the ball on the
+                # line of the curvature centres, no centrifugal force): free across that line;
+                # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
+                eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
+                a11 -= eps
+                a22 -= eps
+                det = a11 * a22 - a12 * a12
             # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
             ux = (a22 * fr - a12 * fz) / det
             uz = (-a12 * fr + a11 * fz) / det

@@ -124,11 +124,14 @@ class Observation:
 @dataclass(frozen=True)
 class ChunkAverage:
     """Time averages over one :meth:`BearingDynamics.advance` call: cage and inner-ring
-    speed (rad/s) over ``duration`` (s)."""
+    speed (rad/s) over ``duration`` (s), and the work the drive did on the inner ring over it,
+    ``drive_work`` (J: the integral of :meth:`BearingDynamics.drive_torque` times the inner-ring
+    speed, step by step)."""
 
     duration: float
     cage_speed: float
     inner_ring_speed: float
+    drive_work: float = 0.0
 
 
 def _finite(name: str, value: float, lo: float | None = None) -> float:
@@ -333,7 +336,7 @@ class BearingDynamics:
         t = self.stats[kn.S_TIME]
         if t <= 0.0:
             return ChunkAverage(0.0, self.cage_speed, self.inner_ring_speed)
-        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t)
+        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t, float(self.stats[kn.S_DRIVE]))
 
     def check_state(self) -> None:
         """Raise if the state is one no bearing can be in (a numerical fault).
@@ -433,6 +436,14 @@ class BearingDynamics:
             tl, _ = kn.cage_land_torque(v, w, z, factor, normal)
             land += abs(tl * w)
         return float(np.sum(self.out[:, kn.O_POWER])) + land
+
+    def drive_torque(self) -> float:
+        """Torque the drive applies to the inner ring at the last step, N m: the moment about the
+        axis of the balls' traction forces at the inner contacts, sum of Q_i mu_i r_ci (the
+        ring's own inertia aside: its rotation is prescribed). At steady state it equals
+        :meth:`friction_torque`; while the balls and cage speed up it also carries their
+        acceleration."""
+        return float(np.sum(self.out[:, kn.O_DRIVE]))
 
     def friction_torque(self) -> float:
         """Bearing friction torque on the inner ring, N m (power loss over inner-ring speed)."""

@@ -18,7 +18,8 @@ Conventions (every kernel):
   the last step.
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
-* ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time).
+* ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time,
+  drive work: the drive torque x inner-ring speed x dt, J).
 
 Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
 direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
@@ -38,7 +39,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.traction import table_lookup, table_power
+from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_power, table_power
 
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
@@ -109,9 +110,11 @@ R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
 R_CX, R_CY, R_CVX, R_CVY, R_LAND_N, R_LAND_F = 7, 8, 9, 10, 11, 12
 NR = 13
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
-NO = 10
+O_DRIVE = 10  # torque the drive applies to the inner ring against ball j's inner traction, N m
+NO = 11
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
-NS = 3
+S_DRIVE = 3  # drive work, J
+NS = 4
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
 
@@ -170,6 +173,18 @@ def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, 
         return mu, slope / ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
     return mu, dmu, 0.0
+
+
+@njit(cache=True, inline="always")
+def contact_traction_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
+    """:func:`contact_traction` and :func:`contact_power` together (one table lookup): traction
+    coefficient, d mu/ds (s/m), Houpert rolling force (N) and dissipated power (W)."""
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        mu, slope, rolling, pw = table_lookup_power(p, int(p[P_TABLE]), contact, s / ue, ue, load)
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue
+    mu, dmu = traction_coefficient(p, s, entrainment)
+    return mu, dmu, 0.0, abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -319,6 +334,14 @@ def solve_quasi_static(
             a12 = hirz + horz
             a22 = hizz + hozz
             det = a11 * a22 - a12 * a12
+            if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
+                # both contacts barely touching along parallel normals at rest (the ball on the
+                # line of the curvature centres, no centrifugal force): free across that line;
+                # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
+                eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
+                a11 -= eps
+                a22 -= eps
+                det = a11 * a22 - a12 * a12
             # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
             ux = (a22 * fr - a12 * fz) / det
             uz = (-a12 * fr + a11 * fz) / det
@@ -674,14 +697,16 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
     return p[P_MU_SLOPE_MAX] / max(entrainment, 1e-3)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
-    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll):
-    traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at >= 0 for
-    the implicit step), sliding velocities (m/s), the lever arms of :func:`ball_kinematics` and
-    the sum of the two contacts' Houpert rolling forces (N; model 2 only, else 0).
+    Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
+    po, fri): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at
+    >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
+    :func:`ball_kinematics`, the sum of the two contacts' Houpert rolling forces (N; model 2
+    only, else 0), the two contacts' dissipated power (W, :func:`contact_power`) and the inner
+    contact's rolling force (N).
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
@@ -689,11 +714,11 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
     uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
-    mui, dmui, fri = contact_traction(p, 0, si, uei, qi)
-    muo, dmuo, fro = contact_traction(p, 1, so, ueo, qo)
+    mui, dmui, fri, pi = contact_traction_power(p, 0, si, uei, qi)
+    muo, dmuo, fro, po = contact_traction_power(p, 1, so, ueo, qo)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
-    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri
 
 
 @njit(cache=True)
@@ -719,13 +744,108 @@ def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float
     out[j, O_FP], out[j, O_SI], out[j, O_SO], out[j, O_FI], out[j, O_FO] = fs, si, so, fi, fo
 
 
+@njit(cache=True, inline="always")
+def contact_moments(
+    p: np.ndarray,
+    inner_scale: float,
+    wa: float,
+    omega_roll: float,
+    sg: float,
+    rb: float,
+    r_ci: float,
+    r_co: float,
+    fi: float,
+    fo: float,
+    si: float,
+    so: float,
+    pi: float,
+    po: float,
+    fri: float,
+    fro: float,
+    qi: float,
+    qo: float,
+    di: float,
+) -> tuple[float, float, float, float]:
+    """The raceway contacts' actions besides their rolling-direction traction (docs/thermal.md,
+    Energy), from the contacts' tractions F (N), sliding velocities s (m/s), dissipated powers
+    P (W, :func:`contact_power`), Houpert rolling forces (N; model 2, from the table lookup),
+    loads (N) and the inner penetration (m); ``inner_scale`` is :func:`inner_speed_scale` of the
+    inner ring's speed and ``sg`` :func:`smooth_sign` of the rolling speed omega_roll. Returns
+    (t_inner, m_outer, m_ring, t_orbit):
+
+    * ``t_inner`` (N m, about the bearing axis, resisting the inner ring): the inner contact's
+      loss beyond traction x sliding (the rheology table's spin and Heathcote losses), taken
+      from the ring that turns through the contact, (P_i - F_i s_i) / omega_i (under
+      outer-raceway control the spin there is the ring's own rotation about the contact
+      normal), plus the moment F_R,i r_ci of the EHL rolling force on the ring's surface;
+    * ``m_outer`` (N m, resisting the ball's rotation about its rolling axis): the outer
+      contact's loss beyond traction x sliding (Heathcote's differential slip; no spin there)
+      taken from the ball, the outer ring being fixed: (P_o - F_o s_o) / omega_a;
+    * ``m_ring`` (N m, about the ball's rolling axis): the inner contact's elastic-hysteresis
+      moment (as in :func:`spin_resistance`), whose reaction acts on the inner ring; its
+      component along the bearing axis, m_ring cos(beta), is part of the drive torque;
+    * ``t_orbit`` (N m, on the ball's orbit): the EHL rolling forces of both contacts, which act
+      on each surface against its motion through the contact (the moment they make on the ball
+      is in :func:`spin_resistance` / the rolling force of the stepper), with the inlet
+      pressure's force through the ball centre, F_H = 2 F_R (2 R_x / D_w) = 2 F_R r_c / r_b,
+      forward at the inner contact and backward at the outer (Harris and Kotzalas, *Advanced
+      Concepts*, ch. 5, hydrodynamic rolling and pressure forces; Gupta's ADORE). A contact
+      then loses 2 F_R u_e in pure rolling, F_R u_e on each surface.
+
+    The first two are smoothed to zero below 1 rad/s of the speed they divide by. Models 0 and
+    1 have no loss beyond traction x sliding; their Houpert force takes u_e = R |omega_roll|
+    as in :func:`spin_resistance`."""
+    r = p[P_RBALL]
+    dip = max(di, 0.0)
+    m_ring = p[P_HYST_IN] * dip * dip
+    t_inner = 0.0
+    m_outer = 0.0
+    if p[P_FRIC_MODEL] == 2.0:
+        t_inner = (pi - fi * si) * inner_scale
+        wa2 = max(abs(wa), SPIN_SIGN_SPEED)
+        m_outer = (po - fo * so) * wa / (wa2 * wa2)
+    elif p[P_FR_IN] > 0.0 or p[P_FR_OUT] > 0.0:
+        u066 = (r * abs(omega_roll)) ** 0.66
+        fri = p[P_FR_IN] * u066 * qi**0.47 if qi > 0.0 else 0.0
+        fro = p[P_FR_OUT] * u066 * qo**0.47 if qo > 0.0 else 0.0
+    t_inner += fri * r_ci * sg
+    t_orbit = (fri * (2.0 * r_ci - rb) - fro * (2.0 * r_co - rb)) * sg
+    return t_inner, m_outer, m_ring * sg, t_orbit
+
+
 @njit(cache=True)
-def ball_power(p: np.ndarray, wm: float, rb: float, omega_i: float, qi: float, qo: float, si: float, so: float, r_ci: float, r_co: float, mres: float, omega_roll: float, fd: float) -> float:
-    """Power (W) dissipated at ball j: both raceway contacts (sliding, spin and Heathcote
-    losses), the rolling-resistance and pocket moments on its rolling, and its drag."""
-    pi = contact_power(p, 0, si, abs((omega_i - wm) * r_ci), qi)
-    po = contact_power(p, 1, so, abs(wm * r_co), qo)
-    return pi + po + abs(mres * omega_roll) + abs(fd * rb * wm)
+def inner_speed_scale(omega_i: float) -> float:
+    """1 / omega_i (s/rad) for :func:`contact_moments`, smoothed to omega_i / (1 rad/s)^2 below
+    1 rad/s (a loss divided by the speed it is drawn through, without a pole at rest)."""
+    w = max(omega_i, SPIN_SIGN_SPEED)
+    return omega_i / (w * w)
+
+
+@njit(cache=True)
+def ball_power(
+    wm: float,
+    wa: float,
+    rb: float,
+    omega_i: float,
+    fi: float,
+    fo: float,
+    si: float,
+    so: float,
+    mres: float,
+    fd: float,
+    t_inner: float,
+    m_ring: float,
+    t_orbit: float,
+    cb: float,
+) -> float:
+    """Power (W) dissipated at ball j, each term the work its force or moment takes from the
+    drive or the bodies in the equations of motion (so that drive work = heat + kinetic and
+    stored energy; :func:`contact_moments`): traction x sliding at both contacts, the inner
+    contact's moments on the ring (t_inner omega_i), the moments resisting the ball's rotation
+    (rolling resistance, pocket friction, the outer contact's Heathcote moment: ``mres``) at its
+    spin omega_a plus the inner ring's share of the hysteresis through its rotation
+    (m_ring cos(beta) omega_i), the EHL forces on its orbit, and the drag."""
+    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm
 
 
 @njit(cache=True)
@@ -880,10 +1000,13 @@ def step_reduced(
         m22 = mc - dt * (dt * kyy + cyy)
         rcx = fcx + dt * (kxx * cvx + kxy * cvy)
         rcy = fcy + dt * (kyx * cvx + kyy * cvy)
+        drive = 0.0
+        inner_scale = inner_speed_scale(omega_i)
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            drive += fi * r_ci
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
@@ -893,10 +1016,15 @@ def step_reduced(
             rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
             fs, ku, cu = pocket_force(p, gap, rate)
             omega_roll = wa + cb * wm
-            sroll = smooth_sign(omega_roll)
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sroll
+            sg = smooth_sign(omega_roll)
+            sroll = sg
+            t_inner, m_outer, m_ring, t_orbit = contact_moments(
+                p, inner_scale, wa, omega_roll, sg, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
+            )
+            drive += t_inner + m_ring * cb
+            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sg + m_outer
             kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
-            gm = rb * (fi + fo - fd) - rm * fs
+            gm = rb * (fi + fo - fd) - rm * fs + t_orbit
             ga = r * (ci * fi - co * fo) - mres
             jmm = rb * (-kti * aim - kto * aom - dfd * rb)
             jma = rb * (-kti * aia + kto * aoa)
@@ -938,9 +1066,12 @@ def step_reduced(
                 fp = fs + dt * ku * rate + ee * rm * x2
                 rcx += nx * fp
                 rcy += ny * fp
+            work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
+            work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         diag = work[:, w0 + 7]
         rhs = work[:, w0 + 8]
         d_omega = work[:, w0 + 9]
@@ -985,12 +1116,21 @@ def step_reduced(
         for j in range(z):
             # the pocket's closing speed seen by the ball: r_m d Omega + t . d v (over r_m)
             coup = dt * work[j, w0 + 4] * (d_omega[j] + (work[j, w0 + 20] * dvx + work[j, w0 + 21] * dvy) / rm)
-            ball[j, B_OMEGA] += work[j, w0 + 2] + work[j, w0 + 0] * coup
-            ball[j, B_SPIN] += work[j, w0 + 3] + work[j, w0 + 1] * coup
+            d_wm = work[j, w0 + 2] + work[j, w0 + 0] * coup
+            d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
+            ball[j, B_OMEGA] += d_wm
+            ball[j, B_SPIN] += d_wa
+            # the drive torque of the traction the step applied: Q mu at the start plus its
+            # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
+            d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
+            drive -= d_drive
+            if keep:
+                out[j, O_DRIVE] -= d_drive
             cage[j, C_OMEGA] += d_omega[j]
             ball[j, B_THETA] += dt * ball[j, B_OMEGA]
             cage[j, C_PHI] += dt * cage[j, C_OMEGA]
             cage_sum += cage[j, C_OMEGA]
+        stats[S_DRIVE] += drive * omega_i * dt
         finish_step(ring, stats, omega_i_old, omega_i, cage_sum / z, dt)
     return worst_iter
 
@@ -1036,19 +1176,25 @@ def step_stiff(
         omega_i = omega_i_old + inner_acceleration * dt
         delta_a, vdelta = ring[R_DELTA], ring[R_VDELTA]
         ring_force = axial_load
+        drive = 0.0
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
             rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            drive += fi * r_ci
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
-            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm)
+            t_inner, m_outer, m_ring, t_orbit = contact_moments(
+                p, inner_speed_scale(omega_i), wa, wa + cb * wm, smooth_sign(wa + cb * wm), rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, di
+            )
+            drive += t_inner + m_ring * cb
+            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
             # momenta at the current positions (p_theta first: p_r's update needs it)
-            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs)
+            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit)
             wnew = ptheta / (m * rb * rb)
             vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
             vz_new = vz + dt * (-qi * niz - qo * noz) / m
@@ -1063,7 +1209,9 @@ def step_stiff(
             torque[j] = rm * fs
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(p, wm, rb, omega_i, qi, qo, si, so, r_ci, aom + r * co * cb, mres, wa + cb * wm, fd)
+                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
+        stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)
             torque[k] += tau

@@ -43,7 +43,7 @@ from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
-from bearing_rig_sim.dynamics.traction import HEADER, SRR_REF, ContactKinematics, build_table
+from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
 
 GRAVITY = 9.80665
 """Standard gravity, m/s^2 (CGPM 1901)."""
@@ -553,8 +553,8 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
         table = traction_table(p)
         v = np.concatenate([v, table])
         # steepest d mu/d SRR of the table: its slope in xi = asinh(SRR/SRR_REF) over SRR_REF
-        n_srr, n_u, n_q, xi_max = int(table[0]), int(table[1]), int(table[2]), table[3]
-        mu = table[HEADER : HEADER + 2 * n_srr * n_u * n_q].reshape(-1, n_srr)
+        n_srr, xi_max = int(table[0]), table[3]
+        mu = mu_nodes(table, 0)
         v[kn.P_MU_SLOPE_MAX] = float(np.max(np.abs(np.diff(mu, axis=1)))) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
     elif v[kn.P_FRIC_MODEL] == 1.0:
         v[kn.P_MU_SLOPE_MAX] = v[kn.P_EHL_MU] / v[kn.P_EHL_SRR]  # d mu/d SRR at SRR = 0

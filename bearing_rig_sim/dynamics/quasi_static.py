@@ -56,10 +56,38 @@ from scipy.optimize import root
 from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.thermal.materials import BEARING_STEEL
 
 
 class LoadDistributionError(RigError):
     """The quasi-static equilibrium could not be found (or a bad input)."""
+
+
+def thermal_clearance_change(params: BearingParameters, inner_ring_c: float, outer_ring_c: float, balls_c: float, reference_c: float, expansion: float | None = None) -> float:
+    """Change of the diametral clearance P_d (m) when the rings and balls leave the temperature
+    ``reference_c`` at which the clearance was set (degC each; add it to
+    :attr:`LoadCase.clearance`): each free body grows by alpha dT times its diameter (Harris and
+    Kotzalas, *Essential Concepts*, thermal expansion and clearance), so
+
+        dP_d = alpha [(d_m + D_w) dT_outer - (d_m - D_w) dT_inner - 2 D_w dT_balls],
+
+    the outer raceway's diameter growing the clearance, the inner raceway's and the two balls'
+    diameters across it taking it up. A spindle's inner ring, warmer than its outer, loses
+    clearance (or gains preload). The fits (shaft and housing expanding with their rings) are
+    not in it.
+
+    Args:
+        expansion: linear expansion coefficient, 1/K (default: bearing steel,
+            :data:`bearing_rig_sim.thermal.materials.BEARING_STEEL`; the same for rings and balls).
+    """
+    alpha = BEARING_STEEL.expansion if expansion is None else float(expansion)
+    for name, value in (("inner_ring_c", inner_ring_c), ("outer_ring_c", outer_ring_c), ("balls_c", balls_c), ("reference_c", reference_c)):
+        if not math.isfinite(value) or not -60.0 <= value <= 400.0:
+            raise LoadDistributionError(f"{name} must be a temperature within -60..400 degC, got {value!r}")
+    if not 0.0 <= alpha <= 3e-5:
+        raise LoadDistributionError(f"expansion must be within 0..3e-5 1/K, got {expansion!r}")
+    dm, dw = params.pitch_diameter, params.ball_diameter
+    return alpha * ((dm + dw) * (outer_ring_c - reference_c) - (dm - dw) * (inner_ring_c - reference_c) - 2.0 * dw * (balls_c - reference_c))
 
 
 @dataclass(frozen=True)

@@ -49,7 +49,7 @@ import numpy as np
 
 from bearing_rig_sim.config import config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.traction import HEADER
+from bearing_rig_sim.dynamics.traction import mu_nodes
 from bearing_rig_sim.errors import RigError
 
 STIFF_SAFETY = 0.5
@@ -136,10 +136,7 @@ def traction_bound(p: np.ndarray) -> float:
     mu_max, or the stepped Coulomb law's larger of mu_s and mu_d."""
     model = p[kn.P_FRIC_MODEL]
     if model == 2.0:
-        base = int(p[kn.P_TABLE])
-        size = int(p[base]) * int(p[base + 1]) * int(p[base + 2])
-        start = base + HEADER
-        return float(np.max(np.abs(p[start : start + 2 * size])))
+        return float(np.max(np.abs(mu_nodes(p, int(p[kn.P_TABLE])))))
     if model == 1.0:
         return float(abs(p[kn.P_EHL_MU]))
     return float(max(abs(p[kn.P_MU_S]), abs(p[kn.P_MU_D])))

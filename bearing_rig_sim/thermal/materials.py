@@ -11,20 +11,24 @@ from dataclasses import dataclass
 
 @dataclass(frozen=True)
 class ThermalMaterial:
-    """Specific heat c (J/(kg K)) and thermal conductivity k (W/(m K)) of a solid, with source."""
+    """Specific heat c (J/(kg K)), thermal conductivity k (W/(m K)) and linear thermal expansion
+    coefficient alpha (1/K; 0 where not needed) of a solid, with source."""
 
     name: str
     specific_heat: float
     conductivity: float
     source: str
+    expansion: float = 0.0
 
 
 BEARING_STEEL = ThermalMaterial(
     "AISI 52100 / GCr15 through-hardened bearing steel",
     475.0,
     46.6,
-    "ASM Handbook vol. 1 (properties of AISI 52100; c 475 J/(kg K), k 46.6 W/(m K) at 20-100 degC); "
-    "Harris and Kotzalas, Essential Concepts, table of bearing steel properties (k 40-47 W/(m K))",
+    "ASM Handbook vol. 1 (properties of AISI 52100; c 475 J/(kg K), k 46.6 W/(m K) at 20-100 degC, "
+    "alpha 11.9e-6 1/K at 20-100 degC); Harris and Kotzalas, Essential Concepts, table of bearing "
+    "steel properties (k 40-47 W/(m K)); bearing makers quote alpha 11-12.5e-6 1/K",
+    11.9e-6,
 )
 POLYIMIDE = ThermalMaterial(
     "polyimide (cage)",

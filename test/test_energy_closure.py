@@ -1,0 +1,101 @@
+"""Energy closes (issue 24): the work the drive does on the inner ring equals the heat the
+engine hands to the thermal network plus the change of the bodies' mechanical energy.
+
+The drive torque (BearingDynamics.drive_torque, per step in the kernel) comes from the contact
+forces and moments on the inner ring; the heat from the engine's dissipation, term by term,
+through the thermal coupling; the mechanical energy from the state (kinetic energy of balls and
+cage, Hertz and rim strain energy, the axial load's potential). Three independent accounts of
+one law, for both shipped lubricants.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.engine import BearingDynamics
+from bearing_rig_sim.dynamics.lubrication import Lubricant
+from bearing_rig_sim.thermal.bearing import ThermalConfig
+from bearing_rig_sim.thermal.coupling import ThermalCoupling
+
+CONFIG = Path(__file__).resolve().parents[1] / "config"
+BEARING = CONFIG / "bearings" / "h7006c.yaml"
+CHUNK_S = 1e-3
+"""Chunk and thermal interval, s: the network takes the engine's heat after every chunk."""
+
+
+def grease_twin() -> BearingParameters:
+    """The shipped bench twin: H7006C with the calibrated running-in grease."""
+    return BearingParameters.from_yaml(BEARING, CONFIG / "calibration" / "h7006c_table3.yaml")
+
+
+def oil_air_twin() -> BearingParameters:
+    """H7006C with the shipped VG32 oil-air lubricant at the bearing file's temperature."""
+    bearing = BearingParameters.from_yaml(BEARING)
+    lub = Lubricant.from_yaml(CONFIG / "lubricants" / "vg32_oil_air.yaml")
+    t = bearing.lubricant_temperature
+    return bearing.replace(lubricant=lub, oil_viscosity=lub.dynamic_viscosity(t), oil_density=lub.density(t), oil_volume_fraction=lub.oil_volume_fraction)
+
+
+def run_up_and_hold(params: BearingParameters, rpm: float, load: float, acceleration: float, hold: float) -> tuple[float, float, float, BearingDynamics]:
+    """From rest under ``load`` (N), up to ``rpm`` at ``acceleration`` (rad/s^2), then ``hold``
+    seconds; returns (drive work, heat into the network, mechanical energy change) in J and the
+    engine."""
+    engine = BearingDynamics(params)
+    engine.initialise(0.0, load)
+    coupling = ThermalCoupling(engine, ThermalConfig.from_yaml(BEARING), interval=CHUNK_S)
+    e0 = engine.energy()
+    work = 0.0
+    target = rpm_to_rad_s(rpm)
+    n_up = int(round(target / acceleration / CHUNK_S))
+    for k in range(n_up + int(round(hold / CHUNK_S))):
+        accel = acceleration if k < n_up else 0.0
+        if k == n_up - 1:
+            accel = (target - engine.inner_ring_speed) / CHUNK_S  # land on the speed exactly
+        work += engine.advance(CHUNK_S, inner_ring_acceleration=accel).drive_work
+        assert coupling.advance(CHUNK_S)
+    assert engine.inner_ring_speed == pytest.approx(target, rel=1e-9)
+    return work, coupling.network.heat_in, engine.energy() - e0, engine
+
+
+@pytest.mark.parametrize("twin", [grease_twin, oil_air_twin], ids=["grease", "oil_air"])
+@pytest.mark.parametrize(("rpm", "load"), [(900.0, 100.0), (2700.0, 700.0)])
+def test_drive_work_is_heat_plus_mechanical_energy(twin: object, rpm: float, load: float) -> None:
+    """Run-up from rest at 500 rad/s^2 and a 0.5 s hold: drive work = heat + energy change within
+    1 %; the drive did work (the balls and cage gained energy and the network was heated)."""
+    assert callable(twin)
+    work, heat, gained, engine = run_up_and_hold(twin(), rpm, load, 500.0, 0.5)
+    assert work > 0.0 and heat > 0.0 and gained > 0.0
+    assert heat + gained == pytest.approx(work, rel=0.01), (work, heat, gained)
+    # at the hold the drive torque carries the whole friction torque
+    assert engine.drive_torque() == pytest.approx(engine.friction_torque(), rel=0.01)
+
+
+def test_reduced_model_conserves_energy_with_every_resistance_off() -> None:
+    """Issue 23, reduced model: friction, damping, drag, land and rolling resistance off, the cage
+    segments set out of step (rim and pocket vibrations). The balls and cage keep their energy to
+    rounding; only the vibration the perturbation injected may be lost (the linearly implicit
+    step is A-stable, so it damps a vibration it does not resolve but never creates energy), and
+    the drive does no work (nothing couples the balls to the inner ring)."""
+    params = grease_twin().conservative()
+    engine = BearingDynamics(params, model="reduced")
+    engine.initialise(rpm_to_rad_s(900.0), 100.0)
+    engine.cage[::2, 1] *= 1.001
+    speeds = engine.cage[:, 1]
+    vibration = 0.5 * engine.vector[kn.P_JSEG] * float(np.sum((speeds - speeds.mean()) ** 2))
+    e0 = engine.energy()
+    energies = [e0]
+    work = 0.0
+    for _ in range(100):
+        work += engine.advance(CHUNK_S).drive_work
+        energies.append(engine.energy())
+    steps = np.diff(energies)
+    assert vibration > 0.0 and work == 0.0
+    assert float(np.max(steps)) <= 1e-14 * e0  # never rises beyond rounding
+    assert 0.0 <= e0 - energies[-1] <= vibration + 1e-12 * e0
+    assert float(np.ptp(energies[50:])) <= 1e-14 * e0  # and is constant once the vibration is gone

@@ -13,7 +13,8 @@ A settings class derives from :class:`NodeSettings` and declares each parameter 
 
 * :data:`Number`, :data:`Integer` and :data:`Flag` are the YAML value kinds (a number is finite
   and never a boolean; YAML 1.1's unsigned exponents such as ``2.0e9``, which PyYAML reads as
-  strings, are numbers);
+  strings, are numbers); :data:`ConfigFile` and :data:`OptionalConfigFile` are files that must
+  exist (absolute, or relative to ``config/``); :func:`one_of` restricts a text to a few words;
 * :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``) and
   whether the parameter may change while the node runs;
 * :meth:`NodeSettings.from_section` (and ``from_values``, ``from_yaml``) validates a mapping and
@@ -28,7 +29,7 @@ No ROS import.
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Self
@@ -39,7 +40,19 @@ from pydantic_core import ErrorDetails
 
 from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
 
-__all__ = ["Flag", "Integer", "NodeSettings", "Number", "ParameterField", "param"]
+__all__ = [
+    "ConfigFile",
+    "Flag",
+    "Integer",
+    "NodeSettings",
+    "Number",
+    "OptionalConfigFile",
+    "ParameterField",
+    "existing_config_file",
+    "one_of",
+    "param",
+    "resolve_config_file",
+]
 
 
 def _number(value: object) -> float:
@@ -75,6 +88,53 @@ Integer = Annotated[int, BeforeValidator(_integer)]
 
 Flag = Annotated[bool, BeforeValidator(_flag)]
 """A YAML boolean (``true`` or ``false``, nothing that merely converts to one)."""
+
+
+def resolve_config_file(value: str) -> Path | None:
+    """A file parameter as a path: None for ``""``, as given if absolute, else under ``config/``."""
+    if not value:
+        return None
+    path = Path(value)
+    return path if path.is_absolute() else config_path(*path.parts)
+
+
+def existing_config_file(raw: object, *, empty_ok: bool = False) -> Path | None:
+    """A file parameter that must exist (absolute or under ``config/``); ``""`` is None where
+    ``empty_ok``. Raises ValueError with the problem (a settings validator's error)."""
+    if not isinstance(raw, str) or (not raw and not empty_ok):
+        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
+    path = resolve_config_file(raw)
+    if path is not None and not path.is_file():
+        raise ValueError(f"file not found: {raw!r} (looked for {path})")
+    return path
+
+
+def _required_file(raw: object) -> Path | None:
+    return existing_config_file(raw)
+
+
+def _optional_file(raw: object) -> Path | None:
+    return existing_config_file(raw, empty_ok=True)
+
+
+ConfigFile = Annotated[Path, BeforeValidator(_required_file)]
+"""A file that exists, named absolute or relative to ``config/`` (never ``""``)."""
+
+OptionalConfigFile = Annotated[Path | None, BeforeValidator(_optional_file)]
+"""As :data:`ConfigFile`, or ``""`` for none (None)."""
+
+
+def one_of(allowed: Sequence[str]) -> BeforeValidator:
+    """The check of a text field that takes one of a few words:
+    ``model: Annotated[str, one_of(MODELS)] = param(...)``."""
+    words = tuple(allowed)
+
+    def check(raw: object) -> str:
+        if raw not in words:
+            raise ValueError(f"must be one of {', '.join(words)}, got {raw!r}")
+        return str(raw)
+
+    return BeforeValidator(check)
 
 
 def param(
@@ -201,6 +261,11 @@ class NodeSettings(BaseModel):
         section = ros_parameters(load_yaml(config_path(cls.SHIPPED_FILE)), cls.NODE_NAME)
         cls.from_section(section)  # the defaults themselves must be valid
         return dict(section.data)
+
+    def replace(self, **changes: Any) -> Self:
+        """A copy with some values changed, not validated again (for tests and for a value the
+        caller has checked, such as a criterion read from a recording)."""
+        return self.model_copy(update=changes)
 
     @classmethod
     def parameter_fields(cls) -> list[ParameterField]:

@@ -4,13 +4,13 @@ one-line errors (file, key, range) and what the node declares to ROS."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar
+from typing import Annotated, ClassVar
 
 import pytest
 
-from bearing_rig_sim.config import ConfigError, Section
+from bearing_rig_sim.config import ConfigError, Section, config_path
 from bearing_rig_sim.load_control.settings import LoadControllerSettings
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param
 
 
 class Toy(NodeSettings):
@@ -121,3 +121,28 @@ def test_shadow_settings_bounds_that_depend_on_another_value() -> None:
         ShadowSettings.from_values({**shipped, "calibration_file": "", "calibration_rms_slip_pct": -1.0})
     with pytest.raises(ConfigError, match="model: must be one of reduced, stiff, got 'fast'"):
         ShadowSettings.from_values({**shipped, "model": "fast"})
+
+
+class Files(NodeSettings):
+    NODE_NAME: ClassVar[str] = "files"
+    SHIPPED_FILE: ClassVar[str] = "files.yaml"
+
+    data_file: ConfigFile = param("a file that must exist")
+    extra_file: OptionalConfigFile = param("a file that may be ''")
+    mode: Annotated[str, one_of(("fast", "slow"))] = param("a word")
+
+
+def test_file_and_word_checks_are_shared(tmp_path: Path) -> None:
+    """One file check and one word check for every settings class: a relative name is under
+    config/, '' is None only where allowed, a missing file names where it was looked for."""
+    good = Files.from_values({"data_file": "rig.yaml", "extra_file": "", "mode": "slow"})
+    assert good.data_file == config_path("rig.yaml") and good.extra_file is None
+    absolute = tmp_path / "x.yaml"
+    absolute.write_text("{}\n")
+    assert Files.from_values({"data_file": str(absolute), "extra_file": str(absolute), "mode": "fast"}).extra_file == absolute
+    with pytest.raises(ConfigError, match=r"files parameters: data_file: must be a file name .*got ''"):
+        Files.from_values({"data_file": "", "extra_file": "", "mode": "fast"})
+    with pytest.raises(ConfigError, match=r"extra_file: file not found: 'nope.yaml' \(looked for .*config/nope.yaml\)"):
+        Files.from_values({"data_file": "rig.yaml", "extra_file": "nope.yaml", "mode": "fast"})
+    with pytest.raises(ConfigError, match=r"mode: must be one of fast, slow, got 'quick'"):
+        Files.from_values({"data_file": "rig.yaml", "extra_file": "", "mode": "quick"})

@@ -4,24 +4,20 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Annotated, ClassVar
 
 from pydantic import ValidationInfo, field_validator
 
 from bearing_rig_sim.config import load_yaml
 from bearing_rig_sim.interfaces import DIAGNOSTICS
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
-from bearing_rig_sim.simulation.settings import existing_config_file
+from bearing_rig_sim.dynamics.engine import MODELS
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param
 
 NODE_NAME = "shadow"
 """The shadow node's name: the key of its block in a ROS 2 parameter file."""
 
 SHIPPED_FILE = "shadow.yaml"
 """The shipped parameter file, under ``config/``."""
-
-MODELS = ("reduced", "stiff")
-"""The engine's models (``reduced`` runs in real time)."""
-
 
 class ShadowSettings(NodeSettings):
     """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason), declared
@@ -33,9 +29,9 @@ class ShadowSettings(NodeSettings):
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
     OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-    bearing_file: Path = param("bearing data file (absolute, or relative to config/)")
-    calibration_file: Path | None = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
-    model: str = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    bearing_file: ConfigFile = param("bearing data file (absolute, or relative to config/)")
+    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
+    model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
     chunk_s: Number = param("engine advance per call", unit="s", gt=0.0, le=0.1)
     window_revolutions: Integer = param("whole cage revolutions per slip window (the monitor's)", unit="1", ge=1, le=1000)
     min_inner_ring_speed_rad_s: Number = param("slower windows are not compared", unit="rad/s", gt=0.0)
@@ -59,23 +55,6 @@ class ShadowSettings(NodeSettings):
     )
     status_rate_hz: Number = param("status publication rate of the node (wall clock)", unit="Hz", gt=0.0)
     diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0)
-
-    @field_validator("bearing_file", mode="before")
-    @classmethod
-    def _bearing_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw)
-
-    @field_validator("calibration_file", mode="before")
-    @classmethod
-    def _calibration_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw, empty_ok=True)
-
-    @field_validator("model", mode="before")
-    @classmethod
-    def _model(cls, raw: object) -> str:
-        if raw not in MODELS:
-            raise ValueError(f"must be one of {', '.join(MODELS)}, got {raw!r}")
-        return str(raw)
 
     @field_validator("recalibrate_parameter", mode="before")
     @classmethod
@@ -105,10 +84,6 @@ class ShadowSettings(NodeSettings):
                 + ("no calibration file is given" if calibration is None else f"{calibration} has none")
             )
         return rms
-
-    def replace(self, **changes: Any) -> ShadowSettings:
-        """A copy with some values changed (not re-validated: for tests and the command line)."""
-        return self.model_copy(update=changes)
 
 
 def calibration_rms(path: Path | None) -> float | None:

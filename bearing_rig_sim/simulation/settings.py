@@ -10,41 +10,40 @@ File parameters (bearing, calibration, rig) are relative to ``config/`` unless a
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from pydantic import PrivateAttr, ValidationInfo, field_validator
 
-from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics.engine import MODELS
 from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
 from bearing_rig_sim.rig.spindle import SpindleConfig
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
+from bearing_rig_sim.settings_model import (
+    ConfigFile,
+    Flag,
+    Integer,
+    NodeSettings,
+    Number,
+    OptionalConfigFile,
+    existing_config_file,
+    one_of,
+    param,
+    resolve_config_file,
+)
+
+__all__ = [
+    "NODE_NAME",
+    "SHIPPED_FILE",
+    "SimulatorSettings",
+    "existing_config_file",
+    "resolve_config_file",
+    "shipped_parameters",
+]
 
 NODE_NAME = "simulator"
 """The simulator node's name: the key of its block in a ROS 2 parameter file."""
 
 SHIPPED_FILE = "simulator.yaml"
 """The shipped parameter file, under ``config/``."""
-
-
-def resolve_config_file(value: str) -> Path | None:
-    """A file parameter as a path: None for ``""``, as given if absolute, else under ``config/``."""
-    if not value:
-        return None
-    path = Path(value)
-    return path if path.is_absolute() else config_path(*path.parts)
-
-
-def existing_config_file(raw: object, *, empty_ok: bool = False) -> Path | None:
-    """A file parameter that must exist (absolute or under ``config/``); ``""`` is None where
-    ``empty_ok``. Raises ValueError with the problem (a settings validator's error)."""
-    if not isinstance(raw, str) or (not raw and not empty_ok):
-        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
-    path = resolve_config_file(raw)
-    if path is not None and not path.is_file():
-        raise ValueError(f"file not found: {raw!r} (looked for {path})")
-    return path
 
 
 class SimulatorSettings(NodeSettings):
@@ -62,10 +61,10 @@ class SimulatorSettings(NodeSettings):
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
     OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-    bearing_file: Path = param("bearing data file (absolute, or relative to the package's config/)")
-    calibration_file: Path | None = param("calibration laid over the bearing data ('' = none; relative to config/)")
-    rig_file: Path = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
-    model: str = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    bearing_file: ConfigFile = param("bearing data file (absolute, or relative to the package's config/)")
+    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = none; relative to config/)")
+    rig_file: ConfigFile = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
+    model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
     chunk_s: Number = param(f"simulated time per engine call and per {CLOCK.name} message (whole engine steps)", unit="s", gt=0.0, le=0.1)
     realtime: Flag = param("lock the simulated time to the wall clock (false: as fast as possible)")
     rate: Number = param("simulated seconds per wall second when in real time", unit="1", gt=0.0, le=100.0)
@@ -84,23 +83,6 @@ class SimulatorSettings(NodeSettings):
     fault_hold_s: Number = param(f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0)
 
     _spindle: SpindleConfig = PrivateAttr()
-
-    @field_validator("bearing_file", "rig_file", mode="before")
-    @classmethod
-    def _required_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw)
-
-    @field_validator("calibration_file", mode="before")
-    @classmethod
-    def _optional_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw, empty_ok=True)
-
-    @field_validator("model", mode="before")
-    @classmethod
-    def _model(cls, raw: object) -> str:
-        if raw not in MODELS:
-            raise ValueError(f"must be one of {', '.join(MODELS)}, got {raw!r}")
-        return str(raw)
 
     @field_validator("initial_speed_rad_s")
     @classmethod

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Self
 
 import annotated_types
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
 from pydantic_core import ErrorDetails
 
 from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
@@ -155,7 +155,8 @@ def param(
 
 @dataclass(frozen=True)
 class ParameterField:
-    """What a node declares to ROS about one parameter, as the settings class states it.
+    """What a node declares to ROS about one parameter, as the settings class states it (no ROS
+    here: :mod:`bearing_rig_sim.nodes.shell` makes the ``ParameterDescriptor``).
 
     Attributes:
         name: the parameter's name.
@@ -176,6 +177,30 @@ class ParameterField:
     high_exclusive: bool
     integer: bool
     live: bool
+
+    @property
+    def numeric(self) -> bool:
+        """A number with a range at both ends (what a ROS range can state)."""
+        return self.low is not None and self.high is not None
+
+    @property
+    def read_only(self) -> bool:
+        """Refused by ``set_parameters`` once declared (read at configure)."""
+        return not self.live
+
+    def constraints(self) -> str:
+        """The descriptor's ``additional_constraints`` text: unit, range, when it applies. ROS
+        ranges are inclusive; an exclusive bound is refused by the settings class at configure
+        and stated here."""
+        parts = []
+        if self.unit:
+            parts.append(f"unit: {self.unit}")
+        if self.low is not None and self.high is not None:
+            low = ">" if self.low_exclusive else ">="
+            high = "<" if self.high_exclusive else "<="
+            parts.append(f"range: {low} {self.low:g} and {high} {self.high:g}")
+        parts.append("may be set live" if self.live else "read-only: set at start (parameter file or -p), read at configure")
+        return "; ".join(parts)
 
 
 _BOUND_WORDS = {
@@ -266,6 +291,23 @@ class NodeSettings(BaseModel):
         """A copy with some values changed, not validated again (for tests and for a value the
         caller has checked, such as a criterion read from a recording)."""
         return self.model_copy(update=changes)
+
+    @classmethod
+    def check_value(cls, name: str, value: object) -> str:
+        """Why ``value`` is refused for parameter ``name`` by its own field checks ("" when it
+        is accepted): a live parameter vetted before the node is configured. Checks across
+        fields (validators naming other parameters) are not run.
+
+        Raises:
+            KeyError: ``name`` is not a parameter of this class.
+        """
+        info = cls.model_fields[name]
+        adapter: TypeAdapter[Any] = TypeAdapter(Annotated[(info.annotation, *info.metadata)])  # type: ignore[arg-type]  # an Annotated built from the field's parts at run time
+        try:
+            adapter.validate_python(value)
+        except ValidationError as exc:
+            return f"{name}: {_problem(exc.errors()[0])}"
+        return ""
 
     @classmethod
     def parameter_fields(cls) -> list[ParameterField]:

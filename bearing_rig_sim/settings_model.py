@@ -38,7 +38,7 @@ import annotated_types
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, ros_parameters
 
 __all__ = [
     "ConfigFile",
@@ -49,6 +49,7 @@ __all__ = [
     "OptionalConfigFile",
     "ParameterField",
     "existing_config_file",
+    "first_error",
     "one_of",
     "param",
     "resolve_config_file",
@@ -222,7 +223,37 @@ def _problem(error: ErrorDetails) -> str:
         return f"must be {word} {ctx[key]}, got {error['input']!r}"
     if kind == "value_error":
         return str(ctx["error"])
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        return f"must be a mapping, got {type(error['input']).__name__}"
     return str(error["msg"])
+
+
+def _model_at(model: type[BaseModel], path: Sequence[int | str]) -> type[BaseModel] | None:
+    """The nested model at ``path`` inside ``model`` (None if the path leads elsewhere)."""
+    for part in path:
+        info = model.model_fields.get(str(part))
+        if info is None or not (isinstance(info.annotation, type) and issubclass(info.annotation, BaseModel)):
+            return None
+        model = info.annotation
+    return model
+
+
+def first_error(model: type[BaseModel], exc: ValidationError) -> tuple[str, str]:
+    """The first error of validating ``model`` in the project's words: the dotted key inside the
+    validated mapping and the problem with its allowed range (``("brake.resistance_ohm", "must
+    be > 0.0, got -2.0")``). A :class:`~bearing_rig_sim.config.ConfigError` raised by a nested
+    check keeps its own key below the nested mapping's."""
+    error = exc.errors()[0]
+    loc = [str(part) for part in error["loc"]]
+    problem = _problem(error)
+    if error["type"] == "extra_forbidden":
+        owner = _model_at(model, loc[:-1])
+        allowed = ", ".join(sorted(owner.model_fields)) if owner is not None else ""
+        problem = f"unknown key; allowed keys: {allowed}"
+    cause = error.get("ctx", {}).get("error")
+    if isinstance(cause, ConfigError):
+        loc, problem = [*loc, cause.key] if cause.key else loc, cause.problem
+    return ".".join(loc), problem
 
 
 class NodeSettings(BaseModel):
@@ -255,8 +286,7 @@ class NodeSettings(BaseModel):
         try:
             return cls.model_validate(values)
         except ValidationError as exc:
-            first = exc.errors()[0]
-            raise s.error(".".join(str(part) for part in first["loc"]), _problem(first)) from None
+            raise s.error(*first_error(cls, exc)) from None
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any], source: str | None = None) -> Self:

@@ -28,7 +28,6 @@ No ROS import.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,7 +37,7 @@ import annotated_types
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import ConfigError, Section, config_path, flag_value, integer_value, load_yaml, number_value, ros_parameters
 
 __all__ = [
     "ConfigFile",
@@ -56,38 +55,13 @@ __all__ = [
 ]
 
 
-def _number(value: object) -> float:
-    if isinstance(value, str):
-        try:
-            value = float(value.strip())  # YAML 1.1 reads "2.0e9" as a string; YAML 1.2 as a float
-        except ValueError:
-            raise ValueError(f"must be a number, got {value!r}") from None
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"must be finite, got {value!r}")
-    return float(value)
-
-
-def _integer(value: object) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"must be an integer, got {value!r}")
-    return value
-
-
-def _flag(value: object) -> bool:
-    if not isinstance(value, bool):
-        raise ValueError(f"must be true or false, got {value!r}")
-    return value
-
-
-Number = Annotated[float, BeforeValidator(_number)]
+Number = Annotated[float, BeforeValidator(number_value)]
 """A finite real number (an integer is taken as one; a boolean is not)."""
 
-Integer = Annotated[int, BeforeValidator(_integer)]
+Integer = Annotated[int, BeforeValidator(integer_value)]
 """An integer (a boolean is not)."""
 
-Flag = Annotated[bool, BeforeValidator(_flag)]
+Flag = Annotated[bool, BeforeValidator(flag_value)]
 """A YAML boolean (``true`` or ``false``, nothing that merely converts to one)."""
 
 

@@ -28,6 +28,7 @@ No ROS import.
 
 from __future__ import annotations
 
+import typing
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -196,9 +197,12 @@ def _problem(error: ErrorDetails) -> str:
         word, key = _BOUND_WORDS[kind]
         return f"must be {word} {ctx[key]}, got {error['input']!r}"
     if kind == "value_error":
-        return str(ctx["error"])
+        cause = ctx["error"]
+        return cause.problem if isinstance(cause, ConfigError) else str(cause)
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         return f"must be a mapping, got {type(error['input']).__name__}"
+    if kind == "list_type":
+        return f"must be a list, got {type(error['input']).__name__}"
     return str(error["msg"])
 
 
@@ -206,9 +210,12 @@ def _model_at(model: type[BaseModel], path: Sequence[int | str]) -> type[BaseMod
     """The nested model at ``path`` inside ``model`` (None if the path leads elsewhere)."""
     for part in path:
         info = model.model_fields.get(str(part))
-        if info is None or not (isinstance(info.annotation, type) and issubclass(info.annotation, BaseModel)):
+        nested = info.annotation if info is not None else None
+        for arg in typing.get_args(nested):  # a list of nested models
+            nested = arg
+        if not (isinstance(nested, type) and issubclass(nested, BaseModel)):
             return None
-        model = info.annotation
+        model = nested
     return model
 
 
@@ -217,17 +224,18 @@ def first_error(model: type[BaseModel], exc: ValidationError) -> tuple[str, str]
     validated mapping and the problem with its allowed range (``("brake.resistance_ohm", "must
     be > 0.0, got -2.0")``). A :class:`~bearing_rig_sim.config.ConfigError` raised by a nested
     check keeps its own key below the nested mapping's."""
-    error = exc.errors()[0]
-    loc = [str(part) for part in error["loc"]]
+    errors = exc.errors()
+    error = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a misspelt key first
+    loc = [f"[{part}]" if isinstance(part, int) else part for part in error["loc"]]
     problem = _problem(error)
     if error["type"] == "extra_forbidden":
-        owner = _model_at(model, loc[:-1])
+        owner = _model_at(model, [part for part in error["loc"][:-1] if not isinstance(part, int)])
         allowed = ", ".join(sorted(owner.model_fields)) if owner is not None else ""
         problem = f"unknown key; allowed keys: {allowed}"
     cause = error.get("ctx", {}).get("error")
     if isinstance(cause, ConfigError):
         loc, problem = [*loc, cause.key] if cause.key else loc, cause.problem
-    return ".".join(loc), problem
+    return ".".join(loc).replace(".[", "["), problem
 
 
 class NodeSettings(BaseModel):

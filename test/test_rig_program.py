@@ -272,3 +272,15 @@ def test_program_file_errors_are_the_parameter_models_wording(tmp_path: Path) ->
     path.write_text(GOOD.split("segments:")[0] + "segments: []\n")
     with pytest.raises(ConfigError, match=r"bad.yaml: segments: must be a non-empty list of mappings"):
         load_program(path)
+
+
+def test_the_rig_files_combined_loading_limits_are_a_checked_record(tmp_path: Path) -> None:
+    rig = tmp_path / "rig.yaml"
+    text = config_path("rig.yaml").read_text(encoding="utf-8")
+    assert "  max_radial_setpoint_n: 0.0\n" in text
+    rig.write_text(text.replace("  max_radial_setpoint_n: 0.0\n", "  max_radial_setpoint_n: 250.0\n"), encoding="utf-8")
+    assert RigLimits.from_rig_file(rig).max_radial_load_n == 250.0
+    rig.write_text(text.replace("  max_radial_setpoint_n: 0.0\n", "  max_radial_setpoint_n: -1.0\n"), encoding="utf-8")
+    with pytest.raises(ConfigError) as info:
+        RigLimits.from_rig_file(rig)
+    assert str(info.value) == f"{rig}: combined_loading.max_radial_setpoint_n: must be >= 0.0, got -1.0"

@@ -34,13 +34,13 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, ClassVar
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 
 from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rad_s_to_rpm, rpm_to_rad_s
 from bearing_rig_sim.rig.loading import LoadingChainConfig
-from bearing_rig_sim.rig.parameters import RIG_FILE
+from bearing_rig_sim.rig.parameters import RIG_FILE, ParameterRecord, bounded
 from bearing_rig_sim.rig.speed_profile import SegmentSpeed, SpeedProfileKind
 from bearing_rig_sim.rig.spindle import SpindleConfig
 from bearing_rig_sim.settings_model import ConfigFile, Flag, Number, first_error, one_of
@@ -142,6 +142,19 @@ bag directories and CSV rows)."""
 
 
 @dataclass(frozen=True)
+class CombinedLoadingLimits(ParameterRecord):
+    """The ``combined_loading`` section of ``config/rig.yaml``: what a radial loader accepts
+    (absent: a loading chain that pulls only axially)."""
+
+    SECTION: ClassVar[str] = "combined_loading"
+
+    max_radial_setpoint_n: float = bounded(ge=0.0, default=0.0)
+    """Largest radial-load set-point, N."""
+    max_moment_setpoint_n_m: float = bounded(ge=0.0, default=0.0)
+    """Largest moment set-point, N m."""
+
+
+@dataclass(frozen=True)
 class RigLimits:
     """What the rig a program runs on accepts (SI units)."""
 
@@ -169,11 +182,16 @@ class RigLimits:
         spindle = SpindleConfig.from_yaml(path)
         chain = LoadingChainConfig.from_yaml(path)
         name = Path(path).name if path is not None else RIG_FILE
-        doc = load_yaml(path or config_path("rig.yaml"))
-        combined = doc.section("combined_loading") if "combined_loading" in doc.data else None
-        radial = combined.number("max_radial_setpoint_n", ge=0.0) if combined is not None else 0.0
-        moment = combined.number("max_moment_setpoint_n_m", ge=0.0) if combined is not None else 0.0
-        return cls(spindle.max_speed_rad_s, spindle.max_acceleration_rad_s2, chain.max_setpoint_n, name, radial, moment)
+        doc = load_yaml(path or config_path(RIG_FILE))
+        combined = CombinedLoadingLimits.from_section(doc.section("combined_loading")) if "combined_loading" in doc.data else CombinedLoadingLimits()
+        return cls(
+            spindle.max_speed_rad_s,
+            spindle.max_acceleration_rad_s2,
+            chain.max_setpoint_n,
+            name,
+            combined.max_radial_setpoint_n,
+            combined.max_moment_setpoint_n_m,
+        )
 
 
 def _name(value: object) -> str:

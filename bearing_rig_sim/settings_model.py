@@ -242,14 +242,14 @@ class NodeSettings(BaseModel):
     """Base of a node's settings: a frozen model whose fields are its parameters (see the module
     documentation). Set ``NODE_NAME`` (the node's name, its block in a parameter file) and
     ``SHIPPED_FILE`` (under ``config/``, the only place the defaults live); ``OTHER_KEYS`` are
-    keys a parameter file may hold that are not the node's own (rclpy's ``use_sim_time``), to be
-    checked by :meth:`check_other_keys`."""
+    keys a parameter file may hold that are not the node's own (by default rclpy's
+    ``use_sim_time``, which every node has), to be checked by :meth:`check_other_keys`."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
 
     NODE_NAME: ClassVar[str]
     SHIPPED_FILE: ClassVar[str]
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ()
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     @classmethod
     def check_other_keys(cls, s: Section) -> None:

@@ -40,7 +40,6 @@ class MonitorSettings(NodeSettings):
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     bearing_file: ConfigFile = param("bearing data file: geometry for the epicyclic cage speed (relative to config/)")
     contact_angle_deg: Number = param(

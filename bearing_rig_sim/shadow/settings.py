@@ -27,7 +27,6 @@ class ShadowSettings(NodeSettings):
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     bearing_file: ConfigFile = param("bearing data file (absolute, or relative to config/)")
     calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")

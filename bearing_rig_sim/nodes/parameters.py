@@ -18,19 +18,20 @@ controller's set-point is live.
 
 from __future__ import annotations
 
-from bearing_rig_sim.load_control.settings import LoadControllerSettings
-from bearing_rig_sim.monitoring.settings import MonitorSettings
+import functools
+from collections.abc import Iterator, Mapping
+
 from bearing_rig_sim.settings_model import NodeSettings, ParameterField
-from bearing_rig_sim.shadow.settings import ShadowSettings
-from bearing_rig_sim.simulation.settings import SimulatorSettings
 
 __all__ = [
     "NODE_PARAMETERS",
     "NODE_SETTINGS",
     "STANDARD_PARAMETERS",
     "STANDARD_PREFIXES",
+    "NODES",
     "ParameterSpec",
     "is_standard",
+    "settings_of",
     "spec_for",
 ]
 
@@ -51,14 +52,71 @@ def is_standard(name: str) -> bool:
 ParameterSpec = ParameterField
 """One parameter of a node as it is declared to ROS (the settings class's field)."""
 
-NODE_SETTINGS: dict[str, type[NodeSettings]] = {
-    settings.NODE_NAME: settings for settings in (SimulatorSettings, LoadControllerSettings, MonitorSettings, ShadowSettings)
-}
+NODES = ("simulator", "load_controller", "monitor", "shadow")
+"""The nodes with parameters."""
+
+
+def settings_of(node: str) -> type[NodeSettings]:
+    """The settings class of ``node``, imported only when asked for: a node process loads its own
+    settings module, not the others' (the simulator's and the shadow's bring in the engine).
+
+    Raises:
+        KeyError: no node of that name.
+    """
+    if node == "simulator":
+        from bearing_rig_sim.simulation.settings import SimulatorSettings
+
+        return SimulatorSettings
+    if node == "load_controller":
+        from bearing_rig_sim.load_control.settings import LoadControllerSettings
+
+        return LoadControllerSettings
+    if node == "monitor":
+        from bearing_rig_sim.monitoring.settings import MonitorSettings
+
+        return MonitorSettings
+    if node == "shadow":
+        from bearing_rig_sim.shadow.settings import ShadowSettings
+
+        return ShadowSettings
+    raise KeyError(node)
+
+
+@functools.cache
+def _parameters_of(node: str) -> dict[str, ParameterSpec]:
+    return {f.name: f for f in settings_of(node).parameter_fields()}
+
+
+class _ByNode(Mapping[str, dict[str, ParameterSpec]]):
+    """Node name -> its parameters, each node's made when first asked for."""
+
+    def __getitem__(self, node: str) -> dict[str, ParameterSpec]:
+        return _parameters_of(node)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(NODES)
+
+    def __len__(self) -> int:
+        return len(NODES)
+
+
+class _SettingsByNode(Mapping[str, type[NodeSettings]]):
+    """Node name -> its settings class, imported when first asked for."""
+
+    def __getitem__(self, node: str) -> type[NodeSettings]:
+        return settings_of(node)
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(NODES)
+
+    def __len__(self) -> int:
+        return len(NODES)
+
+
+NODE_SETTINGS: Mapping[str, type[NodeSettings]] = _SettingsByNode()
 """The settings class of every node with parameters, by node name."""
 
-NODE_PARAMETERS: dict[str, dict[str, ParameterSpec]] = {
-    node: {f.name: f for f in settings.parameter_fields()} for node, settings in NODE_SETTINGS.items()
-}
+NODE_PARAMETERS: Mapping[str, dict[str, ParameterSpec]] = _ByNode()
 """Every parameter of every node (besides rclpy's own ``use_sim_time``), by node name."""
 
 

@@ -232,8 +232,10 @@ class Section:
     def integer(self, key: str, *, ge: int | None = None, le: int | None = None, default: Any = _MISSING) -> int:
         """An integer within ``[ge, le]``."""
         value = self._get(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(key, f"must be an integer, got {value!r}")
+        try:
+            value = integer_value(value)
+        except ValueError as exc:
+            raise self.error(key, str(exc)) from None
         if ge is not None and value < ge:
             raise self.error(key, f"must be >= {ge}, got {value}")
         if le is not None and value > le:
@@ -243,9 +245,10 @@ class Section:
     def boolean(self, key: str, default: Any = _MISSING) -> bool:
         """A YAML boolean."""
         value = self._get(key, default)
-        if not isinstance(value, bool):
-            raise self.error(key, f"must be true or false, got {value!r}")
-        return value
+        try:
+            return flag_value(value)
+        except ValueError as exc:
+            raise self.error(key, str(exc)) from None
 
     def string(self, key: str, default: Any = _MISSING) -> str:
         """A non-empty string."""
@@ -284,6 +287,48 @@ class Section:
         return out
 
 
+def number_value(value: object) -> float:
+    """A YAML value as a finite real number (an integer is one; a boolean is not).
+
+    Raises:
+        ValueError: the problem in the project's words (``must be a number, got 'fast'``).
+    """
+    if isinstance(value, str):
+        # PyYAML follows YAML 1.1, which reads exponents without a sign ("2.0e9") as strings;
+        # YAML 1.2 reads them as floats, and so do we.
+        try:
+            value = float(value.strip())
+        except ValueError:
+            raise ValueError(f"must be a number, got {value!r}") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ValueError(f"must be a number, got {value!r}")
+    if not math.isfinite(value):
+        raise ValueError(f"must be finite, got {value!r}")
+    return float(value)
+
+
+def integer_value(value: object) -> int:
+    """A YAML value as an integer (a boolean or a float is not one).
+
+    Raises:
+        ValueError: the problem in the project's words.
+    """
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"must be an integer, got {value!r}")
+    return value
+
+
+def flag_value(value: object) -> bool:
+    """A YAML boolean (``true`` or ``false``, nothing that merely converts to one).
+
+    Raises:
+        ValueError: the problem in the project's words.
+    """
+    if not isinstance(value, bool):
+        raise ValueError(f"must be true or false, got {value!r}")
+    return value
+
+
 def check_number(
     value: Any,
     source: str,
@@ -299,18 +344,10 @@ def check_number(
     Raises:
         ConfigError: naming ``source``, ``key`` and the allowed range.
     """
-    if isinstance(value, str):
-        # PyYAML follows YAML 1.1, which reads exponents without a sign ("2.0e9") as strings;
-        # YAML 1.2 reads them as floats, and so do we.
-        try:
-            value = float(value.strip())
-        except ValueError:
-            raise ConfigError(source, key, f"must be a number, got {value!r}") from None
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ConfigError(source, key, f"must be a number, got {value!r}")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ConfigError(source, key, f"must be finite, got {value!r}")
+    try:
+        x = number_value(value)
+    except ValueError as exc:
+        raise ConfigError(source, key, str(exc)) from None
     if gt is not None and not x > gt:
         raise ConfigError(source, key, f"must be > {gt}, got {value!r}")
     if ge is not None and not x >= ge:

@@ -13,7 +13,8 @@ A settings class derives from :class:`NodeSettings` and declares each parameter 
 
 * :data:`Number`, :data:`Integer` and :data:`Flag` are the YAML value kinds (a number is finite
   and never a boolean; YAML 1.1's unsigned exponents such as ``2.0e9``, which PyYAML reads as
-  strings, are numbers);
+  strings, are numbers); :data:`ConfigFile` and :data:`OptionalConfigFile` are files that must
+  exist (absolute, or relative to ``config/``); :func:`one_of` restricts a text to a few words;
 * :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``) and
   whether the parameter may change while the node runs;
 * :meth:`NodeSettings.from_section` (and ``from_values``, ``from_yaml``) validates a mapping and
@@ -27,54 +28,89 @@ No ROS import.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping
+import typing
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Self
 
 import annotated_types
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.config import ConfigError, Section, config_path, flag_value, integer_value, load_yaml, number_value, ros_parameters
 
-__all__ = ["Flag", "Integer", "NodeSettings", "Number", "ParameterField", "param"]
-
-
-def _number(value: object) -> float:
-    if isinstance(value, str):
-        try:
-            value = float(value.strip())  # YAML 1.1 reads "2.0e9" as a string; YAML 1.2 as a float
-        except ValueError:
-            raise ValueError(f"must be a number, got {value!r}") from None
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"must be finite, got {value!r}")
-    return float(value)
-
-
-def _integer(value: object) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"must be an integer, got {value!r}")
-    return value
+__all__ = [
+    "ConfigFile",
+    "Flag",
+    "Integer",
+    "NodeSettings",
+    "Number",
+    "OptionalConfigFile",
+    "ParameterField",
+    "existing_config_file",
+    "first_error",
+    "one_of",
+    "param",
+    "resolve_config_file",
+]
 
 
-def _flag(value: object) -> bool:
-    if not isinstance(value, bool):
-        raise ValueError(f"must be true or false, got {value!r}")
-    return value
-
-
-Number = Annotated[float, BeforeValidator(_number)]
+Number = Annotated[float, BeforeValidator(number_value)]
 """A finite real number (an integer is taken as one; a boolean is not)."""
 
-Integer = Annotated[int, BeforeValidator(_integer)]
+Integer = Annotated[int, BeforeValidator(integer_value)]
 """An integer (a boolean is not)."""
 
-Flag = Annotated[bool, BeforeValidator(_flag)]
+Flag = Annotated[bool, BeforeValidator(flag_value)]
 """A YAML boolean (``true`` or ``false``, nothing that merely converts to one)."""
+
+
+def resolve_config_file(value: str) -> Path | None:
+    """A file parameter as a path: None for ``""``, as given if absolute, else under ``config/``."""
+    if not value:
+        return None
+    path = Path(value)
+    return path if path.is_absolute() else config_path(*path.parts)
+
+
+def existing_config_file(raw: object, *, empty_ok: bool = False) -> Path | None:
+    """A file parameter that must exist (absolute or under ``config/``); ``""`` is None where
+    ``empty_ok``. Raises ValueError with the problem (a settings validator's error)."""
+    if not isinstance(raw, str) or (not raw and not empty_ok):
+        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
+    path = resolve_config_file(raw)
+    if path is not None and not path.is_file():
+        raise ValueError(f"file not found: {raw!r} (looked for {path})")
+    return path
+
+
+def _required_file(raw: object) -> Path | None:
+    return existing_config_file(raw)
+
+
+def _optional_file(raw: object) -> Path | None:
+    return existing_config_file(raw, empty_ok=True)
+
+
+ConfigFile = Annotated[Path, BeforeValidator(_required_file)]
+"""A file that exists, named absolute or relative to ``config/`` (never ``""``)."""
+
+OptionalConfigFile = Annotated[Path | None, BeforeValidator(_optional_file)]
+"""As :data:`ConfigFile`, or ``""`` for none (None)."""
+
+
+def one_of(allowed: Sequence[str]) -> BeforeValidator:
+    """The check of a text field that takes one of a few words:
+    ``model: Annotated[str, one_of(MODELS)] = param(...)``."""
+    words = tuple(allowed)
+
+    def check(raw: object) -> str:
+        if raw not in words:
+            raise ValueError(f"must be one of {', '.join(words)}, got {raw!r}")
+        return str(raw)
+
+    return BeforeValidator(check)
 
 
 def param(
@@ -95,7 +131,8 @@ def param(
 
 @dataclass(frozen=True)
 class ParameterField:
-    """What a node declares to ROS about one parameter, as the settings class states it.
+    """What a node declares to ROS about one parameter, as the settings class states it (no ROS
+    here: :mod:`bearing_rig_sim.nodes.shell` makes the ``ParameterDescriptor``).
 
     Attributes:
         name: the parameter's name.
@@ -117,6 +154,30 @@ class ParameterField:
     integer: bool
     live: bool
 
+    @property
+    def numeric(self) -> bool:
+        """A number with a range at both ends (what a ROS range can state)."""
+        return self.low is not None and self.high is not None
+
+    @property
+    def read_only(self) -> bool:
+        """Refused by ``set_parameters`` once declared (read at configure)."""
+        return not self.live
+
+    def constraints(self) -> str:
+        """The descriptor's ``additional_constraints`` text: unit, range, when it applies. ROS
+        ranges are inclusive; an exclusive bound is refused by the settings class at configure
+        and stated here."""
+        parts = []
+        if self.unit:
+            parts.append(f"unit: {self.unit}")
+        if self.low is not None and self.high is not None:
+            low = ">" if self.low_exclusive else ">="
+            high = "<" if self.high_exclusive else "<="
+            parts.append(f"range: {low} {self.low:g} and {high} {self.high:g}")
+        parts.append("may be set live" if self.live else "read-only: set at start (parameter file or -p), read at configure")
+        return "; ".join(parts)
+
 
 _BOUND_WORDS = {
     "greater_than": (">", "gt"),
@@ -136,22 +197,59 @@ def _problem(error: ErrorDetails) -> str:
         word, key = _BOUND_WORDS[kind]
         return f"must be {word} {ctx[key]}, got {error['input']!r}"
     if kind == "value_error":
-        return str(ctx["error"])
+        cause = ctx["error"]
+        return cause.problem if isinstance(cause, ConfigError) else str(cause)
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        return f"must be a mapping, got {type(error['input']).__name__}"
+    if kind == "list_type":
+        return f"must be a list, got {type(error['input']).__name__}"
     return str(error["msg"])
+
+
+def _model_at(model: type[BaseModel], path: Sequence[int | str]) -> type[BaseModel] | None:
+    """The nested model at ``path`` inside ``model`` (None if the path leads elsewhere)."""
+    for part in path:
+        info = model.model_fields.get(str(part))
+        nested = info.annotation if info is not None else None
+        for arg in typing.get_args(nested):  # a list of nested models
+            nested = arg
+        if not (isinstance(nested, type) and issubclass(nested, BaseModel)):
+            return None
+        model = nested
+    return model
+
+
+def first_error(model: type[BaseModel], exc: ValidationError) -> tuple[str, str]:
+    """The first error of validating ``model`` in the project's words: the dotted key inside the
+    validated mapping and the problem with its allowed range (``("brake.resistance_ohm", "must
+    be > 0.0, got -2.0")``). A :class:`~bearing_rig_sim.config.ConfigError` raised by a nested
+    check keeps its own key below the nested mapping's."""
+    errors = exc.errors()
+    error = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])  # a misspelt key first
+    loc = [f"[{part}]" if isinstance(part, int) else part for part in error["loc"]]
+    problem = _problem(error)
+    if error["type"] == "extra_forbidden":
+        owner = _model_at(model, [part for part in error["loc"][:-1] if not isinstance(part, int)])
+        allowed = ", ".join(sorted(owner.model_fields)) if owner is not None else ""
+        problem = f"unknown key; allowed keys: {allowed}"
+    cause = error.get("ctx", {}).get("error")
+    if isinstance(cause, ConfigError):
+        loc, problem = [*loc, cause.key] if cause.key else loc, cause.problem
+    return ".".join(loc).replace(".[", "["), problem
 
 
 class NodeSettings(BaseModel):
     """Base of a node's settings: a frozen model whose fields are its parameters (see the module
     documentation). Set ``NODE_NAME`` (the node's name, its block in a parameter file) and
     ``SHIPPED_FILE`` (under ``config/``, the only place the defaults live); ``OTHER_KEYS`` are
-    keys a parameter file may hold that are not the node's own (rclpy's ``use_sim_time``), to be
-    checked by :meth:`check_other_keys`."""
+    keys a parameter file may hold that are not the node's own (by default rclpy's
+    ``use_sim_time``, which every node has), to be checked by :meth:`check_other_keys`."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", arbitrary_types_allowed=True)
 
     NODE_NAME: ClassVar[str]
     SHIPPED_FILE: ClassVar[str]
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ()
+    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     @classmethod
     def check_other_keys(cls, s: Section) -> None:
@@ -170,8 +268,7 @@ class NodeSettings(BaseModel):
         try:
             return cls.model_validate(values)
         except ValidationError as exc:
-            first = exc.errors()[0]
-            raise s.error(".".join(str(part) for part in first["loc"]), _problem(first)) from None
+            raise s.error(*first_error(cls, exc)) from None
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any], source: str | None = None) -> Self:
@@ -201,6 +298,28 @@ class NodeSettings(BaseModel):
         section = ros_parameters(load_yaml(config_path(cls.SHIPPED_FILE)), cls.NODE_NAME)
         cls.from_section(section)  # the defaults themselves must be valid
         return dict(section.data)
+
+    def replace(self, **changes: Any) -> Self:
+        """A copy with some values changed, not validated again (for tests and for a value the
+        caller has checked, such as a criterion read from a recording)."""
+        return self.model_copy(update=changes)
+
+    @classmethod
+    def check_value(cls, name: str, value: object) -> str:
+        """Why ``value`` is refused for parameter ``name`` by its own field checks ("" when it
+        is accepted): a live parameter vetted before the node is configured. Checks across
+        fields (validators naming other parameters) are not run.
+
+        Raises:
+            KeyError: ``name`` is not a parameter of this class.
+        """
+        info = cls.model_fields[name]
+        adapter: TypeAdapter[Any] = TypeAdapter(Annotated[(info.annotation, *info.metadata)])  # type: ignore[arg-type]  # an Annotated built from the field's parts at run time
+        try:
+            adapter.validate_python(value)
+        except ValidationError as exc:
+            return f"{name}: {_problem(exc.errors()[0])}"
+        return ""
 
     @classmethod
     def parameter_fields(cls) -> list[ParameterField]:

@@ -324,3 +324,56 @@ def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
             graph.close()
         finally:
             lease.release()
+
+
+# -- rig sessions (``bearing-rig run``) ------------------------------------------------------------
+def start_run(ros_graph: RosGraph, program: Path, run_dir: Path, *extra: str) -> subprocess.Popen[str]:
+    """Start ``bearing-rig run PROGRAM --no-realtime`` on the test's graph, recording under
+    ``run_dir/bags``; stopped at teardown whatever the test's outcome."""
+    return ros_graph.spawn_python(
+        "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(run_dir / "bags"), *extra
+    )
+
+
+def the_bag(run_dir: Path) -> Path:
+    """The one bag a session started by :func:`start_run` recorded."""
+    (bag,) = [p for p in (run_dir / "bags").iterdir() if p.is_dir()]
+    return bag
+
+
+def summary_rows(text: str) -> list[list[str]]:
+    """The rows of a session's summary table, each split on whitespace."""
+    lines = text.splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith("summary"))
+    rows = []
+    for line in lines[start + 3 :]:
+        if not line.strip():
+            break
+        rows.append(line.split())
+    return rows
+
+
+def write_foreign_metadata(bag_dir: Path, topics: Sequence[tuple[str, str, int]], files: Sequence[str]) -> None:
+    """A minimal ``metadata.yaml`` (rosbag2 format version 9) as another rosbag2 writer could
+    produce it, beside storage files written by the test: ``topics`` are (name, type, message
+    count), ``files`` the storage files' names. Written by hand, not by the project's writer, so
+    that reading it tests the reader against the format rather than against itself."""
+    import yaml
+
+    doc = {
+        "rosbag2_bagfile_information": {
+            "version": 9,
+            "storage_identifier": "mcap",
+            "duration": {"nanoseconds": 0},
+            "starting_time": {"nanoseconds_since_epoch": 0},
+            "message_count": sum(count for _name, _type, count in topics),
+            "topics_with_message_count": [
+                {"topic_metadata": {"name": name, "type": msgtype, "serialization_format": "cdr", "offered_qos_profiles": []}, "message_count": count}
+                for name, msgtype, count in topics
+            ],
+            "compression_format": "",
+            "compression_mode": "",
+            "relative_file_paths": list(files),
+        }
+    }
+    (bag_dir / "metadata.yaml").write_text(yaml.safe_dump(doc), encoding="utf-8")

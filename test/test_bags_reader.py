@@ -29,6 +29,7 @@ from bearing_rig_sim.synthetic.traffic import (
     rig_traffic,
 )
 from bearing_rig_sim.bags.typestore import msg_folder
+from conftest import write_foreign_metadata
 
 HEADER_DEPENDENCIES = (
     "=" * 80 + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
@@ -68,27 +69,6 @@ def chunk_message_counts(mcap_path: Path) -> list[tuple[int, int, int]]:
             count = sum(isinstance(r, Message) for r in breakup_chunk(chunk))
             out.append((index.chunk_start_offset, index.chunk_start_offset + index.chunk_length, count))
     return out
-
-
-def write_layout(path: Path, topics: list[tuple[str, str, int]], files: list[str]) -> None:
-    """A minimal metadata.yaml as another rosbag2 writer could produce it."""
-    doc = {
-        "rosbag2_bagfile_information": {
-            "version": 9,
-            "storage_identifier": "mcap",
-            "duration": {"nanoseconds": 0},
-            "starting_time": {"nanoseconds_since_epoch": 0},
-            "message_count": sum(count for _t, _m, count in topics),
-            "topics_with_message_count": [
-                {"topic_metadata": {"name": name, "type": msgtype, "serialization_format": "cdr", "offered_qos_profiles": []}, "message_count": count}
-                for name, msgtype, count in topics
-            ],
-            "compression_format": "",
-            "compression_mode": "",
-            "relative_file_paths": files,
-        }
-    }
-    (path / "metadata.yaml").write_text(yaml.safe_dump(doc))
 
 
 @pytest.fixture(scope="module")
@@ -159,7 +139,7 @@ def test_bag_from_an_independent_writer(tmp_path: Path) -> None:
                 writer.write_message("/bench/temperature", temperature, reading, log_time=index * 10_000_000 + 9)
                 sent.append(("/bench/temperature", reading))
         writer.finish()
-    write_layout(bag, [("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", 300), ("/bench/temperature", "bench_msgs/msg/Temperature", 30)], ["bench.mcap"])
+    write_foreign_metadata(bag, [("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", 300), ("/bench/temperature", "bench_msgs/msg/Temperature", 30)], ["bench.mcap"])
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", BagWarning)
@@ -187,7 +167,7 @@ def test_padded_bytes_from_ros2_bag_record_decode(tmp_path: Path) -> None:
         for index in range(50):
             writer.add_message(channel, index * 1_000_000, raw, index * 1_000_000)
         writer.finish()
-    write_layout(bag, [("/rig/speeds", "sensor_msgs/msg/JointState", 50)], ["recorded_0.mcap"])
+    write_foreign_metadata(bag, [("/rig/speeds", "sensor_msgs/msg/JointState", 50)], ["recorded_0.mcap"])
     with AnyReader([bag]) as strict:  # the premise: the strict decoder refuses these bytes
         conn, _t, data = next(strict.messages())
         with pytest.raises(Exception, match="size mismatch"):
@@ -210,7 +190,7 @@ def test_unknown_type_is_skipped_with_a_warning(tmp_path: Path) -> None:
             writer.add_message(known, index * 2, b"\x00\x01\x00\x00" + struct.pack("<d", index), index * 2)
             writer.add_message(secret, index * 2 + 1, b"\x00\x01\x00\x00\x01\x02\x03\x04", index * 2 + 1)
         writer.finish()
-    write_layout(bag, [("/rig/axial_load/setpoint", "std_msgs/msg/Float64", 20), ("/bench/secret", "bench_msgs/msg/Secret", 20)], ["bench_0.mcap"])
+    write_foreign_metadata(bag, [("/rig/axial_load/setpoint", "std_msgs/msg/Float64", 20), ("/bench/secret", "bench_msgs/msg/Secret", 20)], ["bench_0.mcap"])
     with pytest.warns(BagWarning, match=r"topic /bench/secret: type bench_msgs/msg/Secret is unknown"):
         reader = open_bag(bag)
     assert not reader.topics["/bench/secret"].decodable

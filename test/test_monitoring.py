@@ -62,7 +62,7 @@ def decelerating(speed: float, decel: float, strips: int, t0: float, phase: floa
 
 
 def settings(**changes: object) -> MonitorSettings:
-    return dataclasses.replace(MonitorSettings.from_yaml(), **changes)
+    return MonitorSettings.from_yaml().replace(**changes)
 
 
 def make(**changes: object) -> SlipMonitor:

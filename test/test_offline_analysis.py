@@ -26,6 +26,7 @@ from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic, s
 from bearing_rig_sim.bags.typestore import msg_folder
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation import RigTwin, SpindleCommand
+from conftest import write_foreign_metadata
 
 PULSE = "bearing_rig_msgs/msg/FibreOpticPulse"
 HEADER_DEPENDENCIES = (
@@ -324,10 +325,7 @@ def test_bag_from_an_independent_writer_without_truth(tmp_path: Path) -> None:
             message = {"header": {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": "bench"}, "sensor_id": shaft, "strip_id": k % 4, "strip_count": 4, "revolution": k // 4, "pulse_index": k}
             writer.write_message(f"/rig/{shaft}/pulses", schema, message, log_time=sec * 10**9 + nanosec)
         writer.finish()
-    topics = [{"topic_metadata": {"name": f"/rig/{s}/pulses", "type": PULSE, "serialization_format": "cdr", "offered_qos_profiles": []}, "message_count": sum(e[1] == s for e in events)} for s in ("spindle", "cage")]
-    info = {"version": 9, "storage_identifier": "mcap", "relative_file_paths": ["bench.mcap"], "message_count": len(events), "topics_with_message_count": topics}
-    layout = {"rosbag2_bagfile_information": info}
-    (bag / "metadata.yaml").write_text(yaml.safe_dump(layout))
+    write_foreign_metadata(bag, [(f"/rig/{s}/pulses", PULSE, sum(e[1] == s for e in events)) for s in ("spindle", "cage")], ["bench.mcap"])
     with warnings.catch_warnings():
         warnings.simplefilter("error", BagWarning)
         result = analyse_bag(bag)

@@ -27,6 +27,7 @@ from bearing_rig_sim.config import config_path
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 from bearing_rig_sim.offline.analysis import analyse_bag
 from bearing_rig_sim.offline.report import state_name
+from conftest import start_run, summary_rows, the_bag
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
 
@@ -38,24 +39,9 @@ SEGMENT, VERDICT, T_STABLE = 1, 8, 9
 
 
 def run_program(ros_graph: Any, tmp_path: Path, name: str) -> tuple[int, str, Path]:
-    session = ros_graph.spawn_python(
-        "-m", "bearing_rig_sim.cli", "run", str(config_path("programs", f"{name}.yaml")), "--no-realtime", "--quiet",
-        "--bag-dir", str(tmp_path / "bags"),
-    )
+    session = start_run(ros_graph, config_path("programs", f"{name}.yaml"), tmp_path, "--quiet")
     out, err = session.communicate(timeout=SESSION_TIMEOUT_S)
-    (bag,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
-    return session.returncode, out + err, bag
-
-
-def summary_rows(text: str) -> list[list[str]]:
-    lines = text.splitlines()
-    start = next(i for i, line in enumerate(lines) if line.startswith("summary"))
-    rows = []
-    for line in lines[start + 3 :]:
-        if not line.strip():
-            break
-        rows.append(line.split())
-    return rows
+    return session.returncode, out + err, the_bag(tmp_path)
 
 
 def sweep_lines(text: str) -> dict[int, str]:

@@ -95,3 +95,26 @@ def test_code_construction_is_checked_too() -> None:
 def test_record_without_section_cannot_be_read_from_a_file(tmp_path: Path) -> None:
     with pytest.raises(TypeError, match="top-level"):
         Spring.from_yaml(tmp_path / "rig.yaml")
+
+
+def test_errors_are_the_parameter_models_one_line_wording(tmp_path: Path) -> None:
+    """The same words as every node's settings (bearing_rig_sim.settings_model): the range with
+    the value, the allowed keys of the nested mapping, a null taken as absent."""
+    cases = {
+        "stiffness_n_per_m: 2.0e5": ("stiffness_n_per_m: 0", "stage.spring.stiffness_n_per_m: must be > 0.0, got 0.0"),
+        "spring: {stiffness_n_per_m: 2.0e5}": (
+            "spring: {stiffness_n_per_m: 2.0e5, stifness: 1}",
+            "stage.spring.stifness: unknown key; allowed keys: preload_n, stiffness_n_per_m",
+        ),
+        "low_m: -0.001": ("low_m: null", "stage.low_m: missing (required)"),
+        "turns: 3": ("turns: '3'", "stage.turns: must be an integer, got '3'"),
+    }
+    for old, (new, message) in cases.items():
+        doc = section(GOOD.replace(old, new), tmp_path)
+        with pytest.raises(ConfigError) as info:
+            Stage.from_section(doc.section("stage"))
+        assert str(info.value) == f"{tmp_path / 'rig.yaml'}: {message}"
+    with pytest.raises(ConfigError) as info:
+        Spring(stiffness_n_per_m=1.0, preload_n=-1.0)
+    assert str(info.value) == "Spring: preload_n: must be >= 0.0, got -1.0"
+    assert Spring(2.0, 1.0) == Spring(stiffness_n_per_m=2.0, preload_n=1.0)  # still a dataclass

@@ -248,3 +248,39 @@ def test_the_shortest_allowed_step_ramp_is_accepted(tmp_path: Path) -> None:
     path = tmp_path / "fast.yaml"
     path.write_text(GOOD.replace("ramp_s: 1.0", "ramp_s: 0.142", 1))
     assert load_program(path).segments[0].ramp_time == 0.142
+
+
+def test_program_file_errors_are_the_parameter_models_wording(tmp_path: Path) -> None:
+    """The program file is checked by the declarative parameter model (ProgramFile, SegmentFile):
+    the same one-line errors as every node's settings, with list places as ``segments[i]``."""
+    path = tmp_path / "bad.yaml"
+    cases = {
+        "  - {name: a,": ("  - 5\n  - {name: a,", "segments[0]: must be a mapping, got int"),
+        "speed_rpm: 900, ramp_s": ("speed_rpm: 900, sped: 1, ramp_s", "segments[0].sped: unknown key; allowed keys: acceleration_rad_s2, "
+                                   "axial_load_n, dwell_s, moment_n_m, name, radial_load_n, ramp_s, speed_rpm, timeout_s, until_stable"),
+        "axial_load_n: 100, dwell_s": ("axial_load_n: -5, dwell_s", "segments[0].axial_load_n: must be >= 0.0, got -5.0"),
+        "until_stable: true": ("until_stable: 1", "segments[1].until_stable: must be true or false, got 1"),
+    }
+    for old, (new, message) in cases.items():
+        assert old in GOOD
+        path.write_text(GOOD.replace(old, new, 1))
+        with pytest.raises(ConfigError) as info:
+            load_program(path)
+        assert str(info.value) == f"{path}: {message}"
+    path.write_text(GOOD.replace("ramp_s: 1.0, axial_load_n: 100", "ramp_s: 1.0, radial_load_n: null, axial_load_n: 100", 1))
+    assert load_program(path).segments[0].radial_load == 0.0  # a null is an absent optional key
+    path.write_text(GOOD.split("segments:")[0] + "segments: []\n")
+    with pytest.raises(ConfigError, match=r"bad.yaml: segments: must be a non-empty list of mappings"):
+        load_program(path)
+
+
+def test_the_rig_files_combined_loading_limits_are_a_checked_record(tmp_path: Path) -> None:
+    rig = tmp_path / "rig.yaml"
+    text = config_path("rig.yaml").read_text(encoding="utf-8")
+    assert "  max_radial_setpoint_n: 0.0\n" in text
+    rig.write_text(text.replace("  max_radial_setpoint_n: 0.0\n", "  max_radial_setpoint_n: 250.0\n"), encoding="utf-8")
+    assert RigLimits.from_rig_file(rig).max_radial_load_n == 250.0
+    rig.write_text(text.replace("  max_radial_setpoint_n: 0.0\n", "  max_radial_setpoint_n: -1.0\n"), encoding="utf-8")
+    with pytest.raises(ConfigError) as info:
+        RigLimits.from_rig_file(rig)
+    assert str(info.value) == f"{rig}: combined_loading.max_radial_setpoint_n: must be >= 0.0, got -1.0"

@@ -32,6 +32,7 @@ from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
 
 from bearing_rig_sim.bags import open_bag, rig_typestore
+from conftest import start_run, summary_rows, the_bag
 from bearing_rig_sim.config import config_path
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -68,14 +69,7 @@ verdict t_stable conditions."""
 def start_session(ros_graph: Any, tmp_path: Path, *extra: str, program_text: str = SHORT_PROGRAM) -> subprocess.Popen[str]:
     program = tmp_path / "program.yaml"
     program.write_text(program_text, encoding="utf-8")
-    return ros_graph.spawn_python(  # tracked: stopped at teardown whatever the test's outcome
-        "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), *extra
-    )
-
-
-def the_bag(tmp_path: Path) -> Path:
-    (bag,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
-    return bag
+    return start_run(ros_graph, program, tmp_path, *extra)
 
 
 def check_bag_decodes(bag: Path) -> dict[str, int]:
@@ -92,17 +86,6 @@ def check_bag_decodes(bag: Path) -> dict[str, int]:
                 decoded += 1
     assert decoded == sum(counts.values())
     return counts
-
-
-def summary_rows(stdout: str) -> list[list[str]]:
-    lines = stdout.splitlines()
-    start = next(i for i, line in enumerate(lines) if line.startswith("summary"))
-    rows = []
-    for line in lines[start + 3 :]:
-        if not line.strip():
-            break
-        rows.append(line.split())
-    return rows
 
 
 def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ros_graph: Any, tmp_path: Path) -> None:

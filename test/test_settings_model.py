@@ -4,13 +4,26 @@ one-line errors (file, key, range) and what the node declares to ROS."""
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar
+from typing import Annotated, ClassVar
 
 import pytest
 
-from bearing_rig_sim.config import ConfigError, Section
+from bearing_rig_sim.config import ConfigError, Section, config_path
 from bearing_rig_sim.load_control.settings import LoadControllerSettings
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
+from bearing_rig_sim.monitoring.settings import MonitorSettings
+from bearing_rig_sim.settings_model import (
+    ConfigFile,
+    Flag,
+    Integer,
+    NodeSettings,
+    Number,
+    OptionalConfigFile,
+    ParameterField,
+    one_of,
+    param,
+)
+from bearing_rig_sim.shadow.settings import ShadowSettings
+from bearing_rig_sim.simulation.settings import SimulatorSettings
 
 
 class Toy(NodeSettings):
@@ -79,23 +92,56 @@ def test_parameter_fields_state_the_declared_ranges() -> None:
     assert (fields["enabled"].low, fields["enabled"].high, fields["enabled"].live) == (None, None, False)
 
 
-@pytest.mark.parametrize("field", [f for f in LoadControllerSettings.parameter_fields() if f.low is not None and f.high is not None], ids=lambda f: f.name)
-def test_load_controller_file_checks_are_its_declared_ranges(field: object) -> None:
-    """The range the node declares to ROS is the one its YAML is checked against: each end is
-    accepted (or refused when exclusive) and a value beyond the top is refused, naming both."""
-    from bearing_rig_sim.settings_model import ParameterField
+NODE_SETTINGS: tuple[type[NodeSettings], ...] = (LoadControllerSettings, MonitorSettings, ShadowSettings, SimulatorSettings)
 
-    assert isinstance(field, ParameterField) and field.low is not None and field.high is not None
-    shipped = LoadControllerSettings.shipped_parameters()
-    LoadControllerSettings.from_values({**shipped, field.name: field.high})
-    beyond = field.high * 1.5 + 1.0
-    with pytest.raises(ConfigError, match=rf"{field.name}: must be <= {field.high}, got {beyond}"):
-        LoadControllerSettings.from_values({**shipped, field.name: beyond})
+DEPENDENT = {
+    ("simulator", "initial_speed_rad_s"): "at most the rig file's spindle speed limit",
+    ("shadow", "warn_after_s"): "below error_after_s",
+    ("shadow", "error_after_s"): "above warn_after_s",
+}
+"""Bounds checked also against another value (their top may be refused for that reason)."""
+
+RANGED = [
+    (settings, field)
+    for settings in NODE_SETTINGS
+    for field in settings.parameter_fields()
+    if field.low is not None and field.high is not None and (settings.NODE_NAME, field.name) not in DEPENDENT
+]
+
+
+def test_every_number_of_every_node_has_a_unit_and_a_range_at_both_ends() -> None:
+    """What a ROS range can state, and the house rule for physical parameters: a unit and a
+    plausible range on every number a node takes."""
+    for settings in NODE_SETTINGS:
+        shipped = settings.shipped_parameters()
+        for field in settings.parameter_fields():
+            value = shipped[field.name]
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                assert field.unit and field.numeric, (settings.NODE_NAME, field.name)
+                assert field.integer == isinstance(value, int), (settings.NODE_NAME, field.name, value)
+            else:
+                assert not field.numeric and field.unit == "", (settings.NODE_NAME, field.name)
+
+
+@pytest.mark.parametrize(("settings", "field"), RANGED, ids=lambda x: getattr(x, "name", getattr(x, "NODE_NAME", "")))
+def test_file_checks_are_the_declared_ranges(settings: type[NodeSettings], field: ParameterField) -> None:
+    """The range a node declares to ROS is the one its YAML is checked against: each end is
+    accepted (or refused when exclusive) and a value beyond the top is refused, naming both."""
+    assert field.low is not None and field.high is not None
+    shipped = settings.shipped_parameters()
+    cast = int if field.integer else float
+    settings.from_values({**shipped, field.name: cast(field.high)})
+    beyond = cast(field.high * 1.5 + 1.0)
+    high = cast(field.high)
+    with pytest.raises(ConfigError, match=rf"{field.name}: must be <= {high}, got {beyond}"):
+        settings.from_values({**shipped, field.name: beyond})
+    assert settings.check_value(field.name, beyond) == f"{field.name}: must be <= {high}, got {beyond!r}"
     if field.low_exclusive:
-        with pytest.raises(ConfigError, match=rf"{field.name}: must be > {field.low}"):
-            LoadControllerSettings.from_values({**shipped, field.name: field.low})
+        with pytest.raises(ConfigError, match=rf"{field.name}: must be > {cast(field.low)}"):
+            settings.from_values({**shipped, field.name: cast(field.low)})
     else:
-        LoadControllerSettings.from_values({**shipped, field.name: field.low})
+        settings.from_values({**shipped, field.name: cast(field.low)})
+        assert settings.check_value(field.name, cast(field.low)) == ""
 
 
 def test_load_controller_reads_the_shipped_file_and_refuses_sim_time_off(tmp_path: Path) -> None:
@@ -110,8 +156,6 @@ def test_load_controller_reads_the_shipped_file_and_refuses_sim_time_off(tmp_pat
 def test_shadow_settings_bounds_that_depend_on_another_value() -> None:
     """error_after_s is checked against warn_after_s, and a negative calibration RMS is read from
     the calibration file (0.1083 pp in the shipped h7006c_table3.yaml, calibration.rms_slip_pct)."""
-    from bearing_rig_sim.shadow.settings import ShadowSettings
-
     shipped = ShadowSettings.shipped_parameters()
     with pytest.raises(ConfigError, match=r"error_after_s: must be > 2.0 \(warn_after_s\), got 1.5"):
         ShadowSettings.from_values({**shipped, "warn_after_s": 2.0, "error_after_s": 1.5})
@@ -121,3 +165,28 @@ def test_shadow_settings_bounds_that_depend_on_another_value() -> None:
         ShadowSettings.from_values({**shipped, "calibration_file": "", "calibration_rms_slip_pct": -1.0})
     with pytest.raises(ConfigError, match="model: must be one of reduced, stiff, got 'fast'"):
         ShadowSettings.from_values({**shipped, "model": "fast"})
+
+
+class Files(NodeSettings):
+    NODE_NAME: ClassVar[str] = "files"
+    SHIPPED_FILE: ClassVar[str] = "files.yaml"
+
+    data_file: ConfigFile = param("a file that must exist")
+    extra_file: OptionalConfigFile = param("a file that may be ''")
+    mode: Annotated[str, one_of(("fast", "slow"))] = param("a word")
+
+
+def test_file_and_word_checks_are_shared(tmp_path: Path) -> None:
+    """One file check and one word check for every settings class: a relative name is under
+    config/, '' is None only where allowed, a missing file names where it was looked for."""
+    good = Files.from_values({"data_file": "rig.yaml", "extra_file": "", "mode": "slow"})
+    assert good.data_file == config_path("rig.yaml") and good.extra_file is None
+    absolute = tmp_path / "x.yaml"
+    absolute.write_text("{}\n")
+    assert Files.from_values({"data_file": str(absolute), "extra_file": str(absolute), "mode": "fast"}).extra_file == absolute
+    with pytest.raises(ConfigError, match=r"files parameters: data_file: must be a file name .*got ''"):
+        Files.from_values({"data_file": "", "extra_file": "", "mode": "fast"})
+    with pytest.raises(ConfigError, match=r"extra_file: file not found: 'nope.yaml' \(looked for .*config/nope.yaml\)"):
+        Files.from_values({"data_file": "rig.yaml", "extra_file": "nope.yaml", "mode": "fast"})
+    with pytest.raises(ConfigError, match=r"mode: must be one of fast, slow, got 'quick'"):
+        Files.from_values({"data_file": "rig.yaml", "extra_file": "", "mode": "quick"})

@@ -36,7 +36,8 @@ def test_integers_are_accepted_for_numbers_and_an_empty_calibration_means_none()
         ("rate", 0.0, "rate: must be > 0"),
         ("realtime", "yes", "realtime: must be true or false"),
         ("max_batch_chunks", 0, "max_batch_chunks: must be >= 1"),
-        ("initial_speed_rad_s", 1e4, "initial_speed_rad_s: must be <= 1047.19"),  # rig.yaml: 10 000 rpm
+        ("initial_speed_rad_s", 2000.0, "initial_speed_rad_s: must be <= 1047.19"),  # rig.yaml: 10 000 rpm
+        ("initial_speed_rad_s", 1e4, "initial_speed_rad_s: must be <= 4000.0"),  # any bench spindle: about 38 000 rpm
         ("initial_axial_load_n", float("nan"), "initial_axial_load_n: must be finite"),
         ("model", "fast", "model: must be one of reduced, stiff"),
         ("bearing_file", "bearings/none.yaml", "bearing_file: file not found"),

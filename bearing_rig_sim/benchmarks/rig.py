@@ -68,6 +68,7 @@ from bearing_rig_sim.session.processes import (
     session_environment,
     stop_all,
 )
+from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import header_stamp_ns
 
 PULSES_KEPT = 20000
@@ -132,15 +133,14 @@ class _Probe:
         return taken
 
     def missing(self, seen: dict[str, int]) -> dict[str, str]:
-        """Which node is not up yet (as the session judges it)."""
-        missing = {}
-        if not seen.get(CLOCK.name) or self.node.count_subscribers(SPINDLE_COMMAND.name) == 0:
-            missing["simulator"] = f"no {CLOCK.name}, or nobody subscribes {SPINDLE_COMMAND.name}"
-        if not seen.get(AXIAL_LOAD_STATE.name) or self.node.count_subscribers(AXIAL_LOAD_SETPOINT.name) == 0:
-            missing["load_controller"] = f"no {AXIAL_LOAD_STATE.name}, or nobody subscribes {AXIAL_LOAD_SETPOINT.name}"
-        if self.node.count_publishers(SLIP_STATUS.name) == 0:
-            missing["monitor"] = f"nobody publishes {SLIP_STATUS.name}"
-        return missing
+        """Which node is not up yet, by the session's rule
+        (:func:`~bearing_rig_sim.session.readiness.not_ready`)."""
+        return not_ready(
+            clock_seen=bool(seen.get(CLOCK.name)),
+            load_state_seen=bool(seen.get(AXIAL_LOAD_STATE.name)),
+            subscribers=lambda topic: self.node.count_subscribers(topic) - (1 if topic in self.subs else 0),
+            publishers=self.node.count_publishers,
+        )
 
     def command(self, speed_rad_s: float, load_n: float) -> None:
         spindle_type, float_type = self._command_types

@@ -40,7 +40,6 @@ class LoadControllerSettings(NodeSettings):
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     rig_file: Path = param("rig data file with the loading chain ('' = the shipped config/rig.yaml)")
     axial_load_setpoint_n: Number = param(

@@ -1,14 +1,15 @@
-"""The monitor's parameters (``config/monitor.yaml``), validated; SI units, the unit in each name."""
+"""The monitor's parameters (``config/monitor.yaml``), validated; SI units, the unit in each name
+(rpm and percent only where the name says so)."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from pathlib import Path
+from typing import Annotated, ClassVar
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
-from bearing_rig_sim.config import Section, config_path, load_yaml, ros_parameters
+from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.monitoring.windows import LossRules
+from bearing_rig_sim.settings_model import ConfigFile, Integer, NodeSettings, Number, one_of, param
 
 NODE_NAME = "monitor"
 """The monitor node's name: the key of its block in a ROS 2 parameter file."""
@@ -25,132 +26,79 @@ CRITERIA = ("time", "axial_load")
 (k1), as a test program's ``stability_criterion`` says."""
 
 
-@dataclass(frozen=True)
-class MonitorSettings:
-    """The monitor's validated parameters (``config/monitor.yaml`` explains each).
+class MonitorSettings(NodeSettings):
+    """The monitor's validated parameters (``config/monitor.yaml`` explains each), declared once
+    (:mod:`bearing_rig_sim.settings_model`): the YAML checks, the errors and the node's ROS
+    descriptors come from these fields.
 
-    Attributes:
-        bearing_file: bearing data file (geometry for the epicyclic cage speed).
-        contact_angle_deg: contact angle of the slip formula, degrees; negative: nominal.
-        window_revolutions: whole cage revolutions per slip window (>= 1).
-        min_window_s: a slip window lasts at least this long: more whole revolutions at high
-            speed (0: always ``window_revolutions``), s.
-        criterion: "time" or "axial_load".
-        slip_reference: "nominal" (the paper's slip, Eq. 11-12 at ``contact_angle_deg``) or
-            "loaded" (the kinematic slip at the contact angle of the measured axial load,
-            Harris's thrust equilibrium): the slip the criterion judges; both are reported.
-        critical_slope_pct_per_s: k2, %/s.
-        critical_slope_pct_per_n: k1, %/N.
-        slope_span_s: trailing window of the slope against time, s.
-        slope_max_span_s: longest stretch of a steady series the slope against time may rest on
-            when the trailing window cannot decide, s (>= slope_span_s).
-        load_step_n: with the load criterion, windows whose measured loads stay within half of
-            this are one hold at one load, N (:mod:`~bearing_rig_sim.monitoring.load_sweep`).
-        sweep_settle_s: a hold's windows count for its load point from this long after its
-            first window, s.
-        sweep_average_s: and are averaged over this long, s.
-        min_slope_points: points needed for a slope (>= 3).
-        slip_resolution_pct: least scatter of the slip believed, percentage points.
-        change_threshold: prediction standard errors for a change in the slip (1).
-        min_inner_ring_speed_rad_s: below it no slip point (the series restarts), rad/s.
-        restart_speed_change_fraction: the spindle is steady in a window whose mean speed is
-            within this fraction of the previous window's; the series restarts when it turns
-            steady or changing (1); 0 never restarts on speed changes.
-        loss_horizon_revolutions, max_lost_fraction, loss_silence_revolutions,
-        loss_min_timeout_s, silent_shaft_revolutions: the sustained-loss rules
-            (:class:`~bearing_rig_sim.monitoring.windows.LossRules`).
-        fault_hold_s: a malformed pulse stays a fault, a loss a warning, this long, rig s.
-        clock_jump_tolerance_s: a pulse further back than this is a clock jump, s.
-        status_rate_hz: status checks and messages per second of rig time (and on each window).
-        diagnostics_rate_hz: rate of /diagnostics (besides every change), wall Hz.
+    ``slip_reference`` "nominal" is the paper's slip (Eq. 11-12 at ``contact_angle_deg``),
+    "loaded" the kinematic slip at the contact angle of the measured axial load (Harris's thrust
+    equilibrium); both are reported, the criterion judges the one named. The sustained-loss rules
+    are :class:`~bearing_rig_sim.monitoring.windows.LossRules`; the load sweep
+    :mod:`~bearing_rig_sim.monitoring.load_sweep`.
     """
 
-    bearing_file: Path
-    contact_angle_deg: float
-    window_revolutions: int
-    min_window_s: float
-    criterion: str
-    slip_reference: str
-    critical_slope_pct_per_s: float
-    critical_slope_pct_per_n: float
-    slope_span_s: float
-    slope_max_span_s: float
-    load_step_n: float
-    sweep_settle_s: float
-    sweep_average_s: float
-    min_slope_points: int
-    slip_resolution_pct: float
-    change_threshold: float
-    min_inner_ring_speed_rad_s: float
-    restart_speed_change_fraction: float
-    loss_horizon_revolutions: float
-    max_lost_fraction: float
-    loss_silence_revolutions: float
-    loss_min_timeout_s: float
-    silent_shaft_revolutions: float
-    fault_hold_s: float
-    clock_jump_tolerance_s: float
-    status_rate_hz: float
-    diagnostics_rate_hz: float
+    NODE_NAME: ClassVar[str] = NODE_NAME
+    SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
-    @classmethod
-    def from_section(cls, s: Section) -> MonitorSettings:
-        """Validate the parameters in ``s`` (every key required, none unknown besides
-        ``use_sim_time``).
-
-        Raises:
-            ConfigError: naming the source, the key and the allowed range.
-        """
-        s.reject_unknown([*cls.__dataclass_fields__, "use_sim_time"])
-        raw = s.string("bearing_file")
-        bearing = Path(raw) if Path(raw).is_absolute() else config_path(*Path(raw).parts)
-        if not bearing.is_file():
-            raise s.error("bearing_file", f"file not found: {raw!r} (looked for {bearing})")
-        criterion = s.string("criterion")
-        if criterion not in CRITERIA:
-            raise s.error("criterion", f"must be one of {', '.join(CRITERIA)}, got {criterion!r}")
-        reference = s.string("slip_reference")
-        if reference not in SLIP_REFERENCES:
-            raise s.error("slip_reference", f"must be one of {', '.join(SLIP_REFERENCES)}, got {reference!r}")
-        return cls(
-            bearing_file=bearing,
-            slip_reference=reference,
-            contact_angle_deg=s.number("contact_angle_deg", lt=90.0),
-            window_revolutions=s.integer("window_revolutions", ge=1, le=1000),
-            min_window_s=s.number("min_window_s", ge=0.0, le=10.0),
-            criterion=criterion,
-            critical_slope_pct_per_s=s.number("critical_slope_pct_per_s"),
-            critical_slope_pct_per_n=s.number("critical_slope_pct_per_n"),
-            slope_span_s=s.number("slope_span_s", gt=0.0),
-            slope_max_span_s=s.number("slope_max_span_s", gt=0.0),
-            load_step_n=s.number("load_step_n", gt=0.0),
-            sweep_settle_s=s.number("sweep_settle_s", ge=0.0),
-            sweep_average_s=s.number("sweep_average_s", gt=0.0),
-            min_slope_points=s.integer("min_slope_points", ge=3),
-            slip_resolution_pct=s.number("slip_resolution_pct", gt=0.0),
-            change_threshold=s.number("change_threshold", gt=0.0),
-            min_inner_ring_speed_rad_s=s.number("min_inner_ring_speed_rad_s", gt=0.0),
-            restart_speed_change_fraction=s.number("restart_speed_change_fraction", ge=0.0),
-            loss_horizon_revolutions=s.number("loss_horizon_revolutions", gt=0.0),
-            max_lost_fraction=s.number("max_lost_fraction", ge=0.0, le=1.0),
-            loss_silence_revolutions=s.number("loss_silence_revolutions", gt=0.0),
-            loss_min_timeout_s=s.number("loss_min_timeout_s", gt=0.0),
-            silent_shaft_revolutions=s.number("silent_shaft_revolutions", gt=0.0),
-            fault_hold_s=s.number("fault_hold_s", ge=0.0),
-            clock_jump_tolerance_s=s.number("clock_jump_tolerance_s", gt=0.0),
-            status_rate_hz=s.number("status_rate_hz", gt=0.0),
-            diagnostics_rate_hz=s.number("diagnostics_rate_hz", gt=0.0),
-        )
-
-    @classmethod
-    def from_values(cls, values: dict[str, object], source: str = "monitor parameters") -> MonitorSettings:
-        """Validate a flat mapping of parameter values (the node's ROS parameters)."""
-        return cls.from_section(Section(dict(values), source))
-
-    @classmethod
-    def from_yaml(cls, path: str | Path | None = None) -> MonitorSettings:
-        """Read ``monitor: ros__parameters:`` of a parameter file (default: the shipped one)."""
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(SHIPPED_FILE)), NODE_NAME))
+    bearing_file: ConfigFile = param("bearing data file: geometry for the epicyclic cage speed (relative to config/)")
+    contact_angle_deg: Number = param(
+        "contact angle of the slip formula (negative: the bearing file's nominal)", unit="deg", ge=-1.0, le=89.0
+    )
+    window_revolutions: Integer = param("whole cage revolutions per slip window", unit="1", ge=1, le=1000)
+    min_window_s: Number = param(
+        "a slip window lasts at least this long (more whole cage revolutions at high speed; 0: never)", unit="s", ge=0.0, le=10.0
+    )
+    criterion: Annotated[str, one_of(CRITERIA)] = param(
+        "abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)"
+    )
+    slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
+        "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"
+    )
+    critical_slope_pct_per_s: Number = param(
+        "critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0
+    )
+    critical_slope_pct_per_n: Number = param(
+        "critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0
+    )
+    slope_span_s: Number = param("trailing window of the slope against time", unit="s", gt=0.0, le=600.0)
+    slope_max_span_s: Number = param(
+        "longest steady stretch the slope against time may rest on when the trailing window cannot decide", unit="s", gt=0.0, le=3600.0
+    )
+    load_step_n: Number = param(
+        "with the load criterion: windows whose loads stay within half of this are one load hold", unit="N", gt=0.0, le=1000.0
+    )
+    sweep_settle_s: Number = param(
+        "with the load criterion: a hold's windows count for its load point from this long after its start", unit="s", ge=0.0, le=600.0
+    )
+    sweep_average_s: Number = param("with the load criterion: and are averaged over this long", unit="s", gt=0.0, le=600.0)
+    min_slope_points: Integer = param("points needed for a slope", unit="1", ge=3, le=100_000)
+    slip_resolution_pct: Number = param("least scatter of the slip believed", unit="%", gt=0.0, le=10.0)
+    change_threshold: Number = param("prediction standard errors that make a change in the slip", unit="1", gt=0.0, le=100.0)
+    min_inner_ring_speed_rad_s: Number = param(
+        "no slip point below this spindle speed (the series restarts)", unit="rad/s", gt=0.0, le=1000.0
+    )
+    restart_speed_change_fraction: Number = param(
+        "window-to-window speed change that restarts the slip series (0: never)", unit="1", ge=0.0, le=1.0
+    )
+    loss_horizon_revolutions: Number = param("revolutions over which lost pulses are counted", unit="1", gt=0.0, le=1e5)
+    max_lost_fraction: Number = param("fraction of pulses lost over the horizon that is a sustained loss", unit="1", ge=0.0, le=1.0)
+    loss_silence_revolutions: Number = param("a shaft silent for this many of its revolutions is lost", unit="1", gt=0.0, le=1e4)
+    loss_min_timeout_s: Number = param("sensor loss never sooner than this without a pulse", unit="s", gt=0.0, le=600.0)
+    silent_shaft_revolutions: Number = param(
+        "a shaft silent from the start (or not yet running) is lost once the other turned this many revolutions since its last pulse",
+        unit="1",
+        gt=0.0,
+        le=1e4,
+    )
+    fault_hold_s: Number = param("a malformed pulse stays a fault, a loss a warning, this long (rig time)", unit="s", ge=0.0, le=600.0)
+    clock_jump_tolerance_s: Number = param(
+        "a pulse this far before its predecessor is a clock jump (reset all)", unit="s", gt=0.0, le=600.0
+    )
+    status_rate_hz: Number = param(
+        "status checks and messages per second of rig time, plus one per slip window", unit="Hz", gt=0.0, le=1000.0
+    )
+    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
 
     def kinematics(self) -> BearingKinematics:
         """The bearing's kinematics at the configured (or nominal) contact angle."""
@@ -177,6 +125,4 @@ class MonitorSettings:
 
 def shipped_parameters() -> dict[str, object]:
     """The raw values of the shipped ``config/monitor.yaml`` (the node's declared defaults)."""
-    section = ros_parameters(load_yaml(config_path(SHIPPED_FILE)), NODE_NAME)
-    MonitorSettings.from_section(section)
-    return dict(section.data)
+    return MonitorSettings.shipped_parameters()

@@ -90,7 +90,6 @@ from bearing_rig_sim.nodes.common import (
     run_node,
     to_stamp,
 )
-from bearing_rig_sim.nodes.parameters import spec_for
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
@@ -337,7 +336,7 @@ class LoadControllerNode(ManagedNode):
                 continue
             value = _as_number(parameter.value)
             if self.operation is None:  # not configured: validated at configure
-                reason = spec_for(NODE_NAME, SETPOINT_PARAMETER).check(value)
+                reason = LoadControllerSettings.check_value(SETPOINT_PARAMETER, value)
                 if reason:
                     return SetParametersResult(successful=False, reason=reason)
                 continue

@@ -47,7 +47,7 @@ import dataclasses
 import functools
 import math
 import warnings
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
 from collections.abc import Callable
@@ -261,7 +261,7 @@ class OfflineAnalysis:
             settings, source = self._run_settings()
         criterion = program_criterion(bag.run_metadata)
         if source != "given" and criterion and criterion != settings.criterion:
-            settings = replace(settings, criterion=criterion)
+            settings = settings.replace(criterion=criterion)
             source += f", criterion {criterion!r} from the run's test program"
         self.settings = settings
         self.monitor = SlipMonitor(settings.kinematics(), settings)

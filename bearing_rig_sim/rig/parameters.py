@@ -2,21 +2,32 @@
 
 A parameter record is a frozen dataclass whose field names are the YAML keys (units in the
 name: ``resistance_ohm``, ``stiffness_n_per_m``) and whose fields carry their allowed range
-(:func:`bounded`). The same ranges are checked whether a record is read from a file
-(:meth:`ParameterRecord.from_section`, errors name the file and the dotted key) or built in code
-(``__post_init__``, errors name the class and the field). Nested records map to nested YAML
-mappings. Only the top-level section a record class owns (``SECTION``) is read from the file;
-other top-level sections belong to other parts of the project and are ignored.
+(:func:`bounded`). The checks are those of the declarative parameter model
+(:mod:`bearing_rig_sim.settings_model`): each record class gives a pydantic model of its
+fields (:meth:`ParameterRecord.model`), with the same value kinds (a number is finite and never
+a boolean, an integer is no float, a flag is a YAML boolean) and the same one-line errors. They
+apply whether a record is read from a file (:meth:`ParameterRecord.from_section`, errors name
+the file and the dotted key) or built in code (``__post_init__``, errors name the class and the
+field). Nested records map to nested YAML mappings. Only the top-level section a record class
+owns (``SECTION``) is read from the file; other top-level sections belong to other parts of the
+project and are ignored.
+
+Records stay dataclasses (not pydantic models) so that code builds them positionally and
+changes them with :func:`dataclasses.replace`, which checks them again.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import typing
 from pathlib import Path
 from typing import Any, ClassVar, TypeVar
 
-from bearing_rig_sim.config import ConfigError, Section, check_number, config_path, load_yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
+
+from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml
+from bearing_rig_sim.settings_model import Flag, Integer, Number, first_error
 
 R = TypeVar("R", bound="ParameterRecord")
 
@@ -41,15 +52,23 @@ def bounded(
     return dataclasses.field(default=default, metadata={"bounds": bounds})
 
 
-def _bounds(field: dataclasses.Field[Any]) -> dict[str, float | None]:
-    return dict(field.metadata.get("bounds", {}))
+def _is_record(kind: object) -> bool:
+    return isinstance(kind, type) and issubclass(kind, ParameterRecord)
 
 
-def _check_integer(value: Any, source: str, key: str, bounds: dict[str, float | None]) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ConfigError(source, key, f"must be an integer, got {value!r}")
-    check_number(value, source, key, **bounds)
-    return value
+def _without_nulls(data: Any) -> Any:
+    """A YAML ``null`` is an absent key (its default, or "missing")."""
+    if isinstance(data, dict):
+        return {k: _without_nulls(v) for k, v in data.items() if v is not None}
+    return data
+
+
+def _as_mapping(record: ParameterRecord) -> dict[str, Any]:
+    """A record's values as the mapping its model validates (nested records as mappings)."""
+    return {
+        f.name: _as_mapping(getattr(record, f.name)) if isinstance(getattr(record, f.name), ParameterRecord) else getattr(record, f.name)
+        for f in dataclasses.fields(record)  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
+    }
 
 
 class ParameterRecord:
@@ -58,22 +77,38 @@ class ParameterRecord:
     SECTION: ClassVar[str] = ""
     """Top-level section of ``config/rig.yaml`` this record is read from (top-level records)."""
 
-    def __post_init__(self) -> None:
-        hints = typing.get_type_hints(type(self))
-        source = type(self).__name__
-        for field in dataclasses.fields(self):  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
-            value = getattr(self, field.name)
+    @classmethod
+    @functools.cache
+    def _hints(cls) -> dict[str, Any]:
+        """The type of each field."""
+        hints = typing.get_type_hints(cls)
+        return {f.name: hints[f.name] for f in dataclasses.fields(cls)}  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
+
+    @classmethod
+    @functools.cache
+    def model(cls) -> type[BaseModel]:
+        """The pydantic model of the record's fields (nested records as nested models)."""
+        hints = cls._hints()
+        fields: dict[str, Any] = {}
+        for field in dataclasses.fields(cls):  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
             kind = hints[field.name]
-            if isinstance(kind, type) and issubclass(kind, ParameterRecord):
-                if not isinstance(value, kind):
-                    raise ConfigError(source, field.name, f"must be a {kind.__name__}, got {value!r}")
-            elif kind is bool:
-                if not isinstance(value, bool):
-                    raise ConfigError(source, field.name, f"must be true or false, got {value!r}")
-            elif kind is int:
-                _check_integer(value, source, field.name, _bounds(field))
-            else:
-                check_number(value, source, field.name, **_bounds(field))
+            bounds = {k: v for k, v in field.metadata.get("bounds", {}).items() if v is not None}
+            annotation: Any = kind.model() if _is_record(kind) else Flag if kind is bool else Integer if kind is int else Number
+            default = ... if field.default is dataclasses.MISSING else field.default
+            fields[field.name] = (annotation, Field(default, **bounds))
+        model: type[BaseModel] = create_model(cls.__name__, __config__=ConfigDict(extra="forbid", frozen=True), **fields)
+        return model
+
+    def __post_init__(self) -> None:
+        source = type(self).__name__
+        for name, kind in type(self)._hints().items():
+            value = getattr(self, name)
+            if _is_record(kind) and not isinstance(value, kind):
+                raise ConfigError(source, name, f"must be a {kind.__name__}, got {value!r}")
+        try:
+            type(self).model().model_validate(_as_mapping(self))
+        except ValidationError as exc:
+            raise ConfigError(source, *first_error(type(self).model(), exc)) from None
         self.check_consistency(lambda key, problem: ConfigError(source, key, problem))
 
     def check_consistency(self, error: typing.Callable[[str, str], ConfigError]) -> None:
@@ -89,23 +124,20 @@ class ParameterRecord:
         Raises:
             ConfigError: naming the file, the dotted key and the allowed range.
         """
-        hints = typing.get_type_hints(cls)
-        fields = dataclasses.fields(cls)  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
-        section.reject_unknown([f.name for f in fields])
+        model = cls.model()
+        try:
+            checked = model.model_validate(_without_nulls(section.data))
+        except ValidationError as exc:
+            raise section.error(*first_error(model, exc)) from None
+        return cls._build(checked, section)
+
+    @classmethod
+    def _build(cls: type[R], checked: BaseModel, section: Section) -> R:
+        """The record of a validated model; a cross-field rule's error names the file and key."""
         values: dict[str, Any] = {}
-        for field in fields:
-            kind = hints[field.name]
-            optional = {"default": field.default} if field.default is not dataclasses.MISSING else {}
-            key = section.key_path(field.name)
-            if isinstance(kind, type) and issubclass(kind, ParameterRecord):
-                values[field.name] = kind.from_section(section.section(field.name))
-            elif kind is bool:
-                values[field.name] = section.boolean(field.name, **optional)
-            elif kind is int:
-                integer = section.integer(field.name, **optional)
-                values[field.name] = _check_integer(integer, section.source, key, _bounds(field))
-            else:
-                values[field.name] = section.number(field.name, **_bounds(field), **optional)
+        for name, kind in cls._hints().items():
+            value = getattr(checked, name)
+            values[name] = kind._build(value, section.section(name)) if _is_record(kind) else value
         try:
             return cls(**values)
         except ConfigError as exc:  # a cross-field rule: re-attribute it to the file
@@ -122,4 +154,3 @@ class ParameterRecord:
             raise TypeError(f"{cls.__name__} is not a top-level section of {RIG_FILE}")
         doc = load_yaml(path if path is not None else config_path(RIG_FILE))
         return cls.from_section(doc.section(cls.SECTION))
-

@@ -34,18 +34,20 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated, ClassVar
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
 
 from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rad_s_to_rpm, rpm_to_rad_s
 from bearing_rig_sim.rig.loading import LoadingChainConfig
-from bearing_rig_sim.rig.parameters import RIG_FILE
+from bearing_rig_sim.rig.parameters import RIG_FILE, ParameterRecord, bounded
 from bearing_rig_sim.rig.speed_profile import SegmentSpeed, SpeedProfileKind
 from bearing_rig_sim.rig.spindle import SpindleConfig
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Number, first_error, one_of
 
 STABILITY_CRITERIA = ("time", "axial_load")
 """Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
 
-SEGMENT_KEYS = ("name", "speed_rpm", "ramp_s", "acceleration_rad_s2", "axial_load_n", "dwell_s", "until_stable", "timeout_s", "radial_load_n", "moment_n_m")
-PROGRAM_KEYS = ("name", "description", "bearing", "stability_criterion", "initial_speed_rpm", "segments")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -140,6 +142,19 @@ bag directories and CSV rows)."""
 
 
 @dataclass(frozen=True)
+class CombinedLoadingLimits(ParameterRecord):
+    """The ``combined_loading`` section of ``config/rig.yaml``: what a radial loader accepts
+    (absent: a loading chain that pulls only axially)."""
+
+    SECTION: ClassVar[str] = "combined_loading"
+
+    max_radial_setpoint_n: float = bounded(ge=0.0, default=0.0)
+    """Largest radial-load set-point, N."""
+    max_moment_setpoint_n_m: float = bounded(ge=0.0, default=0.0)
+    """Largest moment set-point, N m."""
+
+
+@dataclass(frozen=True)
 class RigLimits:
     """What the rig a program runs on accepts (SI units)."""
 
@@ -167,11 +182,79 @@ class RigLimits:
         spindle = SpindleConfig.from_yaml(path)
         chain = LoadingChainConfig.from_yaml(path)
         name = Path(path).name if path is not None else RIG_FILE
-        doc = load_yaml(path or config_path("rig.yaml"))
-        combined = doc.section("combined_loading") if "combined_loading" in doc.data else None
-        radial = combined.number("max_radial_setpoint_n", ge=0.0) if combined is not None else 0.0
-        moment = combined.number("max_moment_setpoint_n_m", ge=0.0) if combined is not None else 0.0
-        return cls(spindle.max_speed_rad_s, spindle.max_acceleration_rad_s2, chain.max_setpoint_n, name, radial, moment)
+        doc = load_yaml(path or config_path(RIG_FILE))
+        combined = CombinedLoadingLimits.from_section(doc.section("combined_loading")) if "combined_loading" in doc.data else CombinedLoadingLimits()
+        return cls(
+            spindle.max_speed_rad_s,
+            spindle.max_acceleration_rad_s2,
+            chain.max_setpoint_n,
+            name,
+            combined.max_radial_setpoint_n,
+            combined.max_moment_setpoint_n_m,
+        )
+
+
+def _name(value: object) -> str:
+    if not isinstance(value, str) or not value:
+        raise ValueError(f"must be a non-empty string, got {value!r}")
+    if not NAME_PATTERN.fullmatch(value):
+        raise ValueError(f"must be 1-64 letters, digits, '_', '.' or '-' (starting with a letter or digit), got {value!r}")
+    return value
+
+
+def _segment_list(value: object) -> object:
+    if not isinstance(value, list) or not value:
+        raise ValueError("must be a non-empty list of mappings")
+    if len(value) > MAX_SEGMENTS:
+        raise ValueError(f"at most {MAX_SEGMENTS} segments, got {len(value)}")
+    return [{k: v for k, v in item.items() if v is not None} if isinstance(item, dict) else item for item in value]  # null: absent
+
+
+def _text(value: object) -> str:
+    if not isinstance(value, str):
+        raise ValueError(f"must be a string, got {value!r}")
+    return value.strip()
+
+
+Name = Annotated[str, BeforeValidator(_name)]
+"""A program or segment name (:data:`NAME_PATTERN`)."""
+
+_FILE = ConfigDict(frozen=True, extra="forbid")
+
+
+class SegmentFile(BaseModel):
+    """A segment as its program file states it (rpm at this edge); the rules that need the rig
+    or the segment before it are :func:`load_program`'s. Optional keys whose presence matters
+    (``ramp_s`` against ``acceleration_rad_s2``, ``dwell_s`` against ``until_stable``) are read
+    from ``model_fields_set``."""
+
+    model_config = _FILE
+
+    name: Name = Field(description="segment name, unique in its program")
+    speed_rpm: Number = Field(ge=0.0, description="target inner-ring speed, rpm")
+    ramp_s: Number = Field(0.0, ge=0.0, le=MAX_RAMP_S, description="STEP ramp from the previous speed, s (0 = jump)")
+    acceleration_rad_s2: Number = Field(0.0, gt=0.0, description="constant angular acceleration to the target, rad/s^2")
+    axial_load_n: Number = Field(ge=0.0, description="axial-load set-point, N")
+    dwell_s: Number = Field(0.0, gt=0.0, le=MAX_DWELL_S, description="hold at the target speed, s")
+    until_stable: Flag = Field(False, description="end at the first stable verdict (with timeout_s)")
+    timeout_s: Number = Field(0.0, gt=0.0, le=MAX_TIMEOUT_S, description="longest wait for a stable verdict, s")
+    radial_load_n: Number = Field(0.0, ge=0.0, description="radial-load set-point, N")
+    moment_n_m: Number = Field(0.0, description="moment set-point across the radial load, N m")
+
+
+class ProgramFile(BaseModel):
+    """A test program as its file states it (see the module documentation)."""
+
+    model_config = _FILE
+
+    name: Name = Field(description="program name")
+    description: Annotated[str, BeforeValidator(_text)] = Field("", description="what the program is for")
+    bearing: ConfigFile = Field(description="bearing data file, relative to config/ unless absolute")
+    stability_criterion: Annotated[str, one_of(STABILITY_CRITERIA)] = Field(description="abscissa of the slope criterion")
+    initial_speed_rpm: Number = Field(0.0, ge=0.0, description="the spindle's speed before the first segment, rpm")
+    segments: Annotated[list[SegmentFile], BeforeValidator(_segment_list)] = Field(
+        description="the segments, in order"
+    )
 
 
 def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
@@ -187,76 +270,61 @@ def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
     """
     rig = rig if rig is not None else RigLimits.from_rig_file()
     doc = load_yaml(path)
-    doc.reject_unknown(PROGRAM_KEYS)
-    name = _name(doc, "name")
-    bearing = doc.string("bearing")
-    bearing_file = config_path(*Path(bearing).parts) if not Path(bearing).is_absolute() else Path(bearing)
-    if not bearing_file.is_file():
-        raise doc.error("bearing", f"bearing file not found: {bearing!r} (looked for {bearing_file})")
+    try:
+        stated = ProgramFile.model_validate({k: v for k, v in doc.data.items() if v is not None})
+    except ValidationError as exc:
+        raise doc.error(*first_error(ProgramFile, exc)) from None
     max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
-    initial = doc.number("initial_speed_rpm", ge=0.0, default=0.0)
-    if initial > max_rpm * (1.0 + 1e-12):
-        raise doc.error("initial_speed_rpm", f"{initial:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})")
-    sections = doc.sections("segments")
-    if len(sections) > MAX_SEGMENTS:
-        raise doc.error("segments", f"at most {MAX_SEGMENTS} segments, got {len(sections)}")
+    if stated.initial_speed_rpm > max_rpm * (1.0 + 1e-12):
+        raise doc.error(
+            "initial_speed_rpm",
+            f"{stated.initial_speed_rpm:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})",
+        )
     segments: list[Segment] = []
-    start_speed = rpm_to_rad_s(initial)
+    start_speed = rpm_to_rad_s(stated.initial_speed_rpm)
     seen: set[str] = set()
-    for i, section in enumerate(sections):
-        seg = _segment(section, rig, start_speed)
-        if seg.name in seen:
-            raise ConfigError(doc.source, f"segments[{i}].name", f"duplicate segment name {seg.name!r}")
-        seen.add(seg.name)
+    for i, seg_file in enumerate(stated.segments):
+        if seg_file.name in seen:
+            raise ConfigError(doc.source, f"segments[{i}].name", f"duplicate segment name {seg_file.name!r}")
+        seen.add(seg_file.name)
+        seg = _segment(seg_file, Section({}, doc.source, f"segments[{i}]"), rig, start_speed)
         segments.append(seg)
         start_speed = seg.target_speed
-    description = doc.data.get("description", "")
-    if not isinstance(description, str):
-        raise doc.error("description", f"must be a string, got {description!r}")
     return TestProgram(
-        name=name,
-        description=description.strip(),
-        bearing_file=bearing_file,
-        stability_criterion=doc.choice("stability_criterion", STABILITY_CRITERIA),
-        initial_speed=rpm_to_rad_s(initial),
+        name=stated.name,
+        description=stated.description,
+        bearing_file=stated.bearing,
+        stability_criterion=stated.stability_criterion,
+        initial_speed=rpm_to_rad_s(stated.initial_speed_rpm),
         segments=tuple(segments),
         source=doc.source,
     )
-
-
-def _name(s: Section, key: str) -> str:
-    value = s.string(key)
-    if not NAME_PATTERN.fullmatch(value):
-        raise s.error(key, f"must be 1-64 letters, digits, '_', '.' or '-' (starting with a letter or digit), got {value!r}")
-    return value
 
 
 def _limit(rig: RigLimits, key: str) -> str:
     return f"{key} in {rig.source}"
 
 
-def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
-    """One validated segment, starting from ``start_speed`` (rad/s)."""
-    s.reject_unknown(SEGMENT_KEYS)
-    name = _name(s, "name")
+def _segment(stated: SegmentFile, s: Section, rig: RigLimits, start_speed: float) -> Segment:
+    """One segment checked against the rig and the speed it starts from (``start_speed``,
+    rad/s); ``s`` names its place in the file."""
+    given = stated.model_fields_set
 
     def beyond(key: str, problem: str) -> ConfigError:
-        return s.error(key, f"segment {name!r}: {problem}")
+        return s.error(key, f"segment {stated.name!r}: {problem}")
 
-    if "speed_rpm" not in s.data:
-        raise beyond("speed_rpm", "missing (required): the target speed, with ramp_s or acceleration_rad_s2")
-    rpm = s.number("speed_rpm", ge=0.0)
+    rpm = stated.speed_rpm
     max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
     if rpm > max_rpm * (1.0 + 1e-12):
         raise beyond("speed_rpm", f"{rpm:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})")
     speed = rpm_to_rad_s(rpm)
     change = abs(speed - start_speed)
-    if "ramp_s" in s.data and "acceleration_rad_s2" in s.data:
+    if "ramp_s" in given and "acceleration_rad_s2" in given:
         raise beyond("acceleration_rad_s2", "give either ramp_s (STEP ramp) or acceleration_rad_s2, not both")
     max_accel = rig.max_acceleration_rad_s2
     accel_limit = f"the rig's limit of {max_accel:g} rad/s^2 ({_limit(rig, 'spindle.max_acceleration_rad_s2')})"
-    if "acceleration_rad_s2" in s.data:
-        profile, ramp, accel = SpeedProfileKind.CONSTANT_ACCELERATION, 0.0, s.number("acceleration_rad_s2", gt=0.0)
+    if "acceleration_rad_s2" in given:
+        profile, ramp, accel = SpeedProfileKind.CONSTANT_ACCELERATION, 0.0, stated.acceleration_rad_s2
         if accel > max_accel:
             raise beyond("acceleration_rad_s2", f"{accel:g} rad/s^2 is above {accel_limit}")
         if change / accel > MAX_RAMP_S:
@@ -265,7 +333,7 @@ def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
                 f"{accel:g} rad/s^2 takes {change / accel:.3g} s for the speed change, more than the {MAX_RAMP_S:g} s allowed",
             )
     else:
-        profile, ramp, accel = SpeedProfileKind.STEP, s.number("ramp_s", ge=0.0, le=MAX_RAMP_S, default=0.0), 0.0
+        profile, ramp, accel = SpeedProfileKind.STEP, stated.ramp_s, 0.0
         if change > 0.0 and ramp == 0.0:
             raise beyond("ramp_s", f"the speed changes by {rad_s_to_rpm(change):g} rpm: give ramp_s > 0 (a jump exceeds {accel_limit})")
         if change > 0.0 and STEP_PEAK_FACTOR * change / ramp > max_accel:
@@ -275,35 +343,37 @@ def _segment(s: Section, rig: RigLimits, start_speed: float) -> Segment:
                 f"{ramp:g} s gives a peak acceleration of {STEP_PEAK_FACTOR * change / ramp:.4g} rad/s^2, above "
                 f"{accel_limit}; the shortest ramp is {shortest:.3g} s",
             )
-    load = s.number("axial_load_n", ge=0.0)
+    load = stated.axial_load_n
     if load > rig.max_axial_load_n:
         raise beyond(
             "axial_load_n",
             f"{load:g} N is above the rig's limit of {rig.max_axial_load_n:g} N ({_limit(rig, 'loading_chain.max_setpoint_n')})",
         )
-    radial = s.number("radial_load_n", ge=0.0, default=0.0)
+    radial = stated.radial_load_n
     if radial > rig.max_radial_load_n:
         raise beyond(
             "radial_load_n",
             f"{radial:g} N is above the rig's limit of {rig.max_radial_load_n:g} N ({_limit(rig, 'combined_loading.max_radial_setpoint_n')})",
         )
-    moment = s.number("moment_n_m", default=0.0)
+    moment = stated.moment_n_m
     if abs(moment) > rig.max_moment_n_m:
         raise beyond(
             "moment_n_m",
             f"{moment:g} N m is beyond the rig's limit of {rig.max_moment_n_m:g} N m ({_limit(rig, 'combined_loading.max_moment_setpoint_n_m')})",
         )
-    until_stable = s.boolean("until_stable", default=False)
-    if "until_stable" in s.data and not until_stable:
+    until_stable = stated.until_stable
+    if "until_stable" in given and not until_stable:
         raise beyond("until_stable", "must be true when given; use dwell_s for a fixed duration")
     if until_stable:
-        if "dwell_s" in s.data:
+        if "dwell_s" in given:
             raise beyond("dwell_s", "give either dwell_s or until_stable, not both")
-        dwell, timeout = None, s.number("timeout_s", gt=0.0, le=MAX_TIMEOUT_S)
+        if "timeout_s" not in given:
+            raise s.error("timeout_s", "missing (required)")
+        dwell, timeout = None, stated.timeout_s
     else:
-        if "timeout_s" in s.data:
+        if "timeout_s" in given:
             raise beyond("timeout_s", "only with until_stable: true")
-        if "dwell_s" not in s.data:
+        if "dwell_s" not in given:
             raise beyond("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
-        dwell, timeout = s.number("dwell_s", gt=0.0, le=MAX_DWELL_S), None
-    return Segment(name, speed, profile, ramp, accel, load, dwell, until_stable, timeout, radial, moment)
+        dwell, timeout = stated.dwell_s, None
+    return Segment(stated.name, speed, profile, ramp, accel, load, dwell, until_stable, timeout, radial, moment)

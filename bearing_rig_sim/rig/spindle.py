@@ -12,6 +12,10 @@ from typing import ClassVar
 
 from bearing_rig_sim.rig.parameters import ParameterRecord, bounded
 
+PLAUSIBLE_SPINDLE_SPEED_RAD_S = 4000.0
+"""Top of the plausible range of a bench spindle motor's speed, rad/s (about 38 000 rpm): the
+bound of a rig file's spindle limit and of a node's start speed before the rig file is read."""
+
 
 @dataclass(frozen=True)
 class SpindleConfig(ParameterRecord):
@@ -19,7 +23,7 @@ class SpindleConfig(ParameterRecord):
 
     SECTION: ClassVar[str] = "spindle"
 
-    max_speed_rad_s: float = bounded(gt=0.0, le=4000.0)
+    max_speed_rad_s: float = bounded(gt=0.0, le=PLAUSIBLE_SPINDLE_SPEED_RAD_S)
     """Highest inner-ring speed the drive accepts, rad/s (plausible for a bench spindle motor:
     up to about 38 000 rpm, 4000 rad/s)."""
     max_acceleration_rad_s2: float = bounded(gt=0.0, le=1.0e5)

@@ -8,6 +8,7 @@ simulation clock, recorded to a bag, shown live and summarised.
 * :mod:`.progress`: the live progress line and the summary table (no ROS).
 * :mod:`.context`: run id and the run context stored in the bag (no ROS).
 * :mod:`.lifecycle`: the lifecycle manager's bring-up and shut-down order (no ROS).
+* :mod:`.readiness`: when the nodes are ready to run a program (no ROS).
 * :mod:`.manager`: the lifecycle manager's ``lifecycle_msgs`` calls and ``/diagnostics``.
 * :mod:`.node`: the session's ROS node (commands, recorder subscriptions).
 * :mod:`.session`: :func:`run_session`, which puts it all together.

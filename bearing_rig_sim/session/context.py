@@ -125,10 +125,7 @@ def check_parameter_file(path: Path) -> None:
     import difflib
 
     from bearing_rig_sim.config import ConfigError, read_yaml_file
-    from bearing_rig_sim.load_control.settings import LoadControllerSettings
-    from bearing_rig_sim.monitoring.settings import MonitorSettings, shipped_parameters as monitor_shipped
-    from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS, is_standard
-    from bearing_rig_sim.simulation.settings import SimulatorSettings
+    from bearing_rig_sim.nodes.parameters import NODE_PARAMETERS, NODE_SETTINGS, is_standard
 
     source = str(path)
     data = read_yaml_file(path)
@@ -163,15 +160,10 @@ def check_parameter_file(path: Path) -> None:
                 )
             for n in known:
                 given[n][name] = value
-    shipped = {
-        "simulator": (SimulatorSettings.shipped_parameters, SimulatorSettings.from_values),
-        "load_controller": (LoadControllerSettings.shipped_parameters, LoadControllerSettings.from_values),
-        "monitor": (monitor_shipped, MonitorSettings.from_values),
-    }
     for node, values in given.items():
         if values:
-            defaults, validate = shipped[node]
-            validate({**defaults(), **values}, f"{source}: {node}.ros__parameters")
+            settings = NODE_SETTINGS[node]
+            settings.from_values({**settings.shipped_parameters(), **values}, f"{source}: {node}.ros__parameters")
 
 
 def make_run_id(program_name: str, start: datetime) -> str:

@@ -47,6 +47,7 @@ from bearing_rig_sim.interfaces import (
     TRUTH,
 )
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 from bearing_rig_sim.simulation.health import stopped_reason
@@ -257,21 +258,14 @@ class SessionNode(Node):
         return "; ".join(found)
 
     def missing(self) -> dict[str, str]:
-        """Which node is not ready yet, and what is missing (empty when all are ready)."""
-        missing = {}
-        if self.clock_count == 0:
-            missing["simulator"] = f"no {CLOCK.name} received"
-        elif self.subscribers_besides_recorder(SPINDLE_COMMAND.name) == 0:
-            missing["simulator"] = f"nobody subscribes {SPINDLE_COMMAND.name}"
-        if self.live.state_count == 0:
-            missing["load_controller"] = f"no {AXIAL_LOAD_STATE.name} received"
-        elif self.subscribers_besides_recorder(AXIAL_LOAD_SETPOINT.name) == 0:
-            missing["load_controller"] = f"nobody subscribes {AXIAL_LOAD_SETPOINT.name}"
-        if self.count_publishers(SLIP_STATUS.name) == 0:
-            missing["monitor"] = f"nobody publishes {SLIP_STATUS.name}"
-        elif self.subscribers_besides_recorder(CAGE_PULSES.name) == 0:
-            missing["monitor"] = f"nobody subscribes {CAGE_PULSES.name}"
-        return missing
+        """Which node is not ready yet, and what is missing (empty when all are ready;
+        :func:`~bearing_rig_sim.session.readiness.not_ready`)."""
+        return not_ready(
+            clock_seen=self.clock_count > 0,
+            load_state_seen=self.live.state_count > 0,
+            subscribers=self.subscribers_besides_recorder,
+            publishers=self.count_publishers,
+        )
 
     # -- recording --------------------------------------------------------------------------------
     def take(self) -> int:

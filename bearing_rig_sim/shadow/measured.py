@@ -17,7 +17,6 @@ Units: s, rad/s.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 from bearing_rig_sim.monitoring import MonitorSettings, SlipWindow, SlipWindows
@@ -39,7 +38,7 @@ class MeasuredWindows:
 
     def __init__(self, window_revolutions: int, monitor_settings: MonitorSettings | None = None) -> None:
         base = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
-        self.settings = dataclasses.replace(base, window_revolutions=window_revolutions)
+        self.settings = base.replace(window_revolutions=window_revolutions)
         self._counter = SlipWindows(window_revolutions, self.settings.loss_rules(), self.settings.clock_jump_tolerance_s)
         self._invalid: dict[str, tuple[float | None, str]] = {}
 

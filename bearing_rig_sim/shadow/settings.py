@@ -4,24 +4,20 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Annotated, ClassVar
 
 from pydantic import ValidationInfo, field_validator
 
 from bearing_rig_sim.config import load_yaml
 from bearing_rig_sim.interfaces import DIAGNOSTICS
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
-from bearing_rig_sim.simulation.settings import existing_config_file
+from bearing_rig_sim.dynamics.engine import MODELS
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param
 
 NODE_NAME = "shadow"
 """The shadow node's name: the key of its block in a ROS 2 parameter file."""
 
 SHIPPED_FILE = "shadow.yaml"
 """The shipped parameter file, under ``config/``."""
-
-MODELS = ("reduced", "stiff")
-"""The engine's models (``reduced`` runs in real time)."""
-
 
 class ShadowSettings(NodeSettings):
     """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason), declared
@@ -31,51 +27,35 @@ class ShadowSettings(NodeSettings):
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-    bearing_file: Path = param("bearing data file (absolute, or relative to config/)")
-    calibration_file: Path | None = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
-    model: str = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
-    chunk_s: Number = param("engine advance per call", unit="s", gt=0.0, le=0.1)
+    bearing_file: ConfigFile = param("bearing data file (absolute, or relative to config/)")
+    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
+    model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    chunk_s: Number = param("engine advance per call (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
     window_revolutions: Integer = param("whole cage revolutions per slip window (the monitor's)", unit="1", ge=1, le=1000)
-    min_inner_ring_speed_rad_s: Number = param("slower windows are not compared", unit="rad/s", gt=0.0)
+    min_inner_ring_speed_rad_s: Number = param("windows slower than this are not compared", unit="rad/s", gt=0.0, le=1000.0)
     calibration_rms_slip_pct: Number = param(
-        "the calibration's RMS slip error (negative: read from the calibration file)", unit="percentage points", lt=100.0
+        "calibration RMS of the slip (negative: the calibration file's rms_slip_pct)", unit="%", ge=-1.0, le=10.0
     )
-    timing_jitter_std_s: Number = param("the bench sensors' pulse-timing jitter", unit="s", ge=0.0, le=1e-3)
-    band_coverage: Number = param("band half-width in standard uncertainties", unit="1", gt=0.0, le=10.0)
-    warn_after_s: Number = param("a residual outside the band longer than this is a WARN", unit="s", gt=0.0)
-    error_after_s: Number = param("... longer than this an ERROR (more than warn_after_s)", unit="s")
+    timing_jitter_std_s: Number = param("pulse-timing jitter of the bench's fibre-optic sensors", unit="s", ge=0.0, le=1e-3)
+    band_coverage: Number = param("band half-width in combined standard uncertainties", unit="1", gt=0.0, le=10.0)
+    warn_after_s: Number = param("a residual outside its band longer than this is a WARN (bench time)", unit="s", gt=0.0, le=600.0)
+    error_after_s: Number = param(
+        "a residual outside its band longer than this is an ERROR; > warn_after_s", unit="s", gt=0.0, le=3600.0
+    )
     settle_s: Number = param("windows starting sooner than this after an engine (re)start are not compared", unit="s", ge=0.0, le=10.0)
-    max_speed_gap_s: Number = param("speed points further apart restart the engine", unit="s", gt=0.0)
+    max_speed_gap_s: Number = param("spindle speed points further apart restart the engine", unit="s", gt=0.0, le=60.0)
     load_average_s: Number = param("averaging time of the load-cell force", unit="s", gt=0.0, le=10.0)
-    load_timeout_s: Number = param("no load-cell sample for this long is a dropout", unit="s", gt=0.0)
-    recalibrate: Flag = param("track a calibration parameter online")
-    recalibrate_parameter: str = param("the calibration file's parameter tracked (section.key; '' = its first)")
-    forgetting_factor: Number = param("of the recursive least squares, per compared steady window", unit="1", gt=0.5, le=1.0)
-    probe_step_fraction: Number = param("initial offset of the probe engine from the calibrated value", unit="1", gt=0.0, lt=1.0)
+    load_timeout_s: Number = param("no load-cell sample for this long is a dropout", unit="s", gt=0.0, le=60.0)
+    recalibrate: Flag = param("track a calibration parameter online (recursive least squares)")
+    recalibrate_parameter: str = param("the calibration file's parameter tracked ('section.key'; '' = its first one)")
+    forgetting_factor: Number = param("forgetting factor of the recursive least squares, per compared steady window", unit="1", gt=0.5, le=1.0)
+    probe_step_fraction: Number = param("initial offset of the probe engine from the calibrated value", unit="1", gt=0.0, le=0.5)
     steady_speed_fraction: Number = param(
-        "windows whose spindle speed is within this fraction of the previous one's are steady", unit="1", ge=0.0, lt=1.0
+        "windows within this fraction of the previous one's spindle speed are steady", unit="1", ge=0.0, le=0.5
     )
-    status_rate_hz: Number = param("status publication rate of the node (wall clock)", unit="Hz", gt=0.0)
-    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0)
-
-    @field_validator("bearing_file", mode="before")
-    @classmethod
-    def _bearing_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw)
-
-    @field_validator("calibration_file", mode="before")
-    @classmethod
-    def _calibration_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw, empty_ok=True)
-
-    @field_validator("model", mode="before")
-    @classmethod
-    def _model(cls, raw: object) -> str:
-        if raw not in MODELS:
-            raise ValueError(f"must be one of {', '.join(MODELS)}, got {raw!r}")
-        return str(raw)
+    status_rate_hz: Number = param("checks of the twin per second (wall clock), plus each change of level", unit="Hz", gt=0.0, le=1000.0)
+    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
 
     @field_validator("recalibrate_parameter", mode="before")
     @classmethod
@@ -105,10 +85,6 @@ class ShadowSettings(NodeSettings):
                 + ("no calibration file is given" if calibration is None else f"{calibration} has none")
             )
         return rms
-
-    def replace(self, **changes: Any) -> ShadowSettings:
-        """A copy with some values changed (not re-validated: for tests and the command line)."""
-        return self.model_copy(update=changes)
 
 
 def calibration_rms(path: Path | None) -> float | None:

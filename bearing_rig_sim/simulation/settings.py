@@ -10,16 +10,34 @@ File parameters (bearing, calibration, rig) are relative to ``config/`` unless a
 
 from __future__ import annotations
 
-from pathlib import Path
-from typing import Any, ClassVar
+from typing import Annotated, Any, ClassVar
 
 from pydantic import PrivateAttr, ValidationInfo, field_validator
 
-from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics.engine import MODELS
 from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
-from bearing_rig_sim.rig.spindle import SpindleConfig
-from bearing_rig_sim.settings_model import Flag, Integer, NodeSettings, Number, param
+from bearing_rig_sim.rig.spindle import PLAUSIBLE_SPINDLE_SPEED_RAD_S, SpindleConfig
+from bearing_rig_sim.settings_model import (
+    ConfigFile,
+    Flag,
+    Integer,
+    NodeSettings,
+    Number,
+    OptionalConfigFile,
+    existing_config_file,
+    one_of,
+    param,
+    resolve_config_file,
+)
+
+__all__ = [
+    "NODE_NAME",
+    "SHIPPED_FILE",
+    "SimulatorSettings",
+    "existing_config_file",
+    "resolve_config_file",
+    "shipped_parameters",
+]
 
 NODE_NAME = "simulator"
 """The simulator node's name: the key of its block in a ROS 2 parameter file."""
@@ -28,79 +46,47 @@ SHIPPED_FILE = "simulator.yaml"
 """The shipped parameter file, under ``config/``."""
 
 
-def resolve_config_file(value: str) -> Path | None:
-    """A file parameter as a path: None for ``""``, as given if absolute, else under ``config/``."""
-    if not value:
-        return None
-    path = Path(value)
-    return path if path.is_absolute() else config_path(*path.parts)
-
-
-def existing_config_file(raw: object, *, empty_ok: bool = False) -> Path | None:
-    """A file parameter that must exist (absolute or under ``config/``); ``""`` is None where
-    ``empty_ok``. Raises ValueError with the problem (a settings validator's error)."""
-    if not isinstance(raw, str) or (not raw and not empty_ok):
-        raise ValueError(f"must be a file name (absolute or relative to config/), got {raw!r}")
-    path = resolve_config_file(raw)
-    if path is not None and not path.is_file():
-        raise ValueError(f"file not found: {raw!r} (looked for {path})")
-    return path
-
-
 class SimulatorSettings(NodeSettings):
     """The simulator node's validated parameters (SI units; the unit is in each name), declared
     once (:mod:`bearing_rig_sim.settings_model`).
 
     ``initial_speed_rad_s`` is at most the rig file's spindle speed limit. The spindle's limits
     (:attr:`max_spindle_speed_rad_s`, :attr:`max_spindle_acceleration_rad_s2`) are the rig
-    file's ``spindle`` section, not node parameters. The ROS descriptors of these parameters are
-    still listed in :mod:`bearing_rig_sim.nodes.parameters` (a test keeps them inside these
-    ranges).
+    file's ``spindle`` section, not node parameters. The node's ROS descriptors are these fields
+    (:mod:`bearing_rig_sim.nodes.parameters`).
     """
 
     NODE_NAME: ClassVar[str] = NODE_NAME
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
-    OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
-    bearing_file: Path = param("bearing data file (absolute, or relative to the package's config/)")
-    calibration_file: Path | None = param("calibration laid over the bearing data ('' = none; relative to config/)")
-    rig_file: Path = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
-    model: str = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
-    chunk_s: Number = param(f"simulated time per engine call and per {CLOCK.name} message (whole engine steps)", unit="s", gt=0.0, le=0.1)
+    bearing_file: ConfigFile = param("bearing data file (absolute, or relative to the package's config/)")
+    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = none; relative to config/)")
+    rig_file: ConfigFile = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
+    model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    chunk_s: Number = param(
+        f"simulated time per engine call and per {CLOCK.name} message (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1
+    )
     realtime: Flag = param("lock the simulated time to the wall clock (false: as fast as possible)")
     rate: Number = param("simulated seconds per wall second when in real time", unit="1", gt=0.0, le=100.0)
-    loop_period_s: Number = param("period of the loop timer in real time (wall clock)", unit="s", gt=0.0, le=0.1)
+    loop_period_s: Number = param("period of the loop timer in real time (wall clock)", unit="s", ge=1e-4, le=0.1)
     max_batch_chunks: Integer = param("most chunks computed per loop call", unit="1", ge=1, le=10_000)
-    overrun_margin_s: Number = param("lag behind the wall clock counted as an overrun", unit="s", gt=0.0)
-    resync_lag_s: Number = param("lag behind the wall clock beyond which the debt is dropped", unit="s", gt=0.0)
-    rtf_window_s: Number = param("sliding window of the reported real-time factor (wall clock)", unit="s", gt=0.0)
-    initial_speed_rad_s: Number = param("spindle speed at start (at most the rig's spindle limit)", unit="rad/s", ge=0.0)
-    initial_axial_load_n: Number = param("axial load until the loading chain's first force message", unit="N", ge=0.0)
-    max_command_lead_s: Number = param("how far ahead of the rig clock a command's stamp may be", unit="s", ge=0.0)
-    counter_timeout_s: Number = param("the pulse counters show 0 after this long without a pulse", unit="s", gt=0.0)
-    speeds_rate_hz: Number = param(f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", unit="Hz", gt=0.0)
-    truth_rate_hz: Number = param(f"rate of {TRUTH.name} in simulated time", unit="Hz", gt=0.0)
-    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0)
-    fault_hold_s: Number = param(f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0)
+    overrun_margin_s: Number = param("lag behind the wall clock counted as an overrun", unit="s", gt=0.0, le=10.0)
+    resync_lag_s: Number = param("lag behind the wall clock beyond which the debt is dropped", unit="s", gt=0.0, le=60.0)
+    rtf_window_s: Number = param("sliding window of the reported real-time factor (wall clock)", unit="s", gt=0.0, le=600.0)
+    initial_speed_rad_s: Number = param(
+        "spindle speed at start (at most the rig file's spindle limit)", unit="rad/s", ge=0.0, le=PLAUSIBLE_SPINDLE_SPEED_RAD_S
+    )
+    initial_axial_load_n: Number = param("axial load until the loading chain's first force message", unit="N", ge=0.0, le=10_000.0)
+    max_command_lead_s: Number = param("how far ahead of the rig clock a command's stamp may be", unit="s", ge=0.0, le=3600.0)
+    counter_timeout_s: Number = param("the pulse counters show 0 after this long without a pulse", unit="s", gt=0.0, le=60.0)
+    speeds_rate_hz: Number = param(f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", unit="Hz", gt=0.0, le=100_000.0)
+    truth_rate_hz: Number = param(f"rate of {TRUTH.name} in simulated time", unit="Hz", gt=0.0, le=100_000.0)
+    diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
+    fault_hold_s: Number = param(
+        f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0, le=600.0
+    )
 
     _spindle: SpindleConfig = PrivateAttr()
-
-    @field_validator("bearing_file", "rig_file", mode="before")
-    @classmethod
-    def _required_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw)
-
-    @field_validator("calibration_file", mode="before")
-    @classmethod
-    def _optional_file(cls, raw: object) -> Path | None:
-        return existing_config_file(raw, empty_ok=True)
-
-    @field_validator("model", mode="before")
-    @classmethod
-    def _model(cls, raw: object) -> str:
-        if raw not in MODELS:
-            raise ValueError(f"must be one of {', '.join(MODELS)}, got {raw!r}")
-        return str(raw)
 
     @field_validator("initial_speed_rad_s")
     @classmethod

@@ -20,7 +20,7 @@ PACKAGE = "bearing_rig_sim"
 FLOORS: tuple[tuple[str, frozenset[str]], ...] = (
     (
         "foundation: the contract, configuration, errors and plumbing",
-        frozenset({"", "errors", "config", "interfaces", "health", "clock_guard", "dds_profile", "executors", "settings_model"}),
+        frozenset({"", "errors", "config", "interfaces", "health", "clock_guard", "dds_profile", "executors", "settings_model", "numba_cache"}),
     ),
     ("models: the bearing's dynamics, the rig's models, analysis, bag files", frozenset({"dynamics", "thermal", "rig", "analysis", "bags"})),
     (

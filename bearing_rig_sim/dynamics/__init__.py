@@ -16,6 +16,9 @@ from bearing_rig_sim.dynamics.engine import (
 )
 from bearing_rig_sim.dynamics.parameters import BearingParameters, DerivedGeometry, derive
 from bearing_rig_sim.dynamics.step_limit import OperatingEnvelope, StepLimit, StepLimitError
+from bearing_rig_sim.numba_cache import refresh_once
+
+refresh_once()  # numba reads a cache at a function's first call; see numba_cache
 
 __all__ = [
     "MIN_AXIAL_LOAD",

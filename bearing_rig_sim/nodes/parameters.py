@@ -125,6 +125,9 @@ SIMULATOR = [
     ParameterSpec("rtf_window_s", "sliding window of the reported real-time factor (wall clock)", "s", 0.0, 600.0, low_exclusive=True),
     ParameterSpec("initial_speed_rad_s", "spindle speed at start", "rad/s", 0.0, 1000.0),
     ParameterSpec("initial_axial_load_n", "axial load until the loading chain's first force message", "N", 0.0, 10_000.0),
+    ParameterSpec(
+        "initial_temperature_rise_k", "start temperature of the bearing's thermal network above the bearing file's ambient (0: a cold start)", "K", 0.0, 150.0
+    ),
     ParameterSpec("max_command_lead_s", "how far ahead of the rig clock a command's stamp may be", "s", 0.0, 3600.0),
     ParameterSpec("counter_timeout_s", "the pulse counters show 0 after this long without a pulse", "s", 0.0, 60.0, low_exclusive=True),
     ParameterSpec("speeds_rate_hz", f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", "Hz", 0.0, 100_000.0, low_exclusive=True),

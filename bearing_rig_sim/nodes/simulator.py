@@ -301,12 +301,13 @@ class SimulatorNode(ManagedNode):
 
     # -- the thermocouple and the torque meter -------------------------------------------------
     def _configure_bench_sensors(self, bearing_file: Any) -> None:
-        """Couple the bearing's thermal network (one way: the engine keeps its parameters'
-        lubricant temperature, so the session's slip is the calibrated one) and publish the
-        outer-ring thermocouple and the housing torque meter; a bearing file without a
+        """Couple the bearing's thermal network both ways (the engine's lubricant follows the
+        lubricant node every network step, 0.1 s: the session warms up from ambient and its
+        slip with it; :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`) and publish
+        the outer-ring thermocouple and the housing torque meter; a bearing file without a
         ``thermal:`` section has neither."""
         try:
-            self.twin.attach_thermal(bearing_file, feedback=False)
+            self.twin.attach_thermal(bearing_file, initial_rise_k=self.settings.initial_temperature_rise_k)
         except ConfigError as exc:
             self.get_logger().info(f"no thermocouple or torque meter: {exc}")
             return

@@ -76,6 +76,9 @@ class SimulatorSettings(NodeSettings):
     rtf_window_s: Number = param("sliding window of the reported real-time factor (wall clock)", unit="s", gt=0.0)
     initial_speed_rad_s: Number = param("spindle speed at start (at most the rig's spindle limit)", unit="rad/s", ge=0.0)
     initial_axial_load_n: Number = param("axial load until the loading chain's first force message", unit="N", ge=0.0)
+    initial_temperature_rise_k: Number = param(
+        "start temperature of the bearing's thermal network above the bearing file's ambient (0: a cold start)", unit="K", ge=0.0, le=150.0
+    )
     max_command_lead_s: Number = param("how far ahead of the rig clock a command's stamp may be", unit="s", ge=0.0)
     counter_timeout_s: Number = param("the pulse counters show 0 after this long without a pulse", unit="s", gt=0.0)
     speeds_rate_hz: Number = param(f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", unit="Hz", gt=0.0)

@@ -216,11 +216,17 @@ class RigTwin:
         """The bearing's thermal network, when attached (:meth:`attach_thermal`): it takes the
         engine's heat chunk by chunk and sets the lubricant's temperature."""
 
-    def attach_thermal(self, bearing_file: str | Path | None = None, **options: Any) -> ThermalCoupling:
+    def attach_thermal(self, bearing_file: str | Path | None = None, *, initial_rise_k: float = 0.0, **options: Any) -> ThermalCoupling:
         """Couple the bearing's thermal network (the bearing file's ``thermal:`` section; default
-        the shipped H7006C) to the engine from the next chunk on; ``options`` are those of
-        :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`."""
-        self.thermal = ThermalCoupling(self.engine, ThermalConfig.from_yaml(bearing_file), **options)
+        the shipped H7006C) to the engine from the next chunk on, every node starting
+        ``initial_rise_k`` (K, >= 0) above the file's ambient; ``options`` are those of
+        :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling` (by default coupled both ways:
+        the engine's lubricant follows the lubricant node every 0.1 s)."""
+        if not math.isfinite(initial_rise_k) or initial_rise_k < 0.0:
+            raise TwinError(f"initial_rise_k: must be a finite number >= 0 K, got {initial_rise_k!r}")
+        config = ThermalConfig.from_yaml(bearing_file)
+        options.setdefault("initial", config.ambient + initial_rise_k)
+        self.thermal = ThermalCoupling(self.engine, config, **options)
         return self.thermal
 
     @classmethod

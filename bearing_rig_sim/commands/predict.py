@@ -112,12 +112,22 @@ def _uncertainty(args: argparse.Namespace) -> Any:
     return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
 
 
-def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float) -> None:
+def _thermal_calibration(args: argparse.Namespace) -> bool:
+    """Whether the calibration in use was fitted through the thermal steady states
+    (``calibration.thermal`` of its file)."""
+    if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
+        return False
+    doc = load_yaml(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+    return "calibration" in doc and bool(doc.section("calibration").data.get("thermal", False))
+
+
+def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float, thermal: Any = None) -> None:
     """``slip_pct_low`` / ``slip_pct_high``: the 95 % interval from the parameter and load
-    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`)."""
+    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`; with ``thermal``,
+    through the coupled thermal steady state)."""
     from bearing_rig_sim.studies.uncertainty import slip_interval
 
-    low, high, _ = slip_interval(params, unc, omega, load, slip)
+    low, high, _ = slip_interval(params, unc, omega, load, slip, thermal)
     row["slip_pct_low"] = round(low, 4)
     row["slip_pct_high"] = round(high, 4)
 
@@ -175,7 +185,11 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
         row["thermal_residual_k"] = round(ts.residual_k, 3)
         unc = _uncertainty(args)
         if unc is not None:
-            _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
+            if _thermal_calibration(args):
+                # fitted through the thermal steady states: so are the interval's gradients
+                _add_interval(row, params, unc, omega, f, pt.slip_pct, cfg)
+            else:
+                _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
         iso = steady_states(params, [(omega, f)], workers=1)[0]
         row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso.slip_pct, 4), "friction_torque_nm": round(iso.friction_torque, 6)}
         _print(row, args.json)

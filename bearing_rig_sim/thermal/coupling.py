@@ -284,6 +284,8 @@ class ThermalCoupling:
             (:class:`TractionTableGrid`; the tables bracketing the start temperature are built
             here, about a second); False keeps the bearing file's table (the resistances still
             follow).
+        grid: a traction grid of this bearing built beforehand (its tables around the start
+            temperature are built here when missing); default a new one.
     """
 
     def __init__(
@@ -296,6 +298,7 @@ class ThermalCoupling:
         initial: float | None = None,
         feedback: bool = True,
         tables: bool = True,
+        grid: TractionTableGrid | None = None,
     ) -> None:
         if not math.isfinite(interval) or interval <= 0.0:
             raise ValueError(f"interval must be > 0 s, got {interval!r}")
@@ -319,7 +322,7 @@ class ThermalCoupling:
         self._slice_pending = 0.0
         self._previous_temperature = -math.inf
         if self.feedback and tables and self.params.lubricant is not None and self.params.friction_model == "rheology":
-            self.grid = TractionTableGrid(self.params)
+            self.grid = grid if grid is not None else TractionTableGrid(self.params)
             lo, hi, _ = self.grid.bracket(self.network.temperature("lubricant"))
             self.grid.build_now(lo)
             self.grid.build_now(hi)
@@ -389,8 +392,8 @@ class ThermalCoupling:
         if grid is None:
             return
         lo, hi, w = grid.bracket(temperature_c)
-        # the two neighbours (the nearer first), then the next two the way the lubricant goes
-        ahead = (hi + 1, hi + 2) if temperature_c >= self._previous_temperature else (lo - 1, lo - 2)
+        # the two neighbours (the nearer first), then the next one the way the lubricant goes
+        ahead = (hi + 1,) if temperature_c >= self._previous_temperature else (lo - 1,)
         grid.want(*((hi, lo) if w >= 0.5 else (lo, hi)), *ahead)
         self._previous_temperature = float(temperature_c)
         got = grid.blend(temperature_c)

@@ -57,9 +57,7 @@ class ClockGuard:
         ValueError: an argument out of range.
     """
 
-    def __init__(
-        self, *, max_step_ns: int = DEFAULT_MAX_STEP_NS, confirmations: int = DEFAULT_CONFIRMATIONS, name: str = CLOCK.name
-    ) -> None:
+    def __init__(self, *, max_step_ns: int = DEFAULT_MAX_STEP_NS, confirmations: int = DEFAULT_CONFIRMATIONS, name: str = CLOCK.name) -> None:
         if isinstance(max_step_ns, bool) or not isinstance(max_step_ns, int) or max_step_ns <= 0:
             raise ValueError(f"max_step_ns: must be a positive integer, got {max_step_ns!r}")
         if isinstance(confirmations, bool) or not isinstance(confirmations, int) or confirmations < 1:
@@ -100,8 +98,7 @@ class ClockGuard:
             self.jumps += 1
             return ClockVerdict(
                 True,
-                f"{self.name}: jumped from {previous * 1e-9:.9g} s to {stamp_ns * 1e-9:.9g} s "
-                f"(confirmed by {self.confirmations} stamps in a row)",
+                f"{self.name}: jumped from {previous * 1e-9:.9g} s to {stamp_ns * 1e-9:.9g} s (confirmed by {self.confirmations} stamps in a row)",
             )
         self.refused += 1
         direction = "back" if stamp_ns < self.last_ns else "ahead"

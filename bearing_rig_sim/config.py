@@ -92,9 +92,7 @@ class _BoundedSafeLoader(yaml.SafeLoader):
         try:
             if self._depth > MAX_YAML_DEPTH:
                 event = self.peek_event()
-                raise yaml.composer.ComposerError(
-                    None, None, f"nested deeper than {MAX_YAML_DEPTH} levels", event.start_mark
-                )
+                raise yaml.composer.ComposerError(None, None, f"nested deeper than {MAX_YAML_DEPTH} levels", event.start_mark)
             return super().compose_node(parent, index)
         finally:
             self._depth -= 1
@@ -264,9 +262,7 @@ class Section:
             raise self.error(key, f"must be one of {', '.join(map(str, allowed))}, got {value!r}")
         return str(value)
 
-    def number_list(
-        self, key: str, *, gt: float | None = None, ge: float | None = None, min_len: int = 1, default: Any = _MISSING
-    ) -> list[float]:
+    def number_list(self, key: str, *, gt: float | None = None, ge: float | None = None, min_len: int = 1, default: Any = _MISSING) -> list[float]:
         """A list of finite numbers, each within the bounds."""
         value = self._get(key, default)
         if not isinstance(value, list) or len(value) < min_len:

@@ -169,9 +169,7 @@ AXIAL_LOAD_SETPOINT = Topic(
     "program runner, user",
     stamped=False,
 )
-AXIAL_LOAD_STATE = Topic(
-    "/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", "100 Hz (sim)", "N, A", "load controller"
-)
+AXIAL_LOAD_STATE = Topic("/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", "100 Hz (sim)", "N, A", "load controller")
 AXIAL_LOAD_FORCE = Topic(
     "/rig/axial_load/force",
     "geometry_msgs/msg/WrenchStamped",
@@ -233,9 +231,7 @@ HOUSING_TORQUE = Topic(
     "simulator (bench: torque meter on the housing)",
     note="torque.z, the friction torque about the spindle axis",
 )
-DIAGNOSTICS = Topic(
-    "/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node"
-)
+DIAGNOSTICS = Topic("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node")
 
 TOPICS: tuple[Topic, ...] = (
     CLOCK,
@@ -260,9 +256,7 @@ TOPICS: tuple[Topic, ...] = (
 PULSE_TOPICS: dict[str, Topic] = {"spindle": SPINDLE_PULSES, "cage": CAGE_PULSES}
 """The two fibre-optic pulse streams by shaft."""
 
-AXIAL_LOAD_SET = Service(
-    "/rig/axial_load/set", "bearing_rig_msgs/srv/SetAxialLoad", "N", "load controller (server)"
-)
+AXIAL_LOAD_SET = Service("/rig/axial_load/set", "bearing_rig_msgs/srv/SetAxialLoad", "N", "load controller (server)")
 AXIAL_LOAD_RESET_FAULT = Service(
     "/rig/axial_load/reset_fault",
     "std_srvs/srv/Trigger",

@@ -348,4 +348,3 @@ class NodeSettings(BaseModel):
                 )
             )
         return out
-

@@ -112,7 +112,6 @@ def lease_domain(timeout: float = 60.0) -> DomainLease:
         time.sleep(0.2)
 
 
-
 def processes_on_domain(domain_id: int) -> dict[int, str]:
     """Live processes of this host (other than this one) whose environment sets
     ``ROS_DOMAIN_ID=domain_id``: pid -> command line. Empty where ``/proc`` cannot be read."""
@@ -162,6 +161,7 @@ def _prepare_child() -> None:  # runs in the child between fork and exec
         ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)
     except (OSError, AttributeError):
         pass
+
 
 class RosGraph:
     """One test's private ROS graph: its domain id, environment and the ROS objects to clean up.
@@ -220,9 +220,7 @@ class RosGraph:
         self._executors.append(executor)
         return executor
 
-    def spin_until(
-        self, condition: Callable[[], bool], timeout: float, nodes: Sequence[Any] = (), executor: Any = None
-    ) -> bool:
+    def spin_until(self, condition: Callable[[], bool], timeout: float, nodes: Sequence[Any] = (), executor: Any = None) -> bool:
         """Spin ``executor`` (or a new one over ``nodes``) until ``condition()`` or ``timeout`` s.
 
         Returns:
@@ -330,9 +328,7 @@ def ros_graph(monkeypatch: pytest.MonkeyPatch) -> Iterator[RosGraph]:
 def start_run(ros_graph: RosGraph, program: Path, run_dir: Path, *extra: str) -> subprocess.Popen[str]:
     """Start ``bearing-rig run PROGRAM --no-realtime`` on the test's graph, recording under
     ``run_dir/bags``; stopped at teardown whatever the test's outcome."""
-    return ros_graph.spawn_python(
-        "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(run_dir / "bags"), *extra
-    )
+    return ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(run_dir / "bags"), *extra)
 
 
 def the_bag(run_dir: Path) -> Path:

@@ -32,8 +32,10 @@ from bearing_rig_sim.bags.typestore import msg_folder
 from conftest import write_foreign_metadata
 
 HEADER_DEPENDENCIES = (
-    "=" * 80 + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
-    + "=" * 80 + "\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+    "=" * 80
+    + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
+    + "=" * 80
+    + "\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
 )
 TEMPERATURE_SCHEMA = "float64 temperature   # K\nstring sensor\n"
 JOINT_STATE_SCHEMA = "std_msgs/Header header\nstring[] name\nfloat64[] position\nfloat64[] velocity\nfloat64[] effort\n" + HEADER_DEPENDENCIES
@@ -52,10 +54,7 @@ def anyreader_messages(path: Path, topics: set[str] | None = None) -> list[tuple
     store = rig_typestore()
     with AnyReader([path]) as reader:
         connections = [c for c in reader.connections if topics is None or c.topic in topics]
-        return [
-            (c.topic, t, message_fields(reader.deserialize(raw, c.msgtype), c.msgtype, store))
-            for c, t, raw in reader.messages(connections=connections)
-        ]
+        return [(c.topic, t, message_fields(reader.deserialize(raw, c.msgtype), c.msgtype, store)) for c, t, raw in reader.messages(connections=connections)]
 
 
 def chunk_message_counts(mcap_path: Path) -> list[tuple[int, int, int]]:
@@ -87,8 +86,7 @@ def test_reader_agrees_with_anyreader(traffic_bag: tuple[Path, int]) -> None:
         assert bag.message_count == count == len(expected)
         assert bag.start_ns == expected[0][1] and bag.end_ns == expected[-1][1]
         assert {name: (info.msgtype, info.message_count) for name, info in bag.topics.items()} == {
-            topic: (msgtype, sum(1 for t, _time, _f in expected if t == topic))
-            for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()
+            topic: (msgtype, sum(1 for t, _time, _f in expected if t == topic)) for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()
         }
         # the contract's reliable_stream profile, as offered by the twin (docs/interfaces.md)
         speeds_qos = bag.topics[SPEEDS_TOPIC].qos
@@ -131,7 +129,14 @@ def test_bag_from_an_independent_writer(tmp_path: Path) -> None:
         temperature = writer.register_msgdef("bench_msgs/msg/Temperature", TEMPERATURE_SCHEMA)
         for index in range(300):
             stamp = {"sec": index // 100, "nanosec": (index % 100) * 10_000_000}
-            message = {"header": {"stamp": stamp, "frame_id": "bench"}, "sensor_id": "cage", "strip_id": 0, "strip_count": 1, "revolution": index, "pulse_index": index}
+            message = {
+                "header": {"stamp": stamp, "frame_id": "bench"},
+                "sensor_id": "cage",
+                "strip_id": 0,
+                "strip_count": 1,
+                "revolution": index,
+                "pulse_index": index,
+            }
             writer.write_message("/rig/cage/pulses", pulse, message, log_time=index * 10_000_000 + 7)
             sent.append(("/rig/cage/pulses", message))
             if index % 10 == 0:
@@ -139,7 +144,9 @@ def test_bag_from_an_independent_writer(tmp_path: Path) -> None:
                 writer.write_message("/bench/temperature", temperature, reading, log_time=index * 10_000_000 + 9)
                 sent.append(("/bench/temperature", reading))
         writer.finish()
-    write_foreign_metadata(bag, [("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", 300), ("/bench/temperature", "bench_msgs/msg/Temperature", 30)], ["bench.mcap"])
+    write_foreign_metadata(
+        bag, [("/rig/cage/pulses", "bearing_rig_msgs/msg/FibreOpticPulse", 300), ("/bench/temperature", "bench_msgs/msg/Temperature", 30)], ["bench.mcap"]
+    )
 
     with warnings.catch_warnings():
         warnings.simplefilter("error", BagWarning)
@@ -278,7 +285,10 @@ def test_empty_file_of_a_split_bag_is_reported(tmp_path: Path, traffic_bag: tupl
     [
         ("rosbag2_bagfile_information: [unclosed", "not valid YAML"),
         ("something_else: {}", "rosbag2_bagfile_information is missing"),
-        ("rosbag2_bagfile_information: {version: 9, storage_identifier: rosbag_v1, relative_file_paths: [], topics_with_message_count: []}", "storage .rosbag_v1. is not supported"),
+        (
+            "rosbag2_bagfile_information: {version: 9, storage_identifier: rosbag_v1, relative_file_paths: [], topics_with_message_count: []}",
+            "storage .rosbag_v1. is not supported",
+        ),
         ("rosbag2_bagfile_information: {version: 9, storage_identifier: mcap}", "relative_file_paths is missing"),
         # hostile metadata: an alias bomb (a few hundred bytes, gigabytes once expanded) and nesting
         # that used to end in a RecursionError

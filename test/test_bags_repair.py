@@ -278,7 +278,10 @@ def test_empty_file_left_at_a_rollover_gets_the_topics(tmp_path: Path) -> None:
 
     report = repair_bag(bag)
 
-    assert [(f.name, f.action, f.messages_recovered) for f in report.files] == [("run_0.mcap", "intact", report.messages_recovered), ("run_1.mcap", "rebuilt", 0)]
+    assert [(f.name, f.action, f.messages_recovered) for f in report.files] == [
+        ("run_0.mcap", "intact", report.messages_recovered),
+        ("run_1.mcap", "rebuilt", 0),
+    ]
     info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
     assert info["relative_file_paths"] == ["run_0.mcap", "run_1.mcap"]
     with open(bag / "run_1.mcap", "rb") as stream:

@@ -57,10 +57,7 @@ def storage_files(bag: Path) -> list[Path]:
 def read_with_anyreader(bag: Path) -> list[tuple[str, int, dict]]:
     store = rig_typestore()
     with AnyReader([bag]) as reader:
-        return [
-            (conn.topic, stamp, message_fields(reader.deserialize(raw, conn.msgtype), conn.msgtype, store))
-            for conn, stamp, raw in reader.messages()
-        ]
+        return [(conn.topic, stamp, message_fields(reader.deserialize(raw, conn.msgtype), conn.msgtype, store)) for conn, stamp, raw in reader.messages()]
 
 
 def read_with_mcap(bag: Path) -> list[tuple[str, int, dict]]:

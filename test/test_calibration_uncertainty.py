@@ -63,7 +63,18 @@ def test_shipped_calibration_states_its_uncertainty() -> None:
 
 @pytest.mark.slow
 def test_predict_gives_a_95_percent_interval(capsys: pytest.CaptureFixture[str]) -> None:
-    argv = ["predict", "--rpm", "1200", "--load", "100", "--json", "--bearing", str(CONFIG / "bearings" / "h7006c.yaml"), "--calibration", str(CONFIG / "calibration" / "h7006c_table3.yaml")]
+    argv = [
+        "predict",
+        "--rpm",
+        "1200",
+        "--load",
+        "100",
+        "--json",
+        "--bearing",
+        str(CONFIG / "bearings" / "h7006c.yaml"),
+        "--calibration",
+        str(CONFIG / "calibration" / "h7006c_table3.yaml"),
+    ]
     assert main(argv) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["slip_pct_low"] < row["slip_pct"] < row["slip_pct_high"]

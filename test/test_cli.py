@@ -135,12 +135,7 @@ def test_bench_json_lines(fake_benchmark: Any, capsys: pytest.CaptureFixture[str
 def test_bench_table_is_aligned(fake_benchmark: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert cli.main(["bench", "fake", "--points", "2"]) == 0
     # Text columns left-aligned, numeric columns right-aligned, two spaces between columns.
-    assert capsys.readouterr().out == (
-        "case  rtf  steps\n"
-        "----  ---  -----\n"
-        "p0    1.5      1\n"
-        "p1      3     10\n"
-    )
+    assert capsys.readouterr().out == ("case  rtf  steps\n----  ---  -----\np0    1.5      1\np1      3     10\n")
 
 
 def test_table_with_missing_keys_and_no_rows() -> None:

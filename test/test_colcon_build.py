@@ -89,7 +89,7 @@ def test_interface_package_is_installed(workspace: Path) -> None:
     prefix = workspace / "install" / "bearing_rig_msgs"
     assert (prefix / "share" / "bearing_rig_msgs" / "package.xml").is_file()
     assert (prefix / "share" / "ament_index" / "resource_index" / "packages" / "bearing_rig_msgs").is_file()
-    interfaces = (prefix / "share" / "ament_index" / "resource_index" / "rosidl_interfaces" / "bearing_rig_msgs")
+    interfaces = prefix / "share" / "ament_index" / "resource_index" / "rosidl_interfaces" / "bearing_rig_msgs"
     listed = set(interfaces.read_text(encoding="utf-8").split())
     for definition in (REPO_ROOT / "msg_defs").glob("*/*.*"):
         if definition.suffix in (".msg", ".srv"):
@@ -172,7 +172,11 @@ def test_colcon_test_runs_the_package_tests_with_pytest(workspace: Path) -> None
     colcon = str(VENV / "bin" / "colcon")
     result = subprocess.run(
         [colcon, "test", "--paths", "src/bearing-rig-sim", "--event-handlers", "console_direct-", "--pytest-args", "test/test_interfaces.py"],
-        cwd=workspace, env=env, capture_output=True, text=True, timeout=600,
+        cwd=workspace,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert result.returncode == 0, f"{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     summary = subprocess.run(

@@ -167,7 +167,9 @@ def test_bag_info_reports_log_time_outliers(tmp_path: Path, capsys: pytest.Captu
     with BagWriter(bag) as writer:
         writer.add_topic("/clock", "rosgraph_msgs/msg/Clock")
         for k in range(1000):
-            writer.write_message("/clock", k * 1_000_000, types["rosgraph_msgs/msg/Clock"](clock=types["builtin_interfaces/msg/Time"](sec=0, nanosec=k * 1_000_000)))
+            writer.write_message(
+                "/clock", k * 1_000_000, types["rosgraph_msgs/msg/Clock"](clock=types["builtin_interfaces/msg/Time"](sec=0, nanosec=k * 1_000_000))
+            )
         far = (2**31 - 1) * 1_000_000_000
         writer.write_message("/clock", far, types["rosgraph_msgs/msg/Clock"](clock=types["builtin_interfaces/msg/Time"](sec=2**31 - 1, nanosec=0)))
     assert main(["bag", "info", str(bag)]) == 0

@@ -18,7 +18,18 @@ def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[
     assert main(["predict", "--rpm", "1200", "2400", "--load", "100", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [r["rpm"] for r in rows] == [1200.0, 2400.0]
-    assert set(rows[0]) == {"rpm", "axial_load_n", "cage_rpm", "slip_pct", "slip_pct_low", "slip_pct_high", "friction_torque_nm", "power_loss_w", "film_min_um", "lambda_ratio"}
+    assert set(rows[0]) == {
+        "rpm",
+        "axial_load_n",
+        "cage_rpm",
+        "slip_pct",
+        "slip_pct_low",
+        "slip_pct_high",
+        "friction_torque_nm",
+        "power_loss_w",
+        "film_min_um",
+        "lambda_ratio",
+    }
     assert all(r["slip_pct_low"] < r["slip_pct"] < r["slip_pct_high"] for r in rows)
     assert rows[1]["power_loss_w"] > rows[0]["power_loss_w"] > 0.0
     assert rows[0]["power_loss_w"] == pytest.approx(rows[0]["friction_torque_nm"] * 1200 * 2 * 3.141592653589793 / 60, rel=1e-3)
@@ -28,7 +39,14 @@ def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[
         assert r["slip_pct"] == pytest.approx((1 - r["cage_rpm"] / (ratio * r["rpm"])) * 100, abs=2e-3)
 
 
-@pytest.mark.parametrize("argv,needle", [(["--rpm", "1000", "--load", "nan"], "--load"), (["--rpm", "-5", "--load", "100"], "--rpm"), (["--rpm", "1000", "2000", "--load", "1", "2", "3"], "one per speed")])
+@pytest.mark.parametrize(
+    "argv,needle",
+    [
+        (["--rpm", "1000", "--load", "nan"], "--load"),
+        (["--rpm", "-5", "--load", "100"], "--rpm"),
+        (["--rpm", "1000", "2000", "--load", "1", "2", "3"], "one per speed"),
+    ],
+)
 def test_predict_refuses_bad_values(capsys: pytest.CaptureFixture[str], argv: list[str], needle: str) -> None:
     assert main(["predict", *argv]) == 2
     err = capsys.readouterr().err

@@ -70,9 +70,7 @@ def test_config_error_is_a_rig_error_and_a_value_error() -> None:
 def test_missing_key_names_the_dotted_path(tmp_path: Path) -> None:
     path = write(tmp_path, "geometry:\n  pitch_diameter_m: 0.0405\n")
     geometry = load_yaml(path).section("geometry")
-    assert str(error_of(geometry.number, "ball_diameter_m", gt=0)) == (
-        f"{path}: geometry.ball_diameter_m: missing (required)"
-    )
+    assert str(error_of(geometry.number, "ball_diameter_m", gt=0)) == (f"{path}: geometry.ball_diameter_m: missing (required)")
 
 
 def test_null_value_counts_as_missing_unless_defaulted(tmp_path: Path) -> None:
@@ -84,9 +82,7 @@ def test_null_value_counts_as_missing_unless_defaulted(tmp_path: Path) -> None:
 def test_out_of_range_names_file_key_and_bound(tmp_path: Path) -> None:
     path = write(tmp_path, "geometry:\n  ball_diameter_m: -0.0063\n")
     geometry = load_yaml(path).section("geometry")
-    assert str(error_of(geometry.number, "ball_diameter_m", gt=0)) == (
-        f"{path}: geometry.ball_diameter_m: must be > 0, got -0.0063"
-    )
+    assert str(error_of(geometry.number, "ball_diameter_m", gt=0)) == (f"{path}: geometry.ball_diameter_m: must be > 0, got -0.0063")
 
 
 @pytest.mark.parametrize(
@@ -157,17 +153,13 @@ def test_boolean_string_and_choice(tmp_path: Path) -> None:
     doc = load_yaml(path)
     assert str(error_of(doc.boolean, "enabled")) == f"{path}: enabled: must be true or false, got 'yes'"
     assert str(error_of(doc.string, "name")) == f"{path}: name: must be a non-empty string, got ''"
-    assert str(error_of(doc.choice, "criterion", ("time", "axial_load"))) == (
-        f"{path}: criterion: must be one of time, axial_load, got 'speed'"
-    )
+    assert str(error_of(doc.choice, "criterion", ("time", "axial_load"))) == (f"{path}: criterion: must be one of time, axial_load, got 'speed'")
 
 
 def test_unknown_key_lists_the_allowed_keys(tmp_path: Path) -> None:
     path = write(tmp_path, "rig:\n  brake_gain: 1.0\n  brake_gian: 2.0\n")
     rig = load_yaml(path).section("rig")
-    assert str(error_of(rig.reject_unknown, ["brake_gain", "lever_ratio"])) == (
-        f"{path}: rig.brake_gian: unknown key; allowed keys: brake_gain, lever_ratio"
-    )
+    assert str(error_of(rig.reject_unknown, ["brake_gain", "lever_ratio"])) == (f"{path}: rig.brake_gian: unknown key; allowed keys: brake_gain, lever_ratio")
     rig_ok = load_yaml(write(tmp_path, "rig:\n  brake_gain: 1.0\n", "ok.yaml")).section("rig")
     rig_ok.reject_unknown(["brake_gain", "lever_ratio"])
 
@@ -215,9 +207,8 @@ def test_shipped_bearing_file_loads() -> None:
 
 
 # -- hostile documents: bounded, safe parsing ------------------------------------------------
-BILLION_LAUGHS = (
-    'a: &a ["x","x","x","x","x","x","x","x","x"]\n'
-    + "".join(f"{chr(98 + i)}: &{chr(98 + i)} [{','.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8))
+BILLION_LAUGHS = 'a: &a ["x","x","x","x","x","x","x","x","x"]\n' + "".join(
+    f"{chr(98 + i)}: &{chr(98 + i)} [{','.join(['*' + chr(97 + i)] * 9)}]\n" for i in range(8)
 )
 """The classic alias bomb: 9 levels of 9 references each, about 390 million strings once
 expanded, from a document of a few hundred bytes."""

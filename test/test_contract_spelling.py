@@ -24,9 +24,7 @@ def docstring_nodes(tree: ast.AST) -> set[int]:
     """ids of the string constants that stand alone as a statement: module, class and function
     docstrings, and the attribute docstrings under assignments."""
     return {
-        id(node.value)
-        for node in ast.walk(tree)
-        if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
+        id(node.value) for node in ast.walk(tree) if isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
     }
 
 

@@ -58,9 +58,7 @@ loads = st.floats(MIN_AXIAL_LOAD, ENVELOPE.max_axial_load)
 segments = st.builds(
     Segment,
     duration=st.sampled_from([0.005, 0.01, 0.02, 0.05]),
-    acceleration=st.one_of(
-        st.just(0.0), st.just(MAX_ACCELERATION), st.just(-MAX_ACCELERATION), st.floats(-MAX_ACCELERATION, MAX_ACCELERATION)
-    ),
+    acceleration=st.one_of(st.just(0.0), st.just(MAX_ACCELERATION), st.just(-MAX_ACCELERATION), st.floats(-MAX_ACCELERATION, MAX_ACCELERATION)),
     load=loads,
     ramp=st.booleans(),
     radial=st.one_of(st.just(0.0), st.floats(0.0, ENVELOPE.max_axial_load)),

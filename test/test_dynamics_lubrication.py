@@ -160,8 +160,18 @@ def test_traction_table_returns_the_direct_integral_at_its_nodes(bearing: Bearin
     spin, kh = spin_and_heathcote(ContactKinematics(hz, rx, (FI if contact == 0 else FO) * DW, contact == 0), a, DW, DM)
     semi_a, semi_b = hz.semi_axes(q)
     film = film_thickness(lub, bearing.lubricant_temperature, hz.reduced_modulus, rx, hz.ellipticity, semi_b, hz.max_pressure(q), u, q)
-    args = (hz.max_pressure(q), semi_a, semi_b, film.central, lub.dynamic_viscosity(bearing.lubricant_temperature), lub.roelands_index(bearing.lubricant_temperature),
-            lub.eyring_stress, lub.limiting_shear_coefficient, lub.shear_modulus, u)
+    args = (
+        hz.max_pressure(q),
+        semi_a,
+        semi_b,
+        film.central,
+        lub.dynamic_viscosity(bearing.lubricant_temperature),
+        lub.roelands_index(bearing.lubricant_temperature),
+        lub.eyring_stress,
+        lub.limiting_shear_coefficient,
+        lub.shear_modulus,
+        u,
+    )
     mu, pw = ellipse_traction(*args, srr, spin, kh)
     assert table_lookup(t, 0, contact, srr, u, q)[0] == pytest.approx(mu, rel=1e-6, abs=1e-12)
     assert table_power(t, 0, contact, srr, u, q) == pytest.approx(pw, rel=1e-6, abs=1e-15)

@@ -33,7 +33,9 @@ def nominal_slip_pct(params: BearingParameters, cage: float, inner: float) -> fl
     return (1.0 - cage / n_s) * 100.0
 
 
-def run(params: BearingParameters, rpm: float, load: float, *, model: str = "reduced", settle: float = 0.15, average: float = 0.05, dt: float | None = None) -> BearingDynamics:
+def run(
+    params: BearingParameters, rpm: float, load: float, *, model: str = "reduced", settle: float = 0.15, average: float = 0.05, dt: float | None = None
+) -> BearingDynamics:
     e = BearingDynamics(params, model=model, time_step=dt)
     e.initialise(rpm * RPM, load)
     e.advance(settle)
@@ -91,7 +93,9 @@ def test_energy_is_conserved_without_friction_damping_and_drive(clean: BearingPa
     e.cage[::2, 1] *= 1.001  # segments out of step: rim and pocket vibrations too
     e.axial_load = 200.0  # load step from the 100 N equilibrium
     e0 = e.energy()
-    kinetic_orbit = 0.5 * params.ball_count * float(np.mean(e.ball[:, 1] ** 2 * e.ball[:, 3] ** 2)) * math.pi / 6 * params.ball_diameter**3 * params.ball_density
+    kinetic_orbit = (
+        0.5 * params.ball_count * float(np.mean(e.ball[:, 1] ** 2 * e.ball[:, 3] ** 2)) * math.pi / 6 * params.ball_diameter**3 * params.ball_density
+    )
     energies = [e0]
     for _ in range(50):
         e.advance(0.002)

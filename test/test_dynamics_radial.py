@@ -122,7 +122,10 @@ def test_a_program_asking_for_a_radial_load_the_rig_cannot_give_is_refused(tmp_p
     program.write_text(PROGRAM)
     axial_only = tmp_path / "rig.yaml"
     axial_only.write_text(yaml.safe_dump(rig_doc))
-    with pytest.raises(ConfigError, match=r"segments\[1\]\.radial_load_n: segment 'side': 500 N is above the rig's limit of 0 N \(combined_loading\.max_radial_setpoint_n in rig\.yaml\)"):
+    with pytest.raises(
+        ConfigError,
+        match=r"segments\[1\]\.radial_load_n: segment 'side': 500 N is above the rig's limit of 0 N \(combined_loading\.max_radial_setpoint_n in rig\.yaml\)",
+    ):
         load_program(program, RigLimits.from_rig_file(axial_only))
     rig_doc["combined_loading"]["max_radial_setpoint_n"] = 800.0
     axial_only.write_text(yaml.safe_dump(rig_doc))

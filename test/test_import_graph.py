@@ -25,15 +25,14 @@ FLOORS: tuple[tuple[str, frozenset[str]], ...] = (
     ("models: the bearing's dynamics, the rig's models, analysis, bag files", frozenset({"dynamics", "thermal", "rig", "analysis", "bags"})),
     (
         "cores: what the nodes and commands run, without ROS shells",
-        frozenset(
-            {"simulation", "monitoring", "load_control", "shadow", "offline", "replay", "live", "synthetic", "studies", "sweep"}
-        ),
+        frozenset({"simulation", "monitoring", "load_control", "shadow", "offline", "replay", "live", "synthetic", "studies", "sweep"}),
     ),
     ("shells: the ROS 2 nodes and the session that starts them", frozenset({"nodes", "session"})),
     ("front: the command line and its benchmarks", frozenset({"cli", "commands", "benchmarks"})),
 )
 """Bottom to top. A unit is a sub-package or a root module of the package (``""`` is the package
 itself); a module may import from its own floor and the floors below, never from one above."""
+
 
 def module_files(package_dir: Path) -> dict[str, Path]:
     """Dotted module name -> source file, for every ``.py`` under ``package_dir``."""

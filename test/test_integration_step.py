@@ -99,7 +99,9 @@ def test_reduced_limit_matches_the_hand_calculation(params: BearingParameters) -
 
 
 def test_a_step_above_the_limit_is_refused_naming_the_key(tmp_path: Path, params: BearingParameters) -> None:
-    with pytest.raises(StepLimitError, match=r": time_step = 0\.05 s exceeds the stability limit 0\.03\d+ s of the reduced model \(explicit centrifugal") as info:
+    with pytest.raises(
+        StepLimitError, match=r": time_step = 0\.05 s exceeds the stability limit 0\.03\d+ s of the reduced model \(explicit centrifugal"
+    ) as info:
         BearingDynamics(params, time_step=0.05)
     assert "\n" not in str(info.value)
     path = _bearing_file(tmp_path, stiff_time_step_s=4e-6)
@@ -196,7 +198,10 @@ def test_a_forced_divergence_is_detected_not_published(params: BearingParameters
     twin = RigTwin(engine, FibreOpticConfig.from_yaml(None), BearingKinematics.from_config(config_path("bearings", "h7006c.yaml")), initial_axial_load=100.0)
     twin.command_spindle(SpindleCommand(target_speed=900 * RPM, profile=SpeedProfileKind.CONSTANT_ACCELERATION, acceleration=80.0))
     returned = []
-    with pytest.raises(DynamicsDivergedError, match=r"dynamics diverged at t = [\d.e-]+ s: (cage|ball orbit) speed .* outside \[0, [\d.]+\] rad/s.*time step 4e-05 s, stability limit 0\.03\d+ s") as info:
+    with pytest.raises(
+        DynamicsDivergedError,
+        match=r"dynamics diverged at t = [\d.e-]+ s: (cage|ball orbit) speed .* outside \[0, [\d.]+\] rad/s.*time step 4e-05 s, stability limit 0\.03\d+ s",
+    ) as info:
         for _ in range(5000):
             returned.append(twin.tick())
     # Caught in the tick in which it happens (the ring past 0.1 rad/s in the second tick at 80 rad/s^2),
@@ -267,8 +272,10 @@ def test_the_simulator_node_reports_a_divergence_and_stops_publishing(ros_graph:
     stopped: list[DiagnosticStatus] = []
     node.create_subscription(SimulatorTruth, "/rig/truth", truths.append, SENSOR_QOS)
     node.create_subscription(
-        DiagnosticArray, "/diagnostics",
-        lambda msg: stopped.extend(s for s in msg.status if stopped_reason((kv.key, kv.value) for kv in s.values)), RELIABLE_QOS,
+        DiagnosticArray,
+        "/diagnostics",
+        lambda msg: stopped.extend(s for s in msg.status if stopped_reason((kv.key, kv.value) for kv in s.values)),
+        RELIABLE_QOS,
     )
     command = node.create_publisher(SpindleCommandMsg, "/rig/spindle/command", STATUS_QOS)
     assert ros_graph.spin_until(lambda: command.get_subscription_count() > 0, 60.0, executor=executor), "the simulator did not come up"

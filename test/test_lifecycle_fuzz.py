@@ -58,9 +58,7 @@ class Lifecycle:
         self.executor = ros_graph.executor([self.node])
         self.get_state = self.node.create_client(GetState, f"/{target}/get_state")
         self.change_state = self.node.create_client(ChangeState, f"/{target}/change_state")
-        ready = ros_graph.spin_until(
-            lambda: self.get_state.service_is_ready() and self.change_state.service_is_ready(), timeout=WAIT, executor=self.executor
-        )
+        ready = ros_graph.spin_until(lambda: self.get_state.service_is_ready() and self.change_state.service_is_ready(), timeout=WAIT, executor=self.executor)
         assert ready, f"no lifecycle services of /{target}"
 
     def _call(self, client: Any, request: Any, resend_after: float | None = None) -> Any:

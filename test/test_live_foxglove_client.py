@@ -67,7 +67,10 @@ def test_foxglove_published_client_decodes_a_live_session_on_both_subprotocols(r
         assert len(urls) == 2 and "(foxglove.sdk.v1)" in line and "(foxglove.websocket.v1)" in line, line
         for url, subprotocol in zip(urls, ("foxglove.sdk.v1", "foxglove.websocket.v1")):
             clients[subprotocol] = subprocess.Popen(
-                [*node_client, url.rstrip(","), subprotocol, ",".join(f"{t}:{n}" for t, n in COUNTS.items())], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+                [*node_client, url.rstrip(","), subprotocol, ",".join(f"{t}:{n}" for t, n in COUNTS.items())],
+                stdout=subprocess.PIPE,
+                stderr=subprocess.PIPE,
+                text=True,
             )
         for subprotocol, client in clients.items():
             out, err = client.communicate(timeout=300)

@@ -111,6 +111,16 @@ SAMPLES: dict[str, dict[str, Any]] = {
         "anomaly": True,
         "level": 2,
         "detail": "residual +0.338 pp outside its band (±0.198 pp) for 3.2 s: slip higher than predicted",
+        "measured_temperature": 31.25,
+        "predicted_temperature": 30.9,
+        "temperature_residual": 0.35,
+        "temperature_band": 1.82,
+        "temperature_anomaly": True,
+        "measured_torque": 0.1125,
+        "predicted_torque": 0.1086,
+        "torque_residual": 0.0039,
+        "torque_band": 0.0326,
+        "torque_anomaly": True,
     },
     "ShadowEstimate": {
         "header": {"stamp": {"sec": 1_700_000_009, "nanosec": 5}, "frame_id": "bearing"},
@@ -333,9 +343,9 @@ def test_set_axial_load_service_across_processes(ros_graph: Any) -> None:
     node = ros_graph.node("operator")
     client = node.create_client(SetAxialLoad, "/test/set_axial_load")
     executor = ros_graph.executor([node])
-    assert ros_graph.spin_until(
-        lambda: client.service_is_ready() or peer.poll() is not None, timeout=30.0, executor=executor
-    ), "SetAxialLoad server not discovered in 30 s"
+    assert ros_graph.spin_until(lambda: client.service_is_ready() or peer.poll() is not None, timeout=30.0, executor=executor), (
+        "SetAxialLoad server not discovered in 30 s"
+    )
     assert peer.poll() is None, f"server process exited: {peer.communicate()[1]}"
 
     def call(load: float) -> Any:

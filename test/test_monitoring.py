@@ -33,9 +33,7 @@ def expected_slip(inner: float, cage: float) -> float:
     return (1.0 - cage / (ratio() * inner)) * 100.0
 
 
-def train(
-    times: Iterable[float], strips: int, sensor: str, *, first_index: int = 0, first_strip: int = 0
-) -> list[Pulse]:
+def train(times: Iterable[float], strips: int, sensor: str, *, first_index: int = 0, first_strip: int = 0) -> list[Pulse]:
     """Pulses at the given times (strip ids cycling from ``first_strip``)."""
     out = []
     for i, t in enumerate(times):
@@ -229,8 +227,12 @@ def test_a_spindle_sensor_lost_during_the_run_up_is_a_fault_once_the_cage_turned
     spindle = constant(INNER, 4, 0.0, 0.03)  # crossings at 10, 20, 30 ms
     assert len(spindle) == 3
     times = []
-    feed(monitor, train(spindle, 4, "spindle"), train(constant(CAGE, 4, 0.0, 3.0), 4, "cage"),
-         on_check=lambda status: times.append((bool(status.faults), status.faults)))
+    feed(
+        monitor,
+        train(spindle, 4, "spindle"),
+        train(constant(CAGE, 4, 0.0, 3.0), 4, "cage"),
+        on_check=lambda status: times.append((bool(status.faults), status.faults)),
+    )
     faulted = [i for i, (fault, _) in enumerate(times) if fault]
     assert faulted, "the lost spindle sensor was never reported"
     # check k is at about 0.1 k s; the rule is met at 0.03 + 0.487 s, confirmed one check later

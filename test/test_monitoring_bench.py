@@ -484,7 +484,10 @@ def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float,
     assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
 
 
-@pytest.mark.parametrize(("acceleration", "changes"), [(20.0, {"lost_fraction": 0.005, "seed": 1}), (60.0, {"bursts": (Burst("cage", 1.8, 8),)}), (40.0, {"jitter_s": 10e-6, "seed": 2})])
+@pytest.mark.parametrize(
+    ("acceleration", "changes"),
+    [(20.0, {"lost_fraction": 0.005, "seed": 1}), (60.0, {"bursts": (Burst("cage", 1.8, 8),)}), (40.0, {"jitter_s": 10e-6, "seed": 2})],
+)
 def test_run_ups_with_sensor_imperfections_are_judged_stable_after_the_onset(acceleration: float, changes: dict) -> None:
     """The same run-ups with 0.5 % of the pulses lost, a burst of 8 lost cage pulses (2 revolutions)
     just after the onset, or 10 us of jitter: no FAULT, never stable before the onset, stable

@@ -37,10 +37,17 @@ def test_thermocouple_warms_and_torque_meter_reads_the_friction_torque(ros_graph
     node.create_subscription(SimulatorTruth, TRUTH.name, truth.append, SENSOR_QOS)
     executor = ros_graph.executor([node])
     ros_graph.spawn_python(
-        "-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime", "--ros-args",
-        "-p", f"bearing_file:={CONFIG / 'bearings' / 'h7006c.yaml'}",
-        "-p", f"calibration_file:={CONFIG / 'calibration' / 'h7006c_table3.yaml'}",
-        "-p", f"initial_speed_rad_s:={2700 * math.pi / 30}",
+        "-m",
+        "bearing_rig_sim.nodes.simulator",
+        "--autostart",
+        "--no-realtime",
+        "--ros-args",
+        "-p",
+        f"bearing_file:={CONFIG / 'bearings' / 'h7006c.yaml'}",
+        "-p",
+        f"calibration_file:={CONFIG / 'calibration' / 'h7006c_table3.yaml'}",
+        "-p",
+        f"initial_speed_rad_s:={2700 * math.pi / 30}",
     )
     assert ros_graph.spin_until(lambda: len(temps) >= 80 and len(truth) >= 10, WAIT, executor=executor), (len(temps), len(torques))
     stamps = [from_stamp(m.header.stamp) for m in temps]

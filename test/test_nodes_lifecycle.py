@@ -121,9 +121,7 @@ def test_a_failed_configure_is_reported_and_the_node_stays_up(ros_graph: Any) ->
 
 
 def test_autostart_configure_failure_is_one_line_and_exit_2(ros_graph: Any) -> None:
-    process = ros_graph.spawn_python(
-        "-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--ros-args", "-p", "model:=no_such_model"
-    )
+    process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--ros-args", "-p", "model:=no_such_model")
     _, err = process.communicate(timeout=WAIT)
     assert process.returncode == 2, err[-2000:]
     assert "simulator: error:" in err and "model" in err and "no_such_model" in err and "Traceback" not in err

@@ -61,11 +61,13 @@ class Harness:
         self.reset_client = node.create_client(Trigger, "/rig/axial_load/reset_fault")
         self.param_client = node.create_client(SetParameters, "/load_controller/set_parameters")
         ready = self.spin_until(
-            lambda: self.clock.get_subscription_count() > 0
-            and self.setpoint.get_subscription_count() > 0
-            and node.count_publishers("/rig/bearing/axial_force") > 0
-            and node.count_publishers("/diagnostics") > 0
-            and all(c.service_is_ready() for c in (self.set_client, self.reset_client, self.param_client)),
+            lambda: (
+                self.clock.get_subscription_count() > 0
+                and self.setpoint.get_subscription_count() > 0
+                and node.count_publishers("/rig/bearing/axial_force") > 0
+                and node.count_publishers("/diagnostics") > 0
+                and all(c.service_is_ready() for c in (self.set_client, self.reset_client, self.param_client))
+            ),
             timeout=30.0,
         )
         assert ready, self.failure("the load controller did not come up")

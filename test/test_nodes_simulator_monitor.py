@@ -137,11 +137,7 @@ def test_simulator_publishes_the_documented_topics(ros_graph):
         stamps = [from_stamp(p.header.stamp) for p in pulses]
         assert all(b > a for a, b in zip(stamps, stamps[1:]))
     spindle = probe.pulses["spindle"]
-    period = [
-        from_stamp(b.header.stamp) - from_stamp(a.header.stamp)
-        for a, b in zip(spindle, spindle[1:])
-        if b.pulse_index == a.pulse_index + 1
-    ]
+    period = [from_stamp(b.header.stamp) - from_stamp(a.header.stamp) for a, b in zip(spindle, spindle[1:]) if b.pulse_index == a.pulse_index + 1]
     assert period and all(p == pytest.approx(2 * math.pi / spindle_strips / speed, abs=1e-5) for p in period)
 
     # /rig/truth: the engine's truth, 100 Hz of simulated time
@@ -285,7 +281,9 @@ def test_monitor_warns_of_lost_pulses_with_counts_and_no_fault(ros_graph):
             if skipped == 20:
                 stop_at = t + 2.0
             continue
-        msg = FibreOpticPulse(sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index)
+        msg = FibreOpticPulse(
+            sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index
+        )
         msg.header.stamp = to_stamp(pulse.time)
         publishers[shaft].publish(msg)
     assert skipped == 20, "the monitor never reported a slip window while the pulses were published"
@@ -317,7 +315,9 @@ def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
         due = begin + pulse.time - scenario.epoch_s
         while time.monotonic() < due:
             probe.executor.spin_once(timeout_sec=max(0.0, min(0.005, due - time.monotonic())))
-        msg = FibreOpticPulse(sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index)
+        msg = FibreOpticPulse(
+            sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index
+        )
         publishers[shaft].publish(msg)  # header.stamp left at zero
     probe.wait(lambda: sum(math.isfinite(s.slip_rate) for s in probe.status) >= 10, "ten statuses with a slip")
     slips = sorted(s.slip_rate for s in probe.status if math.isfinite(s.slip_rate))
@@ -362,6 +362,7 @@ def test_without_real_time_the_simulator_waits_for_a_reliable_reader_then_goes_o
     assert ready and reader.stdout.readline().strip() == "got the clock"
     os.kill(reader.pid, signal.SIGSTOP)
     try:
+
         def warned() -> bool:
             return any("went on without a reliable reader: /clock" in s.message for s in probe.diag("simulator"))
 

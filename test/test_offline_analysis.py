@@ -30,8 +30,10 @@ from conftest import write_foreign_metadata
 
 PULSE = "bearing_rig_msgs/msg/FibreOpticPulse"
 HEADER_DEPENDENCIES = (
-    "=" * 80 + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
-    + "=" * 80 + "\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
+    "=" * 80
+    + "\nMSG: std_msgs/Header\nbuiltin_interfaces/Time stamp\nstring frame_id\n"
+    + "=" * 80
+    + "\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n"
 )
 
 
@@ -81,9 +83,7 @@ def write_twin_bag(
     def publish_status(bag: BagWriter, now: float) -> None:
         status = live.status()
         last_state[0] = status.state
-        message = types["bearing_rig_msgs/msg/SlipStatus"](
-            header=header(status.time if status.time is not None else now), **status.message_fields()
-        )
+        message = types["bearing_rig_msgs/msg/SlipStatus"](header=header(status.time if status.time is not None else now), **status.message_fields())
         bag.write_message("/rig/slip_status", int(round(now * 1e9)), message)
 
     sent: list[tuple[str, Pulse]] = []
@@ -107,7 +107,14 @@ def write_twin_bag(
             pulses = sorted([("spindle", p) for p in out.spindle_pulses] + [("cage", p) for p in out.cage_pulses], key=lambda sp: sp[1].time)
             for shaft, pulse in pulses:
                 received = wire_pulse(pulse)
-                message = types[PULSE](header=header(pulse.time), sensor_id=shaft, strip_id=pulse.strip_id, strip_count=pulse.strip_count, revolution=pulse.revolution, pulse_index=pulse.pulse_index)
+                message = types[PULSE](
+                    header=header(pulse.time),
+                    sensor_id=shaft,
+                    strip_id=pulse.strip_id,
+                    strip_count=pulse.strip_count,
+                    revolution=pulse.revolution,
+                    pulse_index=pulse.pulse_index,
+                )
                 bag.write_message(f"/rig/{shaft}/pulses", int(round(received.time * 1e9)), message)
                 sent.append((shaft, received))
                 if record_status and live.add_pulse(shaft, received) and live.status().state != last_state[0]:
@@ -124,8 +131,35 @@ def write_twin_bag(
             bag.write_message("/rig/speeds", now, speeds)
             if round(out.time * 1000) % 10 == 0:
                 truth = out.truth
-                values = {f: getattr(truth, f) for f in ("inner_ring_speed", "inner_ring_acceleration", "cage_speed", "theoretical_cage_speed", "slip_rate", "axial_load", "inner_contact_load_mean", "inner_contact_load_max", "outer_contact_load_mean", "outer_contact_load_max", "pocket_load_max", "inner_contact_angle", "outer_contact_angle", "inner_ring_axial_displacement", "friction_torque", "power_loss")}
-                message = types["bearing_rig_msgs/msg/SimulatorTruth"](header=header(out.time), **values, real_time_factor=1.0, step_count=truth.step_count, overruns=0, cage_whirl_radius_um=truth.cage_whirl_radius * 1e6)
+                values = {
+                    f: getattr(truth, f)
+                    for f in (
+                        "inner_ring_speed",
+                        "inner_ring_acceleration",
+                        "cage_speed",
+                        "theoretical_cage_speed",
+                        "slip_rate",
+                        "axial_load",
+                        "inner_contact_load_mean",
+                        "inner_contact_load_max",
+                        "outer_contact_load_mean",
+                        "outer_contact_load_max",
+                        "pocket_load_max",
+                        "inner_contact_angle",
+                        "outer_contact_angle",
+                        "inner_ring_axial_displacement",
+                        "friction_torque",
+                        "power_loss",
+                    )
+                }
+                message = types["bearing_rig_msgs/msg/SimulatorTruth"](
+                    header=header(out.time),
+                    **values,
+                    real_time_factor=1.0,
+                    step_count=truth.step_count,
+                    overruns=0,
+                    cage_whirl_radius_um=truth.cage_whirl_radius * 1e6,
+                )
                 bag.write_message("/rig/truth", now, message)
             if record_status and round(out.time * 1000) % 100 == 0:
                 live.check(out.time)
@@ -182,7 +216,9 @@ def test_pulse_decoder_agrees_with_the_general_decoder() -> None:
         data = bytes(store.serialize_cdr(message, PULSE))
         pulse = decode_pulse(data)
         stamp = message.header.stamp
-        assert pulse == Pulse(stamp.sec + stamp.nanosec * 1e-9, message.strip_id, message.strip_count, message.revolution, message.pulse_index, message.sensor_id)
+        assert pulse == Pulse(
+            stamp.sec + stamp.nanosec * 1e-9, message.strip_id, message.strip_count, message.revolution, message.pulse_index, message.sensor_id
+        )
         with pytest.raises(BagError, match="malformed"):
             decode_pulse(data[: len(data) - 3])
     big_endian = bytes(store.serialize_cdr(sample_message(PULSE, 1, store), PULSE, little_endian=False))
@@ -232,9 +268,7 @@ def test_offline_verdicts_are_the_monitors(twin_bag: tuple[Path, list[tuple[str,
     assert len((tmp_path / WINDOWS_CSV).read_text().splitlines()) == len(windows) + 1
 
 
-def test_a_command_recorded_ahead_of_its_stamp_starts_its_segment_at_the_stamp(
-    twin_bag: tuple[Path, list[tuple[str, Pulse]]], tmp_path: Path
-) -> None:
+def test_a_command_recorded_ahead_of_its_stamp_starts_its_segment_at_the_stamp(twin_bag: tuple[Path, list[tuple[str, Pulse]]], tmp_path: Path) -> None:
     """The session sends a dwell segment's successor up to seconds ahead, and records it when sent:
     analyze starts the segment where the command takes effect, its stamp, not where it was
     recorded, so the segments are those of a bag with the command recorded at its stamp."""
@@ -322,7 +356,14 @@ def test_bag_from_an_independent_writer_without_truth(tmp_path: Path) -> None:
         schema = writer.register_msgdef(PULSE, text)
         for t, shaft, k in events:
             sec, nanosec = stamp_of(t)
-            message = {"header": {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": "bench"}, "sensor_id": shaft, "strip_id": k % 4, "strip_count": 4, "revolution": k // 4, "pulse_index": k}
+            message = {
+                "header": {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": "bench"},
+                "sensor_id": shaft,
+                "strip_id": k % 4,
+                "strip_count": 4,
+                "revolution": k // 4,
+                "pulse_index": k,
+            }
             writer.write_message(f"/rig/{shaft}/pulses", schema, message, log_time=sec * 10**9 + nanosec)
         writer.finish()
     write_foreign_metadata(bag, [(f"/rig/{s}/pulses", PULSE, sum(e[1] == s for e in events)) for s in ("spindle", "cage")], ["bench.mcap"])

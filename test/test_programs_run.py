@@ -55,7 +55,7 @@ def sweep_lines(text: str) -> dict[int, str]:
 
 
 def verdict_of(text: str) -> str:
-    """"stable from 500 N" or "no stable state" of a load-sweep verdict's text."""
+    """ "stable from 500 N" or "no stable state" of a load-sweep verdict's text."""
     return text.split(" (")[0] if text.startswith("stable from") else "no stable state"
 
 

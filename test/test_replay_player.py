@@ -326,7 +326,9 @@ def test_ctrl_c_stops_a_looping_replay_cleanly(ros_graph, tmp_path: Path) -> Non
     node = ros_graph.node("listener")
     received: list[int] = []
     node.create_subscription(FibreOpticPulse, CAGE, lambda m: received.append(m.pulse_index), QoSProfile(depth=200, reliability=ReliabilityPolicy.BEST_EFFORT))
-    process = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--loop", "--rate", "4", "--wait-for-subscribers", "--delay", "20")
+    process = ros_graph.spawn_python(
+        "-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--loop", "--rate", "4", "--wait-for-subscribers", "--delay", "20"
+    )
     executor = ros_graph.executor([node])
     # a second pass has begun: pulse_index 0 came again after the last one
     assert ros_graph.spin_until(lambda: received.count(0) >= 2, timeout=30.0, executor=executor), f"received {len(received)} pulses"

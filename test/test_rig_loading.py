@@ -105,9 +105,7 @@ def settle_bound(config: LoadingChainConfig, start: float, target: float) -> flo
 
 
 @pytest.mark.parametrize("start, target", [(0.0, 500.0), (0.0, 1000.0), (500.0, 1000.0), (1000.0, 100.0)])
-def test_load_step_settles_within_2_percent_in_the_stated_time(
-    shipped: LoadingChainConfig, start: float, target: float
-) -> None:
+def test_load_step_settles_within_2_percent_in_the_stated_time(shipped: LoadingChainConfig, start: float, target: float) -> None:
     chain = loaded_chain(shipped, start) if start > 0 else LoadingChain(shipped)
     chain.engage()
     chain.set_setpoint(target)

@@ -50,7 +50,9 @@ WAIT = 120.0
 """Longest wait for one answer or state, s (a first configure compiles the engine's kernels)."""
 ATTEMPT_S = 30.0
 """A repeatable ``ros2`` verb that has not ended by then is started again (see ``Ros2.run``)."""
-REPEATABLE = frozenset({("param", "describe"), ("param", "get"), ("param", "dump"), ("param", "set"), ("param", "load"), ("lifecycle", "get"), ("topic", "echo")})
+REPEATABLE = frozenset(
+    {("param", "describe"), ("param", "get"), ("param", "dump"), ("param", "set"), ("param", "load"), ("lifecycle", "get"), ("topic", "echo")}
+)
 """Verbs whose repetition changes nothing: they read, or set a parameter to the same value."""
 
 
@@ -142,7 +144,9 @@ class Ros2:
             if not undiscovered or time.monotonic() > deadline:
                 return result
 
-    def until(self, argv: tuple[str, ...], wanted: Callable[[subprocess.CompletedProcess[str]], bool], timeout: float = WAIT) -> subprocess.CompletedProcess[str]:
+    def until(
+        self, argv: tuple[str, ...], wanted: Callable[[subprocess.CompletedProcess[str]], bool], timeout: float = WAIT
+    ) -> subprocess.CompletedProcess[str]:
         """``ros2 argv...`` again until its result is ``wanted`` (a node being discovered, a
         state being reached); the last result."""
         deadline = time.monotonic() + timeout
@@ -155,8 +159,15 @@ class Ros2:
         """``ros2 argv...`` in the background, its output to ``<logs>/<name>.log``."""
         log = open(self.logs / f"{name}.log", "w", encoding="utf-8")
         process = subprocess.Popen(
-            [self.ros2, *argv], env=self.env, cwd=REPO_ROOT, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT,
-            text=True, preexec_fn=_prepare_child, start_new_session=True,
+            [self.ros2, *argv],
+            env=self.env,
+            cwd=REPO_ROOT,
+            stdin=subprocess.DEVNULL,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            text=True,
+            preexec_fn=_prepare_child,
+            start_new_session=True,
         )
         log.close()
         self.started.append(process)

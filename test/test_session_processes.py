@@ -34,9 +34,7 @@ def python_child(tmp_path: Path, name: str, code: str) -> NodeProcess:
 
 
 def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Path) -> None:
-    child = python_child(
-        tmp_path, "simulator", "import sys\nfor i in range(40): print('line', i, file=sys.stderr)\nsys.exit(3)"
-    )
+    child = python_child(tmp_path, "simulator", "import sys\nfor i in range(40): print('line', i, file=sys.stderr)\nsys.exit(3)")
     child.start(os.environ)
     assert child.wait(20.0) == 3 and not child.running
     text = child.describe_exit(lines=5)
@@ -46,12 +44,8 @@ def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Pat
 
 
 def test_stop_all_stops_a_child_that_ignores_sigint(tmp_path: Path) -> None:
-    stubborn = python_child(
-        tmp_path, "monitor", "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nprint('up', flush=True)\ntime.sleep(60)"
-    )
-    polite = python_child(
-        tmp_path, "load_controller", "import time\nprint('up', flush=True)\ntry:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    pass"
-    )
+    stubborn = python_child(tmp_path, "monitor", "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nprint('up', flush=True)\ntime.sleep(60)")
+    polite = python_child(tmp_path, "load_controller", "import time\nprint('up', flush=True)\ntry:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    pass")
     for child in (stubborn, polite):
         child.start(os.environ)
     for _ in range(200):  # until both have started (and the stubborn one ignores SIGINT)
@@ -154,8 +148,13 @@ def test_parameter_arguments_reach_a_node_unchanged(ros_graph: object) -> None:
     from bearing_rig_sim.session.context import parameter_arguments
 
     values: dict[str, str | bool | int | float] = {
-        "empty": "", "path": "/data/bearings: v2 #1/h7006c.yaml", "word": "true", "digits": "1.5",
-        "flag": False, "rate": 2.5, "count": 3,
+        "empty": "",
+        "path": "/data/bearings: v2 #1/h7006c.yaml",
+        "word": "true",
+        "digits": "1.5",
+        "flag": False,
+        "rate": 2.5,
+        "count": 3,
     }
     context = rclpy.Context()
     rclpy.init(args=["probe", "--ros-args", *parameter_arguments(values)], context=context)
@@ -189,7 +188,10 @@ def test_a_program_naming_a_file_that_is_no_bearing_data_is_refused_at_load(tmp_
     "text, problem",
     [
         ("root:x:0:0:root:/root:/bin/bash\n", "maps node names to blocks; its top level is a str"),
-        ("simulater:\n  ros__parameters:\n    rate: 2.0\n", "simulater: no node of a session has this name (its nodes: simulator, load_controller, monitor; did you mean simulator?)"),
+        (
+            "simulater:\n  ros__parameters:\n    rate: 2.0\n",
+            "simulater: no node of a session has this name (its nodes: simulator, load_controller, monitor; did you mean simulator?)",
+        ),
         ("load_controller:\n  ros__parameters:\n    kp: 3.0\n", "load_controller.ros__parameters.kp: load_controller has no such parameter"),
         ("/**:\n  ros__parameters:\n    nosuch: 1\n", "/**.ros__parameters.nosuch: simulator load_controller monitor have no such parameter"),
         ("simulator:\n  ros__parameters:\n    rate: -5.0\n", "simulator.ros__parameters: rate: must be > 0"),
@@ -215,8 +217,7 @@ def test_a_sound_parameter_file_passes(tmp_path: Path) -> None:
 
     path = tmp_path / "params.yaml"
     path.write_text(
-        "/**:\n  ros__parameters:\n    use_sim_time: false\n    rate: 2.0\n"
-        "/rig/load_controller:\n  ros__parameters:\n    use_sim_time: true\n",
+        "/**:\n  ros__parameters:\n    use_sim_time: false\n    rate: 2.0\n/rig/load_controller:\n  ros__parameters:\n    use_sim_time: true\n",
         encoding="utf-8",
     )
     check_parameter_file(path)

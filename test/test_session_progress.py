@@ -37,31 +37,71 @@ def test_progress_line_shows_rpm_percent_and_state() -> None:
 
 def test_progress_line_before_any_data() -> None:
     line = format_progress(
-        snapshot(segment_number=0, segment_name="-", phase="starting", inner_ring_speed=None, cage_speed=None,
-                 slip_rate=None, slip_state=None, real_time_factor=None, sim_time=0.0)
+        snapshot(
+            segment_number=0,
+            segment_name="-",
+            phase="starting",
+            inner_ring_speed=None,
+            cage_speed=None,
+            slip_rate=None,
+            slip_state=None,
+            real_time_factor=None,
+            sim_time=0.0,
+        )
     )
     assert line == "[0/8 - starting] t=0.0 s  inner -  cage -  slip -  -  rtf -"
 
 
 def outcome(index: int, name: str, rpm: float, verdict: Verdict, **changes: object) -> SegmentOutcome:
     values: dict[str, object] = dict(
-        index=index, name=name, target_speed=rpm_to_rad_s(rpm), axial_load=100.0, verdict=verdict,
-        start_time=0.0, ramp_end=1.0, end_time=3.0, time_to_stable=2.314, measured_slip=3.2151,
-        truth_slip=3.2203, bearing_force=99.94,
+        index=index,
+        name=name,
+        target_speed=rpm_to_rad_s(rpm),
+        axial_load=100.0,
+        verdict=verdict,
+        start_time=0.0,
+        ramp_end=1.0,
+        end_time=3.0,
+        time_to_stable=2.314,
+        measured_slip=3.2151,
+        truth_slip=3.2203,
+        bearing_force=99.94,
     )
     values.update(changes)
     return SegmentOutcome(**values)  # type: ignore[arg-type]
 
 
 def test_summary_table_rows_and_alignment() -> None:
-    table = format_summary([
-        outcome(0, "load_up", 0.0, Verdict.UNKNOWN, time_to_stable=None, measured_slip=None, truth_slip=None),
-        outcome(1, "n0900", 900.0, Verdict.STABLE),
-        outcome(2, "n1200", 1200.0, Verdict.TIMEOUT, time_to_stable=None),
-    ])
+    table = format_summary(
+        [
+            outcome(0, "load_up", 0.0, Verdict.UNKNOWN, time_to_stable=None, measured_slip=None, truth_slip=None),
+            outcome(1, "n0900", 900.0, Verdict.STABLE),
+            outcome(2, "n1200", 1200.0, Verdict.TIMEOUT, time_to_stable=None),
+        ]
+    )
     lines = table.splitlines()
-    assert lines[0].split() == ["#", "segment", "speed", "rpm", "meas", "rpm", "load", "N", "F_bearing", "N", "slip", "%",
-                                "meas", "slip", "%", "truth", "verdict", "t_stable", "s", "conditions"]
+    assert lines[0].split() == [
+        "#",
+        "segment",
+        "speed",
+        "rpm",
+        "meas",
+        "rpm",
+        "load",
+        "N",
+        "F_bearing",
+        "N",
+        "slip",
+        "%",
+        "meas",
+        "slip",
+        "%",
+        "truth",
+        "verdict",
+        "t_stable",
+        "s",
+        "conditions",
+    ]
     assert set(lines[1]) <= {"-", " "}
     assert lines[2].split() == ["1", "load_up", "0", "-", "100", "99.9", "-", "-", "unknown", "-", "ok"]
     assert lines[3].split() == ["2", "n0900", "900", "-", "100", "99.9", "3.215", "3.220", "stable", "2.31", "ok"]
@@ -72,12 +112,20 @@ def test_summary_table_rows_and_alignment() -> None:
 
 
 def test_segments_whose_conditions_were_not_met_are_marked_and_explained() -> None:
-    table = format_summary([
-        outcome(0, "n7000", 7000.0, Verdict.STABLE, measured_speed=rpm_to_rad_s(5000.0),
-                conditions=("speed 5000 rpm measured, 7000 rpm commanded",)),
-        outcome(1, "n0900", 900.0, Verdict.STABLE, measured_speed=rpm_to_rad_s(900.0), bearing_force=30.0,
-                conditions=("load 30.0 N on the bearing, 100 N commanded", "disturbed: a message on /rig/axial_load/setpoint not sent by this session")),
-    ])
+    table = format_summary(
+        [
+            outcome(0, "n7000", 7000.0, Verdict.STABLE, measured_speed=rpm_to_rad_s(5000.0), conditions=("speed 5000 rpm measured, 7000 rpm commanded",)),
+            outcome(
+                1,
+                "n0900",
+                900.0,
+                Verdict.STABLE,
+                measured_speed=rpm_to_rad_s(900.0),
+                bearing_force=30.0,
+                conditions=("load 30.0 N on the bearing, 100 N commanded", "disturbed: a message on /rig/axial_load/setpoint not sent by this session"),
+            ),
+        ]
+    )
     lines = table.splitlines()
     assert lines[2].split()[3] == "5000" and lines[2].split()[-1] == "speed"
     assert lines[3].split()[-1] == "load,disturbed"

@@ -35,9 +35,7 @@ def program(tmp_path: Path) -> TestProgram:
 
 
 def status(t: float, state: StatusState, slip: float = 3.0, cage: float = 40.0, revolutions: int = 1, confidence: float = 0.99) -> SlipObservation:
-    return SlipObservation(
-        time=t, state=state, slip_rate=slip, inner_ring_speed=94.0, cage_speed=cage, window_revolutions=revolutions, confidence=confidence
-    )
+    return SlipObservation(time=t, state=state, slip_rate=slip, inner_ring_speed=94.0, cage_speed=cage, window_revolutions=revolutions, confidence=confidence)
 
 
 # The shipped monitor's verdict rests on the windows of the last slope_span_s = 1 s, at least 5 of
@@ -218,7 +216,9 @@ def test_speed_within_one_percent_meets_the_conditions(program: TestProgram) -> 
     runner = ProgramRunner(program)
     runner.start(0.0)
     runner.update(1.0)
-    near = SlipObservation(time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(900.0) * 0.995, cage_speed=40.0, window_revolutions=1)
+    near = SlipObservation(
+        time=3.0, state=StatusState.UNKNOWN, slip_rate=3.0, inner_ring_speed=rpm_to_rad_s(900.0) * 0.995, cage_speed=40.0, window_revolutions=1
+    )
     runner.observe_status(near)
     runner.observe_status(SlipObservation(**{**near.__dict__, "time": 3.5, "state": StatusState.STABLE}))
     runner.update(3.6)

@@ -30,6 +30,10 @@ DETECTION_S = 2.0
 (warn_after_s 1 s + the engine's half-revolution lag + one window + the first window's start)."""
 DRAG_KEY = "lubricant.consistency_pa_sn"
 """The grease's Herschel-Bulkley consistency: the viscous part of ball and cage-land drag."""
+WARM_K = 13.0
+"""The twin playing the bench starts this far above ambient (22 degC): at 35 degC, the
+calibration's reference temperature, where the grease values hold (docs/model.md,
+Calibration); the shadow twin's network starts at the bench thermocouple's first reading."""
 TRACTION_KEY = "lubricant.eyring_stress_pa"
 """The lubricant's Eyring stress: 30 % less of it is less traction at a given sliding."""
 
@@ -47,6 +51,12 @@ def replay(run: BenchRun | list[tuple[float, str, object]], twin: ShadowTwin, ch
         if kind == "force":
             assert isinstance(payload, float)
             twin.add_force(t, payload)
+        elif kind == "temperature":
+            assert isinstance(payload, float)
+            twin.add_temperature(t, payload)
+        elif kind == "torque":
+            assert isinstance(payload, float)
+            twin.add_torque(t, payload)
         else:
             assert isinstance(payload, Pulse)
             rows += twin.add_pulse(kind, payload)
@@ -55,7 +65,7 @@ def replay(run: BenchRun | list[tuple[float, str, object]], twin: ShadowTwin, ch
 
 @pytest.fixture(scope="module")
 def same_bench() -> BenchRun:
-    return twin_bench_run(HOLDS, clock_offset_s=BENCH_CLOCK)
+    return twin_bench_run(HOLDS, clock_offset_s=BENCH_CLOCK, initial_rise_k=WARM_K)
 
 
 def changed_bench(key: str, directory: Path) -> BenchRun:
@@ -68,7 +78,7 @@ def changed_bench(key: str, directory: Path) -> BenchRun:
         lubricant = BearingParameters.calibrated().lubricant
         assert lubricant is not None
         cal = scaled_calibration(source, key, 0.7, directory / "changed.yaml", base=lubricant.eyring_stress)
-    return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK)
+    return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK, initial_rise_k=WARM_K)
 
 
 @pytest.fixture(scope="module")
@@ -164,12 +174,46 @@ def test_round_trip_same_calibration_stays_inside_the_band(same_bench: BenchRun)
     assert twin.health().level == HealthLevel.OK
     # the prediction is the engine's, not a copy of the measurement: it differs from it
     assert any(r.residual != 0.0 for r in compared)
+    # the thermocouple and the torque meter beside it: the same physics, inside their bands
+    assert same_bench.temperatures and same_bench.torques
+    heat = [r for r in compared if math.isfinite(r.temperature_residual) and math.isfinite(r.torque_residual)]
+    assert len(heat) >= 0.9 * len(compared)
+    assert all(abs(r.temperature_residual) <= r.temperature_band for r in heat)
+    assert all(abs(r.torque_residual) <= r.torque_band for r in heat)
+    assert not any(r.temperature_anomaly or r.torque_anomaly for r in rows)
+    # the bench warmed during the run, and so did the twin's outer ring
+    assert heat[-1].measured_temperature > heat[0].measured_temperature + 0.2
+    assert heat[-1].predicted_temperature > heat[0].predicted_temperature + 0.2
+
+
+def test_a_thermocouple_reading_high_and_a_torque_meter_reading_high_are_flagged(same_bench: BenchRun) -> None:
+    """The same bench whose thermocouple reads 5 K high from 2 s on (beyond the band, about
+    1.8-1.9 K here: 2 x sqrt((0.3 x the rise since the network's start, under 1 K)^2 + 0.9^2);
+    the twin's network starts at the first reading, so the offset comes later) and whose torque meter reads 50 % high (beyond 2 x 15 %):
+    the temperature and torque rules flag it after warn_after_s, the slip's does not."""
+    twin = ShadowTwin(ShadowSettings.from_yaml())
+    start = same_bench.events()[0][0]
+
+    def faulty(t: float, kind: str, payload: object) -> object:
+        if kind == "temperature" and t > start + 2.0:
+            return float(payload) + 5.0  # type: ignore[arg-type]  # a temperature reading is a float
+        if kind == "torque":
+            return 1.5 * float(payload)  # type: ignore[arg-type]  # a torque sample is a float
+        return payload
+
+    events = [(t, kind, faulty(t, kind, payload)) for t, kind, payload in same_bench.events()]
+    rows = replay(events, twin)
+    assert not any(r.anomaly for r in rows)
+    assert any(r.temperature_anomaly for r in rows) and any(r.torque_anomaly for r in rows)
+    flagged = [r for r in rows if r.temperature_anomaly]
+    assert all(r.temperature_residual > r.temperature_band for r in flagged)
+    assert all(r.torque_residual > r.torque_band for r in rows if r.torque_anomaly)
+    health = twin.health()
+    assert health.level >= HealthLevel.WARN and any("outer-ring temperature" in m for m in health.reasons)
 
 
 @pytest.mark.parametrize("key", [DRAG_KEY, TRACTION_KEY])
-def test_bench_with_more_drag_or_less_traction_is_flagged_after_each_steady_speed(
-    key: str, dragged_bench: BenchRun, tmp_path: Path
-) -> None:
+def test_bench_with_more_drag_or_less_traction_is_flagged_after_each_steady_speed(key: str, dragged_bench: BenchRun, tmp_path: Path) -> None:
     bench = dragged_bench if key == DRAG_KEY else changed_bench(key, tmp_path)
     twin = ShadowTwin(ShadowSettings.from_yaml())
     rows = replay(bench, twin)
@@ -208,7 +252,7 @@ def test_online_recalibration_converges_to_the_changed_drag(dragged_bench: Bench
 
 # -- faults in the inputs ---------------------------------------------------------------------------
 def test_lost_pulses_and_a_load_cell_dropout_give_no_false_anomaly(same_bench: BenchRun) -> None:
-    run = BenchRun(list(same_bench.spindle), list(same_bench.cage), list(same_bench.forces), [])
+    run = BenchRun(list(same_bench.spindle), list(same_bench.cage), list(same_bench.forces), [], list(same_bench.temperatures), list(same_bench.torques))
     del run.spindle[100:102]  # two spindle pulses lost (about 1.7 s)
     del run.cage[60]  # one cage pulse lost (about 2.3 s)
     t_mid = BENCH_CLOCK + 6.0

@@ -79,7 +79,13 @@ def test_no_realtime_flag_becomes_a_parameter_override():
 
     assert node_arguments(["simulator"]) == ["simulator"]
     assert node_arguments(["simulator", "--no-realtime", "--ros-args", "-p", "rate:=2.0"]) == [
-        "simulator", "--ros-args", "-p", "rate:=2.0", "--ros-args", "-p", "realtime:=false",
+        "simulator",
+        "--ros-args",
+        "-p",
+        "rate:=2.0",
+        "--ros-args",
+        "-p",
+        "realtime:=false",
     ]
 
 

@@ -79,3 +79,43 @@ def test_more_parameters_than_rows_is_refused() -> None:
         calibrate(BearingParameters.from_yaml(), [BenchPoint(100.0, 100.0, 3.0)])
     with pytest.raises(CalibrationError, match="not calibratable"):
         calibrate(BearingParameters.from_yaml(), [BenchPoint(100.0, 100.0, 3.0)] * 3, fitted=("ball_count",))
+
+
+@pytest.mark.slow
+def test_thermal_rows_are_the_coupled_thermal_steady_states() -> None:
+    """With a thermal configuration a calibration row is the coupled thermal steady state (the
+    same slip and temperatures), and the bearing is warmer at the faster row; without one the
+    temperatures are NaN (isothermal, at the bearing file's temperature)."""
+    from bearing_rig_sim.studies.calibration import steady_state
+    from bearing_rig_sim.thermal.bearing import ThermalConfig
+    from bearing_rig_sim.thermal.coupling import thermal_steady_state
+
+    cfg = ThermalConfig.from_yaml(None)
+    params = BearingParameters.calibrated()
+    speeds = [rpm_to_rad_s(n) for n in (900, 2700)]
+    rows = steady_states(params, [(w, 100.0) for w in speeds], workers=2, thermal=cfg)
+    direct = thermal_steady_state(params, cfg, speeds[0], 100.0)
+    assert rows[0].slip_pct == direct.point.slip_pct and rows[0].friction_torque == direct.point.torque
+    assert rows[0].lubricant_temperature == direct.temperatures["lubricant"]
+    assert rows[0].outer_ring_temperature == direct.temperatures["outer_ring"]
+    assert cfg.ambient < rows[0].outer_ring_temperature < rows[1].outer_ring_temperature
+    assert math.isnan(steady_state(params, speeds[0], 100.0).lubricant_temperature)
+
+
+def test_a_thermal_calibration_file_says_so_and_gives_each_rows_temperatures(tmp_path: Path) -> None:
+    from bearing_rig_sim.studies.calibration import CalibrationResult, SteadyState
+
+    params = BearingParameters.calibrated()
+    point = BenchPoint(rpm_to_rad_s(900), 100.0, 3.22)
+    row = SteadyState(point.inner_ring_speed, 100.0, 37.0, 3.3, 0.1, 9.0, 1e-7, 1e-7, 33.456, 30.123)
+    result = CalibrationResult({"yield_stress": 500.0, "consistency": 60.0}, {}, (point,), (row,), 0.08, 5, params, True)
+    out = tmp_path / "cal.yaml"
+    write_calibration(result, out, "bench.csv")
+    import yaml
+
+    doc = yaml.safe_load(out.read_text(encoding="utf-8"))
+    assert doc["calibration"]["thermal"] is True
+    assert doc["calibration"]["rows"][0]["lubricant_temperature_c"] == 33.46 and doc["calibration"]["rows"][0]["outer_ring_temperature_c"] == 30.12
+    assert "# Thermal: every row is the coupled thermal steady state" in out.read_text(encoding="utf-8")
+    reloaded = BearingParameters.from_yaml(None, out)
+    assert reloaded.lubricant is not None and reloaded.lubricant.consistency == 60.0

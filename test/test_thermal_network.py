@@ -143,7 +143,9 @@ def test_twin_with_the_network_warms_up_chunk_by_chunk() -> None:
     within a second and the network has taken the engine's heat ten times a second."""
     from bearing_rig_sim.simulation.twin import RigTwin
 
-    twin = RigTwin.from_files(BEARING, CONFIG / "calibration" / "h7006c_table3.yaml", CONFIG / "rig.yaml", initial_speed=2700 * math.pi / 30, initial_axial_load=100.0)
+    twin = RigTwin.from_files(
+        BEARING, CONFIG / "calibration" / "h7006c_table3.yaml", CONFIG / "rig.yaml", initial_speed=2700 * math.pi / 30, initial_axial_load=100.0
+    )
     coupling = twin.attach_thermal(BEARING)
     start = coupling.temperature("outer_ring")
     for _ in range(1000):

@@ -73,9 +73,7 @@ def strictly_increasing(name: str, values: FloatArray) -> None:
     bad = np.flatnonzero(~(steps > 0.0))
     if bad.size:
         i = int(bad[0]) + 1
-        raise AnalysisError(
-            f"{name}: must increase strictly, but {name}[{i}] = {float(values[i])!r} <= {name}[{i - 1}] = {float(values[i - 1])!r}"
-        )
+        raise AnalysisError(f"{name}: must increase strictly, but {name}[{i}] = {float(values[i])!r} <= {name}[{i - 1}] = {float(values[i - 1])!r}")
 
 
 def finite_number(name: str, value: Any) -> float:

@@ -42,7 +42,6 @@ MIN_PHASE_REVOLUTIONS = 2.0
 be), so that the strips' offsets are told apart from the curvature (1)."""
 
 
-
 @dataclass(frozen=True)
 class PhaseEstimate:
     """A slope of slip against time from the cage's phase.

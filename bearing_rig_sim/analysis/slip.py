@@ -68,9 +68,7 @@ class BearingKinematics:
         if not self.ball_diameter > 0.0:
             raise AnalysisError(f"ball_diameter: must be > 0 m, got {self.ball_diameter!r}")
         if not self.pitch_diameter > self.ball_diameter:
-            raise AnalysisError(
-                f"pitch_diameter: must exceed the ball diameter {self.ball_diameter!r} m, got {self.pitch_diameter!r}"
-            )
+            raise AnalysisError(f"pitch_diameter: must exceed the ball diameter {self.ball_diameter!r} m, got {self.pitch_diameter!r}")
         if not 0.0 <= self.contact_angle < 0.5 * math.pi:
             raise AnalysisError(f"contact_angle: must be in [0, pi/2) rad, got {self.contact_angle!r}")
 
@@ -146,9 +144,7 @@ class BearingKinematics:
             same_length(cage_speed=cage, inner_ring_speed=inner)
         bad = np.flatnonzero(~(inner > 0.0))
         if bad.size:
-            raise AnalysisError(
-                f"inner_ring_speed: must be > 0 rad/s for a slip rate, got {float(inner[bad[0]])!r} at index {bad[0]}"
-            )
+            raise AnalysisError(f"inner_ring_speed: must be > 0 rad/s for a slip rate, got {float(inner[bad[0]])!r} at index {bad[0]}")
         out = (1.0 - cage / (self.epicyclic_ratio() * inner)) * 100.0
         return float(out[0]) if cage_scalar and inner_scalar else out
 
@@ -159,9 +155,7 @@ def _speeds(name: str, value: float | FloatArray) -> tuple[FloatArray, bool]:
     return finite_array(name, value), scalar
 
 
-def epicyclic_cage_speed(
-    inner_ring_speed: float | FloatArray, ball_diameter: float, pitch_diameter: float, contact_angle: float
-) -> float | FloatArray:
+def epicyclic_cage_speed(inner_ring_speed: float | FloatArray, ball_diameter: float, pitch_diameter: float, contact_angle: float) -> float | FloatArray:
     """Pure-rolling cage speed n_s (rad/s); paper Eq. 12.
 
     Args:
@@ -313,9 +307,15 @@ class ThrustContact:
         m = doc.section("materials")
         ball, ring = m.section("ball"), m.section("ring")
         inner, outer = raceway_contacts(
-            dw, dm, a0, fi, fo,
-            ball.number("youngs_modulus_pa", gt=0.0), ball.number("poisson_ratio", ge=0.0, lt=0.5),
-            ring.number("youngs_modulus_pa", gt=0.0), ring.number("poisson_ratio", ge=0.0, lt=0.5),
+            dw,
+            dm,
+            a0,
+            fi,
+            fo,
+            ball.number("youngs_modulus_pa", gt=0.0),
+            ball.number("poisson_ratio", ge=0.0, lt=0.5),
+            ring.number("youngs_modulus_pa", gt=0.0),
+            ring.number("poisson_ratio", ge=0.0, lt=0.5),
         )
         k_n = (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5
         return cls(z, a0, fi + fo - 1.0, dw, k_n)

@@ -125,9 +125,7 @@ def slope_function(curve: SlipCurve, step: float) -> Callable[[FloatArray], Floa
     return central
 
 
-def classify(
-    x: FloatArray | Sequence[float], curve: SlipCurve, critical_slope: float, *, step: float | None = None
-) -> npt.NDArray[np.str_]:
+def classify(x: FloatArray | Sequence[float], curve: SlipCurve, critical_slope: float, *, step: float | None = None) -> npt.NDArray[np.str_]:
     """State of each sample point by the slope of the fitted curve there.
 
     Args:

@@ -218,8 +218,7 @@ def read_layout(bag_dir: Path) -> BagLayout:
     mode = str(info.get("compression_mode") or "").lower()
     if mode not in ("", "none"):
         raise BagError(
-            f"{source}: rosbag2 {mode}-level compression is not supported (record with MCAP chunk "
-            "compression instead, or decompress with `ros2 bag convert`)"
+            f"{source}: rosbag2 {mode}-level compression is not supported (record with MCAP chunk compression instead, or decompress with `ros2 bag convert`)"
         )
     paths = _get(info, "relative_file_paths", source, list, where)
     file_info = {PurePath(str(f.get("path", ""))).name: f for f in info.get("files") or [] if isinstance(f, dict)}
@@ -230,7 +229,11 @@ def read_layout(bag_dir: Path) -> BagLayout:
     files = []
     for name in (PurePath(str(raw)).name for raw in paths):
         entry = file_info.get(name, {})
-        files.append(FileEntry(name, ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds"), int(entry.get("message_count", 0) or 0)))
+        files.append(
+            FileEntry(
+                name, ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds"), int(entry.get("message_count", 0) or 0)
+            )
+        )
     topics = []
     for index, item in enumerate(_get(info, "topics_with_message_count", source, list, where)):
         at = f"{where}topics_with_message_count[{index}]."
@@ -292,9 +295,7 @@ def layout_from_indexes(
                 except BagError as exc:
                     report(str(exc))
                     qos = []
-                entry = topics[channel.topic] = TopicEntry(
-                    channel.topic, msgtype, qos, channel.metadata.get("topic_type_hash", ""), 0, channel.encoding
-                )
+                entry = topics[channel.topic] = TopicEntry(channel.topic, msgtype, qos, channel.metadata.get("topic_type_hash", ""), 0, channel.encoding)
             elif msgtype and entry.msgtype and msgtype != entry.msgtype:
                 report(f"{index.path.name}: topic {channel.topic} carries {msgtype} here but {entry.msgtype} before; left out")
                 continue

@@ -309,8 +309,7 @@ def index_file(path: Path) -> McapIndex:
                 index.problems.append(f"{path.name}: the MCAP header record is damaged; read through the file's summary")
             else:
                 index.problems.append(
-                    f"{path.name}: file ends after {index.file_size} bytes, before its header is complete "
-                    "(recording interrupted as it started?): no data"
+                    f"{path.name}: file ends after {index.file_size} bytes, before its header is complete (recording interrupted as it started?): no data"
                 )
             return index
         assert isinstance(header, Header)  # checked by its opcode above
@@ -379,11 +378,7 @@ def iter_file_messages(
     def keep(channel_id: int, log_time: int) -> bool:
         return (wanted is None or channel_id in wanted) and low <= log_time < high
 
-    refs = [
-        r
-        for r in index.chunks
-        if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)
-    ]
+    refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
     refs.sort(key=lambda r: (r.start_ns, r.offset))
     try:
         stream = open(index.path, "rb")  # closed in finally

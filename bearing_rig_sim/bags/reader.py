@@ -295,9 +295,9 @@ class BagReader:
         except Exception as exc:  # TypesysError and parser errors
             self._report(f"{self.path}: the bag's message definitions are inconsistent ({exc}); using the built-in ones")
             return rig
-        needed = {
-            channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels
-        } | ({t.msgtype for t in self.layout.topics} if self.layout else set())
+        needed = {channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels} | (
+            {t.msgtype for t in self.layout.topics} if self.layout else set()
+        )
         missing = {name for name in dependencies(rig, needed) if name not in store.fielddefs}
         if missing:
             try:
@@ -310,11 +310,7 @@ class BagReader:
         types = {t.name: t.msgtype for t in self._found.topics}
         for index in self._indexes:
             self._channel_topics.append(
-                {
-                    cid: channel.topic
-                    for cid, channel in index.channels.items()
-                    if channel_msgtype(index, cid, self.layout) == types.get(channel.topic)
-                }
+                {cid: channel.topic for cid, channel in index.channels.items() if channel_msgtype(index, cid, self.layout) == types.get(channel.topic)}
             )
         topics = {}
         for entry in sorted(self._found.topics, key=lambda t: t.name):

@@ -40,7 +40,6 @@ BACKUP_SUFFIX = ".orig"
 """Appended to the name of a file the repair replaced (``run_0.mcap.orig``)."""
 
 
-
 @dataclass
 class FileRepair:
     """What the repair did to one storage file.
@@ -100,16 +99,10 @@ class RepairReport:
         """A few lines for a person: what was done, recovered and lost."""
         if not self.changed:
             return f"{self.path}: nothing to repair ({self.messages_recovered} messages, all files finished properly)"
-        lines = [
-            f"{self.path}: {self.messages_recovered} messages recovered, {self.messages_lost} messages and "
-            f"{self.bytes_lost} bytes lost"
-        ]
+        lines = [f"{self.path}: {self.messages_recovered} messages recovered, {self.messages_lost} messages and {self.bytes_lost} bytes lost"]
         for f in self.files:
             kept = f"; original kept as {f.backup.name}" if f.backup else ""
-            lines.append(
-                f"  {f.name}: {f.action}, {f.messages_recovered} messages, {f.messages_lost} messages and "
-                f"{f.bytes_lost} bytes lost{kept}"
-            )
+            lines.append(f"  {f.name}: {f.action}, {f.messages_recovered} messages, {f.messages_lost} messages and {f.bytes_lost} bytes lost{kept}")
             lines.extend(f"    {p}" for p in f.problems)
         if self.metadata_rewritten:
             kept = f" (old one kept as {self.metadata_backup.name})" if self.metadata_backup else ""

@@ -105,4 +105,3 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
             "verdict_ms_p99": round(float(np.percentile(verdict_ms, 99)), 3),
             "final_state": monitor.verdict().state.label,
         }
-

@@ -144,10 +144,23 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
     counts = {SPINDLE_PULSES_TOPIC: 0, CAGE_PULSES_TOPIC: 0}
     shafts = {SPINDLE_PULSES_TOPIC: "spindle", CAGE_PULSES_TOPIC: "cage"}
     status: Any = store.types["bearing_rig_msgs/msg/SlipStatus"](
-        header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"), inner_ring_speed=0.0, cage_speed=0.0,
-        theoretical_cage_speed=0.0, slip_rate=0.0, fitted_slope=0.0, critical_slope=-0.03, state=2, criterion="time",
-        confidence=0.9, window_revolutions=1, detail="slope -0.001 +- 0.002 over 7 points (0.953) clearly >= k = -0.03; P(slope >= k) 1.000",
-        axial_load=100.0, kinematic_slip_rate=0.0, loaded_contact_angle=0.2845, sweep_speed=104.72, sweep_stable_from=300.0,
+        header=types["std_msgs/msg/Header"](stamp=stamp(0), frame_id="bearing"),
+        inner_ring_speed=0.0,
+        cage_speed=0.0,
+        theoretical_cage_speed=0.0,
+        slip_rate=0.0,
+        fitted_slope=0.0,
+        critical_slope=-0.03,
+        state=2,
+        criterion="time",
+        confidence=0.9,
+        window_revolutions=1,
+        detail="slope -0.001 +- 0.002 over 7 points (0.953) clearly >= k = -0.03; P(slope >= k) 1.000",
+        axial_load=100.0,
+        kinematic_slip_rate=0.0,
+        loaded_contact_angle=0.2845,
+        sweep_speed=104.72,
+        sweep_stable_from=300.0,
         sweep_verdict="stable from 300 N (2-term Gaussian, R^2 0.9991, RMSE 0.012 %, 8 loads)",
     )
     dt = 1e-3

@@ -113,10 +113,7 @@ class _Probe:
             AXIAL_LOAD_STATE.name: AxialLoadState,
         }
         qos = {CLOCK.name: reliable, SLIP_STATUS.name: latched, AXIAL_LOAD_STATE.name: reliable}
-        self.subs = {
-            name: self.tap.create_subscription(msgtype, name, lambda _m: None, qos.get(name, best), raw=True)
-            for name, msgtype in self.types.items()
-        }
+        self.subs = {name: self.tap.create_subscription(msgtype, name, lambda _m: None, qos.get(name, best), raw=True) for name, msgtype in self.types.items()}
         self.spindle = self.node.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
         self.setpoint = self.node.create_publisher(Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
         self._command_types = (SpindleCommand, Float64)

@@ -46,7 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.rig.fibre_optic import Pulse
-from bearing_rig_sim.shadow import ShadowSettings, ShadowTwin
+from bearing_rig_sim.shadow import ResidualWindow, ShadowSettings, ShadowTwin
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.synthetic.twin_bench import BenchRun, Hold, twin_bench_run, write_bench_bag
 
@@ -99,8 +99,15 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                         twin.check(tick)
                         tick += CHECK_PERIOD_S
                     t0 = time.perf_counter()
+                    rows: list[ResidualWindow]
                     if kind == "force":
                         twin.add_force(t, float(payload))  # type: ignore[arg-type]  # a decoded float64 field
+                        rows = []
+                    elif kind == "temperature":
+                        twin.add_temperature(t, float(payload))  # type: ignore[arg-type]  # a decoded float64 field
+                        rows = []
+                    elif kind == "torque":
+                        twin.add_torque(t, float(payload))  # type: ignore[arg-type]  # a decoded float64 field
                         rows = []
                     else:
                         assert isinstance(payload, Pulse)
@@ -162,7 +169,11 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
     env, lease = session_environment(os.environ)
     apply_rig_profile(env, work)
     shadow = NodeProcess("shadow", [*node_command(NodeSpec("shadow", "bearing-rig-shadow")), "--autostart"], work / "shadow.log")
-    replay = NodeProcess("replay", [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"], work / "replay.log")
+    replay = NodeProcess(
+        "replay",
+        [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"],
+        work / "replay.log",
+    )
     context = rclpy.Context()
     pulses: list[tuple[int, bytes]] = []
     residuals: list[tuple[int, bytes]] = []

@@ -22,7 +22,13 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser("analyze", help="slip and stability report of a bag (markdown, PNG, CSV)", description=__doc__)
     p.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder (default: out/analyze/<bag name>)")
-    p.add_argument("--monitor-params", type=Path, default=None, metavar="FILE", help="monitor parameter file (default: the one recorded in the bag, else config/monitor.yaml)")
+    p.add_argument(
+        "--monitor-params",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="monitor parameter file (default: the one recorded in the bag, else config/monitor.yaml)",
+    )
     p.add_argument("--max-points", type=int, default=2000, metavar="N", help="points per plotted series (default 2000)")
     p.set_defaults(func=run)
 

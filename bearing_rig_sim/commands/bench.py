@@ -116,16 +116,11 @@ def print_table(rows: list[dict[str, Any]], out: TextIO) -> None:
     for row in rows:
         columns.extend(key for key in row if key not in columns)
     cells = [[_cell(row.get(col, "")) for col in columns] for row in rows]
-    numeric = [
-        all(isinstance(row[col], numbers.Real) and not isinstance(row[col], bool) for row in rows if col in row)
-        for col in columns
-    ]
+    numeric = [all(isinstance(row[col], numbers.Real) and not isinstance(row[col], bool) for row in rows if col in row) for col in columns]
     widths = [max(len(col), *(len(line[i]) for line in cells)) for i, col in enumerate(columns)]
 
     def fmt(values: list[str]) -> str:
-        return "  ".join(
-            v.rjust(w) if num else v.ljust(w) for v, w, num in zip(values, widths, numeric)
-        ).rstrip()
+        return "  ".join(v.rjust(w) if num else v.ljust(w) for v, w, num in zip(values, widths, numeric)).rstrip()
 
     out.write(fmt(columns) + "\n")
     out.write("  ".join("-" * w for w in widths) + "\n")

@@ -1,4 +1,9 @@
-"""``bearing-rig calibrate DATA.csv``: fit the engine's uncertain resistances to bench slip data."""
+"""``bearing-rig calibrate DATA.csv``: fit the engine's uncertain resistances to bench slip data.
+
+With ``--thermal`` every row is the coupled thermal steady state (the bearing file's
+``thermal:`` section): the bench's slips are steady, warm values, and the fitted values are the
+grease's at the bearing file's lubricant temperature (the reference of its temperature laws).
+The shipped calibration is made so (docs/model.md, section Calibration)."""
 
 from __future__ import annotations
 
@@ -16,6 +21,7 @@ from bearing_rig_sim.commands import output_file
 from bearing_rig_sim.config import check_number, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 
 def register(subparsers: Any) -> None:
@@ -28,14 +34,17 @@ def register(subparsers: Any) -> None:
         "--out",
         type=Path,
         default=None,
-        help="calibration file to write (default: out/calibration/<data>.yaml; the shipped config/calibration/ "
-        "files change only when named here)",
+        help="calibration file to write (default: out/calibration/<data>.yaml; the shipped config/calibration/ files change only when named here)",
     )
     p.add_argument("--force", action="store_true", help="replace the --out file if it exists")
     p.add_argument(
-        "--load-sigma", type=float, default=LOAD_SIGMA_N, metavar="N",
+        "--load-sigma",
+        type=float,
+        default=LOAD_SIGMA_N,
+        metavar="N",
         help=f"standard uncertainty of the bench's axial load, N (a nuisance offset common to all rows; default {LOAD_SIGMA_N:g})",
     )
+    p.add_argument("--thermal", action="store_true", help="fit the coupled thermal steady states (the bench's warm slips; the bearing file's thermal: section)")
     p.add_argument("--json", action="store_true", help="print the result as one JSON object")
     p.set_defaults(func=run)
 
@@ -45,21 +54,41 @@ def run(args: argparse.Namespace) -> int:
     points = read_bench_csv(args.data)
     out = output_file(args.out or Path("out") / "calibration" / f"{args.data.stem}.yaml", "--out", overwrite=args.force)
     check_number(args.load_sigma, "command line", "--load-sigma", ge=0.0, le=1000.0)
-    result = calibrate(BearingParameters.from_yaml(args.bearing), points, fitted=tuple(args.fit))
+    thermal = ThermalConfig.from_yaml(args.bearing) if args.thermal else None
+    result = calibrate(BearingParameters.from_yaml(args.bearing), points, fitted=tuple(args.fit), thermal=thermal)
     names = tuple(result.fitted)
     unc = fit_uncertainty(
-        result.params, [(p.inner_ring_speed, p.axial_load, p.slip_pct) for p in points], names, [result.fitted[n] for n in names], load_sigma_n=args.load_sigma
+        result.params,
+        [(p.inner_ring_speed, p.axial_load, p.slip_pct) for p in points],
+        names,
+        [result.fitted[n] for n in names],
+        load_sigma_n=args.load_sigma,
+        thermal=thermal,
     )
     check_identifiable(names, np.array(unc.noise_correlation), unc.condition_number)  # refused before anything is written
     write_calibration(result, out, args.data.name)
     with out.open("a", encoding="utf-8") as stream:
         stream.write(yaml.safe_dump({"uncertainty": unc.as_dict()}, sort_keys=False))
     if args.json:
-        print(json.dumps({"fitted": result.fitted, "fixed": result.fixed, "rms_slip_pct": result.rms_pct, "file": str(out), "uncertainty": unc.as_dict()}))
+        print(
+            json.dumps(
+                {
+                    "fitted": result.fitted,
+                    "fixed": result.fixed,
+                    "rms_slip_pct": result.rms_pct,
+                    "thermal": result.thermal,
+                    "file": str(out),
+                    "uncertainty": unc.as_dict(),
+                }
+            )
+        )
         return 0
-    print(f"{'rpm':>8} {'load N':>8} {'bench %':>8} {'twin %':>8} {'diff pp':>8}")
+    print(f"{'rpm':>8} {'load N':>8} {'bench %':>8} {'twin %':>8} {'diff pp':>8}" + (f" {'lub degC':>8} {'outer degC':>10}" if result.thermal else ""))
     for p, s in zip(result.points, result.predicted):
-        print(f"{rad_s_to_rpm(p.inner_ring_speed):8.0f} {p.axial_load:8.1f} {p.slip_pct:8.3f} {s.slip_pct:8.3f} {s.slip_pct - p.slip_pct:8.3f}")
+        line = f"{rad_s_to_rpm(p.inner_ring_speed):8.0f} {p.axial_load:8.1f} {p.slip_pct:8.3f} {s.slip_pct:8.3f} {s.slip_pct - p.slip_pct:8.3f}"
+        if result.thermal:
+            line += f" {s.lubricant_temperature:8.2f} {s.outer_ring_temperature:10.2f}"
+        print(line)
     for name, value, se in zip(unc.names, unc.values, unc.standard_errors):
         print(f"fitted {name} = {value:.6g} +- {100 * se:.1f} % (standard error, load uncertainty +-{unc.load_sigma_n:g} N included)")
     for a in range(len(names)):

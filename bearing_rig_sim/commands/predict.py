@@ -42,7 +42,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--rpm", type=float, nargs="+", required=True, help="inner-ring speeds, rpm")
     p.add_argument("--load", type=float, nargs="+", required=True, help="axial loads, N (one, or one per speed)")
     p.add_argument("--radial-load", type=float, nargs="+", default=None, help="radial loads, N (one, or one per speed): adds the load distribution")
-    p.add_argument("--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)")
+    p.add_argument(
+        "--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)"
+    )
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
     p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: config/calibration/h7006c_table3.yaml)")
     p.add_argument("--lubricant", type=Path, default=None, help="lubricant file replacing the bearing file's (config/lubricants/)")
@@ -112,12 +114,22 @@ def _uncertainty(args: argparse.Namespace) -> Any:
     return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
 
 
-def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float) -> None:
+def _thermal_calibration(args: argparse.Namespace) -> bool:
+    """Whether the calibration in use was fitted through the thermal steady states
+    (``calibration.thermal`` of its file)."""
+    if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
+        return False
+    doc = load_yaml(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+    return "calibration" in doc and bool(doc.section("calibration").data.get("thermal", False))
+
+
+def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float, thermal: Any = None) -> None:
     """``slip_pct_low`` / ``slip_pct_high``: the 95 % interval from the parameter and load
-    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`)."""
+    uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`; with ``thermal``,
+    through the coupled thermal steady state)."""
     from bearing_rig_sim.studies.uncertainty import slip_interval
 
-    low, high, _ = slip_interval(params, unc, omega, load, slip)
+    low, high, _ = slip_interval(params, unc, omega, load, slip, thermal)
     row["slip_pct_low"] = round(low, 4)
     row["slip_pct_high"] = round(high, 4)
 
@@ -127,7 +139,9 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
         print(json.dumps(row))
         return
     if "time_s" in row:
-        print(f"{row['time_s']:8.1f} s   outer ring {row['outer_ring_c']:6.2f} degC   lubricant {row['lubricant_c']:6.2f} degC   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm")
+        print(
+            f"{row['time_s']:8.1f} s   outer ring {row['outer_ring_c']:6.2f} degC   lubricant {row['lubricant_c']:6.2f} degC   torque {row['friction_torque_nm'] * 1e3:7.2f} N mm"
+        )
         return
     line = (
         f"{row['rpm']:8.1f} rpm {row['axial_load_n']:7.1f} N   cage {row['cage_rpm']:9.3f} rpm   slip {row['slip_pct']:7.3f} %"
@@ -137,8 +151,7 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
         line += f"   slip 95 % [{row['slip_pct_low']:.3f}, {row['slip_pct_high']:.3f}] %"
     if "loaded_balls" in row:
         line += (
-            f"   Q {row['ball_load_min_n']:.1f}-{row['ball_load_max_n']:.1f} N on {row['loaded_balls']} balls"
-            f" at {row['contact_angle_max_load_deg']:.2f} deg"
+            f"   Q {row['ball_load_min_n']:.1f}-{row['ball_load_max_n']:.1f} N on {row['loaded_balls']} balls at {row['contact_angle_max_load_deg']:.2f} deg"
         )
     if "outer_ring_temperature_c" in row:
         line += f"   outer ring {row['outer_ring_temperature_c']:6.2f} degC"
@@ -168,16 +181,27 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
         row["lubricant_temperature_c"] = round(ts.temperatures["lubricant"], 2)
         row["temperatures_c"] = {k: round(v, 2) for k, v in ts.temperatures.items()}
         row["heat_w"] = {
-            "inner_contacts": round(ts.sources.inner_contacts, 4), "outer_contacts": round(ts.sources.outer_contacts, 4), "drag": round(ts.sources.drag, 4),
-            "land": round(ts.sources.land, 4), "rolling_and_pockets": round(ts.sources.rolling_and_pockets, 4),
+            "inner_contacts": round(ts.sources.inner_contacts, 4),
+            "outer_contacts": round(ts.sources.outer_contacts, 4),
+            "drag": round(ts.sources.drag, 4),
+            "land": round(ts.sources.land, 4),
+            "rolling_and_pockets": round(ts.sources.rolling_and_pockets, 4),
         }
         row["time_constants_s"] = [round(t, 1) for t in ts.time_constants[:3]]
         row["thermal_residual_k"] = round(ts.residual_k, 3)
         unc = _uncertainty(args)
         if unc is not None:
-            _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
+            if _thermal_calibration(args):
+                # fitted through the thermal steady states: so are the interval's gradients
+                _add_interval(row, params, unc, omega, f, pt.slip_pct, cfg)
+            else:
+                _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
         iso = steady_states(params, [(omega, f)], workers=1)[0]
-        row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso.slip_pct, 4), "friction_torque_nm": round(iso.friction_torque, 6)}
+        row["isothermal"] = {
+            "temperature_c": params.lubricant_temperature,
+            "slip_pct": round(iso.slip_pct, 4),
+            "friction_torque_nm": round(iso.friction_torque, 6),
+        }
         _print(row, args.json)
     return 0
 

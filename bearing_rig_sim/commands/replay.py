@@ -28,7 +28,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--topics", nargs="+", metavar="T", default=None, help=f"topics to replay (default: all; {CLOCK.name} always)")
     p.add_argument("--start", type=float, default=0.0, metavar="S", help="start S seconds after the bag's first message")
     p.add_argument("--duration", type=float, default=None, metavar="D", help="replay D seconds of the bag (default: to the end)")
-    p.add_argument("--clock-hz", type=float, default=100.0, metavar="HZ", help=f"rate of the {CLOCK.name} made when the bag has none, per bag second (default 100)")
+    p.add_argument(
+        "--clock-hz", type=float, default=100.0, metavar="HZ", help=f"rate of the {CLOCK.name} made when the bag has none, per bag second (default 100)"
+    )
     p.add_argument("--delay", type=float, default=0.5, metavar="S", help="wall seconds to wait before the first message, for discovery (default 0.5)")
     p.add_argument(
         "--wait-for-subscribers",

@@ -33,9 +33,9 @@ def add_foxglove_argument(parser: argparse.ArgumentParser) -> None:
         const=FOXGLOVE_PORT,
         default=None,
         metavar="PORT",
-        help=f"serve the rig's topics live to the Foxglove app on ws://localhost:PORT (default {FOXGLOVE_PORT}); "
-        "layout: config/foxglove/rig.json",
+        help=f"serve the rig's topics live to the Foxglove app on ws://localhost:PORT (default {FOXGLOVE_PORT}); layout: config/foxglove/rig.json",
     )
+
 
 DEFAULT_PROGRAM = ("programs", "validation.yaml")
 """The default program, under ``config/``: the validation program (paper Table 3 conditions)."""

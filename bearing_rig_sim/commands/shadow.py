@@ -56,7 +56,9 @@ def run(args: argparse.Namespace) -> int:
         if not args.calibration.is_file():
             raise ConfigError(str(args.calibration), "calibration", "file not found")
         rms = calibration_rms(args.calibration)
-        settings = settings.replace(calibration_file=args.calibration.resolve(), calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct)
+        settings = settings.replace(
+            calibration_file=args.calibration.resolve(), calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct
+        )
     if args.recalibrate is not None:
         settings = settings.replace(recalibrate=True, recalibrate_parameter=args.recalibrate or settings.recalibrate_parameter)
     if args.bag is None:
@@ -70,7 +72,9 @@ def run(args: argparse.Namespace) -> int:
         result = shadow_bag(args.bag, out, settings)
     c = result.counts
     inside = f"{100.0 * result.inside_fraction:.2f} %" if c["compared"] else "-"
-    print(f"{args.bag}: {c['windows']} slip windows, {c['compared']} compared, {inside} inside the band, {c['anomalous']} flagged in {len(result.stretches)} stretch(es)")
+    print(
+        f"{args.bag}: {c['windows']} slip windows, {c['compared']} compared, {inside} inside the band, {c['anomalous']} flagged in {len(result.stretches)} stretch(es)"
+    )
     for s in result.stretches:
         print(f"  {s.start_s:.3f}-{s.end_s:.3f} s {s.worst.name}: {s.detail}")
     if result.estimate is not None:

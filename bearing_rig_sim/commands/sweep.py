@@ -44,9 +44,7 @@ def run(args: argparse.Namespace) -> int:
         raise RigError(f"--workers must be >= 1, got {args.workers}")
     spec = load_spec(args.spec)
     out = output_folder(args.out or Path("sweeps") / spec.name, "--out")  # before the points run
-    outcome = run_sweep(
-        spec, out, scheduler=args.scheduler, workers=args.workers, method=INTEGRATE if args.integrate else SOLVE, progress=not args.no_progress
-    )
+    outcome = run_sweep(spec, out, scheduler=args.scheduler, workers=args.workers, method=INTEGRATE if args.integrate else SOLVE, progress=not args.no_progress)
     table = pq.read_table(outcome.path)
     figure = None
     found: dict[str, dict[float, float | None]] = {}
@@ -66,7 +64,9 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(summary))
         return 0
-    print(f"{outcome.points} points in {outcome.path} ({outcome.computed} computed now in {outcome.seconds:.1f} s on {outcome.workers} workers, {outcome.errors} failed)")
+    print(
+        f"{outcome.points} points in {outcome.path} ({outcome.computed} computed now in {outcome.seconds:.1f} s on {outcome.workers} workers, {outcome.errors} failed)"
+    )
     for branch, rows in found.items():
         text = ", ".join(f"{k:g} rpm: {'-' if v is None else f'{v:g} N'}" for k, v in rows.items())
         print(f"skid boundary ({branch}, slip < {spec.skid_slip_pct:g} % from this load up): {text}")

@@ -218,10 +218,7 @@ class BearingDynamics:
             rpm = omega * 30.0 / math.pi
             if self.model == "reduced":
                 limit = reduced_limit(self.vector, state)
-                mechanism = (
-                    f"explicit centrifugal coupling of the contact loads at {rpm:.0f} rpm, {load:g} N: "
-                    f"ball orbit {state.orbit_speed:.0f} rad/s"
-                )
+                mechanism = f"explicit centrifugal coupling of the contact loads at {rpm:.0f} rpm, {load:g} N: ball orbit {state.orbit_speed:.0f} rad/s"
             else:
                 linear, mode = stiff_limit(self.vector, state)
                 limit = STIFF_SAFETY * linear
@@ -329,7 +326,18 @@ class BearingDynamics:
         self.stats[:] = 0.0
         if n > 0:
             self._step(
-                self.vector, self.ball, self.cage, self.ring, self.out, self.stats, self.work, n, self.time_step, self.axial_load, accel, 0,
+                self.vector,
+                self.ball,
+                self.cage,
+                self.ring,
+                self.out,
+                self.stats,
+                self.work,
+                n,
+                self.time_step,
+                self.axial_load,
+                accel,
+                0,
                 self.radial_load,
             )
         self.check_state()
@@ -461,8 +469,15 @@ class BearingDynamics:
         o = self.out
         alpha_i, alpha_o = float(np.mean(o[:, kn.O_AI])), float(np.mean(o[:, kn.O_AO]))
         inner, outer = raceway_contacts(
-            p.ball_diameter, p.pitch_diameter, 0.5 * (alpha_i + alpha_o), p.inner_curvature_ratio, p.outer_curvature_ratio,
-            p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson,
+            p.ball_diameter,
+            p.pitch_diameter,
+            0.5 * (alpha_i + alpha_o),
+            p.inner_curvature_ratio,
+            p.outer_curvature_ratio,
+            p.ball_modulus,
+            p.ball_poisson,
+            p.ring_modulus,
+            p.ring_poisson,
         )
         r, rm = 0.5 * p.ball_diameter, 0.5 * p.pitch_diameter
         wm = float(np.mean(self.ball[:, kn.B_OMEGA]))
@@ -502,4 +517,3 @@ class BearingDynamics:
             cage_whirl_radius=self.cage_whirl_radius,
             cage_centre=(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY])),
         )
-

@@ -72,9 +72,7 @@ def curvature_difference_of_ellipticity(kappa: float) -> float:
     return ((kappa * kappa + 1.0) * ee - 2.0 * ek) / ((kappa * kappa - 1.0) * ee)
 
 
-def point_contact(
-    rho_1i: float, rho_1ii: float, rho_2i: float, rho_2ii: float, e1: float, nu1: float, e2: float, nu2: float
-) -> HertzContact:
+def point_contact(rho_1i: float, rho_1ii: float, rho_2i: float, rho_2ii: float, e1: float, nu1: float, e2: float, nu2: float) -> HertzContact:
     """Solve the elliptical Hertz point contact of two bodies.
 
     Args:
@@ -104,7 +102,7 @@ def point_contact(
         ek, ee = float(ellipk(m)), float(ellipe(m))
     # delta = F (9/(2 E Rsum) (Q/(pi kappa E'))^2)^(1/3)  ->  Q = K delta^1.5
     coef = ek * (9.0 * rho_sum / (2.0 * ee) / (math.pi * kappa * ep) ** 2) ** (1.0 / 3.0)
-    stiffness = coef ** -1.5
+    stiffness = coef**-1.5
     return HertzContact(stiffness, kappa, ek, ee, rho_sum, f_rho, ep)
 
 
@@ -132,10 +130,6 @@ def raceway_contacts(
     """
     gamma = ball_diameter * math.cos(contact_angle) / pitch_diameter
     rb = 2.0 / ball_diameter
-    inner = point_contact(
-        rb, rb, rb * gamma / (1.0 - gamma), -1.0 / (inner_curvature_ratio * ball_diameter), e_ball, nu_ball, e_ring, nu_ring
-    )
-    outer = point_contact(
-        rb, rb, -rb * gamma / (1.0 + gamma), -1.0 / (outer_curvature_ratio * ball_diameter), e_ball, nu_ball, e_ring, nu_ring
-    )
+    inner = point_contact(rb, rb, rb * gamma / (1.0 - gamma), -1.0 / (inner_curvature_ratio * ball_diameter), e_ball, nu_ball, e_ring, nu_ring)
+    outer = point_contact(rb, rb, -rb * gamma / (1.0 + gamma), -1.0 / (outer_curvature_ratio * ball_diameter), e_ball, nu_ball, e_ring, nu_ring)
     return inner, outer

@@ -280,7 +280,14 @@ def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> 
 
 @njit(cache=True)
 def solve_quasi_static(
-    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, axial_load: float, tol: float, max_iter: int,
+    p: np.ndarray,
+    ball: np.ndarray,
+    ring: np.ndarray,
+    geo: np.ndarray,
+    work: np.ndarray,
+    axial_load: float,
+    tol: float,
+    max_iter: int,
     radial_load: float = 0.0,
 ) -> int:
     """Newton solution of the normal (radial-axial) equilibrium of every ball and of the inner
@@ -737,7 +744,9 @@ def cage_segment_torque(p: np.ndarray, cage: np.ndarray, k: int, z: int, factor:
 
 
 @njit(cache=True)
-def record(out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float, fs: float, si: float, so: float, fi: float, fo: float) -> None:
+def record(
+    out: np.ndarray, j: int, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float, fs: float, si: float, so: float, fi: float, fo: float
+) -> None:
     """Write ball j's diagnostics into ``out`` (angles from the contact normals)."""
     out[j, O_QI], out[j, O_QO] = qi, qo
     out[j, O_AI], out[j, O_AO] = math.atan2(-niz, -nir), math.atan2(noz, nor)
@@ -916,9 +925,17 @@ def cage_centre_forces(p: np.ndarray, ring: np.ndarray, omega_c: float) -> tuple
     ring[R_LAND_N] = normal
     ring[R_LAND_F] = land_shear_factor(p, math.sqrt(x * x + y * y) / p[P_LAND_CLEAR])
     return (
-        fx, fy + p[P_CAGE_GRAV_Y], normal,
-        (f1x - fx) / hx, (f2x - fx) / hx, (f1y - fy) / hx, (f2y - fy) / hx,
-        (f3x - fx) / hv, (f4x - fx) / hv, (f3y - fy) / hv, (f4y - fy) / hv,
+        fx,
+        fy + p[P_CAGE_GRAV_Y],
+        normal,
+        (f1x - fx) / hx,
+        (f2x - fx) / hx,
+        (f1y - fy) / hx,
+        (f2y - fy) / hx,
+        (f3x - fx) / hv,
+        (f4x - fx) / hv,
+        (f3y - fy) / hv,
+        (f4y - fy) / hv,
     )
 
 
@@ -1082,11 +1099,9 @@ def step_reduced(
             e = work[k, w0 + 4]
             gc = rm * work[k, w0 + 6] + tau
             diag[k] = jseg + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
-            rhs[k] = dt * (
-                gc
-                + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA])
-                + dt * rm * work[k, w0 + 5]
-            ) + dt * e * work[k, w0 + 2]
+            rhs[k] = (
+                dt * (gc + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA]) + dt * rm * work[k, w0 + 5]) + dt * e * work[k, w0 + 2]
+            )
         cyclic_tridiagonal(diag, -dt * lc, rhs, d_omega, tri_work)
         dvx = dvy = 0.0
         if centre:
@@ -1189,7 +1204,25 @@ def step_stiff(
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
             t_inner, m_outer, m_ring, t_orbit = contact_moments(
-                p, inner_speed_scale(omega_i), wa, wa + cb * wm, smooth_sign(wa + cb * wm), rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, di
+                p,
+                inner_speed_scale(omega_i),
+                wa,
+                wa + cb * wm,
+                smooth_sign(wa + cb * wm),
+                rb,
+                r_ci,
+                aom + r * co * cb,
+                fi,
+                fo,
+                si,
+                so,
+                pi,
+                po,
+                fri,
+                froll - fri,
+                qi,
+                qo,
+                di,
             )
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer

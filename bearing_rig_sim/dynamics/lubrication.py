@@ -258,7 +258,16 @@ def starvation_reduction(meniscus_ratio: float, rx: float, semi_width: float, ce
 
 
 def film_thickness(
-    lub: Lubricant, temperature_c: float, e_reduced: float, rx: float, ellipticity: float, semi_width: float, max_pressure: float, entrainment: float, load: float, slide_roll: float = 0.0
+    lub: Lubricant,
+    temperature_c: float,
+    e_reduced: float,
+    rx: float,
+    ellipticity: float,
+    semi_width: float,
+    max_pressure: float,
+    entrainment: float,
+    load: float,
+    slide_roll: float = 0.0,
 ) -> Film:
     """Film of one contact: Hamrock-Dowson with the thermal and starvation reductions.
 

@@ -287,7 +287,12 @@ the paper's stepped Coulomb law in the sliding speed; ``ehl_traction`` an expone
 slide-to-roll ratio; ``rheology`` the film rheology integrated over the Hertz ellipse
 (:mod:`.traction`), which needs a lubricant file."""
 
-LUBRICANT_OVERRIDES = {"yield_stress_pa": "yield_stress", "consistency_pa_sn": "consistency", "fill_fraction": "fill_fraction", "eyring_stress_pa": "eyring_stress"}
+LUBRICANT_OVERRIDES = {
+    "yield_stress_pa": "yield_stress",
+    "consistency_pa_sn": "consistency",
+    "fill_fraction": "fill_fraction",
+    "eyring_stress_pa": "eyring_stress",
+}
 """Keys of the bearing file's ``lubricant:`` section that override the lubricant file (a
 calibration sets them): key -> :class:`Lubricant` field."""
 
@@ -382,7 +387,9 @@ def traction_table(p: BearingParameters) -> np.ndarray:
     lub = p.lubricant
     assert lub is not None
     film_only = dataclasses.replace(lub, yield_stress=0.0, consistency=0.0, flow_index=1.0, fill_fraction=1.0)
-    key = p.replace(lubricant=film_only, ball_drag_scale=1.0, cage_land_viscous_scale=1.0, pocket_friction=0.0, rolling_hysteresis_factor=0.0, ehl_rolling_scale=1.0)
+    key = p.replace(
+        lubricant=film_only, ball_drag_scale=1.0, cage_land_viscous_scale=1.0, pocket_friction=0.0, rolling_hysteresis_factor=0.0, ehl_rolling_scale=1.0
+    )
     return _traction_table(key).copy()
 
 

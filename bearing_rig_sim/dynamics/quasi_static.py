@@ -63,7 +63,9 @@ class LoadDistributionError(RigError):
     """The quasi-static equilibrium could not be found (or a bad input)."""
 
 
-def thermal_clearance_change(params: BearingParameters, inner_ring_c: float, outer_ring_c: float, balls_c: float, reference_c: float, expansion: float | None = None) -> float:
+def thermal_clearance_change(
+    params: BearingParameters, inner_ring_c: float, outer_ring_c: float, balls_c: float, reference_c: float, expansion: float | None = None
+) -> float:
     """Change of the diametral clearance P_d (m) when the rings and balls leave the temperature
     ``reference_c`` at which the clearance was set (degC each; add it to
     :attr:`LoadCase.clearance`): each free body grows by alpha dT times its diameter (Harris and
@@ -177,8 +179,15 @@ class QuasiStaticBearing:
         self.big_a = self.gi + self.go
         self.ri = 0.5 * self.dm + self.gi * math.cos(self.a0)
         inner, outer = raceway_contacts(
-            p.ball_diameter, p.pitch_diameter, p.contact_angle, p.inner_curvature_ratio, p.outer_curvature_ratio,
-            p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson,
+            p.ball_diameter,
+            p.pitch_diameter,
+            p.contact_angle,
+            p.inner_curvature_ratio,
+            p.outer_curvature_ratio,
+            p.ball_modulus,
+            p.ball_poisson,
+            p.ring_modulus,
+            p.ring_poisson,
         )
         self.ki, self.ko = inner.stiffness, outer.stiffness
         self.kn = (self.ki ** (-2.0 / 3.0) + self.ko ** (-2.0 / 3.0)) ** -1.5
@@ -194,7 +203,9 @@ class QuasiStaticBearing:
         beta = math.atan2(math.sin(ao), math.cos(ao) + g)
         orbit = omega * (1.0 - g * math.cos(ai)) / (1.0 + math.cos(ai - ao))
         tb = math.tan(beta)
-        den = ((math.cos(ao) + tb * math.sin(ao)) / (1.0 + g * math.cos(ao)) + (math.cos(ai) + tb * math.sin(ai)) / (1.0 - g * math.cos(ai))) * g * math.cos(beta)
+        den = (
+            ((math.cos(ao) + tb * math.sin(ao)) / (1.0 + g * math.cos(ao)) + (math.cos(ai) + tb * math.sin(ai)) / (1.0 - g * math.cos(ai))) * g * math.cos(beta)
+        )
         return orbit, omega / den, beta
 
     def _ball(self, a1: float, a2: float, omega: float, gyro: bool, x0: np.ndarray | None) -> tuple[float, float, float, float, float, np.ndarray]:
@@ -302,9 +313,15 @@ class QuasiStaticBearing:
         qi, qo, ai, ao, wm = self._balls(u, case, centres)
         forces = self._ring_forces(qi, ai)
         return LoadDistribution(
-            azimuths=self.psi.copy(), inner_loads=qi, outer_loads=qo, inner_angles=ai, outer_angles=ao,
-            displacement=(float(u[0]), float(u[1]), float(u[2])), tilt=(float(u[3]), float(u[4])),
-            reaction_moment=(float(forces[3]), float(forces[4])), orbit_speeds=wm,
+            azimuths=self.psi.copy(),
+            inner_loads=qi,
+            outer_loads=qo,
+            inner_angles=ai,
+            outer_angles=ao,
+            displacement=(float(u[0]), float(u[1]), float(u[2])),
+            tilt=(float(u[3]), float(u[4])),
+            reaction_moment=(float(forces[3]), float(forces[4])),
+            orbit_speeds=wm,
         )
 
 

@@ -91,7 +91,9 @@ largest magnitude) count as unstable."""
 
 
 @njit(cache=True)
-def _load_state(x: np.ndarray, omega_i: float, rm: float, base_ball: np.ndarray, base_ring: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray) -> None:
+def _load_state(
+    x: np.ndarray, omega_i: float, rm: float, base_ball: np.ndarray, base_ring: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray
+) -> None:
     """Write the symmetric state x = (omega_m, omega_a, Omega, u) into the engine arrays."""
     z = ball.shape[0]
     ball[:, :] = base_ball

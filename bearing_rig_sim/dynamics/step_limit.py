@@ -124,9 +124,15 @@ def contact_state(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.nda
     r_ci, r_co, ci, co, *_ = kn.ball_kinematics(p, nir, niz, nor, noz, rb)
     wm = ball[j, kn.B_OMEGA]
     return ContactState(
-        float(geo[j, kn.G_QI]), float(geo[j, kn.G_QO]), float(ci), float(co),
-        float(abs((ring[kn.R_OMEGA] - wm) * r_ci)), float(abs(wm * r_co)),
-        float(geo[j, kn.G_DI]), float(geo[j, kn.G_DO]), float(abs(wm)),
+        float(geo[j, kn.G_QI]),
+        float(geo[j, kn.G_QO]),
+        float(ci),
+        float(co),
+        float(abs((ring[kn.R_OMEGA] - wm) * r_ci)),
+        float(abs(wm * r_co)),
+        float(geo[j, kn.G_DI]),
+        float(geo[j, kn.G_DO]),
+        float(abs(wm)),
     )
 
 

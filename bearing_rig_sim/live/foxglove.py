@@ -99,7 +99,9 @@ class _WebsocketV1Server:
 
     def add_channel(self, topic: str, msgtype: str, schema: str) -> int:
         """Advertise a channel; its id."""
-        return int(self._call(self._server.add_channel({"topic": topic, "encoding": "cdr", "schemaName": msgtype, "schema": schema, "schemaEncoding": "ros2msg"})))
+        return int(
+            self._call(self._server.add_channel({"topic": topic, "encoding": "cdr", "schemaName": msgtype, "schema": schema, "schemaEncoding": "ros2msg"}))
+        )
 
     def send(self, channel_id: int, log_time_ns: int, data: bytes) -> None:
         """Queue one message for the clients subscribed to ``channel_id`` (none: dropped here)."""

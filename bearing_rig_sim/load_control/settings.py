@@ -48,9 +48,7 @@ class LoadControllerSettings(NodeSettings):
     engage_clutch_on_start: Flag = param("close the magnet clutch when the node is configured")
     state_rate_hz: Number = param(f"rate of {AXIAL_LOAD_STATE.name} in simulated time", unit="Hz", gt=0.0, le=1000.0)
     diagnostics_period_s: Number = param(f"simulated time between two periodic {DIAGNOSTICS.name}", unit="s", gt=0.0, le=600.0)
-    max_clock_gap_s: Number = param(
-        "longest clock advance stepped at once (a larger jump is stepped as this much)", unit="s", gt=0.0, le=600.0
-    )
+    max_clock_gap_s: Number = param("longest clock advance stepped at once (a larger jump is stepped as this much)", unit="s", gt=0.0, le=600.0)
     force_rate_hz: Number = param("rate of the force messages (one chain step each) in simulated time", unit="Hz", gt=0.0, le=10_000.0)
     step_period_s: Number = param(f"wall time between two wake-ups stepping the chain to the {CLOCK.name} time", unit="s", ge=0.001, le=0.1)
 

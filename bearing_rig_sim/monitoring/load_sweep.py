@@ -101,11 +101,7 @@ class LoadSweep:
         if not (math.isfinite(axial_load) and math.isfinite(slip_rate)):
             return None
         hold = self._hold
-        if (
-            hold is None
-            or abs(axial_load - hold.load) > 0.5 * self.load_step_n
-            or abs(inner_ring_speed - hold.speed) > SPEED_TOLERANCE * hold.speed
-        ):
+        if hold is None or abs(axial_load - hold.load) > 0.5 * self.load_step_n or abs(inner_ring_speed - hold.speed) > SPEED_TOLERANCE * hold.speed:
             hold = self._hold = _Hold(start, axial_load, inner_ring_speed)
         if hold.done:
             return None

@@ -100,9 +100,7 @@ STABLE_CONFIDENCE = 0.95
 one-sided 95 % bound the verdict itself uses."""
 
 
-def evidence_start(
-    stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int, min_window_s: float = 0.0
-) -> float:
+def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int, min_window_s: float = 0.0) -> float:
     """The earliest time the verdict of a status stamped ``stamp`` (s) can rest on, s.
 
     Its slope is fitted to the slip windows that ended in the last ``slope_span_s`` (at least the

@@ -42,32 +42,20 @@ class MonitorSettings(NodeSettings):
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     bearing_file: ConfigFile = param("bearing data file: geometry for the epicyclic cage speed (relative to config/)")
-    contact_angle_deg: Number = param(
-        "contact angle of the slip formula (negative: the bearing file's nominal)", unit="deg", ge=-1.0, le=89.0
-    )
+    contact_angle_deg: Number = param("contact angle of the slip formula (negative: the bearing file's nominal)", unit="deg", ge=-1.0, le=89.0)
     window_revolutions: Integer = param("whole cage revolutions per slip window", unit="1", ge=1, le=1000)
-    min_window_s: Number = param(
-        "a slip window lasts at least this long (more whole cage revolutions at high speed; 0: never)", unit="s", ge=0.0, le=10.0
-    )
-    criterion: Annotated[str, one_of(CRITERIA)] = param(
-        "abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)"
-    )
+    min_window_s: Number = param("a slip window lasts at least this long (more whole cage revolutions at high speed; 0: never)", unit="s", ge=0.0, le=10.0)
+    criterion: Annotated[str, one_of(CRITERIA)] = param("abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)")
     slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
         "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"
     )
-    critical_slope_pct_per_s: Number = param(
-        "critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0
-    )
-    critical_slope_pct_per_n: Number = param(
-        "critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0
-    )
+    critical_slope_pct_per_s: Number = param("critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0)
+    critical_slope_pct_per_n: Number = param("critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0)
     slope_span_s: Number = param("trailing window of the slope against time", unit="s", gt=0.0, le=600.0)
     slope_max_span_s: Number = param(
         "longest steady stretch the slope against time may rest on when the trailing window cannot decide", unit="s", gt=0.0, le=3600.0
     )
-    load_step_n: Number = param(
-        "with the load criterion: windows whose loads stay within half of this are one load hold", unit="N", gt=0.0, le=1000.0
-    )
+    load_step_n: Number = param("with the load criterion: windows whose loads stay within half of this are one load hold", unit="N", gt=0.0, le=1000.0)
     sweep_settle_s: Number = param(
         "with the load criterion: a hold's windows count for its load point from this long after its start", unit="s", ge=0.0, le=600.0
     )
@@ -75,12 +63,8 @@ class MonitorSettings(NodeSettings):
     min_slope_points: Integer = param("points needed for a slope", unit="1", ge=3, le=100_000)
     slip_resolution_pct: Number = param("least scatter of the slip believed", unit="%", gt=0.0, le=10.0)
     change_threshold: Number = param("prediction standard errors that make a change in the slip", unit="1", gt=0.0, le=100.0)
-    min_inner_ring_speed_rad_s: Number = param(
-        "no slip point below this spindle speed (the series restarts)", unit="rad/s", gt=0.0, le=1000.0
-    )
-    restart_speed_change_fraction: Number = param(
-        "window-to-window speed change that restarts the slip series (0: never)", unit="1", ge=0.0, le=1.0
-    )
+    min_inner_ring_speed_rad_s: Number = param("no slip point below this spindle speed (the series restarts)", unit="rad/s", gt=0.0, le=1000.0)
+    restart_speed_change_fraction: Number = param("window-to-window speed change that restarts the slip series (0: never)", unit="1", ge=0.0, le=1.0)
     loss_horizon_revolutions: Number = param("revolutions over which lost pulses are counted", unit="1", gt=0.0, le=1e5)
     max_lost_fraction: Number = param("fraction of pulses lost over the horizon that is a sustained loss", unit="1", ge=0.0, le=1.0)
     loss_silence_revolutions: Number = param("a shaft silent for this many of its revolutions is lost", unit="1", gt=0.0, le=1e4)
@@ -92,12 +76,8 @@ class MonitorSettings(NodeSettings):
         le=1e4,
     )
     fault_hold_s: Number = param("a malformed pulse stays a fault, a loss a warning, this long (rig time)", unit="s", ge=0.0, le=600.0)
-    clock_jump_tolerance_s: Number = param(
-        "a pulse this far before its predecessor is a clock jump (reset all)", unit="s", gt=0.0, le=600.0
-    )
-    status_rate_hz: Number = param(
-        "status checks and messages per second of rig time, plus one per slip window", unit="Hz", gt=0.0, le=1000.0
-    )
+    clock_jump_tolerance_s: Number = param("a pulse this far before its predecessor is a clock jump (reset all)", unit="s", gt=0.0, le=600.0)
+    status_rate_hz: Number = param("status checks and messages per second of rig time, plus one per slip window", unit="Hz", gt=0.0, le=1000.0)
     diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
 
     def kinematics(self) -> BearingKinematics:

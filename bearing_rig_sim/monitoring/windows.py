@@ -518,7 +518,13 @@ class SlipWindows:
         confirmed = {name: reason for name, reason in quiet.items() if name in self._suspect}
         self._suspect = set(quiet)
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
-        if all(s.slowing() and s.last_time is not None and s.last_period is not None and now - s.last_time > max(rules.loss_min_timeout_s, STOP_SILENCE_PERIODS * s.last_period) for s in (spindle, cage)):
+        if all(
+            s.slowing()
+            and s.last_time is not None
+            and s.last_period is not None
+            and now - s.last_time > max(rules.loss_min_timeout_s, STOP_SILENCE_PERIODS * s.last_period)
+            for s in (spindle, cage)
+        ):
             self.stopped = "spindle and cage stopped (their pulse periods grew before the pulses ceased)"
             self.silent = {}
         else:

@@ -28,6 +28,7 @@ from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import QOS_DESCRIPTIONS, QOS_TABLE, QosEntry, Topic
 
+
 def qos_profile(which: Topic | str | QosEntry) -> QoSProfile:
     """The rclpy QoS profile of a topic of the contract (its publisher's), of a profile named in
     :data:`bearing_rig_sim.interfaces.QOS_TABLE`, or of an entry of that table."""

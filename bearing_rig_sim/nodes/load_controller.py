@@ -72,7 +72,17 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64
 from std_srvs.srv import SetBool, Trigger
 
-from bearing_rig_sim.interfaces import AXIAL_LOAD_CLUTCH, AXIAL_LOAD_FORCE, AXIAL_LOAD_RESET_FAULT, AXIAL_LOAD_SET, AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS
+from bearing_rig_sim.interfaces import (
+    AXIAL_LOAD_CLUTCH,
+    AXIAL_LOAD_FORCE,
+    AXIAL_LOAD_RESET_FAULT,
+    AXIAL_LOAD_SET,
+    AXIAL_LOAD_SETPOINT,
+    AXIAL_LOAD_STATE,
+    BEARING_AXIAL_FORCE,
+    CLOCK,
+    DIAGNOSTICS,
+)
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource

@@ -32,11 +32,13 @@ from collections.abc import Sequence
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
+from sensor_msgs.msg import Temperature
 
 from bearing_rig_msgs.msg import FibreOpticPulse, ShadowEstimate, ShadowResidual
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, DIAGNOSTICS, SPINDLE_PULSES, TWIN_ESTIMATE, TWIN_RESIDUAL
+from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE
 from bearing_rig_sim.nodes.common import PULSE_READER_QOS, diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -59,6 +61,16 @@ def residual_fields(row: ResidualWindow) -> dict[str, Any]:
         "anomaly": row.anomaly,
         "level": int(row.level),
         "detail": row.note,
+        "measured_temperature": row.measured_temperature,
+        "predicted_temperature": row.predicted_temperature,
+        "temperature_residual": row.temperature_residual,
+        "temperature_band": row.temperature_band,
+        "temperature_anomaly": row.temperature_anomaly,
+        "measured_torque": row.measured_torque,
+        "predicted_torque": row.predicted_torque,
+        "torque_residual": row.torque_residual,
+        "torque_band": row.torque_band,
+        "torque_anomaly": row.torque_anomaly,
     }
 
 
@@ -95,6 +107,8 @@ class ShadowNode(ManagedNode):
         self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), sensor)
         self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), sensor)
         self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, qos_profile(AXIAL_LOAD_FORCE))
+        self.subscription(Temperature, OUTER_RING_TEMPERATURE.name, self._on_temperature, qos_profile(OUTER_RING_TEMPERATURE))
+        self.subscription(WrenchStamped, HOUSING_TORQUE.name, self._on_torque, qos_profile(HOUSING_TORQUE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer(1.0 / self.settings.status_rate_hz, self._on_check_timer, clock=steady)
         self.timer(1.0 / self.settings.diagnostics_rate_hz, self._publish_diagnostics, clock=steady)
@@ -134,6 +148,16 @@ class ShadowNode(ManagedNode):
         self._received["force"] += 1
         self._stamp_seen(t)
         self.twin.add_force(t, float(msg.wrench.force.z))
+
+    @survives_shutdown
+    def _on_temperature(self, msg: Temperature) -> None:
+        assert self.twin is not None  # fed only while active
+        self.twin.add_temperature(from_stamp(msg.header.stamp), float(msg.temperature))
+
+    @survives_shutdown
+    def _on_torque(self, msg: WrenchStamped) -> None:
+        assert self.twin is not None  # fed only while active
+        self.twin.add_torque(from_stamp(msg.header.stamp), float(msg.wrench.torque.z))
 
     # -- periodic ------------------------------------------------------------------------------
     def _bench_now(self) -> float | None:
@@ -187,6 +211,12 @@ class ShadowNode(ManagedNode):
         latest = self.twin.latest
         if latest is not None:
             values.update(residual_pct=f"{latest.residual:.4g}", band_pct=f"{latest.band:.4g}", predicted_slip_pct=f"{latest.predicted_slip:.4g}")
+            values.update(
+                temperature_residual_k=f"{latest.temperature_residual:.4g}",
+                temperature_band_k=f"{latest.temperature_band:.4g}",
+                torque_residual_nm=f"{latest.torque_residual:.4g}",
+                torque_band_nm=f"{latest.torque_band:.4g}",
+            )
         stamp = to_stamp(max(self._last_stamp, 0.0) if math.isfinite(self._last_stamp) else 0.0)
         status = diagnostic_status(f"{NODE_NAME}: bench against twin", int(health.level), health.message, values)
         self._diag_pub.publish(diagnostic_array(stamp, [status]))

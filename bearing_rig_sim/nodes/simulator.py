@@ -185,8 +185,11 @@ class SimulatorNode(ManagedNode):
         self._stream_pubs = {
             topic.name: pub
             for topic, pub in (
-                (CLOCK, self._clock_pub), (SPINDLE_PULSES, self._pulse_pubs["spindle"]), (CAGE_PULSES, self._pulse_pubs["cage"]),
-                (SPEEDS, self._speeds_pub), (TRUTH, self._truth_pub),
+                (CLOCK, self._clock_pub),
+                (SPINDLE_PULSES, self._pulse_pubs["spindle"]),
+                (CAGE_PULSES, self._pulse_pubs["cage"]),
+                (SPEEDS, self._speeds_pub),
+                (TRUTH, self._truth_pub),
             )
         }
         self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
@@ -194,7 +197,10 @@ class SimulatorNode(ManagedNode):
         # instead of one per message), from a reader on a node no executor spins.
         self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
         self._force_sub = self._force_tap.create_subscription(
-            WrenchStamped, BEARING_AXIAL_FORCE.name, _unused, FORCE_QOS,
+            WrenchStamped,
+            BEARING_AXIAL_FORCE.name,
+            _unused,
+            FORCE_QOS,
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
         )
 
@@ -301,12 +307,13 @@ class SimulatorNode(ManagedNode):
 
     # -- the thermocouple and the torque meter -------------------------------------------------
     def _configure_bench_sensors(self, bearing_file: Any) -> None:
-        """Couple the bearing's thermal network (one way: the engine keeps its parameters'
-        lubricant temperature, so the session's slip is the calibrated one) and publish the
-        outer-ring thermocouple and the housing torque meter; a bearing file without a
+        """Couple the bearing's thermal network to the engine (its heat, term by term; with
+        ``lubricant_feedback`` also back: the engine's lubricant follows the lubricant node every
+        network step, 0.1 s; :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`) and publish
+        the outer-ring thermocouple and the housing torque meter; a bearing file without a
         ``thermal:`` section has neither."""
         try:
-            self.twin.attach_thermal(bearing_file, feedback=False)
+            self.twin.attach_thermal(bearing_file, initial_rise_k=self.settings.initial_temperature_rise_k, feedback=self.settings.lubricant_feedback)
         except ConfigError as exc:
             self.get_logger().info(f"no thermocouple or torque meter: {exc}")
             return

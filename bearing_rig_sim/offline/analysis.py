@@ -287,9 +287,7 @@ class OfflineAnalysis:
         self._shaft_of = {topic: shaft for shaft, topic in PULSE_TOPICS.items()}
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
-        self._segments = SegmentTracker(
-            self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings
-        )
+        self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings)
         self._commands_ahead: list[tuple[float, Any]] = []
         """Spindle commands read before their stamp: (stamp s, message), in order."""
         self._sinks: list[CsvWriter] = []
@@ -592,4 +590,3 @@ def analyse_bag(
             on_window=on_window,
         )
         return analysis.run()
-

@@ -156,7 +156,15 @@ def _thermal_plot(result: OfflineResult, out_dir: Path, plt: Any) -> Path:
             right.set_ylabel("torque (N mm)")
             right.legend(loc="lower right", fontsize="small")
             drawn = True
-        return _finish(fig, ax, out_dir / "thermal.png", "Outer-ring temperature and friction torque", "temperature (degC)", drawn, "no thermocouple or torque meter in the bag")
+        return _finish(
+            fig,
+            ax,
+            out_dir / "thermal.png",
+            "Outer-ring temperature and friction torque",
+            "temperature (degC)",
+            drawn,
+            "no thermocouple or torque meter in the bag",
+        )
     finally:
         plt.close(fig)
 
@@ -327,8 +335,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         "",
         "## Summary",
         "",
-        f"* pulses: {result.pulses['spindle']} spindle, {result.pulses['cage']} cage, over {span:.3f} s of rig time "
-        "(time below runs from the first pulse)",
+        f"* pulses: {result.pulses['spindle']} spindle, {result.pulses['cage']} cage, over {span:.3f} s of rig time (time below runs from the first pulse)",
         f"* slip windows: {result.windows}; status rows: {result.status_rows} (one per check at the monitor's status rate and per closed window)",
     ]
     final = result.final_status
@@ -345,9 +352,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         lines.append(f"* recorded verdicts: none (the bag has no {STATUS})")
     total = sum(result.state_durations.values())
     if total > 0.0:
-        shares = ", ".join(
-            f"{state_name(s)} {d:.2f} s ({100.0 * d / total:.1f} %)" for s, d in sorted(result.state_durations.items())
-        )
+        shares = ", ".join(f"{state_name(s)} {d:.2f} s ({100.0 * d / total:.1f} %)" for s, d in sorted(result.state_durations.items()))
         lines.append(f"* time in each state (offline): {shares}")
     lines.append(f"* state changes: {max(len(result.transitions) - 1, 0)} offline, {max(len(result.recorded_transitions) - 1, 0)} recorded")
     if result.transitions_dropped:

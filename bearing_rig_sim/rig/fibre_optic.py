@@ -162,8 +162,7 @@ class FibreOpticSensor:
             raise SensorError(f"{owner}: step end t1={t1!r} s must be after its start t0={t0!r} s")
         if self._last_step_end is not None and t0 < self._last_step_end:
             raise SensorError(
-                f"{owner}: step starts at t0={t0!r} s, before the previous step's end {self._last_step_end!r} s; "
-                "reset the sensor after a clock jump"
+                f"{owner}: step starts at t0={t0!r} s, before the previous step's end {self._last_step_end!r} s; reset the sensor after a clock jump"
             )
         self._last_step_end = t1
         if self._first_crossing is None:

@@ -431,14 +431,10 @@ class LoadingChain:
         if span >= limits.rate_window_s - 1e-12:
             rate = (reading - history[0][1]) / span
             if rate > limits.max_rate_n_per_s:
-                self._trip(
-                    f"rate limit: load cell force rising at {rate:.0f} N/s > max_rate_n_per_s {limits.max_rate_n_per_s:g} N/s"
-                )
+                self._trip(f"rate limit: load cell force rising at {rate:.0f} N/s > max_rate_n_per_s {limits.max_rate_n_per_s:g} N/s")
                 return
         if self.clutch.state is ClutchState.SLIPPING:
-            self._trip(
-                f"clutch slip: force reached the magnet's holding force {self.config.clutch.holding_force_n:g} N"
-            )
+            self._trip(f"clutch slip: force reached the magnet's holding force {self.config.clutch.holding_force_n:g} N")
 
     def _trip(self, reason: str) -> None:
         self._fault_reason = reason

@@ -49,7 +49,6 @@ STABILITY_CRITERIA = ("time", "axial_load")
 """Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
 
 
-
 # ---------------------------------------------------------------------------------------------
 # Segments and programs (the speed profile of a segment: :mod:`bearing_rig_sim.rig.speed_profile`)
 # ---------------------------------------------------------------------------------------------
@@ -252,9 +251,7 @@ class ProgramFile(BaseModel):
     bearing: ConfigFile = Field(description="bearing data file, relative to config/ unless absolute")
     stability_criterion: Annotated[str, one_of(STABILITY_CRITERIA)] = Field(description="abscissa of the slope criterion")
     initial_speed_rpm: Number = Field(0.0, ge=0.0, description="the spindle's speed before the first segment, rpm")
-    segments: Annotated[list[SegmentFile], BeforeValidator(_segment_list)] = Field(
-        description="the segments, in order"
-    )
+    segments: Annotated[list[SegmentFile], BeforeValidator(_segment_list)] = Field(description="the segments, in order")
 
 
 def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:

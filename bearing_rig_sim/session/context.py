@@ -139,8 +139,7 @@ def check_parameter_file(path: Path) -> None:
         if not wildcard and last not in nodes:
             near = difflib.get_close_matches(last, nodes, n=1)
             raise ConfigError(
-                source, str(key), f"no node of a session has this name (its nodes: {', '.join(nodes)}"
-                + (f"; did you mean {near[0]}?)" if near else ")")
+                source, str(key), f"no node of a session has this name (its nodes: {', '.join(nodes)}" + (f"; did you mean {near[0]}?)" if near else ")")
             )
         params = block.get("ros__parameters") if isinstance(block, dict) else None
         if not isinstance(params, dict):
@@ -154,7 +153,8 @@ def check_parameter_file(path: Path) -> None:
                 names = sorted({p for n in targets for p in NODE_PARAMETERS[n]})
                 near = difflib.get_close_matches(name, names, n=1)
                 raise ConfigError(
-                    source, f"{key}.ros__parameters.{name}",
+                    source,
+                    f"{key}.ros__parameters.{name}",
                     f"{' '.join(targets)} {'has' if len(targets) == 1 else 'have'} no such parameter"
                     + (f"; did you mean {near[0]}?" if near else f" (see config/{targets[0]}.yaml)"),
                 )

@@ -113,9 +113,7 @@ class LifecycleManager:
             self._queue.clear()
         step = record.step
         level = OK if record.success else ERROR
-        message = (
-            f"{step.transition}: {GOAL[step.transition]}" if record.success else f"{step.transition} failed: {record.detail or 'refused'}"
-        )
+        message = f"{step.transition}: {GOAL[step.transition]}" if record.success else f"{step.transition} failed: {record.detail or 'refused'}"
         status = diagnostic_status(
             DIAGNOSTIC_PREFIX + step.node, level, message, {"state": record.state, "transition": step.transition}, hardware_id="bearing_rig_session"
         )

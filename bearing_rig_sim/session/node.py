@@ -71,6 +71,7 @@ the 3x of a session without real time. The reader's history drops its oldest sam
 wait (reliable or not): at 5000 a session held up for two seconds on a busy host lost stretches of
 /clock."""
 
+
 def message_class(msgtype: str) -> type:
     """The rclpy class of a ``pkg/msg/Name`` message type (from its generated ``pkg.msg`` module).
 
@@ -240,8 +241,7 @@ class SessionNode(Node):
             self.tap.destroy_subscription(subscription)
             self._recorded[i] = (topic, msgtype, self.tap.create_subscription(msgtype, topic.name, _unused, qos, raw=True))
             changes.append(
-                f"recording {topic.name} best effort: {', '.join(weak)} publishes it best effort "
-                "(a reliable reader receives nothing from such a writer)"
+                f"recording {topic.name} best effort: {', '.join(weak)} publishes it best effort (a reliable reader receives nothing from such a writer)"
             )
         return changes
 
@@ -363,4 +363,3 @@ class SessionNode(Node):
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun
     """Callback of the recorder's subscriptions; their queues are taken by ``drain``."""
-

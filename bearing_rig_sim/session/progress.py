@@ -82,8 +82,17 @@ def format_progress(snap: ProgressSnapshot) -> str:
 
 
 SUMMARY_COLUMNS = (
-    "#", "segment", "speed rpm", "meas rpm", "load N", "F_bearing N", "slip % meas", "slip % truth", "verdict",
-    "t_stable s", "conditions",
+    "#",
+    "segment",
+    "speed rpm",
+    "meas rpm",
+    "load N",
+    "F_bearing N",
+    "slip % meas",
+    "slip % truth",
+    "verdict",
+    "t_stable s",
+    "conditions",
 )
 _LEFT = {"segment", "verdict", "conditions"}
 

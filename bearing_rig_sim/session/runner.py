@@ -100,7 +100,6 @@ settle bound is under 0.37 s for any step within 0-1000 N (``settle_time_bound``
 sent at the start reaches the load controller within this too."""
 
 
-
 StatusState = SlipState
 """The ``STATE_*`` constants of SlipStatus.msg: the project's one state enum."""
 
@@ -392,9 +391,7 @@ class ProgramRunner:
         else:
             force = None
         last = data.last_status
-        measured_speed = (
-            last.inner_ring_speed if last is not None and last.time >= plan.ramp_end and math.isfinite(last.inner_ring_speed) else None
-        )
+        measured_speed = last.inner_ring_speed if last is not None and last.time >= plan.ramp_end and math.isfinite(last.inner_ring_speed) else None
         outcome = SegmentOutcome(
             index=plan.index,
             name=plan.segment.name,
@@ -497,9 +494,7 @@ class ProgramRunner:
         return before[-1] if before else None
 
 
-def _conditions(
-    segment: Segment, measured_speed: float | None, bearing_force: float | None, disturbances: list[str], verdict: Verdict
-) -> tuple[str, ...]:
+def _conditions(segment: Segment, measured_speed: float | None, bearing_force: float | None, disturbances: list[str], verdict: Verdict) -> tuple[str, ...]:
     """What was off in a segment (see the module documentation). An interrupted segment's speed
     and load are not judged, nor a measurement that is missing (a segment shorter than
     :data:`LOAD_SETTLE_S` has no settled load)."""

@@ -11,7 +11,9 @@ Output in ``out_dir``:
 * ``residuals.csv``: one row per slip window: ``time_s`` (window end, s from the first pulse),
   ``inner_ring_rpm``, ``axial_load_n``, ``measured_slip_pct``, ``predicted_slip_pct``,
   ``residual_pct``, ``band_pct``, ``anomaly`` (0/1), then ``compared`` (0/1), ``level``
-  (0 OK, 1 WARN, 2 ERROR), ``note``;
+  (0 OK, 1 WARN, 2 ERROR), ``note``, then the outer-ring thermocouple's and the housing torque
+  meter's columns (``measured_temperature_c`` ... ``torque_anomaly``; empty where the bag has no
+  such topic);
 * ``report.md``: inputs, settings, counts, flagged stretches, the re-calibrated parameter;
 * ``shadow.png``: measured and predicted slip, residual with its band, flagged stretches shaded.
 
@@ -32,7 +34,7 @@ from bearing_rig_sim.bags.reader import open_bag
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import HealthLevel
-from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, SPINDLE_PULSES
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.offline.analysis import decode_pulse
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.shadow.recalibration import ParameterEstimate
@@ -54,6 +56,16 @@ COLUMNS = (
     "compared",
     "level",
     "note",
+    "measured_temperature_c",
+    "predicted_temperature_c",
+    "temperature_residual_k",
+    "temperature_band_k",
+    "temperature_anomaly",
+    "measured_torque_nm",
+    "predicted_torque_nm",
+    "torque_residual_nm",
+    "torque_band_nm",
+    "torque_anomaly",
 )
 """Columns of ``residuals.csv``, in order."""
 
@@ -102,7 +114,9 @@ def _force_of(message: Any) -> tuple[float, float]:
     return stamp.sec + stamp.nanosec * 1e-9, float(message.wrench.force.z)
 
 
-def shadow_bag(bag_path: str | Path, out_dir: str | Path | None, settings: ShadowSettings | None = None, params: BearingParameters | None = None) -> ShadowResult:
+def shadow_bag(
+    bag_path: str | Path, out_dir: str | Path | None, settings: ShadowSettings | None = None, params: BearingParameters | None = None
+) -> ShadowResult:
     """Run shadow mode over a bag; write the files when ``out_dir`` is given.
 
     Raises:
@@ -121,13 +135,25 @@ def shadow_bag(bag_path: str | Path, out_dir: str | Path | None, settings: Shado
                 raise BagError(f"{bag.path}: no topic {name} ({msgtype}) in the bag; shadow mode needs both pulse topics and the load cell")
             if info.msgtype != msgtype:
                 raise BagError(f"{bag.path}: topic {name} carries {info.msgtype}, not {msgtype}")
+        optional = {OUTER_RING_TEMPERATURE.name: OUTER_RING_TEMPERATURE.msgtype, HOUSING_TORQUE.name: HOUSING_TORQUE.msgtype}
+        present = [name for name, msgtype in optional.items() if name in bag.topics and bag.topics[name].msgtype == msgtype]
+        decode_temperature = make_decoder(bag.typestore, OUTER_RING_TEMPERATURE.msgtype) if OUTER_RING_TEMPERATURE.name in present else None
+        decode_torque = make_decoder(bag.typestore, HOUSING_TORQUE.msgtype) if HOUSING_TORQUE.name in present else None
         decode_force = make_decoder(bag.typestore, AXIAL_LOAD_FORCE.msgtype)
         decode_general = make_decoder(bag.typestore, SPINDLE_PULSES.msgtype)
         shaft_of = {SPINDLE_PULSES.name: "spindle", CAGE_PULSES.name: "cage"}
         origin: float | None = None
         tick = -math.inf
-        for topic, _log_ns, _type, payload in bag.messages(list(needed), raw=True):
+        for topic, _log_ns, _type, payload in bag.messages([*needed, *present], raw=True):
             data = cast(bytes, payload)
+            if topic == OUTER_RING_TEMPERATURE.name and decode_temperature is not None:
+                m_t: Any = decode_temperature(data)
+                twin.add_temperature(m_t.header.stamp.sec + m_t.header.stamp.nanosec * 1e-9, float(m_t.temperature))
+                continue
+            if topic == HOUSING_TORQUE.name and decode_torque is not None:
+                m_m: Any = decode_torque(data)
+                twin.add_torque(m_m.header.stamp.sec + m_m.header.stamp.nanosec * 1e-9, float(m_m.wrench.torque.z))
+                continue
             if topic == AXIAL_LOAD_FORCE.name:
                 t, force = _force_of(decode_force(data))
                 twin.add_force(t, force)
@@ -136,7 +162,14 @@ def shadow_bag(bag_path: str | Path, out_dir: str | Path | None, settings: Shado
                 pulse = decode_pulse(data)
             else:
                 m: Any = decode_general(data)
-                pulse = Pulse(m.header.stamp.sec + m.header.stamp.nanosec * 1e-9, int(m.strip_id), int(m.strip_count), int(m.revolution), int(m.pulse_index), str(m.sensor_id))
+                pulse = Pulse(
+                    m.header.stamp.sec + m.header.stamp.nanosec * 1e-9,
+                    int(m.strip_id),
+                    int(m.strip_count),
+                    int(m.revolution),
+                    int(m.pulse_index),
+                    str(m.sensor_id),
+                )
             t = pulse.time
             if math.isfinite(t):
                 if origin is None:
@@ -148,7 +181,9 @@ def shadow_bag(bag_path: str | Path, out_dir: str | Path | None, settings: Shado
                     tick += period
             rows += twin.add_pulse(shaft_of[topic], pulse)
         rows += twin.check(tick + 10.0 * period)
-    result = ShadowResult(Path(bag_path), origin if origin is not None else 0.0, rows, flagged_stretches(rows, origin or 0.0), dict(twin.counts), twin.estimate())
+    result = ShadowResult(
+        Path(bag_path), origin if origin is not None else 0.0, rows, flagged_stretches(rows, origin or 0.0), dict(twin.counts), twin.estimate()
+    )
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
@@ -199,6 +234,16 @@ def write_csv(path: Path, rows: list[ResidualWindow], origin: float) -> Path:
                     int(r.compared),
                     int(r.level),
                     r.note,
+                    _num(r.measured_temperature, 3),
+                    _num(r.predicted_temperature, 3),
+                    _num(r.temperature_residual, 3),
+                    _num(r.temperature_band, 3),
+                    int(r.temperature_anomaly),
+                    _num(r.measured_torque, 6),
+                    _num(r.predicted_torque, 6),
+                    _num(r.torque_residual, 6),
+                    _num(r.torque_band, 6),
+                    int(r.torque_anomaly),
                 ]
             )
     return path
@@ -224,6 +269,7 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
         if c["compared"]
         else f"| {c['windows']} | 0 | - | {c['anomalous']} |",
         "",
+        *_heat_lines(result.rows),
         "## Flagged stretches",
         "",
     ]
@@ -249,9 +295,32 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
             "Not written to the calibration file.",
         ]
         if not e.in_range and e.range is not None:
-            lines += ["", f"**Outside the parameter's stated plausible range {e.range[0]:g}-{e.range[1]:g}**: the bench has changed beyond what this parameter can explain."]
+            lines += [
+                "",
+                f"**Outside the parameter's stated plausible range {e.range[0]:g}-{e.range[1]:g}**: the bench has changed beyond what this parameter can explain.",
+            ]
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
+
+
+def _heat_lines(rows: list[ResidualWindow]) -> list[str]:
+    """The report's lines on the temperature and torque residuals (none without them)."""
+    out = []
+    for name, unit, residual, band, flag in (
+        ("Outer-ring temperature", "K", "temperature_residual", "temperature_band", "temperature_anomaly"),
+        ("Housing torque", "N m", "torque_residual", "torque_band", "torque_anomaly"),
+    ):
+        compared = [r for r in rows if math.isfinite(getattr(r, residual))]
+        if not compared:
+            continue
+        inside = sum(abs(getattr(r, residual)) <= getattr(r, band) for r in compared)
+        worst = max(compared, key=lambda r: abs(getattr(r, residual)))
+        out += [
+            f"{name}: {len(compared)} windows compared, {inside} inside the band, {sum(getattr(r, flag) for r in rows)} flagged; "
+            f"largest residual {getattr(worst, residual):+.4g} {unit} (band +-{getattr(worst, band):.4g} {unit}).",
+            "",
+        ]
+    return out
 
 
 def write_plot(path: Path, result: ShadowResult) -> Path | None:

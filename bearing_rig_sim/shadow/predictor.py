@@ -16,7 +16,17 @@ longer than ``max_speed_gap_s`` (a stopped spindle, a sensor gap, a clock jump f
 clock jump back. :attr:`MeasuredDrive.started_at` says when, so that windows before the slip has
 settled are not compared.
 
-Units: s, rad/s, rad/s^2, N; slip in percent.
+With the bearing's thermal network (``thermal=``, the bearing file's ``thermal:`` section) the
+engine is coupled to it as the rig session's is, the lubricant following the network's
+temperature only with ``lubricant_feedback``
+(:class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`): the network starts at its first
+start (at :attr:`MeasuredDrive.thermal_start_c`, the bench's thermocouple when known, else
+ambient) and keeps its temperatures across restarts (the bearing does not cool when the engine
+restarts). Beside the speeds, the friction torque's integral and the outer ring's temperature
+through the thermocouple's lag (noise-free) are kept at each chunk's end, so a window also gets
+the twin's mean torque and its thermocouple reading at the window's end.
+
+Units: s, rad/s, rad/s^2, N, N m, degC; slip in percent.
 """
 
 from __future__ import annotations
@@ -28,6 +38,14 @@ from dataclasses import dataclass
 
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters
 from bearing_rig_sim.shadow.inputs import SpeedPoint
+from bearing_rig_sim.thermal.bearing import ThermalConfig
+from bearing_rig_sim.thermal.coupling import ThermalCoupling, TractionTableGrid
+from bearing_rig_sim.thermal.sensors import Thermocouple
+
+
+TORQUE_PERIOD_S = 0.01
+"""How often the twin's friction torque is evaluated, s of engine time (the housing torque
+meter's 100 Hz)."""
 
 
 @dataclass(frozen=True)
@@ -39,6 +57,9 @@ class Prediction:
         cage_speed: mean cage speed, rad/s.
         inner_ring_speed: mean inner-ring speed, rad/s.
         axial_load: mean axial force applied, N.
+        friction_torque: mean friction torque, N m.
+        outer_ring_temperature: the outer ring's temperature at ``end_time`` through the
+            thermocouple's lag, degC (NaN without the thermal network).
     """
 
     start_time: float
@@ -46,6 +67,8 @@ class Prediction:
     cage_speed: float
     inner_ring_speed: float
     axial_load: float
+    friction_torque: float = math.nan
+    outer_ring_temperature: float = math.nan
 
 
 class MeasuredDrive:
@@ -57,6 +80,10 @@ class MeasuredDrive:
         chunk: longest engine advance per call, s.
         max_speed_gap: speed points further apart restart the engine, s.
         load_at: the axial force (N) to apply at a bench time (s); NaN: none known yet.
+        thermal: the bearing's thermal network data (None: isothermal, at the bearing file's
+            lubricant temperature).
+        lubricant_feedback: with ``thermal``, the engine's lubricant follows the network's
+            lubricant temperature (False: held at the bearing file's, the calibration's).
     """
 
     def __init__(
@@ -67,8 +94,29 @@ class MeasuredDrive:
         chunk: float = 1e-3,
         max_speed_gap: float = 0.5,
         load_at: Callable[[float], float],
+        thermal: ThermalConfig | None = None,
+        lubricant_feedback: bool = False,
     ) -> None:
         self.engine = BearingDynamics(params, model=model)
+        self.thermal_config = thermal
+        self.coupling: ThermalCoupling | None = None
+        """The engine's thermal network (None: isothermal); it starts warming at the first start."""
+        self.thermal_start_c: float | None = None
+        """Start temperature of the network at the first start, degC (None: ambient)."""
+        self._grid: TractionTableGrid | None = None
+        if lubricant_feedback and thermal is not None and params.lubricant is not None and params.friction_model == "rheology":
+            # the traction tables around ambient now, not in the first pulse's callback
+            self._grid = TractionTableGrid(params)
+            lo, hi, _ = self._grid.bracket(thermal.ambient)
+            self._grid.build_now(lo)
+            self._grid.build_now(hi)
+        self._thermal_started = False
+        if thermal is not None:
+            # built now (the node's configure), not in the first pulse's callback
+            self.coupling = ThermalCoupling(self.engine, thermal, feedback=lubricant_feedback, grid=self._grid)
+        self._thermocouple = Thermocouple(noise=0.0)
+        self._torque_now = 0.0
+        self._torque_age = math.inf
         self.chunk = chunk
         self.max_speed_gap = max_speed_gap
         self.load_at = load_at
@@ -83,7 +131,14 @@ class MeasuredDrive:
         self._cage: list[float] = []
         self._inner: list[float] = []
         self._load: list[float] = []
-        self._cum = (0.0, 0.0, 0.0)
+        self._torque: list[float] = []
+        self._temperature: list[float] = []
+        self._cum = (0.0, 0.0, 0.0, 0.0)
+
+    @property
+    def thermal_started(self) -> bool:
+        """Whether the thermal network has started (at the engine's first start)."""
+        return self._thermal_started
 
     @property
     def time(self) -> float:
@@ -103,12 +158,41 @@ class MeasuredDrive:
         if self.origin is None:
             self.origin = point.time
         self.engine.initialise(point.speed, max(load, MIN_AXIAL_LOAD), time=point.time - self.origin)
+        if self.coupling is not None:
+            if not self._thermal_started:
+                self._thermal_started = True
+                if self.thermal_start_c is not None:  # the bench's bearing at its first reading
+                    net = self.coupling.network
+                    net.temperatures[:] = self.thermal_start_c
+                    net.initial_temperatures[:] = self.thermal_start_c
+                    grid = self.coupling.grid
+                    if grid is not None:
+                        lo, hi, _ = grid.bracket(self.thermal_start_c)
+                        grid.build_now(lo)
+                        grid.build_now(hi)
+            self.coupling.retune()
         self.started_at = point.time
         self.restarts += 1
         self._last_point = point
-        self._times, self._cage, self._inner, self._load = [point.time], [0.0], [0.0], [0.0]
-        self._cum = (0.0, 0.0, 0.0)
+        self._times, self._cage, self._inner, self._load, self._torque = [point.time], [0.0], [0.0], [0.0], [0.0]
+        self._temperature = [self._thermocouple_reading(0.0)]
+        self._cum = (0.0, 0.0, 0.0, 0.0)
+        self._torque_age = math.inf
         return True
+
+    def _friction_torque(self, h: float) -> float:
+        """The engine's friction torque, N m, evaluated every :data:`TORQUE_PERIOD_S` of engine
+        time and held between (the torque meter's own rate; it costs a quarter of a chunk)."""
+        self._torque_age += h
+        if self._torque_age >= TORQUE_PERIOD_S - 1e-12:
+            self._torque_now = self.engine.friction_torque()
+            self._torque_age = 0.0
+        return self._torque_now
+
+    def _thermocouple_reading(self, h: float) -> float:
+        if self.coupling is None:
+            return math.nan
+        return self._thermocouple.update(self.coupling.temperature("outer_ring"), h)
 
     def jump_back(self) -> None:
         """The bench clock went back: the next speed point restarts the engine."""
@@ -140,22 +224,31 @@ class MeasuredDrive:
                 avg = engine.advance(h, axial_load=load)
                 if avg.duration <= 0.0:
                     break
-            cum_c, cum_i, cum_l = self._cum
-            self._cum = (cum_c + avg.cage_speed * avg.duration, cum_i + avg.inner_ring_speed * avg.duration, cum_l + load * avg.duration)
+            if self.coupling is not None:
+                self.coupling.advance(avg.duration)
+            cum_c, cum_i, cum_l, cum_m = self._cum
+            self._cum = (
+                cum_c + avg.cage_speed * avg.duration,
+                cum_i + avg.inner_ring_speed * avg.duration,
+                cum_l + load * avg.duration,
+                cum_m + self._friction_torque(avg.duration) * avg.duration,
+            )
             self._times.append(self.origin + engine.time)
             self._cage.append(self._cum[0])
             self._inner.append(self._cum[1])
             self._load.append(self._cum[2])
+            self._torque.append(self._cum[3])
+            self._temperature.append(self._thermocouple_reading(avg.duration))
         self._last_point = point
 
-    def _integrals(self, t: float) -> tuple[float, float, float]:
+    def _integrals(self, t: float) -> tuple[float, float, float, float, float]:
         times = self._times
         k = bisect.bisect_right(times, t) - 1
         k = max(0, min(k, len(times) - 2))
         t0, t1 = times[k], times[k + 1]
         f = (t - t0) / (t1 - t0)
         return tuple(  # type: ignore[return-value]  # a fixed-length tuple built from a generator
-            a[k] + f * (a[k + 1] - a[k]) for a in (self._cage, self._inner, self._load)
+            a[k] + f * (a[k + 1] - a[k]) for a in (self._cage, self._inner, self._load, self._torque, self._temperature)
         )
 
     def covers(self, start: float, end: float) -> bool:
@@ -166,16 +259,16 @@ class MeasuredDrive:
         """The engine's mean speeds over ``[start, end]`` (bench s); None unless :meth:`covers`."""
         if end <= start or not self.covers(start, end):
             return None
-        c0, i0, l0 = self._integrals(start)
-        c1, i1, l1 = self._integrals(end)
+        c0, i0, l0, m0, _ = self._integrals(start)
+        c1, i1, l1, m1, temperature = self._integrals(end)
         d = end - start
-        return Prediction(start, end, (c1 - c0) / d, (i1 - i0) / d, (l1 - l0) / d)
+        return Prediction(start, end, (c1 - c0) / d, (i1 - i0) / d, (l1 - l0) / d, (m1 - m0) / d, temperature)
 
     def forget_before(self, time: float) -> None:
         """Drop the integrals before ``time`` (s), keeping one point at or before it."""
         k = bisect.bisect_right(self._times, time) - 1
         if k > 0:
-            for a in (self._times, self._cage, self._inner, self._load):
+            for a in (self._times, self._cage, self._inner, self._load, self._torque, self._temperature):
                 del a[:k]
 
     def swap_parameters(self, params: BearingParameters) -> None:
@@ -184,3 +277,5 @@ class MeasuredDrive:
         engine = BearingDynamics(params, model=self.engine.model, time_step=self.engine.time_step)
         engine.restore(snap)
         self.engine = engine
+        if self.coupling is not None:
+            self.coupling.rebind(engine)

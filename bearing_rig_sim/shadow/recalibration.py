@@ -73,9 +73,7 @@ class CalibrationParameter:
         entries = calibration.section("parameters").data
         key = name or next(iter(entries), "")
         if key not in entries:
-            raise RecalibrationError(
-                f"recalibrate_parameter: {name!r} is not a parameter of {calibration_file} (it has {', '.join(entries) or 'none'})"
-            )
+            raise RecalibrationError(f"recalibrate_parameter: {name!r} is not a parameter of {calibration_file} (it has {', '.join(entries) or 'none'})")
         entry = entries[key]
         value = entry.get("value") if isinstance(entry, dict) else entry
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value == 0.0:

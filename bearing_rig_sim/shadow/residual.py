@@ -18,7 +18,20 @@ than ``error_after_s`` an ERROR. A window that cannot be compared (input fault, 
 spindle below the minimum speed) ends the excursion too: a fault never builds up to an anomaly.
 The sign names the likely class (see :func:`likely_cause`).
 
-Units: s; slip, residual and band in percentage points.
+**Temperature and torque bands** (beside the slip's; the same coverage factor ``k``):
+
+    u_T = sqrt((f_T (T_pred - T_start))^2 + u_tc^2),     band_T = k u_T   (K)
+    u_M = sqrt((f_M M_pred)^2 + sigma_M^2 / n),          band_M = k u_M   (N m)
+
+``f_T`` is the thermal network's relative uncertainty of the outer ring's rise since the
+network's start ``T_start`` (the bench thermocouple's first reading, or ambient; its
+conductances: convection films and contact conductances are known to about +-30 %), ``u_tc``
+the thermocouple's standard uncertainty (its accuracy class); ``f_M`` the friction torque's
+relative uncertainty from the calibration (the grease parameters' standard errors, 6-12 %, and
+what they leave out), ``sigma_M`` the torque meter's noise averaged over its ``n`` samples in the
+window. The settings carry the values and their sources (``config/shadow.yaml``).
+
+Units: s; slip, residual and band in percentage points; temperature in K, torque in N m.
 """
 
 from __future__ import annotations
@@ -49,6 +62,24 @@ def band_pct(duration_s: float, *, calibration_rms_pct: float, jitter_std_s: flo
     module docstring)."""
     sensor = 100.0 * 2.0 * jitter_std_s / duration_s if duration_s > 0.0 else math.inf
     return coverage * math.hypot(calibration_rms_pct, sensor)
+
+
+def temperature_band_k(predicted_c: float, start_c: float, *, model_fraction: float, sensor_k: float, coverage: float) -> float:
+    """Half-width of the outer-ring temperature residual's band, K (module docstring): the
+    prediction ``predicted_c`` and the network's start ``start_c``, degC; NaN without a
+    prediction."""
+    if not (math.isfinite(predicted_c) and math.isfinite(start_c)):
+        return math.nan
+    return coverage * math.hypot(model_fraction * (predicted_c - start_c), sensor_k)
+
+
+def torque_band_nm(predicted_nm: float, samples: int, *, model_fraction: float, noise_nm: float, coverage: float) -> float:
+    """Half-width of the housing torque residual's band, N m (module docstring); NaN without a
+    prediction."""
+    if not math.isfinite(predicted_nm):
+        return math.nan
+    averaged = noise_nm / math.sqrt(samples) if samples > 0 else noise_nm
+    return coverage * math.hypot(model_fraction * predicted_nm, averaged)
 
 
 @dataclass(frozen=True)
@@ -87,8 +118,9 @@ class AnomalyRule:
         self._since, self._sum, self._count = None, 0.0, 0
         self.state = AnomalyState(HealthLevel.OK, 0.0, "")
 
-    def add(self, start: float, end: float, residual: float | None, band: float) -> AnomalyState:
-        """One window ``[start, end]`` (s) with its residual (None: not compared) and band (pp)."""
+    def add(self, start: float, end: float, residual: float | None, band: float, *, unit: str = "pp") -> AnomalyState:
+        """One window ``[start, end]`` (s) with its residual (None: not compared) and band, in
+        ``unit`` (pp for the slip, whose sign names the likely class)."""
         if residual is None or not math.isfinite(residual) or abs(residual) <= band:
             self.reset()
             return self.state
@@ -106,9 +138,12 @@ class AnomalyRule:
             level = HealthLevel.OK
         detail = ""
         if level != HealthLevel.OK:
+            fmt = ".3f" if unit == "pp" else ".3g"
             detail = (
-                f"residual {mean:+.3f} pp outside its band (+-{band:.3f} pp) for {outside:.2f} s "
-                f"(limit {self.warn_after_s if level == HealthLevel.WARN else self.error_after_s:g} s): {likely_cause(mean)}"
+                f"residual {mean:+{fmt}} {unit} outside its band (+-{band:{fmt}} {unit}) for {outside:.2f} s "
+                f"(limit {self.warn_after_s if level == HealthLevel.WARN else self.error_after_s:g} s)"
             )
+            if unit == "pp":
+                detail += f": {likely_cause(mean)}"
         self.state = AnomalyState(level, outside, detail)
         return self.state

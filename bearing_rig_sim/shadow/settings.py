@@ -19,6 +19,7 @@ NODE_NAME = "shadow"
 SHIPPED_FILE = "shadow.yaml"
 """The shipped parameter file, under ``config/``."""
 
+
 class ShadowSettings(NodeSettings):
     """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason), declared
     once (:mod:`bearing_rig_sim.settings_model`). ``calibration_rms_slip_pct`` below zero is
@@ -34,15 +35,17 @@ class ShadowSettings(NodeSettings):
     chunk_s: Number = param("engine advance per call (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
     window_revolutions: Integer = param("whole cage revolutions per slip window (the monitor's)", unit="1", ge=1, le=1000)
     min_inner_ring_speed_rad_s: Number = param("windows slower than this are not compared", unit="rad/s", gt=0.0, le=1000.0)
-    calibration_rms_slip_pct: Number = param(
-        "calibration RMS of the slip (negative: the calibration file's rms_slip_pct)", unit="%", ge=-1.0, le=10.0
-    )
+    calibration_rms_slip_pct: Number = param("calibration RMS of the slip (negative: the calibration file's rms_slip_pct)", unit="%", ge=-1.0, le=10.0)
     timing_jitter_std_s: Number = param("pulse-timing jitter of the bench's fibre-optic sensors", unit="s", ge=0.0, le=1e-3)
     band_coverage: Number = param("band half-width in combined standard uncertainties", unit="1", gt=0.0, le=10.0)
     warn_after_s: Number = param("a residual outside its band longer than this is a WARN (bench time)", unit="s", gt=0.0, le=600.0)
-    error_after_s: Number = param(
-        "a residual outside its band longer than this is an ERROR; > warn_after_s", unit="s", gt=0.0, le=3600.0
-    )
+    error_after_s: Number = param("a residual outside its band longer than this is an ERROR; > warn_after_s", unit="s", gt=0.0, le=3600.0)
+    thermal: Flag = param("couple the twin's engine to the bearing's thermal network (the bearing file's thermal: section) and compare temperature and torque")
+    lubricant_feedback: Flag = param("with thermal: the engine's lubricant follows the network's lubricant temperature (false: the calibration's)")
+    temperature_model_fraction: Number = param("relative uncertainty of the network's outer-ring rise since its start", unit="1", ge=0.0, le=1.0)
+    thermocouple_uncertainty_k: Number = param("standard uncertainty of the bench's outer-ring thermocouple", unit="K", ge=0.0, le=20.0)
+    torque_model_fraction: Number = param("relative uncertainty of the twin's friction torque", unit="1", ge=0.0, le=1.0)
+    torque_meter_noise_nm: Number = param("noise of one torque-meter sample (standard deviation)", unit="N m", ge=0.0, le=1.0)
     settle_s: Number = param("windows starting sooner than this after an engine (re)start are not compared", unit="s", ge=0.0, le=10.0)
     max_speed_gap_s: Number = param("spindle speed points further apart restart the engine", unit="s", gt=0.0, le=60.0)
     load_average_s: Number = param("averaging time of the load-cell force", unit="s", gt=0.0, le=10.0)
@@ -51,9 +54,7 @@ class ShadowSettings(NodeSettings):
     recalibrate_parameter: str = param("the calibration file's parameter tracked ('section.key'; '' = its first one)")
     forgetting_factor: Number = param("forgetting factor of the recursive least squares, per compared steady window", unit="1", gt=0.5, le=1.0)
     probe_step_fraction: Number = param("initial offset of the probe engine from the calibrated value", unit="1", gt=0.0, le=0.5)
-    steady_speed_fraction: Number = param(
-        "windows within this fraction of the previous one's spindle speed are steady", unit="1", ge=0.0, le=0.5
-    )
+    steady_speed_fraction: Number = param("windows within this fraction of the previous one's spindle speed are steady", unit="1", ge=0.0, le=0.5)
     status_rate_hz: Number = param("checks of the twin per second (wall clock), plus each change of level", unit="Hz", gt=0.0, le=1000.0)
     diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
 

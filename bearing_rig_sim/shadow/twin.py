@@ -20,7 +20,23 @@ Nothing is dropped: every window gives a row.
 The status (:meth:`ShadowTwin.health`) is OK, WARN or ERROR: the anomaly rule's level, or WARN
 for an input problem (faults, dropout, stopped rig, waiting for inputs), with the reasons.
 
-Units: s, rad/s, N; slip, residual and band in percentage points.
+**Temperature and torque.** With the bearing's thermal network (the bearing file's ``thermal:``
+section; ``thermal`` setting) the engine is coupled to it both ways, as the rig session's is
+(:class:`~bearing_rig_sim.shadow.predictor.MeasuredDrive`). Beside the slip, each window then
+compares, when the bench has the sensor:
+
+* the outer-ring thermocouple (``/rig/outer_ring/temperature``): its latest reading at the
+  window's end against the twin's outer ring through the thermocouple's lag; band
+  :func:`~bearing_rig_sim.shadow.residual.temperature_band_k`;
+* the housing torque meter (``/rig/housing/torque``): the mean of its samples inside the window
+  against the twin's mean friction torque; band :func:`~bearing_rig_sim.shadow.residual.torque_band_nm`.
+
+Each has its own anomaly rule (the same warn and error times); a compared slip window is required
+(the same input faults spoil all three). The twin's network starts at the bench thermocouple's
+first reading when one came before the engine's first start, else at ambient.
+
+Units: s, rad/s, N, N m, degC; slip, residual and band in percentage points; temperature
+residual and band in K.
 """
 
 from __future__ import annotations
@@ -28,8 +44,10 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
+from typing import Any
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -37,8 +55,9 @@ from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.shadow.measured import MeasuredWindow, MeasuredWindows
 from bearing_rig_sim.shadow.predictor import MeasuredDrive, Prediction
 from bearing_rig_sim.shadow.recalibration import CalibrationParameter, OnlineCalibration, ParameterEstimate, RecalibrationError
-from bearing_rig_sim.shadow.residual import AnomalyRule, band_pct
+from bearing_rig_sim.shadow.residual import AnomalyRule, band_pct, temperature_band_k, torque_band_nm
 from bearing_rig_sim.shadow.settings import ShadowSettings
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 STALE_WINDOW_S = 2.0
 """A measured window the engine has not reached this long after its end (bench time) is given
@@ -67,6 +86,18 @@ class ResidualWindow:
         anomaly: whether the anomaly rule stood at WARN or ERROR after it.
         level: the anomaly rule's level after it.
         note: why it was not compared, or the anomaly's detail; empty otherwise.
+        measured_temperature: the bench thermocouple's latest reading at the window's end, degC
+            (NaN: none).
+        predicted_temperature: the twin's outer ring at the window's end through the
+            thermocouple's lag, degC (NaN: no network).
+        temperature_residual: measured minus predicted, K (NaN if not compared).
+        temperature_band: its band's half-width, K (NaN without a prediction).
+        temperature_anomaly: the temperature rule stood at WARN or ERROR after the window.
+        measured_torque: mean of the bench torque meter's samples inside the window, N m (NaN: none).
+        predicted_torque: the twin's mean friction torque over the window, N m (NaN if not predicted).
+        torque_residual: measured minus predicted, N m (NaN if not compared).
+        torque_band: its band's half-width, N m (NaN without a prediction).
+        torque_anomaly: the torque rule stood at WARN or ERROR after the window.
     """
 
     start_time: float
@@ -83,6 +114,16 @@ class ResidualWindow:
     anomaly: bool
     level: HealthLevel
     note: str
+    measured_temperature: float = math.nan
+    predicted_temperature: float = math.nan
+    temperature_residual: float = math.nan
+    temperature_band: float = math.nan
+    temperature_anomaly: bool = False
+    measured_torque: float = math.nan
+    predicted_torque: float = math.nan
+    torque_residual: float = math.nan
+    torque_band: float = math.nan
+    torque_anomaly: bool = False
 
 
 @dataclass
@@ -107,8 +148,19 @@ class ShadowTwin:
         self.measured = measured if measured is not None else MeasuredWindows(settings.window_revolutions)
         self.speed = SpindleSpeedTrack(self.measured.clock_jump_tolerance_s)
         self.load = LoadCellTrack(settings.load_average_s)
+        self.thermal_config: ThermalConfig | None = None
+        """The bearing's thermal network data (None: isothermal; no temperature prediction)."""
+        if settings.thermal:
+            try:
+                self.thermal_config = ThermalConfig.from_yaml(settings.bearing_file)
+            except ConfigError:
+                self.thermal_config = None  # a bearing file without a thermal: section
         self.drive = self._make_drive(self.params)
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
+        self.temperature_rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
+        self.torque_rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
+        self._temperatures: deque[tuple[float, float]] = deque()
+        self._torques: deque[tuple[float, float]] = deque()
         self.calibration: OnlineCalibration | None = None
         if settings.recalibrate:
             if settings.calibration_file is None:
@@ -131,7 +183,15 @@ class ShadowTwin:
 
     def _make_drive(self, params: BearingParameters) -> MeasuredDrive:
         st = self.settings
-        return MeasuredDrive(params, model=st.model, chunk=st.chunk_s, max_speed_gap=st.max_speed_gap_s, load_at=self.load.force_at)
+        return MeasuredDrive(
+            params,
+            model=st.model,
+            chunk=st.chunk_s,
+            max_speed_gap=st.max_speed_gap_s,
+            load_at=self.load.force_at,
+            thermal=self.thermal_config,
+            lubricant_feedback=st.lubricant_feedback,
+        )
 
     # -- input ---------------------------------------------------------------------------------
     def add_force(self, time: float, force: float) -> None:
@@ -140,6 +200,35 @@ class ShadowTwin:
         if self.load.add(time, force) and last is not None and time - last > self.settings.load_timeout_s:
             self._dropouts.append((last, time))
         self._now = max(self._now, time) if math.isfinite(time) else self._now
+
+    def add_temperature(self, time: float, temperature_c: float) -> None:
+        """One outer-ring thermocouple reading: bench time (s), degC. Non-finite ones are ignored."""
+        if not (math.isfinite(time) and math.isfinite(temperature_c)):
+            return
+        drives = [self.drive] + ([self.calibration.probe] if self.calibration is not None else [])
+        for drive in drives:
+            if not drive.thermal_started and drive.thermal_start_c is None:
+                drive.thermal_start_c = float(temperature_c)  # the twin's bearing starts where the bench's is
+        self._temperatures.append((time, float(temperature_c)))
+
+    def add_torque(self, time: float, torque_nm: float) -> None:
+        """One housing torque-meter sample: bench time (s), torque about the axis (N m)."""
+        if math.isfinite(time) and math.isfinite(torque_nm):
+            self._torques.append((time, float(torque_nm)))
+
+    def _measured_temperature(self, end: float) -> float:
+        """The latest thermocouple reading at or before ``end`` (within a second), degC."""
+        latest = math.nan
+        for t, value in self._temperatures:
+            if t > end:
+                break
+            latest = value if end - t <= 1.0 else math.nan
+        return latest
+
+    def _measured_torque(self, start: float, end: float) -> tuple[float, int]:
+        """Mean of the torque samples inside ``[start, end]``, N m, and their number."""
+        inside = [v for t, v in self._torques if start <= t <= end]
+        return (sum(inside) / len(inside), len(inside)) if inside else (math.nan, 0)
 
     def add_pulse(self, shaft: str, pulse: Pulse) -> list[ResidualWindow]:
         """One pulse of ``"spindle"`` or ``"cage"``; the rows completed by it (never raises on
@@ -172,8 +261,12 @@ class ShadowTwin:
             self.calibration.jump_back()
         self.load.reset()
         self._dropouts.clear()
+        self._temperatures.clear()
+        self._torques.clear()
         self._now = -math.inf
         self.rule.reset()
+        self.temperature_rule.reset()
+        self.torque_rule.reset()
 
     def check(self, now: float) -> list[ResidualWindow]:
         """Time-based checks at bench time ``now`` (s): the monitor's sensor-loss and stop checks,
@@ -202,6 +295,9 @@ class ShadowTwin:
             self.calibration.forget_before(keep - 1.0)
         while self._dropouts and self._dropouts[0][1] < keep - 10.0:
             self._dropouts.popleft()
+        for track in (self._temperatures, self._torques):
+            while len(track) > 1 and track[1][0] < keep - 2.0:
+                track.popleft()
         return out
 
     def _why_not(self, item: _Pending) -> str:
@@ -223,7 +319,9 @@ class ShadowTwin:
         w, st = item.window, self.settings
         kin = self.kinematics
         measured = float(kin.slip_rate(w.cage_speed, w.inner_ring_speed)) if w.inner_ring_speed > 0.0 else math.nan
-        band = band_pct(w.end_time - w.start_time, calibration_rms_pct=st.calibration_rms_slip_pct, jitter_std_s=st.timing_jitter_std_s, coverage=st.band_coverage)
+        band = band_pct(
+            w.end_time - w.start_time, calibration_rms_pct=st.calibration_rms_slip_pct, jitter_std_s=st.timing_jitter_std_s, coverage=st.band_coverage
+        )
         predicted = cage = load = math.nan
         if prediction is not None and prediction.inner_ring_speed > 0.0:
             predicted = float(kin.slip_rate(prediction.cage_speed, prediction.inner_ring_speed))
@@ -237,6 +335,7 @@ class ShadowTwin:
         steady = self._steady(w.inner_ring_speed)
         if compared and steady and self.calibration is not None:
             self.calibration.update(w.start_time, w.end_time, measured, predicted, lambda c, i: float(kin.slip_rate(c, i)))
+        heat = self._heat_residuals(w, prediction if compared else None)
         row = ResidualWindow(
             start_time=w.start_time,
             time=w.end_time,
@@ -252,6 +351,7 @@ class ShadowTwin:
             anomaly=anomaly,
             level=state.level,
             note=state.detail if anomaly else why,
+            **heat,
         )
         self.latest = row
         self.counts["windows"] += 1
@@ -259,6 +359,39 @@ class ShadowTwin:
         self.counts["inside"] += int(compared and abs(residual) <= band)
         self.counts["anomalous"] += int(anomaly)
         return row
+
+    def _heat_residuals(self, w: MeasuredWindow, prediction: Prediction | None) -> dict[str, Any]:
+        """The temperature and torque columns of a window (see the module docstring)."""
+        st = self.settings
+        t_meas = self._measured_temperature(w.end_time)
+        m_meas, samples = self._measured_torque(w.start_time, w.end_time)
+        t_pred = prediction.outer_ring_temperature if prediction is not None else math.nan
+        m_pred = prediction.friction_torque if prediction is not None else math.nan
+        coupling = self.drive.coupling
+        start = math.nan
+        if coupling is not None:
+            net = coupling.network
+            start = float(net.initial_temperatures[list(net.names).index("outer_ring")])
+        t_band = temperature_band_k(
+            t_pred, start, model_fraction=st.temperature_model_fraction, sensor_k=st.thermocouple_uncertainty_k, coverage=st.band_coverage
+        )
+        m_band = torque_band_nm(m_pred, samples, model_fraction=st.torque_model_fraction, noise_nm=st.torque_meter_noise_nm, coverage=st.band_coverage)
+        t_res = t_meas - t_pred if math.isfinite(t_meas) and math.isfinite(t_pred) else math.nan
+        m_res = m_meas - m_pred if math.isfinite(m_meas) and math.isfinite(m_pred) else math.nan
+        t_state = self.temperature_rule.add(w.start_time, w.end_time, t_res if math.isfinite(t_res) else None, t_band, unit="K")
+        m_state = self.torque_rule.add(w.start_time, w.end_time, m_res if math.isfinite(m_res) else None, m_band, unit="N m")
+        return {
+            "measured_temperature": t_meas,
+            "predicted_temperature": t_pred,
+            "temperature_residual": t_res,
+            "temperature_band": t_band,
+            "temperature_anomaly": t_state.level != HealthLevel.OK,
+            "measured_torque": m_meas,
+            "predicted_torque": m_pred,
+            "torque_residual": m_res,
+            "torque_band": m_band,
+            "torque_anomaly": m_state.level != HealthLevel.OK,
+        }
 
     def _steady(self, inner: float) -> bool:
         previous, self._previous_inner = self._previous_inner, inner
@@ -276,15 +409,17 @@ class ShadowTwin:
         level = self.rule.state.level
         if level != HealthLevel.OK:
             reasons.append(self.rule.state.detail)
+        for name, rule in (("outer-ring temperature", self.temperature_rule), ("housing torque", self.torque_rule)):
+            if rule.state.level != HealthLevel.OK:
+                level = max(level, rule.state.level)
+                reasons.append(f"{name}: {rule.state.detail}")
         problems = list(self.measured.faults())
         stopped = self.measured.stopped()
         if stopped:
             problems.append(stopped)
         silent = self.load.silent_for(t)
         if silent > self.settings.load_timeout_s and math.isfinite(t):
-            problems.append(
-                "load cell: no sample yet" if self.load.last_time is None else f"load cell: no sample for {silent:.3g} s (last force held)"
-            )
+            problems.append("load cell: no sample yet" if self.load.last_time is None else f"load cell: no sample for {silent:.3g} s (last force held)")
         if self.drive.origin is None:
             problems.append("waiting for a whole spindle revolution and a load-cell sample")
         if problems:
@@ -292,7 +427,5 @@ class ShadowTwin:
             reasons.extend(problems)
         if not reasons and self.latest is not None:
             r = self.latest
-            reasons.append(
-                f"residual {r.residual:+.3f} pp within +-{r.band:.3f} pp" if r.compared else f"last window not compared: {r.note}"
-            )
+            reasons.append(f"residual {r.residual:+.3f} pp within +-{r.band:.3f} pp" if r.compared else f"last window not compared: {r.note}")
         return Health(level, tuple(reasons))

@@ -182,9 +182,7 @@ class SpindleDrive:
             if not accel > 0.0:
                 raise SpindleCommandError(f"acceleration: must be > 0 rad/s^2, got {command.acceleration!r}")
             if accel > self.max_acceleration:
-                raise SpindleCommandError(
-                    f"acceleration: {accel!r} rad/s^2 is above the rig's limit of {self.max_acceleration!r} rad/s^2"
-                )
+                raise SpindleCommandError(f"acceleration: {accel!r} rad/s^2 is above the rig's limit of {self.max_acceleration!r} rad/s^2")
         time = None
         if command.time is not None:
             time = _finite("time", command.time)

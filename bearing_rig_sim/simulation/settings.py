@@ -63,9 +63,7 @@ class SimulatorSettings(NodeSettings):
     calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = none; relative to config/)")
     rig_file: ConfigFile = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
     model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
-    chunk_s: Number = param(
-        f"simulated time per engine call and per {CLOCK.name} message (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1
-    )
+    chunk_s: Number = param(f"simulated time per engine call and per {CLOCK.name} message (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
     realtime: Flag = param("lock the simulated time to the wall clock (false: as fast as possible)")
     rate: Number = param("simulated seconds per wall second when in real time", unit="1", gt=0.0, le=100.0)
     loop_period_s: Number = param("period of the loop timer in real time (wall clock)", unit="s", ge=1e-4, le=0.1)
@@ -73,18 +71,20 @@ class SimulatorSettings(NodeSettings):
     overrun_margin_s: Number = param("lag behind the wall clock counted as an overrun", unit="s", gt=0.0, le=10.0)
     resync_lag_s: Number = param("lag behind the wall clock beyond which the debt is dropped", unit="s", gt=0.0, le=60.0)
     rtf_window_s: Number = param("sliding window of the reported real-time factor (wall clock)", unit="s", gt=0.0, le=600.0)
-    initial_speed_rad_s: Number = param(
-        "spindle speed at start (at most the rig file's spindle limit)", unit="rad/s", ge=0.0, le=PLAUSIBLE_SPINDLE_SPEED_RAD_S
-    )
+    initial_speed_rad_s: Number = param("spindle speed at start (at most the rig file's spindle limit)", unit="rad/s", ge=0.0, le=PLAUSIBLE_SPINDLE_SPEED_RAD_S)
     initial_axial_load_n: Number = param("axial load until the loading chain's first force message", unit="N", ge=0.0, le=10_000.0)
+    initial_temperature_rise_k: Number = param(
+        "start temperature of the bearing's thermal network above the bearing file's ambient (0: a cold start)", unit="K", ge=0.0, le=150.0
+    )
+    lubricant_feedback: Flag = param(
+        "the engine's lubricant follows the thermal network's lubricant temperature (false: held at the bearing file's temperature, the calibration's)"
+    )
     max_command_lead_s: Number = param("how far ahead of the rig clock a command's stamp may be", unit="s", ge=0.0, le=3600.0)
     counter_timeout_s: Number = param("the pulse counters show 0 after this long without a pulse", unit="s", gt=0.0, le=60.0)
     speeds_rate_hz: Number = param(f"rate of {SPEEDS.name} in simulated time (at most one per chunk)", unit="Hz", gt=0.0, le=100_000.0)
     truth_rate_hz: Number = param(f"rate of {TRUTH.name} in simulated time", unit="Hz", gt=0.0, le=100_000.0)
     diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
-    fault_hold_s: Number = param(
-        f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0, le=600.0
-    )
+    fault_hold_s: Number = param(f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0, le=600.0)
 
     _spindle: SpindleConfig = PrivateAttr()
 

@@ -195,9 +195,7 @@ class RigTwin:
         if isinstance(counter_timeout, bool) or not isinstance(counter_timeout, (int, float)) or not counter_timeout > 0.0:
             raise TwinError(f"counter_timeout: must be > 0 s, got {counter_timeout!r}")
         self.counter_timeout = float(counter_timeout)
-        self.drive = SpindleDrive(
-            initial_speed, 0.0, max_speed=max_speed, max_acceleration=max_acceleration, max_lead=max_command_lead
-        )
+        self.drive = SpindleDrive(initial_speed, 0.0, max_speed=max_speed, max_acceleration=max_acceleration, max_lead=max_command_lead)
         self.load_clamped = False
         """Whether the latest axial force asked for was below the engine's minimum
         (:data:`~bearing_rig_sim.dynamics.MIN_AXIAL_LOAD`) and was raised to it."""
@@ -218,11 +216,17 @@ class RigTwin:
         """The bearing's thermal network, when attached (:meth:`attach_thermal`): it takes the
         engine's heat chunk by chunk and sets the lubricant's temperature."""
 
-    def attach_thermal(self, bearing_file: str | Path | None = None, **options: Any) -> ThermalCoupling:
+    def attach_thermal(self, bearing_file: str | Path | None = None, *, initial_rise_k: float = 0.0, **options: Any) -> ThermalCoupling:
         """Couple the bearing's thermal network (the bearing file's ``thermal:`` section; default
-        the shipped H7006C) to the engine from the next chunk on; ``options`` are those of
-        :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`."""
-        self.thermal = ThermalCoupling(self.engine, ThermalConfig.from_yaml(bearing_file), **options)
+        the shipped H7006C) to the engine from the next chunk on, every node starting
+        ``initial_rise_k`` (K, >= 0) above the file's ambient; ``options`` are those of
+        :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling` (by default coupled both ways:
+        the engine's lubricant follows the lubricant node every 0.1 s)."""
+        if not math.isfinite(initial_rise_k) or initial_rise_k < 0.0:
+            raise TwinError(f"initial_rise_k: must be a finite number >= 0 K, got {initial_rise_k!r}")
+        config = ThermalConfig.from_yaml(bearing_file)
+        options.setdefault("initial", config.ambient + initial_rise_k)
+        self.thermal = ThermalCoupling(self.engine, config, **options)
         return self.thermal
 
     @classmethod
@@ -260,9 +264,7 @@ class RigTwin:
             raise TwinError(f"chunk: must be a finite number > 0 s, got {chunk!r}")
         steps = chunk / self.engine.time_step
         if steps < 1.0 - CHUNK_STEP_TOLERANCE or abs(steps - round(steps)) > CHUNK_STEP_TOLERANCE:
-            raise TwinError(
-                f"chunk: {chunk!r} s is not a whole number of engine time steps ({self.engine.time_step!r} s)"
-            )
+            raise TwinError(f"chunk: {chunk!r} s is not a whole number of engine time steps ({self.engine.time_step!r} s)")
         return float(chunk)
 
     # -- inputs --------------------------------------------------------------------------------

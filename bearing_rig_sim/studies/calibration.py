@@ -7,6 +7,12 @@ speed, axial load, slip) rows by nonlinear least squares on their logarithms, ru
 to a steady state at every row; a best fit outside a parameter's physically plausible range is
 an error, not a result. The slip of the bench rows and of the engine is the paper's S_c (paper
 Eq. 11-12) at the nominal contact angle, computed from cage and inner-ring speeds.
+
+With a thermal configuration (``thermal=``, the bearing file's ``thermal:`` section) every row is
+the coupled thermal steady state (:func:`bearing_rig_sim.thermal.coupling.thermal_steady_state`):
+the bench's slips are steady, warm values, so the fitted values are those at the bearing file's
+lubricant temperature (the reference of the grease's temperature laws) that give the bench's
+slips at the temperatures the bearing reaches at each row.
 """
 
 from __future__ import annotations
@@ -30,6 +36,7 @@ from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.dynamics.steady import solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.executors import process_pool
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 DEFAULT_FITTED: tuple[str, ...] = ("yield_stress", "consistency")
 """Parameters fitted by default: the Herschel-Bulkley yield stress and consistency of the grease
@@ -86,6 +93,11 @@ class SteadyState:
     power_loss: float = math.nan
     film_min_inner: float = math.nan
     film_min_outer: float = math.nan
+    lubricant_temperature: float = field(default=math.nan, compare=False)
+    """degC: the thermal steady state's lubricant temperature (NaN: isothermal, at the bearing
+    file's temperature; left out of equality, NaN being unequal to itself)."""
+    outer_ring_temperature: float = field(default=math.nan, compare=False)
+    """degC: the thermal steady state's outer-ring temperature (NaN: isothermal)."""
 
     def as_row(self) -> dict[str, float]:
         """The point at the edge: rpm, N, %."""
@@ -120,6 +132,8 @@ class CalibrationResult:
     rms_pct: float
     evaluations: int
     params: BearingParameters = field(repr=False)
+    thermal: bool = False
+    """Whether the rows were the coupled thermal steady states."""
 
 
 def read_bench_csv(path: str | Path) -> list[BenchPoint]:
@@ -153,16 +167,35 @@ def read_bench_csv(path: str | Path) -> list[BenchPoint]:
     return points
 
 
-def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load: float) -> SteadyState:
+def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load: float, thermal: ThermalConfig | None = None) -> SteadyState:
     """The default engine's steady state reached from the rolling start, by the direct solver
-    (which integrates where Newton cannot settle it; :mod:`bearing_rig_sim.dynamics.steady`)."""
+    (which integrates where Newton cannot settle it; :mod:`bearing_rig_sim.dynamics.steady`);
+    with ``thermal``, the coupled thermal steady state (the lubricant at the temperature its own
+    heat gives it)."""
+    if thermal is not None:
+        from bearing_rig_sim.thermal.coupling import thermal_steady_state
+
+        ts = thermal_steady_state(params, thermal, inner_ring_speed, axial_load)
+        pt = ts.point
+        return SteadyState(
+            pt.inner_ring_speed,
+            axial_load,
+            pt.cage_speed,
+            pt.slip_pct,
+            pt.torque,
+            pt.power,
+            pt.film_min_inner,
+            pt.film_min_outer,
+            ts.temperatures["lubricant"],
+            ts.temperatures["outer_ring"],
+        )
     point = solver_for(params).solve(inner_ring_speed, axial_load)
     return SteadyState(
         point.inner_ring_speed, axial_load, point.cage_speed, point.slip_pct, point.torque, point.power, point.film_min_inner, point.film_min_outer
     )
 
 
-def _steady_state_job(job: tuple[BearingParameters, float, float]) -> SteadyState:
+def _steady_state_job(job: tuple[BearingParameters, float, float, ThermalConfig | None]) -> SteadyState:
     return steady_state(*job)
 
 
@@ -172,11 +205,13 @@ def steady_states(
     workers: int | None = None,
     pool: Executor | None = None,
     progress: Callable[[int, int], None] | None = None,
+    thermal: ThermalConfig | None = None,
 ) -> list[SteadyState]:
     """Steady states of many (inner-ring speed rad/s, axial load N) points, on ``pool`` or on
     ``workers`` new processes (default: all cores). Order is kept; results do not depend on
-    the number of processes. ``progress(done, total)`` is called as points complete."""
-    jobs = [(params, float(w), float(f)) for w, f in points]
+    the number of processes. ``progress(done, total)`` is called as points complete. With
+    ``thermal``, each is the coupled thermal steady state (:func:`steady_state`)."""
+    jobs = [(params, float(w), float(f), thermal) for w, f in points]
     workers = workers or os.cpu_count() or 1
     if pool is None and (workers <= 1 or len(jobs) <= 1):
         return _collect(map(_steady_state_job, jobs), len(jobs), progress)
@@ -240,12 +275,14 @@ def calibrate(
     fitted: Sequence[str] = DEFAULT_FITTED,
     fixed: dict[str, float] | None = None,
     workers: int | None = None,
+    thermal: ThermalConfig | None = None,
 ) -> CalibrationResult:
     """Fit ``fitted`` physical parameters so the engine's steady slip matches ``points``.
 
     Each parameter is fitted as its logarithm (it must stay positive), starting from its value
     in ``params``; ``fixed`` values are set first. The residuals are slip differences in
-    percentage points.
+    percentage points. With ``thermal`` every row is the coupled thermal steady state (module
+    doc) and the values fitted are those at the bearing file's lubricant temperature.
 
     Raises:
         CalibrationError: more than :data:`MAX_FITTED` parameters, or a best fit outside the
@@ -272,7 +309,7 @@ def calibrate(
         values = {k: float(math.exp(v)) for k, v in zip(fitted, x)}
         trial = with_values(base, values)
         try:
-            return steady_states(trial, speeds_loads, 1, pool)
+            return steady_states(trial, speeds_loads, 1, pool, thermal=thermal)
         except DynamicsDivergedError as exc:
             # No slip to fit there: name the parameter that left its range, else the fault.
             check_in_range(values, "the fit's trial value")
@@ -281,15 +318,13 @@ def calibrate(
 
     with process_pool(min(workers, len(points))) if workers > 1 else nullcontext() as pool:
         # Slip is reported to 0.01 %: a relative step of 1e-4 in the log-parameters is ample.
-        fit = least_squares(
-            lambda x: np.array([s.slip_pct for s in model(x, pool)]) - target, x0, diff_step=1e-3, xtol=1e-4, ftol=1e-6, max_nfev=40
-        )
+        fit = least_squares(lambda x: np.array([s.slip_pct for s in model(x, pool)]) - target, x0, diff_step=1e-3, xtol=1e-4, ftol=1e-6, max_nfev=40)
         values = {k: float(math.exp(v)) for k, v in zip(fitted, fit.x)}
         final = with_values(base, values)
-        predicted = steady_states(final, speeds_loads, 1, pool)
+        predicted = steady_states(final, speeds_loads, 1, pool, thermal=thermal)
     rms = float(np.sqrt(np.mean((np.array([s.slip_pct for s in predicted]) - target) ** 2)))
     check_in_range(values)
-    return CalibrationResult(values, fixed, tuple(points), tuple(predicted), rms, evaluations, final)
+    return CalibrationResult(values, fixed, tuple(points), tuple(predicted), rms, evaluations, final, thermal is not None)
 
 
 def write_calibration(result: CalibrationResult, path: str | Path, data_name: str) -> None:
@@ -310,12 +345,21 @@ def write_calibration(result: CalibrationResult, path: str | Path, data_name: st
             "fitted": [f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}" for k in result.fitted],
             "fixed": {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": float(v) for k, v in result.fixed.items()},
             "rms_slip_pct": round(float(result.rms_pct), 4),
+            "thermal": bool(result.thermal),
             "rows": [
                 {
                     "rpm": round(float(rad_s_to_rpm(p.inner_ring_speed)), 3),
                     "axial_load_n": float(p.axial_load),
                     "measured_slip_pct": float(p.slip_pct),
                     "model_slip_pct": round(float(s.slip_pct), 4),
+                    **(
+                        {
+                            "lubricant_temperature_c": round(float(s.lubricant_temperature), 2),
+                            "outer_ring_temperature_c": round(float(s.outer_ring_temperature), 2),
+                        }
+                        if result.thermal
+                        else {}
+                    ),
                 }
                 for p, s in zip(result.points, result.predicted)
             ],
@@ -327,5 +371,12 @@ def write_calibration(result: CalibrationResult, path: str | Path, data_name: st
         "# The fitted quantities are physical properties of the grease the balls and cage shear in the\n"
         "# bearing's running-in state; each carries its plausible range (a fit outside it fails).\n"
         "# What they mean and what the bench should measure: docs/model.md, section Calibration.\n"
+        + (
+            "# Thermal: every row is the coupled thermal steady state (the bench's slips are warm, steady\n"
+            "# values); the values are the grease's at the bearing file's lubricant temperature, the\n"
+            "# reference of its temperature laws (config/lubricants/).\n"
+            if result.thermal
+            else ""
+        )
     )
     Path(path).write_text(header + yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")

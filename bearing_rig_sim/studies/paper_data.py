@@ -21,7 +21,12 @@ in the source."""
 PAPER_TABLE6: dict[int, tuple[float, float, float]] = {1: (1.16e-4, 0.9997, 0.0048), 2: (1.92e-4, 0.9994, 0.0098)}
 """Slip vs time fit quality: terms -> (SSE %^2, R^2, RMSE %)."""
 
-PAPER_TABLE7: dict[float, tuple[float, float, float]] = {20.0: (3.5, -1.52, 1.29), 40.0: (1.64, -0.73, 0.9), 60.0: (1.33, -0.49, 0.72), 80.0: (0.76, -0.09, 0.45)}
+PAPER_TABLE7: dict[float, tuple[float, float, float]] = {
+    20.0: (3.5, -1.52, 1.29),
+    40.0: (1.64, -0.73, 0.9),
+    60.0: (1.33, -0.49, 0.72),
+    80.0: (0.76, -0.09, 0.45),
+}
 """rad/s^2 -> (lambda %, k s, d s) of the slip of a run-up from rest at 200 N,
 y = lambda exp(-((t - k)/d)^2)."""
 

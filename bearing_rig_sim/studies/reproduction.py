@@ -73,9 +73,7 @@ def save_raw(raw: RawResults, path: Path) -> None:
     doc = {
         "validation": [_state_to_json(s) for s in raw.validation],
         "sweep": {str(k): [_state_to_json(s) for s in v] for k, v in raw.sweep.items()},
-        "acceleration": [
-            {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in dataclasses.asdict(a).items()} for a in raw.acceleration
-        ],
+        "acceleration": [{k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in dataclasses.asdict(a).items()} for a in raw.acceleration],
     }
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(doc))
@@ -85,9 +83,7 @@ def load_raw(path: Path) -> RawResults:
     """Read raw results written by :func:`save_raw`."""
     doc = json.loads(path.read_text())
     accel = [
-        AccelerationSeries(
-            a["acceleration"], a["axial_load"], *(np.array(a[k]) for k in ("time", "inner_ring_speed", "cage_speed", "slip_pct"))
-        )
+        AccelerationSeries(a["acceleration"], a["axial_load"], *(np.array(a[k]) for k in ("time", "inner_ring_speed", "cage_speed", "slip_pct")))
         for a in doc["acceleration"]
     ]
     return RawResults(
@@ -143,5 +139,3 @@ def reproduce(
         raw = run_experiments(params, workers, progress)
         save_raw(raw, cache)
     return write_report(raw, out, params, cached)
-
-

@@ -99,6 +99,7 @@ def acceleration_fit_problem(fit: GaussianFit) -> str:
         return f"RMSE {fit.rmse:.3g} % above {ACCEL_MAX_RMSE_PCT:g} %"
     return ""
 
+
 BORE_M = 0.030
 """H7006C bore d, m (paper Table 2); with D and the base-oil viscosity the SKF model's inputs."""
 OUTSIDE_DIAMETER_M = 0.055
@@ -142,14 +143,23 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
     files.append(path)
     errs = [r["slip_pct"] - PAPER_TABLE3[int(round(r["rpm"]))][0] for r in rows if int(round(r["rpm"])) in PAPER_TABLE3]
     rms = float(np.sqrt(np.mean(np.square(errs)))) if errs else float("nan")
-    lines += ["## Validation at 100 N (Table 3 analogue)", "", "| n_i (rpm) | bench S_c (%) | paper's model (%) | twin (%) | twin - bench (pp) |", "|---|---|---|---|---|"]
+    lines += [
+        "## Validation at 100 N (Table 3 analogue)",
+        "",
+        "| n_i (rpm) | bench S_c (%) | paper's model (%) | twin (%) | twin - bench (pp) |",
+        "|---|---|---|---|---|",
+    ]
     for r in rows:
         n = int(round(r["rpm"]))
         bench, paper = PAPER_TABLE3.get(n, (None, None))
         diff = r["slip_pct"] - bench if bench is not None else None
         lines.append(f"| {n} | {_fmt(bench)} | {_fmt(paper)} | {r['slip_pct']:.2f} | {_fmt(diff, 2)} |")
-    lines += ["", f"RMS twin - bench over the four calibration rows: **{rms:.3f} pp** (the paper's model: 0.11 pp over seven speeds).",
-              "The 1200, 1800 and 2400 rpm rows are blind predictions: the bench values are withheld.", ""]
+    lines += [
+        "",
+        f"RMS twin - bench over the four calibration rows: **{rms:.3f} pp** (the paper's model: 0.11 pp over seven speeds).",
+        "The 1200, 1800 and 2400 rpm rows are blind predictions: the bench values are withheld.",
+        "",
+    ]
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot([r["rpm"] for r in rows], [r["slip_pct"] for r in rows], "o-", label="twin")
     ax.plot(list(PAPER_TABLE3), [v[0] for v in PAPER_TABLE3.values()], "s", label="bench (paper Table 3)")
@@ -158,22 +168,32 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot([r["rpm"] for r in rows], [r["cage_rpm"] for r in rows], "o-", label="twin cage speed")
     ax.plot([r["rpm"] for r in rows], [params.epicyclic_ratio * r["rpm"] for r in rows], "--", label="epicyclic n_s (Eq. 12)")
-    files.append(_finish(ax, fig, out / "fig06_validation_cage_speed.png", "inner-ring speed n_i (rpm)", "cage speed n_c (rpm)", "Fig. 6 analogue: cage speed at 100 N"))
+    files.append(
+        _finish(ax, fig, out / "fig06_validation_cage_speed.png", "inner-ring speed n_i (rpm)", "cage speed n_c (rpm)", "Fig. 6 analogue: cage speed at 100 N")
+    )
 
     # -- 2. load sweep ----------------------------------------------------------------------
     path = out / "load_sweep.csv"
-    _write_csv(path, ["rpm", "axial_load_n", "cage_rpm", "slip_pct"], [[s.as_row()[k] for k in ("rpm", "axial_load_n", "cage_rpm", "slip_pct")] for v in raw.sweep.values() for s in v])
+    _write_csv(
+        path,
+        ["rpm", "axial_load_n", "cage_rpm", "slip_pct"],
+        [[s.as_row()[k] for k in ("rpm", "axial_load_n", "cage_rpm", "slip_pct")] for v in raw.sweep.values() for s in v],
+    )
     files.append(path)
     load_onsets: dict[float, float | None] = {}
     reasons: dict[str, str] = {}
-    lines += ["## Load sweep (Figures 7-8; Tables 4-5 analogues)", "",
-              f"Slip against axial load {min(SWEEP_LOADS_N):.0f}-{max(SWEEP_LOADS_N):.0f} N. Points in gross skid (S_c > {SKID_SLIP_PCT:.0f} %) are listed "
-              "but not fitted: the Gaussian-slope method presumes a smooth slip curve. Gaussian sums fitted by nonlinear least squares to the rolling points; "
-              f"stable where the fitted slope >= k1, read as {K1_AXIAL_LOAD:g} %/N (slip in percent) and, second reading, {K1_FRACTION_READING:g} %/N (slip as a fraction). "
-              f"A fit is a result only with R^2 >= {SWEEP_MIN_R_SQUARE} and RMSE <= {SWEEP_MAX_RMSE_PCT} %, or RMSE <= {SWEEP_FLAT_RMSE_PCT} % (a flat sweep); "
-              "otherwise the row says so (docs/method.md).", "",
-              "| n_i (rpm) | skids up to (N) | 1-term SSE / R^2 / RMSE | 2-term SSE / R^2 / RMSE | kept | a1 | a2 | b1 (N) | b2 (N) | c1 (N) | c2 (N) | stable from (N), k1 %/N | stable from (N), k1 fraction/N |",
-              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [
+        "## Load sweep (Figures 7-8; Tables 4-5 analogues)",
+        "",
+        f"Slip against axial load {min(SWEEP_LOADS_N):.0f}-{max(SWEEP_LOADS_N):.0f} N. Points in gross skid (S_c > {SKID_SLIP_PCT:.0f} %) are listed "
+        "but not fitted: the Gaussian-slope method presumes a smooth slip curve. Gaussian sums fitted by nonlinear least squares to the rolling points; "
+        f"stable where the fitted slope >= k1, read as {K1_AXIAL_LOAD:g} %/N (slip in percent) and, second reading, {K1_FRACTION_READING:g} %/N (slip as a fraction). "
+        f"A fit is a result only with R^2 >= {SWEEP_MIN_R_SQUARE} and RMSE <= {SWEEP_MAX_RMSE_PCT} %, or RMSE <= {SWEEP_FLAT_RMSE_PCT} % (a flat sweep); "
+        "otherwise the row says so (docs/method.md).",
+        "",
+        "| n_i (rpm) | skids up to (N) | 1-term SSE / R^2 / RMSE | 2-term SSE / R^2 / RMSE | kept | a1 | a2 | b1 (N) | b2 (N) | c1 (N) | c2 (N) | stable from (N), k1 %/N | stable from (N), k1 fraction/N |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
     fig7, ax7 = plt.subplots(figsize=(6, 4))
     fig8, ax8 = plt.subplots(figsize=(6, 4))
     for rpm, states in raw.sweep.items():
@@ -218,29 +238,55 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
             f"{chosen.n_terms} | {p[0, 0]:.3g} | {p[1, 0]:.3g} | {p[0, 1]:.4g} | {p[1, 1]:.4g} | {p[0, 2]:.4g} | {p[1, 2]:.4g} | {_fmt(onset.onset, 4)} | {_fmt(onset_fraction.onset, 4)} |"
         )
     a = PAPER_TABLE5_1000RPM
-    lines += ["", f"The paper (Table 4, fits pooled): 1-term SSE {PAPER_TABLE4[1][0]}, R^2 {PAPER_TABLE4[1][1]}, RMSE {PAPER_TABLE4[1][2]}; "
-              f"2-term SSE {PAPER_TABLE4[2][0]}, R^2 {PAPER_TABLE4[2][1]}, RMSE {PAPER_TABLE4[2][2]} (2 terms kept). "
-              f"Table 5 at 1000 rpm: a1 {a[0]}, a2 {a[1]}, b1 {a[2]}, b2 {a[3]}, c1 {a[4]}, c2 {a[5]}; its other rows are garbled in the source.", ""]
-    files.append(_finish(ax7, fig7, out / "fig07_load_sweep_cage_speed.png", "axial load F_a (N)", "cage speed n_c (rpm)", "Fig. 7 analogue: cage speed against axial load"))
-    files.append(_finish(ax8, fig8, out / "fig08_load_sweep_slip.png", "axial load F_a (N)", "cage slip rate S_c (%)", "Fig. 8 analogue: slip against load (x: skid; lines: fits)", log_if_positive=True))
+    lines += [
+        "",
+        f"The paper (Table 4, fits pooled): 1-term SSE {PAPER_TABLE4[1][0]}, R^2 {PAPER_TABLE4[1][1]}, RMSE {PAPER_TABLE4[1][2]}; "
+        f"2-term SSE {PAPER_TABLE4[2][0]}, R^2 {PAPER_TABLE4[2][1]}, RMSE {PAPER_TABLE4[2][2]} (2 terms kept). "
+        f"Table 5 at 1000 rpm: a1 {a[0]}, a2 {a[1]}, b1 {a[2]}, b2 {a[3]}, c1 {a[4]}, c2 {a[5]}; its other rows are garbled in the source.",
+        "",
+    ]
+    files.append(
+        _finish(
+            ax7, fig7, out / "fig07_load_sweep_cage_speed.png", "axial load F_a (N)", "cage speed n_c (rpm)", "Fig. 7 analogue: cage speed against axial load"
+        )
+    )
+    files.append(
+        _finish(
+            ax8,
+            fig8,
+            out / "fig08_load_sweep_slip.png",
+            "axial load F_a (N)",
+            "cage slip rate S_c (%)",
+            "Fig. 8 analogue: slip against load (x: skid; lines: fits)",
+            log_if_positive=True,
+        )
+    )
 
     # -- 3. acceleration sweep --------------------------------------------------------------
     path = out / "acceleration.csv"
     _write_csv(
         path,
         ["acceleration_rad_s2", "time_s", "inner_rpm", "cage_rpm", "slip_pct"],
-        [[a.acceleration, float(t), rad_s_to_rpm(float(wi)), rad_s_to_rpm(float(wc)), float(s)] for a in raw.acceleration for t, wi, wc, s in zip(a.time, a.inner_ring_speed, a.cage_speed, a.slip_pct)],
+        [
+            [a.acceleration, float(t), rad_s_to_rpm(float(wi)), rad_s_to_rpm(float(wc)), float(s)]
+            for a in raw.acceleration
+            for t, wi, wc, s in zip(a.time, a.inner_ring_speed, a.cage_speed, a.slip_pct)
+        ],
     )
     files.append(path)
     acc_onsets: dict[float, float | None] = {}
-    lines += ["## Constant acceleration at 200 N (Figures 9-10; Tables 6-7 analogues)", "",
-              f"Slip against time from rest; Gaussian sums y = sum lambda exp(-((t - k)/d)^2), 1 and 2 terms, the better kept by the paper's RMSE rule (the paper keeps 1 term), fitted to the points out of gross skid "
-              f"(S_c <= {SKID_SLIP_PCT:g} %, as in the load sweep); stable where the slope >= k2 = {K2_TIME:g} %/s. A fit is a result only with, for every term, "
-              f"0 < lambda < {ACCEL_MAX_LAMBDA_PCT:g} %, {ACCEL_CENTRE_RANGE_S[0]:g} s <= k <= {ACCEL_CENTRE_RANGE_S[1]:g} s, "
-              f"{ACCEL_WIDTH_RANGE_S[0]:g} s <= d <= {ACCEL_WIDTH_RANGE_S[1]:g} s, R^2 >= {ACCEL_MIN_R_SQUARE} and RMSE <= {ACCEL_MAX_RMSE_PCT:g} %; "
-              "otherwise the row says why there is none.", "",
-              "| alpha (rad/s^2) | skid | 1-term SSE / R^2 / RMSE | 2-term SSE / R^2 / RMSE | lambda (%) | k (s) | d (s) | stable from (s) | paper lambda / k / d | paper onset (s) |",
-              "|---|---|---|---|---|---|---|---|---|---|"]
+    lines += [
+        "## Constant acceleration at 200 N (Figures 9-10; Tables 6-7 analogues)",
+        "",
+        f"Slip against time from rest; Gaussian sums y = sum lambda exp(-((t - k)/d)^2), 1 and 2 terms, the better kept by the paper's RMSE rule (the paper keeps 1 term), fitted to the points out of gross skid "
+        f"(S_c <= {SKID_SLIP_PCT:g} %, as in the load sweep); stable where the slope >= k2 = {K2_TIME:g} %/s. A fit is a result only with, for every term, "
+        f"0 < lambda < {ACCEL_MAX_LAMBDA_PCT:g} %, {ACCEL_CENTRE_RANGE_S[0]:g} s <= k <= {ACCEL_CENTRE_RANGE_S[1]:g} s, "
+        f"{ACCEL_WIDTH_RANGE_S[0]:g} s <= d <= {ACCEL_WIDTH_RANGE_S[1]:g} s, R^2 >= {ACCEL_MIN_R_SQUARE} and RMSE <= {ACCEL_MAX_RMSE_PCT:g} %; "
+        "otherwise the row says why there is none.",
+        "",
+        "| alpha (rad/s^2) | skid | 1-term SSE / R^2 / RMSE | 2-term SSE / R^2 / RMSE | lambda (%) | k (s) | d (s) | stable from (s) | paper lambda / k / d | paper onset (s) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
     fig9, ax9 = plt.subplots(figsize=(6, 4))
     fig10, ax10 = plt.subplots(figsize=(6, 4))
     accepted: dict[float, tuple[float, float, float] | None] = {}
@@ -262,7 +308,9 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         two_terms: GaussianFit | None = selected[1][1] if selected is not None else None
         kept: GaussianFit | None = selected[0] if selected is not None else None
         skid_txt = f"skid (S_c > {SKID_SLIP_PCT:g} %) to {skid_until:.2f} s" if skid_until is not None else "no skid"
-        problem = "fit failed" if kept is None else f"the kept {kept.n_terms}-term fit's {acceleration_fit_problem(kept)}" if acceleration_fit_problem(kept) else ""
+        problem = (
+            "fit failed" if kept is None else f"the kept {kept.n_terms}-term fit's {acceleration_fit_problem(kept)}" if acceleration_fit_problem(kept) else ""
+        )
         two_txt = f"{_fmt(two_terms.sse)} / {_fmt(two_terms.r_square, 4)} / {_fmt(two_terms.rmse)}" if two_terms is not None else "-"
         one_txt = f"{_fmt(one.sse)} / {_fmt(one.r_square, 4)} / {_fmt(one.rmse)}" if one is not None else "-"
         if kept is None or problem:
@@ -283,10 +331,32 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
             f"| {series.acceleration:.0f} | {skid_txt} | {one_txt} | {two_txt} | {q[0]:.3g} | {q[1]:.3g} | {q[2]:.3g} | "
             f"{_fmt(onset.onset)} | {lam} / {kk} / {dd} | {_fmt(paper_onset)} |"
         )
-    lines += ["", f"The paper (Table 6): 1-term SSE {PAPER_TABLE6[1][0]}, R^2 {PAPER_TABLE6[1][1]}, RMSE {PAPER_TABLE6[1][2]}; "
-              f"2-term SSE {PAPER_TABLE6[2][0]}, R^2 {PAPER_TABLE6[2][1]}, RMSE {PAPER_TABLE6[2][2]} (1 term kept).", ""]
-    files.append(_finish(ax9, fig9, out / "fig09_acceleration_cage_speed.png", "time t (s)", "cage speed n_c (rpm)", "Fig. 9 analogue: cage speed under constant acceleration"))
-    files.append(_finish(ax10, fig10, out / "fig10_acceleration_slip.png", "time t (s)", "cage slip rate S_c (%)", "Fig. 10 analogue: twin slip (dots, lines: accepted fits) beside the paper's Table 7 (dashed)"))
+    lines += [
+        "",
+        f"The paper (Table 6): 1-term SSE {PAPER_TABLE6[1][0]}, R^2 {PAPER_TABLE6[1][1]}, RMSE {PAPER_TABLE6[1][2]}; "
+        f"2-term SSE {PAPER_TABLE6[2][0]}, R^2 {PAPER_TABLE6[2][1]}, RMSE {PAPER_TABLE6[2][2]} (1 term kept).",
+        "",
+    ]
+    files.append(
+        _finish(
+            ax9,
+            fig9,
+            out / "fig09_acceleration_cage_speed.png",
+            "time t (s)",
+            "cage speed n_c (rpm)",
+            "Fig. 9 analogue: cage speed under constant acceleration",
+        )
+    )
+    files.append(
+        _finish(
+            ax10,
+            fig10,
+            out / "fig10_acceleration_slip.png",
+            "time t (s)",
+            "cage slip rate S_c (%)",
+            "Fig. 10 analogue: twin slip (dots, lines: accepted fits) beside the paper's Table 7 (dashed)",
+        )
+    )
     plt.close("all")
     lines += run_up_section(raw, params, accepted)
     lines += friction_section(raw, params)
@@ -330,9 +400,7 @@ def run_up_section(raw: RawResults, params: BearingParameters, accepted: dict[fl
         twin = [float(np.interp(w, wi[rising], y[rising])) if wi[rising].max() >= w else math.nan for w in RUN_UP_SPEEDS_RAD_S]
         lam, kk, dd = PAPER_TABLE7.get(series.acceleration, (math.nan, math.nan, math.nan))
         paper = [float(_gaussian(lam, kk, dd)(w / series.acceleration)) for w in RUN_UP_SPEEDS_RAD_S]
-        lines.append(
-            f"| {series.acceleration:.0f} | " + " | ".join(_fmt(v) for v in twin) + " | " + " / ".join(_fmt(v) for v in paper) + " |"
-        )
+        lines.append(f"| {series.acceleration:.0f} | " + " | ".join(_fmt(v) for v in twin) + " | " + " / ".join(_fmt(v) for v in paper) + " |")
     lines += [
         "",
         "Where it disagrees with the paper: (1) the twin starts in gross skid (tens of percent near rest), the paper's curves at "
@@ -391,12 +459,17 @@ def friction_section(raw: RawResults, params: BearingParameters) -> list[str]:
     if lub is None:
         return []
     nu = lub.kinematic_viscosity(params.lubricant_temperature)
-    lines = ["## Friction torque: the twin beside the SKF model", "",
-             f"Twin: power dissipated in the bearing over the inner-ring speed (lubricant `{lub.name}`). SKF: catalogue model "
-             f"M = phi_ish phi_rs M_rr + M_sl for a single-row angular contact ball bearing, oil of {nu * 1e6:.1f} mm^2/s (the base oil at "
-             f"{params.lubricant_temperature:.0f} degC), no drag term. With grease in its running-in state the twin's torque is expected "
-             "above the oil estimate (docs/model.md, section Calibration).", "",
-             "| n_i (rpm) | F_a (N) | slip (%) | twin torque (N mm) | twin power (W) | SKF torque (N mm) | twin / SKF |", "|---|---|---|---|---|---|---|"]
+    lines = [
+        "## Friction torque: the twin beside the SKF model",
+        "",
+        f"Twin: power dissipated in the bearing over the inner-ring speed (lubricant `{lub.name}`). SKF: catalogue model "
+        f"M = phi_ish phi_rs M_rr + M_sl for a single-row angular contact ball bearing, oil of {nu * 1e6:.1f} mm^2/s (the base oil at "
+        f"{params.lubricant_temperature:.0f} degC), no drag term. With grease in its running-in state the twin's torque is expected "
+        "above the oil estimate (docs/model.md, section Calibration).",
+        "",
+        "| n_i (rpm) | F_a (N) | slip (%) | twin torque (N mm) | twin power (W) | SKF torque (N mm) | twin / SKF |",
+        "|---|---|---|---|---|---|---|",
+    ]
     states: list[SteadyState] = list(raw.validation)
     picks = {min(SWEEP_LOADS_N), 400.0, max(SWEEP_LOADS_N)}
     states += [s for v in raw.sweep.values() for s in v if s.axial_load in picks]
@@ -405,5 +478,7 @@ def friction_section(raw: RawResults, params: BearingParameters) -> list[str]:
             continue
         rpm = rad_s_to_rpm(s.inner_ring_speed)
         m_skf = skf_frictional_moment(rpm, s.axial_load, BORE_M, OUTSIDE_DIAMETER_M, nu).total
-        lines.append(f"| {rpm:.0f} | {s.axial_load:.0f} | {s.slip_pct:.2f} | {s.friction_torque * 1e3:.2f} | {s.power_loss:.2f} | {m_skf * 1e3:.2f} | {s.friction_torque / m_skf:.2f} |")
+        lines.append(
+            f"| {rpm:.0f} | {s.axial_load:.0f} | {s.slip_pct:.2f} | {s.friction_torque * 1e3:.2f} | {s.power_loss:.2f} | {m_skf * 1e3:.2f} | {s.friction_torque / m_skf:.2f} |"
+        )
     return lines + [""]

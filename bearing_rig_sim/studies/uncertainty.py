@@ -36,6 +36,7 @@ import numpy as np
 from bearing_rig_sim.config import load_yaml
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 LOAD_SIGMA_N = 2.0
 """Standard uncertainty of the bench's axial load, N (one offset common to all rows).
@@ -175,13 +176,15 @@ def check_identifiable(names: Sequence[str], noise_correlation: np.ndarray, cond
                     "(fit one of them, or add rows that separate them: other loads or speeds)"
                 )
     if condition > MAX_CONDITION:
-        raise IdentifiabilityError(f"{', '.join(names)}: the scaled Jacobian's condition number {condition:.3g} exceeds {MAX_CONDITION:g}; not identifiable from these rows")
+        raise IdentifiabilityError(
+            f"{', '.join(names)}: the scaled Jacobian's condition number {condition:.3g} exceeds {MAX_CONDITION:g}; not identifiable from these rows"
+        )
 
 
-def _slips(params: BearingParameters, points: Sequence[tuple[float, float]]) -> np.ndarray:
+def _slips(params: BearingParameters, points: Sequence[tuple[float, float]], thermal: ThermalConfig | None = None) -> np.ndarray:
     from bearing_rig_sim.studies.calibration import steady_states
 
-    return np.array([s.slip_pct for s in steady_states(params, points)])  # on the Dask cluster when one is set
+    return np.array([s.slip_pct for s in steady_states(params, points, thermal=thermal)])  # on the Dask cluster when one is set
 
 
 def _shifted(params: BearingParameters, names: Sequence[str], values: Sequence[float], k: int) -> BearingParameters:
@@ -191,15 +194,22 @@ def _shifted(params: BearingParameters, names: Sequence[str], values: Sequence[f
 
 
 def fit_uncertainty(
-    params: BearingParameters, points: Sequence[tuple[float, float, float]], names: Sequence[str], values: Sequence[float], *, load_sigma_n: float = LOAD_SIGMA_N
+    params: BearingParameters,
+    points: Sequence[tuple[float, float, float]],
+    names: Sequence[str],
+    values: Sequence[float],
+    *,
+    load_sigma_n: float = LOAD_SIGMA_N,
+    thermal: ThermalConfig | None = None,
 ) -> FitUncertainty:
     """The uncertainty of a fit: ``params`` carry the best-fit ``values`` of ``names``; ``points``
     are the bench rows (inner-ring speed rad/s, nominal load N, slip %). Costs (p + 2) n steady
-    states."""
+    states (with ``thermal``, coupled thermal steady states: the Jacobians then include the
+    temperature each change of a parameter or the load brings)."""
     rows = [(w, f) for w, f, _ in points]
-    base = _slips(params, rows)
-    j_theta = np.column_stack([(_slips(_shifted(params, names, values, k), rows) - base) / LOG_STEP for k in range(len(names))])
-    j_load = (_slips(params, [(w, f + LOAD_STEP_N) for w, f in rows]) - base) / LOAD_STEP_N
+    base = _slips(params, rows, thermal)
+    j_theta = np.column_stack([(_slips(_shifted(params, names, values, k), rows, thermal) - base) / LOG_STEP for k in range(len(names))])
+    j_load = (_slips(params, [(w, f + LOAD_STEP_N) for w, f in rows], thermal) - base) / LOAD_STEP_N
     residuals = base - np.array([s for _, _, s in points])
     lin = linear_uncertainty(j_theta, j_load, residuals, load_sigma_n)
     tup = lambda m: tuple(tuple(float(c) for c in row) for row in m)
@@ -227,16 +237,20 @@ def read_uncertainty(calibration_file: str | Path) -> FitUncertainty | None:
     return FitUncertainty.from_dict(doc.data["uncertainty"])
 
 
-def slip_interval(params: BearingParameters, unc: FitUncertainty, inner_ring_speed: float, axial_load: float, slip_pct: float) -> tuple[float, float, float]:
+def slip_interval(
+    params: BearingParameters, unc: FitUncertainty, inner_ring_speed: float, axial_load: float, slip_pct: float, thermal: ThermalConfig | None = None
+) -> tuple[float, float, float]:
     """95 % interval of the predicted slip at one point from the parameter and load uncertainty:
     (low, high, standard deviation), %. ``params`` carry the calibration's values (or those
-    values moved to another lubricant temperature); ``slip_pct`` is their slip there."""
+    values moved to another lubricant temperature); ``slip_pct`` is their slip there. With
+    ``thermal`` the gradients are those of the coupled thermal steady state (``params`` then
+    carry the calibration's values at its reference temperature)."""
     from bearing_rig_sim.studies.calibration import current_value
 
     rows = [(inner_ring_speed, axial_load)]
     here = [current_value(params, n) for n in unc.names]  # the calibration's, or moved to a temperature
-    g_theta = np.array([(_slips(_shifted(params, unc.names, here, k), rows)[0] - slip_pct) / LOG_STEP for k in range(len(unc.names))])
-    g_load = (_slips(params, [(inner_ring_speed, axial_load + LOAD_STEP_N)])[0] - slip_pct) / LOAD_STEP_N
+    g_theta = np.array([(_slips(_shifted(params, unc.names, here, k), rows, thermal)[0] - slip_pct) / LOG_STEP for k in range(len(unc.names))])
+    g_load = (_slips(params, [(inner_ring_speed, axial_load + LOAD_STEP_N)], thermal)[0] - slip_pct) / LOAD_STEP_N
     cov = np.array(unc.noise_covariance)
     through_fit = float(g_theta @ np.array(unc.load_sensitivity)) + g_load
     var = float(g_theta @ cov @ g_theta) + (through_fit * unc.load_sigma_n) ** 2

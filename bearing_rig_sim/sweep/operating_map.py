@@ -111,7 +111,10 @@ def plot_operating_map(table: Any, path: str | Path, threshold_pct: float, facto
     left.set_title("slip against load")
     _slip_field(fig, right, branch, rpm, load, slip)
     found = boundaries(table, threshold_pct)
-    for b, marker, label in ((KIND_ROLLING_START, "o-", "skid boundary, rolling start"), (KIND_CONTINUATION, "s--", "skid boundary, continued from lower loads")):
+    for b, marker, label in (
+        (KIND_ROLLING_START, "o-", "skid boundary, rolling start"),
+        (KIND_CONTINUATION, "s--", "skid boundary, continued from lower loads"),
+    ):
         if b in found:
             xs = [v if v is not None else math.nan for v in found[b].values()]
             right.plot(xs, list(found[b]), marker, label=label)

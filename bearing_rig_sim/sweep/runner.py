@@ -119,7 +119,15 @@ def plan_tasks(spec: SweepSpec, params: BearingParameters, done: set[str], metho
     for i in range(0, len(missing), batch):
         chunk = missing[i : i + batch]
         tasks.append(
-            SweepTask(f"steady-{i // batch}", KIND_ROLLING_START, params, tuple(p for p, _ in chunk), tuple(k for _, k in chunk), frozenset(k for _, k in chunk), method)
+            SweepTask(
+                f"steady-{i // batch}",
+                KIND_ROLLING_START,
+                params,
+                tuple(p for p, _ in chunk),
+                tuple(k for _, k in chunk),
+                frozenset(k for _, k in chunk),
+                method,
+            )
         )
     if spec.continuation and method == SOLVE:
         rows: dict[str, list[dict[str, float]]] = defaultdict(list)
@@ -219,4 +227,3 @@ def run_sweep(
     from pyarrow.parquet import read_metadata
 
     return SweepOutcome(path, read_metadata(path).num_rows, computed, errors, time.perf_counter() - start, n_workers)
-

@@ -189,7 +189,14 @@ def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
 
     messages: list[tuple[float, str, Any]] = []
     for shaft, p in bench_pulses(scenario):
-        message = types[pulse_type](header=header(0.0 if scenario.unstamped else p.time), sensor_id=shaft, strip_id=p.strip_id, strip_count=p.strip_count, revolution=p.revolution, pulse_index=p.pulse_index)
+        message = types[pulse_type](
+            header=header(0.0 if scenario.unstamped else p.time),
+            sensor_id=shaft,
+            strip_id=p.strip_id,
+            strip_count=p.strip_count,
+            revolution=p.revolution,
+            pulse_index=p.pulse_index,
+        )
         messages.append((p.time, PULSE_TOPICS[shaft].name, message))
     vector = types["geometry_msgs/msg/Vector3"]
     for when, force in load_samples(scenario):

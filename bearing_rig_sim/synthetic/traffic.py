@@ -129,9 +129,7 @@ def _joint_state_template(store: Typestore) -> tuple[bytearray, list[int]]:
     sentinels = [1111111111, 2222222222, 1.25e301, 2.5e301, 3.75e301, 5.0e301]
     types = store.types
     message = types["sensor_msgs/msg/JointState"](
-        header=types["std_msgs/msg/Header"](
-            stamp=types["builtin_interfaces/msg/Time"](sec=sentinels[0], nanosec=sentinels[1]), frame_id=""
-        ),
+        header=types["std_msgs/msg/Header"](stamp=types["builtin_interfaces/msg/Time"](sec=sentinels[0], nanosec=sentinels[1]), frame_id=""),
         name=["inner_ring", "cage"],
         position=np.array(sentinels[2:4]),
         velocity=np.array(sentinels[4:6]),

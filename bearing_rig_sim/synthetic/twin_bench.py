@@ -5,8 +5,10 @@ for shadow-mode round trips (no ROS).
 fibre-optic sensors with their timing jitter) through :class:`Hold` segments, each reached by the
 paper's STEP ramp, and returns what the bench's topics would carry: both pulse streams and the
 load cell's force at 1 kHz with its noise (``config/rig.yaml``: 1 N standard deviation). Stamps
-may be put on a bench system clock (``clock_offset_s``). :func:`write_bench_bag` writes them as a
-bag with the three topics shadow mode needs.
+may be put on a bench system clock (``clock_offset_s``). With the bearing's thermal network
+(``thermal=True``, the default, coupled both ways as in the rig session) it also records the
+outer-ring thermocouple (10 Hz) and the housing torque meter (100 Hz) as the simulator node
+emits them. :func:`write_bench_bag` writes them as a bag with the topics shadow mode reads.
 
 Units: s, rpm and N at this edge (the programme), SI in the events.
 """
@@ -14,16 +16,17 @@ Units: s, rpm and N at this edge (the programme), SI in the events.
 from __future__ import annotations
 
 import random
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, SPINDLE_PULSES
+from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import RigTwin
+from bearing_rig_sim.thermal import sensors as bench_sensors
 
 
 @dataclass(frozen=True)
@@ -45,18 +48,24 @@ class BenchRun:
         spindle, cage: the pulses of each sensor.
         forces: load-cell samples (time, force N).
         truth_slip: the engine's true slip at the end of each hold, percent (for reference only).
+        temperatures: outer-ring thermocouple readings (time, degC); empty without the network.
+        torques: housing torque-meter samples (time, N m); empty without the network.
     """
 
     spindle: list[Pulse]
     cage: list[Pulse]
     forces: list[tuple[float, float]]
     truth_slip: list[float]
+    temperatures: list[tuple[float, float]] = field(default_factory=list)
+    torques: list[tuple[float, float]] = field(default_factory=list)
 
     def events(self) -> list[tuple[float, str, object]]:
         """Every message merged in time order: (time, ``"spindle"``/``"cage"``/``"force"``, payload)."""
         out: list[tuple[float, str, object]] = [(p.time, "spindle", p) for p in self.spindle]
         out += [(p.time, "cage", p) for p in self.cage]
         out += [(t, "force", f) for t, f in self.forces]
+        out += [(t, "temperature", v) for t, v in self.temperatures]
+        out += [(t, "torque", v) for t, v in self.torques]
         out.sort(key=lambda e: e[0])
         return out
 
@@ -69,6 +78,8 @@ def twin_bench_run(
     load_noise_std_n: float = 1.0,
     clock_offset_s: float = 0.0,
     seed: int = 7,
+    thermal: bool = True,
+    initial_rise_k: float = 0.0,
 ) -> BenchRun:
     """Run the twin through ``holds`` (from rest at 0 s) and record its bench topics.
 
@@ -79,6 +90,9 @@ def twin_bench_run(
         load_noise_std_n: load-cell noise, N (standard deviation of each 1 kHz sample).
         clock_offset_s: added to every stamp (a bench system clock), s.
         seed: of the load-cell noise.
+        thermal: couple the bearing's thermal network both ways and record the thermocouple and
+            the torque meter (the bearing file's ``thermal:`` section).
+        initial_rise_k: the network's start above the bearing file's ambient, K.
     """
     from bearing_rig_sim.config import config_path
 
@@ -86,6 +100,12 @@ def twin_bench_run(
     twin = RigTwin.from_files(bearing_file, cal, None, initial_axial_load=holds[0].axial_load_n if holds else 100.0)
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
+    coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k) if thermal else None
+    thermocouple, torque_meter = bench_sensors.Thermocouple(), bench_sensors.TorqueMeter()
+    chunk = twin.chunk
+    temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))
+    torque_every = max(1, round(1.0 / (bench_sensors.TORQUE_METER_RATE_HZ * chunk)))
+    chunks = 0
 
     def shifted(p: Pulse) -> Pulse:
         return Pulse(p.time + clock_offset_s, p.strip_id, p.strip_count, p.revolution, p.pulse_index, p.sensor_id)
@@ -99,6 +119,12 @@ def twin_bench_run(
             run.spindle.extend(shifted(p) for p in out.spindle_pulses)
             run.cage.extend(shifted(p) for p in out.cage_pulses)
             run.forces.append((out.time + clock_offset_s, hold.axial_load_n + rng.gauss(0.0, load_noise_std_n)))
+            chunks += 1
+            if coupling is not None:
+                if chunks % temperature_every == 0:
+                    run.temperatures.append((out.time + clock_offset_s, thermocouple.update(coupling.temperature("outer_ring"), temperature_every * chunk)))
+                if chunks % torque_every == 0:
+                    run.torques.append((out.time + clock_offset_s, torque_meter.update(twin.engine.friction_torque(), torque_every * chunk)))
         truth = twin.truth()
         run.truth_slip.append(truth.slip_rate)
     return run
@@ -117,10 +143,25 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
         return types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
 
     with BagWriter(path, typestore=store) as writer:
-        for topic in (SPINDLE_PULSES, CAGE_PULSES, AXIAL_LOAD_FORCE):
+        topics = [SPINDLE_PULSES, CAGE_PULSES, AXIAL_LOAD_FORCE]
+        topics += [OUTER_RING_TEMPERATURE] if run.temperatures else []
+        topics += [HOUSING_TORQUE] if run.torques else []
+        for topic in topics:
             writer.add_topic(topic.name, topic.msgtype, topic.qos)
         for t, kind, payload in run.events():
             header = types["std_msgs/msg/Header"](stamp=stamp(t), frame_id="bench")
+            if kind == "temperature":
+                msg = types["sensor_msgs/msg/Temperature"](header=header, temperature=float(payload), variance=bench_sensors.THERMOCOUPLE_NOISE_K**2)  # type: ignore[arg-type]  # rosbags' message constructors are loosely typed
+                writer.write_message(OUTER_RING_TEMPERATURE.name, int(round(t * 1e9)), msg)
+                continue
+            if kind == "torque":
+                vec = types["geometry_msgs/msg/Vector3"]
+                msg = types["geometry_msgs/msg/WrenchStamped"](
+                    header=header,
+                    wrench=types["geometry_msgs/msg/Wrench"](force=vec(x=0.0, y=0.0, z=0.0), torque=vec(x=0.0, y=0.0, z=float(payload))),  # type: ignore[arg-type]  # rosbags' message constructors are loosely typed
+                )
+                writer.write_message(HOUSING_TORQUE.name, int(round(t * 1e9)), msg)
+                continue
             if kind == "force":
                 vec = types["geometry_msgs/msg/Vector3"]
                 msg = types["geometry_msgs/msg/WrenchStamped"](

@@ -218,7 +218,13 @@ def cavity_fluid(params: BearingParameters, temperature_c: float) -> Fluid:
 
 
 def build_network(
-    params: BearingParameters, cfg: ThermalConfig, inner_ring_speed: float, axial_load: float, *, lubricant_temperature: float | None = None, initial: float | None = None
+    params: BearingParameters,
+    cfg: ThermalConfig,
+    inner_ring_speed: float,
+    axial_load: float,
+    *,
+    lubricant_temperature: float | None = None,
+    initial: float | None = None,
 ) -> ThermalNetwork:
     """The bearing's network at an operating point (inner-ring speed rad/s, axial load N): the
     convection and contact conductances depend on both; rebuild it when they change.
@@ -246,7 +252,11 @@ def build_network(
     free = math.pi / 4.0 * (d_os**2 - d_is**2) * b - m_balls / params.ball_density - geo.cage_mass / params.cage_density
     rho_c = cavity_fluid(params, t_lub)
     if lub is not None and lub.kind == "grease":
-        lub_mass, lub_cp, lub_src = cfg.grease_fill * free * lub.density(t_lub), lub.specific_heat, f"grease fill {cfg.grease_fill:g} of the free volume {free * 1e6:.2f} cm^3"
+        lub_mass, lub_cp, lub_src = (
+            cfg.grease_fill * free * lub.density(t_lub),
+            lub.specific_heat,
+            f"grease fill {cfg.grease_fill:g} of the free volume {free * 1e6:.2f} cm^3",
+        )
     elif lub is not None and lub.kind == "oil_bath":
         lub_mass, lub_cp, lub_src = lub.fill_fraction * free * lub.density(t_lub), lub.specific_heat, "oil in the cavity (fill fraction of the free volume)"
     else:
@@ -267,7 +277,15 @@ def build_network(
     g_seat_in = 1.0 / (1.0 / (cfg.fit_conductance * math.pi * d * b) + math.log(r_in_mean / (0.5 * d)) / (2.0 * math.pi * k * b))
     g_seat_out = 1.0 / (1.0 / (cfg.fit_conductance * math.pi * big_d * b) + math.log(0.5 * big_d / r_out_mean) / (2.0 * math.pi * k * b))
     inner, outer = raceway_contacts(
-        dw, dm, a0, params.inner_curvature_ratio, params.outer_curvature_ratio, params.ball_modulus, params.ball_poisson, params.ring_modulus, params.ring_poisson
+        dw,
+        dm,
+        a0,
+        params.inner_curvature_ratio,
+        params.outer_curvature_ratio,
+        params.ball_modulus,
+        params.ball_poisson,
+        params.ring_modulus,
+        params.ring_poisson,
     )
     q = max(axial_load, 1.0) / (z * math.sin(a0))
     g_contacts = []
@@ -281,7 +299,9 @@ def build_network(
     g_inner_lub = wet * _plate_conductance(rho_c, (omega - omega_cage) * 0.5 * d_is, math.pi * d_is / z, math.pi * d_is * b)
     g_outer_lub = wet * _plate_conductance(rho_c, omega_cage * 0.5 * d_os, math.pi * d_os / z, math.pi * d_os * b)
     g_cage_lub = wet * _plate_conductance(
-        rho_c, omega_cage * 0.25 * (params.cage_inner_diameter + params.cage_outer_diameter), math.pi * params.cage_outer_diameter / z,
+        rho_c,
+        omega_cage * 0.25 * (params.cage_inner_diameter + params.cage_outer_diameter),
+        math.pi * params.cage_outer_diameter / z,
         math.pi * (params.cage_inner_diameter + params.cage_outer_diameter) * params.cage_width,
     )
     k_land = lub.thermal_conductivity if lub is not None and lub.kind != "oil_air" else 0.13

@@ -7,10 +7,16 @@
   rheology traction table.
 * :class:`ThermalCoupling`: a running engine heats the network chunk by chunk; every
   ``interval`` seconds the network takes the engine's dissipation (term by term) and, when the
-  lubricant has moved by ``retune_k``, the engine's temperature-dependent resistances (drag,
-  land, EHL rolling force) are set to the new temperature. The traction table keeps the
-  bearing file's temperature while running (rebuilding it takes about a second; the steady
-  solutions below rebuild it).
+  lubricant has moved by ``retune_k`` (default: every step), the engine's lubricant follows the
+  lubricant node: its temperature-dependent resistances (grease drag and land through the
+  grease's yield stress and consistency, the EHL rolling force through the base oil's viscosity)
+  are set to the new temperature, and so is its rheology traction table, blended linearly
+  between tables at the two neighbouring temperatures of a grid :data:`TABLE_STEP_K` apart
+  (:class:`TractionTableGrid`). A table costs about half a second to build, too long for a real
+  time chunk: the grid's tables are built a slice (one contact, load and entrainment speed, a
+  millisecond or two) every :data:`TABLE_SLICE_S` of simulated time, ahead of the lubricant's
+  temperature, so the session keeps real time and runs the same on any machine. Until the
+  table on the far side of the lubricant's temperature is built the nearest built one is used.
 * :func:`thermal_steady_state`: the steady operating point where the heat the engine dissipates
   at the lubricant's temperature is what the network carries away at that temperature
   (secant iteration on the lubricant temperature).
@@ -22,19 +28,43 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
-from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
+from bearing_rig_sim.dynamics.hertz import raceway_contacts
+from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
+from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, traction_table
 from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
+from bearing_rig_sim.dynamics.traction import (
+    HEADER,
+    LOAD_RANGE,
+    N_LOAD,
+    N_SPEED,
+    N_SRR,
+    SPEED_RANGE,
+    SRR_MAX,
+    SRR_REF,
+    ContactKinematics,
+    ellipse_traction,
+    spin_and_heathcote,
+)
 from bearing_rig_sim.thermal.bearing import HeatSources, ThermalConfig, build_network, heat_sources, node_heat
 from bearing_rig_sim.thermal.network import ThermalNetwork
 
 TEMPERATURE_DEPENDENT = (
-    kn.P_DRAG_LIN, kn.P_DRAG_QUAD, kn.P_LAND_VISC, kn.P_LAND_COULOMB, kn.P_DRAG_YIELD, kn.P_DRAG_POW, kn.P_LAND_POW, kn.P_FR_IN, kn.P_FR_OUT,
+    kn.P_DRAG_LIN,
+    kn.P_DRAG_QUAD,
+    kn.P_LAND_VISC,
+    kn.P_LAND_COULOMB,
+    kn.P_DRAG_YIELD,
+    kn.P_DRAG_POW,
+    kn.P_LAND_POW,
+    kn.P_FR_IN,
+    kn.P_FR_OUT,
 )
 """Entries of the kernel parameter vector that depend on the lubricant temperature (the traction
 table aside)."""
@@ -61,6 +91,201 @@ def resistance_vector(params: BearingParameters, temperature_c: float) -> np.nda
     return vector[: kn.P_SIZE]
 
 
+TABLE_STEP_K = 5.0
+"""Spacing of the temperature grid of the coupled engine's traction tables, K (grid points at
+whole multiples). The table's values move smoothly with the base oil's viscosity: between two
+grid points the engine's table is their linear blend."""
+TABLE_SLICE_S = 0.01
+"""Simulated time between two slices of a table under construction, s: a slice
+(:data:`SRR_PER_SLICE` ellipse integrations) costs about a millisecond, so a table
+(2 x 12 x 12 x 4 slices) takes about 11.5 s of simulated time and its building adds about a
+tenth to a 1 ms chunk's cost while it lasts."""
+
+
+SRR_PER_SLICE = 25
+"""SRR nodes per slice of a table under construction (a quarter of a speed's row)."""
+
+
+class _Slice(NamedTuple):
+    contact: int
+    load_index: int
+    speed_index: int
+    srr_start: int
+
+
+class TableBuild:
+    """One traction table at ``temperature_c`` (degC), built a slice at a time: the same table
+    as :func:`bearing_rig_sim.dynamics.parameters.traction_table` of the bearing with its
+    lubricant at that temperature (:func:`params_at_temperature`), node for node."""
+
+    def __init__(self, params: BearingParameters, temperature_c: float) -> None:
+        warm = params_at_temperature(params, temperature_c)
+        lub = warm.lubricant
+        if lub is None:
+            raise ValueError(f"{params.source}: no lubricant file, no traction table")
+        self.temperature = float(temperature_c)
+        dw, dm, a0 = warm.ball_diameter, warm.pitch_diameter, warm.contact_angle
+        inner, outer = raceway_contacts(
+            dw, dm, a0, warm.inner_curvature_ratio, warm.outer_curvature_ratio, warm.ball_modulus, warm.ball_poisson, warm.ring_modulus, warm.ring_poisson
+        )
+        gamma = dw * math.cos(a0) / dm
+        self._contacts = (
+            ContactKinematics(inner, 0.5 * dw * (1.0 - gamma), warm.inner_curvature_ratio * dw, True),
+            ContactKinematics(outer, 0.5 * dw * (1.0 + gamma), warm.outer_curvature_ratio * dw, False),
+        )
+        self._lub = lub
+        self._geometry = (
+            warm.ball_count,
+            a0,
+            warm.inner_curvature_ratio + warm.outer_curvature_ratio - 1.0,
+            dw,
+            dm,
+            (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5,
+        )
+        self._xi_max = math.asinh(SRR_MAX / SRR_REF)
+        self._srrs = SRR_REF * np.sinh(np.linspace(-self._xi_max, self._xi_max, N_SRR))
+        self._lu = np.linspace(math.log(SPEED_RANGE[0]), math.log(SPEED_RANGE[1]), N_SPEED)
+        self._lq = np.linspace(math.log(LOAD_RANGE[0]), math.log(LOAD_RANGE[1]), N_LOAD)
+        self._eta0 = lub.dynamic_viscosity(self.temperature)
+        self._z = lub.roelands_index(self.temperature)
+        self._mu = np.zeros((2, N_LOAD, N_SPEED, N_SRR))
+        self._pw = np.zeros_like(self._mu)
+        self._todo = [_Slice(c, iq, iu, k) for c in range(2) for iq in range(N_LOAD) for iu in range(N_SPEED) for k in range(0, N_SRR, SRR_PER_SLICE)]
+        self._next = 0
+        self._contact_at_load: dict[tuple[int, int], tuple[float, float, float, float, float, float]] = {}
+        self._film = 0.0
+
+    @property
+    def done(self) -> bool:
+        """Whether every slice is built."""
+        return self._next >= len(self._todo)
+
+    def step(self) -> None:
+        """Build the next slice (one contact, load and entrainment speed; up to
+        :data:`SRR_PER_SLICE` SRR nodes)."""
+        if self.done:
+            return
+        c, iq, iu, k0 = self._todo[self._next]
+        self._next += 1
+        contact, lub = self._contacts[c], self._lub
+        q = float(np.exp(self._lq)[iq])
+        got = self._contact_at_load.get((c, iq))
+        if got is None:
+            z, a0, b_total, dw, dm, k_n = self._geometry
+            alpha = harris_thrust_angle(q * z * math.sin(a0), z, a0, b_total, dw, k_n)
+            alpha = harris_thrust_angle(q * z * math.sin(alpha), z, a0, b_total, dw, k_n)
+            spin, kh = spin_and_heathcote(contact, alpha, dw, dm)
+            a, b = contact.hertz.semi_axes(q)
+            got = self._contact_at_load[(c, iq)] = (spin, kh, a, b, contact.hertz.max_pressure(q), q)
+        spin, kh, a, b, ph, q = got
+        u = float(np.exp(self._lu)[iu])
+        if k0 == 0:
+            film = film_thickness(lub, self.temperature, contact.hertz.reduced_modulus, contact.rx, contact.hertz.ellipticity, b, ph, u, q)
+            self._film = max(film.central, 1e-9)
+        h = self._film
+        for k in range(k0, min(k0 + SRR_PER_SLICE, N_SRR)):
+            srr = self._srrs[k]
+            self._mu[c, iq, iu, k], self._pw[c, iq, iu, k] = ellipse_traction(
+                ph, a, b, h, self._eta0, self._z, lub.eyring_stress, lub.limiting_shear_coefficient, lub.shear_modulus, u, srr, spin, kh
+            )
+
+    def table(self) -> np.ndarray:
+        """The finished table (layout of :data:`bearing_rig_sim.dynamics.traction.HEADER`)."""
+        if not self.done:
+            raise RuntimeError(f"traction table at {self.temperature:g} degC: {len(self._todo) - self._next} slices still to build")
+        lu, lq = self._lu, self._lq
+        head = np.array([N_SRR, N_SPEED, N_LOAD, self._xi_max, lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
+        return np.concatenate([head, self._mu.ravel(), self._pw.ravel()])
+
+
+class TractionTableGrid:
+    """The bearing's traction tables at whole multiples of ``step_k`` degC, built on demand a
+    slice at a time (:class:`TableBuild`), and their blend at a temperature.
+
+    Args:
+        params: the bearing (its lubricant file's temperature laws; its own temperature is the
+            reference of the grease's rheology).
+        step_k: grid spacing, K (> 0).
+    """
+
+    def __init__(self, params: BearingParameters, step_k: float = TABLE_STEP_K) -> None:
+        if not math.isfinite(step_k) or step_k <= 0.0:
+            raise ValueError(f"step_k must be > 0 K, got {step_k!r}")
+        self.params = params
+        self.step_k = float(step_k)
+        self.tables: dict[int, np.ndarray] = {}
+        """Built tables by grid index (temperature = index x step_k)."""
+        self.queue: list[int] = []
+        """Grid points waiting to be built, first first."""
+        self._build: TableBuild | None = None
+        self._index = 0
+
+    def temperature(self, index: int) -> float:
+        """A grid point's temperature, degC."""
+        return index * self.step_k
+
+    def build_now(self, index: int) -> None:
+        """Build a grid point's table at once (start-up; about half a second)."""
+        if index not in self.tables:
+            self.tables[index] = traction_table(params_at_temperature(self.params, self.temperature(index)))
+
+    def want(self, *indices: int) -> None:
+        """Build these grid points next, in this order (those not built yet); the table under
+        construction is finished first, grid points queued before and not named are dropped."""
+        building = self._index if self._build is not None else None
+        self.queue = [i for i in dict.fromkeys(indices) if i not in self.tables and i != building]
+
+    def work(self) -> bool:
+        """Build one slice of the table under construction (starting the next queued one);
+        returns True when a table was finished."""
+        if self._build is None:
+            if not self.queue:
+                return False
+            self._index = self.queue.pop(0)
+            self._build = TableBuild(self.params, self.temperature(self._index))
+        self._build.step()
+        if self._build.done:
+            self.tables[self._index] = self._build.table()
+            self._build = None
+            return True
+        return False
+
+    @property
+    def busy(self) -> bool:
+        """Whether a table is being built or waits to be."""
+        return self._build is not None or bool(self.queue)
+
+    def bracket(self, temperature_c: float) -> tuple[int, int, float]:
+        """The grid points below and above ``temperature_c`` and its weight on the upper one."""
+        x = temperature_c / self.step_k
+        lo = math.floor(x)
+        return lo, lo + 1, x - lo
+
+    def blend(self, temperature_c: float) -> tuple[np.ndarray, float] | None:
+        """The table at ``temperature_c``: the linear blend of the two neighbouring grid tables
+        when both are built, else the nearer built one of them (None when neither is); with the
+        temperature it stands for, degC."""
+        lo, hi, w = self.bracket(temperature_c)
+        a, b = self.tables.get(lo), self.tables.get(hi)
+        if a is not None and b is not None:
+            out = a.copy()
+            out[HEADER:] += w * (b[HEADER:] - a[HEADER:])
+            return out, float(temperature_c)
+        if a is not None:
+            return a, self.temperature(lo)
+        if b is not None:
+            return b, self.temperature(hi)
+        return None
+
+
+def steepest_traction_slope(table: np.ndarray) -> float:
+    """The table's steepest d mu/d SRR (the kernel's ``P_MU_SLOPE_MAX``, as
+    :func:`bearing_rig_sim.dynamics.parameters.derive` sets it)."""
+    n_srr, n_u, n_q, xi_max = int(table[0]), int(table[1]), int(table[2]), table[3]
+    mu = table[HEADER : HEADER + 2 * n_srr * n_u * n_q].reshape(-1, n_srr)
+    return float(np.max(np.abs(np.diff(mu, axis=1)))) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
+
+
 class ThermalCoupling:
     """A running engine and the bearing's network, coupled at chunk level.
 
@@ -69,15 +294,31 @@ class ThermalCoupling:
         config: the bearing file's thermal data.
         interval: how often (s of simulated time) the network takes the engine's heat (> 0);
             the network's shortest time constant is seconds, so 0.1 s resolves it.
-        retune_k: lubricant temperature change (K) after which the engine's resistances are
-            set to the new temperature.
+        retune_k: lubricant temperature change (K) after which the engine's lubricant is set to
+            the new temperature (0: at every network step).
         initial: start temperature of every node, degC (default: ambient).
-        feedback: set the engine's resistances to the lubricant's temperature (both ways); False
-            leaves the engine as its parameters say and only tracks the temperatures (one way).
+        feedback: set the engine's lubricant to the lubricant node's temperature (both ways);
+            False leaves the engine as its parameters say and only tracks the temperatures (one
+            way).
+        tables: with ``feedback``, let the rheology traction table follow the temperature too
+            (:class:`TractionTableGrid`; the tables bracketing the start temperature are built
+            here, about a second); False keeps the bearing file's table (the resistances still
+            follow).
+        grid: a traction grid of this bearing built beforehand (its tables around the start
+            temperature are built here when missing); default a new one.
     """
 
     def __init__(
-        self, engine: BearingDynamics, config: ThermalConfig, *, interval: float = 0.1, retune_k: float = 0.5, initial: float | None = None, feedback: bool = True
+        self,
+        engine: BearingDynamics,
+        config: ThermalConfig,
+        *,
+        interval: float = 0.1,
+        retune_k: float = 0.0,
+        initial: float | None = None,
+        feedback: bool = True,
+        tables: bool = True,
+        grid: TractionTableGrid | None = None,
     ) -> None:
         if not math.isfinite(interval) or interval <= 0.0:
             raise ValueError(f"interval must be > 0 s, got {interval!r}")
@@ -94,6 +335,17 @@ class ThermalCoupling:
         """The lubricant temperature the engine's resistances are set to, degC."""
         self.sources = HeatSources(0.0, 0.0, 0.0, 0.0, 0.0)
         """The latest heat split, W."""
+        self.table_temperature = self.params.lubricant_temperature
+        """The temperature the engine's traction table stands for, degC."""
+        self.grid: TractionTableGrid | None = None
+        """The traction tables on their temperature grid (None: the table stays the file's)."""
+        self._slice_pending = 0.0
+        self._previous_temperature = -math.inf
+        if self.feedback and tables and self.params.lubricant is not None and self.params.friction_model == "rheology":
+            self.grid = grid if grid is not None else TractionTableGrid(self.params)
+            lo, hi, _ = self.grid.bracket(self.network.temperature("lubricant"))
+            self.grid.build_now(lo)
+            self.grid.build_now(hi)
         if self.feedback:
             self._retune(self.network.temperature("lubricant"))
 
@@ -105,6 +357,11 @@ class ThermalCoupling:
         """Account ``h`` seconds of the engine's running (call after each chunk); returns True
         when the network stepped."""
         self._pending += h
+        if self.grid is not None and self.grid.busy:
+            self._slice_pending += h
+            if self._slice_pending >= TABLE_SLICE_S - 1e-12:
+                self._slice_pending = 0.0
+                self.grid.work()
         if self._pending < self.interval - 1e-12:
             return False
         engine = self.engine
@@ -125,11 +382,46 @@ class ThermalCoupling:
             self._retune(t_lub)
         return True
 
+    def retune(self) -> None:
+        """Set the engine's lubricant to the lubricant node's temperature now (after the engine
+        was re-initialised; with ``feedback`` only)."""
+        if self.feedback:
+            self._retune(self.network.temperature("lubricant"))
+
+    def rebind(self, engine: BearingDynamics) -> None:
+        """Go on with another engine (other parameters of the same bearing: an online
+        re-calibration); its lubricant is set to the network's temperature. The traction grid
+        is rebuilt for the new parameters when they change the film's rheology."""
+        self.engine = engine
+        if engine.params != self.params:
+            self.params = engine.params
+            if self.grid is not None:
+                self.grid = TractionTableGrid(self.params)
+                lo, hi, _ = self.grid.bracket(self.network.temperature("lubricant"))
+                self.grid.build_now(lo)
+                self.grid.build_now(hi)
+        self.retune()
+
     def _retune(self, temperature_c: float) -> None:
         v = resistance_vector(self.params, temperature_c)
+        vector = self.engine.vector
         for i in TEMPERATURE_DEPENDENT:
-            self.engine.vector[i] = v[i]
+            vector[i] = v[i]
         self.applied_temperature = float(temperature_c)
+        grid = self.grid
+        if grid is None:
+            return
+        lo, hi, w = grid.bracket(temperature_c)
+        # the two neighbours (the nearer first), then the next one the way the lubricant goes
+        ahead = (hi + 1,) if temperature_c >= self._previous_temperature else (lo - 1,)
+        grid.want(*((hi, lo) if w >= 0.5 else (lo, hi)), *ahead)
+        self._previous_temperature = float(temperature_c)
+        got = grid.blend(temperature_c)
+        if got is not None:
+            table, self.table_temperature = got
+            base = int(vector[kn.P_TABLE])
+            vector[base : base + table.size] = table
+            vector[kn.P_MU_SLOPE_MAX] = steepest_traction_slope(table)
 
 
 @dataclass(frozen=True)
@@ -190,12 +482,16 @@ class _HeatAtTemperature:
         return got
 
 
-def _steady_temperatures(params: BearingParameters, config: ThermalConfig, speed: float, load: float, t_lub: float, sources: HeatSources) -> tuple[np.ndarray, ThermalNetwork]:
+def _steady_temperatures(
+    params: BearingParameters, config: ThermalConfig, speed: float, load: float, t_lub: float, sources: HeatSources
+) -> tuple[np.ndarray, ThermalNetwork]:
     net = build_network(params, config, speed, load, lubricant_temperature=t_lub)
     return net.steady(node_heat(sources)), net
 
 
-def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, *, tolerance_k: float = 0.2, max_iter: int = 10) -> ThermalSteadyState:
+def thermal_steady_state(
+    params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, *, tolerance_k: float = 0.2, max_iter: int = 10
+) -> ThermalSteadyState:
     """The steady state where the dissipation at the lubricant temperature T heats the network to
     T: the root of g(T) = T_lub,ss(heat(T)) - T by secant steps from the bearing file's
     temperature (g falls with T: warmer lubricant, less heat)."""
@@ -230,7 +526,9 @@ def thermal_steady_state(params: BearingParameters, config: ThermalConfig, inner
     return ThermalSteadyState(point, src, dict(zip(net.names, map(float, temps))), it, tuple(map(float, net.time_constants())), float(g1))
 
 
-def warm_up(params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, duration: float, *, step: float = 1.0, grid: int = 4) -> list[dict[str, float]]:
+def warm_up(
+    params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, duration: float, *, step: float = 1.0, grid: int = 4
+) -> list[dict[str, float]]:
     """Temperatures and torque over ``duration`` seconds from ambient, at constant speed (rad/s)
     and axial load (N): the engine's steady heat at ``grid`` lubricant temperatures from
     ambient to the coupled steady one, interpolated in the lubricant's temperature as the

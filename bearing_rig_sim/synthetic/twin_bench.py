@@ -80,6 +80,7 @@ def twin_bench_run(
     seed: int = 7,
     thermal: bool = True,
     initial_rise_k: float = 0.0,
+    lubricant_feedback: bool = False,
 ) -> BenchRun:
     """Run the twin through ``holds`` (from rest at 0 s) and record its bench topics.
 
@@ -90,9 +91,11 @@ def twin_bench_run(
         load_noise_std_n: load-cell noise, N (standard deviation of each 1 kHz sample).
         clock_offset_s: added to every stamp (a bench system clock), s.
         seed: of the load-cell noise.
-        thermal: couple the bearing's thermal network both ways and record the thermocouple and
-            the torque meter (the bearing file's ``thermal:`` section).
+        thermal: couple the bearing's thermal network and record the thermocouple and the torque
+            meter (the bearing file's ``thermal:`` section).
         initial_rise_k: the network's start above the bearing file's ambient, K.
+        lubricant_feedback: the engine's lubricant follows the network's temperature (the
+            simulator's parameter of that name; default as shipped, off).
     """
     from bearing_rig_sim.config import config_path
 
@@ -100,7 +103,7 @@ def twin_bench_run(
     twin = RigTwin.from_files(bearing_file, cal, None, initial_axial_load=holds[0].axial_load_n if holds else 100.0)
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
-    coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k) if thermal else None
+    coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=lubricant_feedback) if thermal else None
     thermocouple, torque_meter = bench_sensors.Thermocouple(), bench_sensors.TorqueMeter()
     chunk = twin.chunk
     temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))

@@ -41,6 +41,7 @@ from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.dynamics.traction import (
     HEADER,
+    mu_nodes,
     LOAD_RANGE,
     N_LOAD,
     N_SPEED,
@@ -195,7 +196,7 @@ class TableBuild:
             raise RuntimeError(f"traction table at {self.temperature:g} degC: {len(self._todo) - self._next} slices still to build")
         lu, lq = self._lu, self._lq
         head = np.array([N_SRR, N_SPEED, N_LOAD, self._xi_max, lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
-        return np.concatenate([head, self._mu.ravel(), self._pw.ravel()])
+        return np.concatenate([head, np.stack([self._mu, self._pw], axis=-1).ravel()])  # as traction.build_table lays it out
 
 
 class TractionTableGrid:
@@ -281,8 +282,8 @@ class TractionTableGrid:
 def steepest_traction_slope(table: np.ndarray) -> float:
     """The table's steepest d mu/d SRR (the kernel's ``P_MU_SLOPE_MAX``, as
     :func:`bearing_rig_sim.dynamics.parameters.derive` sets it)."""
-    n_srr, n_u, n_q, xi_max = int(table[0]), int(table[1]), int(table[2]), table[3]
-    mu = table[HEADER : HEADER + 2 * n_srr * n_u * n_q].reshape(-1, n_srr)
+    n_srr, xi_max = int(table[0]), table[3]
+    mu = mu_nodes(table, 0)
     return float(np.max(np.abs(np.diff(mu, axis=1)))) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
 
 

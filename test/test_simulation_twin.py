@@ -23,7 +23,7 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
-from bearing_rig_sim.simulation.twin import AxialLoadError, RigTwin, TwinError
+from bearing_rig_sim.simulation.twin import AxialLoadError, RadialLoadError, RigTwin, TwinError
 
 RPM = math.pi / 30.0
 BEARING = config_path("bearings", "h7006c.yaml")
@@ -191,6 +191,28 @@ def test_axial_load_is_validated_and_raised_to_the_engine_minimum(params):
     assert twin.set_axial_load(250.0) == 250.0 and not twin.load_clamped
     out = twin.tick()
     assert out.truth is not None and out.truth.axial_load == 250.0
+
+
+def test_radial_load_is_the_magnitude_of_its_components_and_reaches_the_engine(params):
+    """force.x, force.y (3-4-5: 300 N, 400 N) give a 500 N radial load applied every chunk; a
+    non-finite component or a bad axial force leaves both loads as they were; the axisymmetric
+    stiff model refuses any radial load."""
+    twin = make_twin(params, initial_speed=900 * RPM, initial_axial_load=163.0)
+    assert twin.set_loads(163.0, 300.0, -400.0) == (163.0, 500.0)
+    twin.tick()
+    assert twin.engine.radial_load == 500.0
+    with pytest.raises(RadialLoadError, match="force.y must be a finite"):
+        twin.set_loads(200.0, 0.0, math.inf)
+    with pytest.raises(AxialLoadError, match=">= 0"):
+        twin.set_loads(-1.0, 0.0, 0.0)
+    assert (twin.axial_load, twin.radial_load) == (163.0, 500.0)
+    assert twin.set_loads(163.0) == (163.0, 0.0)
+    twin.tick()
+    assert twin.engine.radial_load == 0.0
+    stiff = RigTwin(BearingDynamics(params, model="stiff"), sensors(), BearingKinematics.from_config(BEARING), initial_axial_load=163.0)
+    with pytest.raises(RadialLoadError, match="reduced model"):
+        stiff.set_loads(163.0, 1.0, 0.0)
+    assert stiff.set_loads(170.0, 0.0, 0.0) == (170.0, 0.0)
 
 
 def test_deceleration_to_rest_keeps_whole_chunks_and_the_counters_fall_to_zero(params):

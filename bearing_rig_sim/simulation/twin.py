@@ -54,6 +54,11 @@ class AxialLoadError(RigError):
     """An axial force the twin refuses (non-finite or negative); the load stays as it was."""
 
 
+class RadialLoadError(RigError):
+    """A radial force the twin refuses (non-finite components, or any radial load on the
+    axisymmetric ``stiff`` model); the loads stay as they were."""
+
+
 @dataclass(frozen=True)
 class MeasuredSpeeds:
     """What the bench's pulse counters show at the end of a chunk.
@@ -202,6 +207,7 @@ class RigTwin:
         self.requested_axial_load = 0.0
         """The latest axial force asked for, N (before raising it to the minimum)."""
         self._load = self._checked_load(initial_axial_load)
+        self._radial = 0.0
         engine.initialise(self.drive.speed_at(0.0), self._load, time=0.0)
         self.spindle_sensor: FibreOpticSensor = sensors.sensor("spindle")
         self.cage_sensor: FibreOpticSensor = sensors.sensor("cage")
@@ -300,6 +306,41 @@ class RigTwin:
         self._load = self._checked_load(force_n)
         return self._load
 
+    @property
+    def radial_load(self) -> float:
+        """The radial load the engine applies, N (>= 0; along the engine's +x, see
+        :meth:`set_loads`)."""
+        return self._radial
+
+    def _checked_radial(self, force_x: float, force_y: float) -> float:
+        for name, value in (("x", force_x), ("y", force_y)):
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise RadialLoadError(f"radial force: force.{name} must be a finite number of newtons, got {value!r}")
+        radial = math.hypot(force_x, force_y)
+        if radial > 0.0 and self.engine.model != "reduced":
+            raise RadialLoadError(f"radial force: {radial:g} N needs the reduced model (the {self.engine.model} model is axisymmetric)")
+        return radial
+
+    def set_loads(self, axial_n: float, radial_x_n: float = 0.0, radial_y_n: float = 0.0) -> tuple[float, float]:
+        """Apply an axial force and a radial force (its x and y components in the bearing's
+        frame, N) from the next chunk on; returns the axial and radial loads applied, N.
+
+        The radial load is the components' magnitude, applied as the engine's radial load: the
+        engine puts it along its fixed +x, so the load zone's azimuth is the engine's, whatever
+        the force's direction in the bearing's frame (the bearing is axisymmetric: only the
+        load zone's position relative to the cage sensor's strip would differ). The axial force
+        is handled as by :meth:`set_axial_load`. Both are checked before either is applied.
+
+        Raises:
+            AxialLoadError: a non-finite or negative axial force.
+            RadialLoadError: a non-finite component, or a radial load on the stiff model.
+            Either way both loads stay as they were.
+        """
+        radial = self._checked_radial(radial_x_n, radial_y_n)
+        self.set_axial_load(axial_n)
+        self._radial = radial
+        return self._load, self._radial
+
     def command_spindle(self, command: SpindleCommand) -> None:
         """Give the spindle drive a speed command (see :meth:`SpindleDrive.submit`).
 
@@ -334,13 +375,13 @@ class RigTwin:
         steps = int(round(h / engine.time_step))
         t_end = t0 + steps * engine.time_step
         accel = self.drive.chunk_acceleration(t0, h, engine.inner_ring_speed)
-        engine.advance(h, axial_load=self._load, inner_ring_acceleration=accel)
+        engine.advance(h, axial_load=self._load, inner_ring_acceleration=accel, radial_load=self._radial)
         remaining = t_end - engine.time
         if remaining > 0.5 * engine.time_step:
             # A deceleration that reaches rest inside the chunk: the engine stops integrating
             # there rather than reverse; the rest of the chunk is spent at the profile's speed.
             engine.set_inner_ring_speed(max(self.drive.speed_at(t_end), 0.0))
-            engine.advance(remaining, axial_load=self._load)
+            engine.advance(remaining, axial_load=self._load, radial_load=self._radial)
         self.step_count += steps
         self._acceleration = accel
         if self.thermal is not None:

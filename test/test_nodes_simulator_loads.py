@@ -1,0 +1,118 @@
+"""A bench that loads radially drives the simulator through the topic contract.
+
+``/rig/bearing/axial_force`` carries the axial load in force.z and the radial load's components
+in force.x and force.y; a moment (torque.x, torque.y) is ignored with a WARN. The simulator runs
+in its own process with ``--no-realtime`` on the test's isolated ROS domain; every wait is for a
+message, bounded.
+
+Expected values: under a pure axial load every ball carries the same load and the cage stays on
+the axis (the bearing is axisymmetric); under F_a = 163 N, F_r = 500 N (F_a = 1.216 F_r tan a
+with a = 15 deg: the half-loaded ring) the largest ball load is Stribeck/Sjovall's
+Q_max = 4.37 F_r / (Z cos a) (Harris and Kotzalas vol. 1, ch. 7), 141.4 N for the H7006C's 16
+balls, and the balls' pocket forces push the cage off the axis.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import pytest
+import yaml
+
+pytestmark = pytest.mark.ros
+rclpy = pytest.importorskip("rclpy")
+
+from bearing_rig_msgs.msg import SimulatorTruth  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+
+from bearing_rig_sim.config import config_path  # noqa: E402
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, from_stamp  # noqa: E402
+
+WAIT = 60.0
+"""Longest wait for any one condition, wall s (node start-up takes a few seconds)."""
+
+FORCE_TOPIC = "/rig/bearing/axial_force"
+AXIAL_N = 163.0
+RADIAL_N = 500.0
+
+
+def stribeck_max_ball_load(radial: float) -> float:
+    """Q_max = 4.37 F_r / (Z cos a), N, for the shipped bearing's ball count and contact angle."""
+    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    return 4.37 * radial / (g["ball_count"] * math.cos(math.radians(g["contact_angle_deg"])))
+
+
+class Bench:
+    """A test node: publishes the force on the bearing, records truth and diagnostics."""
+
+    def __init__(self, ros_graph: Any) -> None:
+        self.graph = ros_graph
+        self.node = ros_graph.node("radial_bench")
+        self.executor = ros_graph.executor([self.node])
+        self.truth: list[SimulatorTruth] = []
+        self.diagnostics: list[DiagnosticStatus] = []
+        self.node.create_subscription(SimulatorTruth, "/rig/truth", self.truth.append, SENSOR_QOS)
+        self.node.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, RELIABLE_QOS)
+        self.force = self.node.create_publisher(WrenchStamped, FORCE_TOPIC, RELIABLE_QOS)
+
+    def _on_diagnostics(self, msg: DiagnosticArray) -> None:
+        self.diagnostics += [s for s in msg.status if s.name.startswith("simulator")]
+
+    def wait(self, condition: Any, what: str) -> None:
+        assert self.graph.spin_until(condition, WAIT, executor=self.executor), f"timed out waiting for {what}"
+
+    def time(self) -> float:
+        return from_stamp(self.truth[-1].header.stamp) if self.truth else -1.0
+
+    def send(self, z: float, x: float = 0.0, torque_x: float = 0.0) -> None:
+        self.wait(lambda: self.force.get_subscription_count() > 0, "the simulator's force subscription")
+        msg = WrenchStamped()
+        msg.header.frame_id = "bearing"
+        msg.wrench.force.z, msg.wrench.force.x, msg.wrench.torque.x = z, x, torque_x
+        self.force.publish(msg)
+
+    def status_with(self, level: bytes, text: str) -> bool:
+        return any(d.level == level and text in d.message for d in self.diagnostics)
+
+
+def test_radial_force_on_the_topic_loads_the_twin_and_a_moment_only_warns(ros_graph):
+    process = ros_graph.spawn_python(
+        "-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime", "--ros-args", "-p", f"initial_speed_rad_s:={900 * math.pi / 30!r}"
+    )
+    bench = Bench(ros_graph)
+    bench.wait(lambda: bench.time() > 0.05, "the simulator")
+
+    # axial only: every ball loaded alike, the cage on the axis
+    bench.send(AXIAL_N, 0.0)
+    bench.wait(lambda: bench.truth[-1].axial_load == AXIAL_N, "the axial load of 163 N")
+    start = len(bench.truth) - 1
+    applied = bench.time()
+    bench.wait(lambda: bench.time() > applied + 0.2, "0.2 s simulated under the axial load")
+    axial_only = bench.truth[start:]
+    assert all(t.cage_whirl_radius_um == 0.0 for t in axial_only)
+    assert all(t.inner_contact_load_max == pytest.approx(t.inner_contact_load_mean, rel=1e-9) for t in axial_only)
+
+    # force.x = 500 N: a load zone (Stribeck's Q_max) and the cage pushed off the axis
+    bench.send(AXIAL_N, RADIAL_N)
+    bench.wait(lambda: bench.truth[-1].cage_whirl_radius_um > 1.0, "the cage off the axis under the radial load")
+    loaded = bench.time()
+    bench.wait(lambda: bench.time() > loaded + 0.1, "0.1 s simulated under the radial load")
+    last = bench.truth[-1]
+    assert last.axial_load == AXIAL_N
+    assert last.inner_contact_load_max == pytest.approx(stribeck_max_ball_load(RADIAL_N), rel=0.03)
+    assert last.inner_contact_load_max > 2.0 * last.inner_contact_load_mean  # balls outside the zone unloaded
+
+    # a moment is ignored: the node stays up and WARNs naming the topic and the field
+    bench.send(AXIAL_N, RADIAL_N, torque_x=5.0)
+    bench.wait(lambda: bench.status_with(DiagnosticStatus.WARN, f"{FORCE_TOPIC}: moment in torque.x ignored"), "WARN for the moment")
+    warned = bench.time()
+    bench.wait(lambda: bench.time() > warned + 0.05, "the simulation going on")
+    assert process.poll() is None
+    assert bench.truth[-1].cage_whirl_radius_um > 1.0  # the radial load still applied
+
+    # a non-finite radial component is refused like a non-finite axial force
+    bench.send(AXIAL_N, math.nan)
+    bench.wait(lambda: bench.status_with(DiagnosticStatus.ERROR, "radial force refused: radial force: force.x must be a finite number"), "ERROR for NaN force.x")
+    assert process.poll() is None

@@ -993,11 +993,12 @@ def step_reduced(
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
-        # the cage centre moves once something pushes it off the axis: a radial load, its weight
-        # (horizontal spindle) or a state left off it; a centred cage under a purely axial load
-        # is an exact equilibrium (the pockets' forces cancel, the film has none) and skips the
-        # centre's terms
-        centre = radial_load != 0.0 or p[P_CAGE_GRAV_Y] != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        # the cage centre moves once something pushes it off the axis: a radial load or a state
+        # left off it; a centred cage under a purely axial load is an exact equilibrium (the
+        # pockets' forces cancel, the film has none) and skips the centre's terms. The cage's
+        # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
+        # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
+        centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
         if centre:
             omega_c = 0.0

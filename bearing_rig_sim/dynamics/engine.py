@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import film_thickness
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.dynamics.step_limit import (
@@ -468,17 +467,7 @@ class BearingDynamics:
             return math.nan, math.nan
         o = self.out
         alpha_i, alpha_o = float(np.mean(o[:, kn.O_AI])), float(np.mean(o[:, kn.O_AO]))
-        inner, outer = raceway_contacts(
-            p.ball_diameter,
-            p.pitch_diameter,
-            0.5 * (alpha_i + alpha_o),
-            p.inner_curvature_ratio,
-            p.outer_curvature_ratio,
-            p.ball_modulus,
-            p.ball_poisson,
-            p.ring_modulus,
-            p.ring_poisson,
-        )
+        inner, outer = p.raceway_contacts(0.5 * (alpha_i + alpha_o))
         r, rm = 0.5 * p.ball_diameter, 0.5 * p.pitch_diameter
         wm = float(np.mean(self.ball[:, kn.B_OMEGA]))
         films = []

@@ -41,7 +41,7 @@ import numpy as np
 
 from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
+from bearing_rig_sim.dynamics.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
 
@@ -262,6 +262,40 @@ class BearingParameters:
             raise ValueError("this bearing has no lubricant file")
         return self.replace(lubricant=self.lubricant.replace_rheology(**changes))
 
+    def raceway_contacts(self, contact_angle: float | None = None) -> tuple[HertzContact, HertzContact]:
+        """The ball-inner and ball-outer raceway Hertz contacts at ``contact_angle`` (rad; the
+        free contact angle when None)."""
+        a = self.contact_angle if contact_angle is None else contact_angle
+        return raceway_contacts(
+            self.ball_diameter,
+            self.pitch_diameter,
+            a,
+            self.inner_curvature_ratio,
+            self.outer_curvature_ratio,
+            self.ball_modulus,
+            self.ball_poisson,
+            self.ring_modulus,
+            self.ring_poisson,
+        )
+
+    def contact_kinematics(self) -> tuple[ContactKinematics, ContactKinematics]:
+        """The inner and outer contacts' rolling geometry at the free contact angle, as the
+        traction table is built on it: rolling radii Dw(1 -+ gamma)/2 and groove radii f Dw."""
+        dw = self.ball_diameter
+        gamma = dw * math.cos(self.contact_angle) / self.pitch_diameter
+        inner, outer = self.raceway_contacts()
+        return (
+            ContactKinematics(inner, 0.5 * dw * (1.0 - gamma), self.inner_curvature_ratio * dw, True),
+            ContactKinematics(outer, 0.5 * dw * (1.0 + gamma), self.outer_curvature_ratio * dw, False),
+        )
+
+    @property
+    def combined_constant(self) -> float:
+        """The inner and outer contacts' load-deflection constants in series at the free contact
+        angle, K_n = (K_i^(-2/3) + K_o^(-2/3))^(-3/2), N/m^1.5 (Harris and Kotzalas Eq. 7.19)."""
+        inner, outer = self.raceway_contacts()
+        return float((inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5)
+
     @property
     def epicyclic_ratio(self) -> float:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
@@ -359,16 +393,8 @@ def _traction_table(p: BearingParameters) -> np.ndarray:
     lub = p.lubricant
     assert lub is not None
     dw, dm, a0 = p.ball_diameter, p.pitch_diameter, p.contact_angle
-    inner, outer = raceway_contacts(
-        dw, dm, a0, p.inner_curvature_ratio, p.outer_curvature_ratio, p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson
-    )
-    gamma = dw * math.cos(a0) / dm
-    rx_in, rx_out = 0.5 * dw * (1.0 - gamma), 0.5 * dw * (1.0 + gamma)
     return build_table(
-        (
-            ContactKinematics(inner, rx_in, p.inner_curvature_ratio * dw, True),
-            ContactKinematics(outer, rx_out, p.outer_curvature_ratio * dw, False),
-        ),
+        p.contact_kinematics(),
         lub,
         p.lubricant_temperature,
         ball_count=p.ball_count,
@@ -376,7 +402,7 @@ def _traction_table(p: BearingParameters) -> np.ndarray:
         ball_diameter=dw,
         pitch_diameter=dm,
         total_curvature=p.inner_curvature_ratio + p.outer_curvature_ratio - 1.0,
-        combined_constant=(inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5,
+        combined_constant=p.combined_constant,
     )
 
 
@@ -425,9 +451,7 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     # Groove curvature centres (r, z) with zero clearance at the free contact angle.
     ci_r, ci_z = rm + (ri - rball) * math.cos(a0), (ri - rball) * math.sin(a0)
     co_r, co_z = rm - (ro - rball) * math.cos(a0), -(ro - rball) * math.sin(a0)
-    inner, outer = raceway_contacts(
-        dw, dm, a0, p.inner_curvature_ratio, p.outer_curvature_ratio, p.ball_modulus, p.ball_poisson, p.ring_modulus, p.ring_poisson
-    )
+    inner, outer = p.raceway_contacts()
     # Ball in a cylindrical pocket (axis radial): concave radius d_p/2 across, straight along.
     pocket = point_contact(2.0 / dw, 2.0 / dw, -2.0 / p.pocket_diameter, 0.0, p.ball_modulus, p.ball_poisson, p.cage_modulus, p.cage_poisson)
     ball_mass = p.ball_density * math.pi * dw**3 / 6.0

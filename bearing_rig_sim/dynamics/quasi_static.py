@@ -53,7 +53,6 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import root
 
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.thermal.materials import BEARING_STEEL
@@ -178,19 +177,9 @@ class QuasiStaticBearing:
         self.go = (p.outer_curvature_ratio - 0.5) * p.ball_diameter
         self.big_a = self.gi + self.go
         self.ri = 0.5 * self.dm + self.gi * math.cos(self.a0)
-        inner, outer = raceway_contacts(
-            p.ball_diameter,
-            p.pitch_diameter,
-            p.contact_angle,
-            p.inner_curvature_ratio,
-            p.outer_curvature_ratio,
-            p.ball_modulus,
-            p.ball_poisson,
-            p.ring_modulus,
-            p.ring_poisson,
-        )
+        inner, outer = p.raceway_contacts()
         self.ki, self.ko = inner.stiffness, outer.stiffness
-        self.kn = (self.ki ** (-2.0 / 3.0) + self.ko ** (-2.0 / 3.0)) ** -1.5
+        self.kn = p.combined_constant
         self.mass = p.ball_density * math.pi * self.dw**3 / 6.0
         self.inertia = p.ball_density * math.pi * self.dw**5 / 60.0
         self.psi = 2.0 * math.pi * np.arange(self.z) / self.z

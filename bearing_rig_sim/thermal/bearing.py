@@ -46,7 +46,6 @@ from numba import njit
 from bearing_rig_sim.config import Section, config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.thermal.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
 from bearing_rig_sim.thermal.network import Conductance, Node, ThermalNetwork
@@ -276,17 +275,7 @@ def build_network(
     r_in_mean, r_out_mean = 0.25 * (d + d_is), 0.25 * (d_os + big_d)
     g_seat_in = 1.0 / (1.0 / (cfg.fit_conductance * math.pi * d * b) + math.log(r_in_mean / (0.5 * d)) / (2.0 * math.pi * k * b))
     g_seat_out = 1.0 / (1.0 / (cfg.fit_conductance * math.pi * big_d * b) + math.log(0.5 * big_d / r_out_mean) / (2.0 * math.pi * k * b))
-    inner, outer = raceway_contacts(
-        dw,
-        dm,
-        a0,
-        params.inner_curvature_ratio,
-        params.outer_curvature_ratio,
-        params.ball_modulus,
-        params.ball_poisson,
-        params.ring_modulus,
-        params.ring_poisson,
-    )
+    inner, outer = params.raceway_contacts(a0)
     q = max(axial_load, 1.0) / (z * math.sin(a0))
     g_contacts = []
     for con in (inner, outer):

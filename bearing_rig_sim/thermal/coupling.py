@@ -34,7 +34,6 @@ import numpy as np
 
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, traction_table
 from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
@@ -49,7 +48,6 @@ from bearing_rig_sim.dynamics.traction import (
     SPEED_RANGE,
     SRR_MAX,
     SRR_REF,
-    ContactKinematics,
     ellipse_traction,
     spin_and_heathcote,
 )
@@ -126,14 +124,7 @@ class TableBuild:
             raise ValueError(f"{params.source}: no lubricant file, no traction table")
         self.temperature = float(temperature_c)
         dw, dm, a0 = warm.ball_diameter, warm.pitch_diameter, warm.contact_angle
-        inner, outer = raceway_contacts(
-            dw, dm, a0, warm.inner_curvature_ratio, warm.outer_curvature_ratio, warm.ball_modulus, warm.ball_poisson, warm.ring_modulus, warm.ring_poisson
-        )
-        gamma = dw * math.cos(a0) / dm
-        self._contacts = (
-            ContactKinematics(inner, 0.5 * dw * (1.0 - gamma), warm.inner_curvature_ratio * dw, True),
-            ContactKinematics(outer, 0.5 * dw * (1.0 + gamma), warm.outer_curvature_ratio * dw, False),
-        )
+        self._contacts = warm.contact_kinematics()
         self._lub = lub
         self._geometry = (
             warm.ball_count,
@@ -141,7 +132,7 @@ class TableBuild:
             warm.inner_curvature_ratio + warm.outer_curvature_ratio - 1.0,
             dw,
             dm,
-            (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5,
+            warm.combined_constant,
         )
         self._xi_max = math.asinh(SRR_MAX / SRR_REF)
         self._srrs = SRR_REF * np.sinh(np.linspace(-self._xi_max, self._xi_max, N_SRR))

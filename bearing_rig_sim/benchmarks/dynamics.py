@@ -4,6 +4,9 @@
 keys ``rpm``, ``axial_load_n``, ``radial_load_n``, ``model``, ``dt_s``, ``sim_s``, ``wall_s``, ``rtf`` (simulated
 seconds per wall-clock second, median of ``--repeats`` runs, compile time excluded),
 ``rtf_min``, ``compile_s`` (first-call JIT compilation or cache load) and ``cage_speed_rad_s``.
+Model ``exudyn`` is the reference: Exudyn's rigid 6-DOF ball bearing
+(:mod:`.exudyn_bearing`) at :data:`EXUDYN_POINT`, whose row adds ``reduced_over_exudyn``, the
+reduced engine's rtf at that point over Exudyn's, both measured in the same run.
 Run on one core: the engine is single-threaded.
 """
 
@@ -14,6 +17,7 @@ import statistics
 import time
 from collections.abc import Iterator
 
+from bearing_rig_sim.benchmarks.exudyn_bearing import run_exudyn
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 
@@ -22,21 +26,28 @@ POINTS: tuple[tuple[float, float], ...] = ((900, 100), (2700, 100), (5000, 300),
 RADIAL_POINTS: tuple[tuple[float, float, float], ...] = ((900, 163, 500), (5000, 300, 300))
 """Operating points (rpm, axial N, radial N) under combined load (reduced model only: each
 ball's loads from the ring's radial balance every step)."""
+EXUDYN_POINT: tuple[float, float] = (900, 100)
+"""Operating point (rpm, axial N) of the Exudyn comparison."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``bearing-rig bench dynamics``."""
     parser.add_argument("--sim-seconds", type=float, default=1.0, help="simulated time per run of the reduced model (s)")
     parser.add_argument("--stiff-sim-seconds", type=float, default=0.02, help="simulated time per run of the stiff reference (s)")
+    parser.add_argument("--exudyn-sim-seconds", type=float, default=0.02, help="simulated time per run of Exudyn's bearing (s)")
     parser.add_argument("--repeats", type=int, default=3, help="runs per point; the median is reported")
-    parser.add_argument("--models", nargs="+", default=["reduced", "stiff"], choices=["reduced", "stiff"])
+    parser.add_argument("--models", nargs="+", default=["reduced", "stiff", "exudyn"], choices=["reduced", "stiff", "exudyn"])
     parser.add_argument("--uncalibrated", action="store_true", help="use the clean bearing data instead of the bench calibration")
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
     """Measure the real-time factor of each model at each operating point."""
     params = BearingParameters.from_yaml() if args.uncalibrated else BearingParameters.calibrated()
+    reduced_rtf: float | None = None
     for model in args.models:
+        if model == "exudyn":
+            yield _exudyn_row(params, args, reduced_rtf)
+            continue
         sim_s = args.sim_seconds if model == "reduced" else args.stiff_sim_seconds
         t0 = time.perf_counter()
         warm = BearingDynamics(params, model=model)
@@ -55,6 +66,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 wall = time.perf_counter() - start
                 rtfs.append(avg.duration / wall)
             rtf = statistics.median(rtfs)
+            if model == "reduced" and (rpm, load, radial) == (*EXUDYN_POINT, 0.0):
+                reduced_rtf = rtf
             yield {
                 "bench": "dynamics",
                 "rpm": rpm,
@@ -69,6 +82,28 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "compile_s": round(compile_s, 3),
                 "cage_speed_rad_s": round(avg.cage_speed, 6),
             }
+
+
+def _exudyn_row(params: BearingParameters, args: argparse.Namespace, reduced_rtf: float | None) -> dict:
+    """Time Exudyn's rigid ball bearing at :data:`EXUDYN_POINT` (median of ``--repeats`` runs)."""
+    rpm, load = EXUDYN_POINT
+    runs = [run_exudyn(params, rpm_to_rad_s(rpm), load, args.exudyn_sim_seconds) for _ in range(max(1, args.repeats))]
+    rtf = statistics.median(r.rtf for r in runs)
+    row = {
+        "bench": "dynamics",
+        "rpm": rpm,
+        "axial_load_n": load,
+        "radial_load_n": 0.0,
+        "model": "exudyn",
+        "sim_s": args.exudyn_sim_seconds,
+        "wall_s": round(args.exudyn_sim_seconds / rtf, 6),
+        "rtf": round(rtf, 5),
+        "rtf_min": round(min(r.rtf for r in runs), 5),
+        "cage_speed_rad_s": round(runs[-1].cage_speed_rad_s, 6),
+    }
+    if reduced_rtf is not None:
+        row["reduced_over_exudyn"] = round(reduced_rtf / rtf, 1)
+    return row
 
 
 def main() -> None:  # pragma: no cover - convenience entry point

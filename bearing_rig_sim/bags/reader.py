@@ -7,11 +7,11 @@
         for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]):
             ...
 
-Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk.
-Types are decoded with the definitions the bag carries (an old bag keeps decoding after a message
-changes), else with ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (what is
-still read: ``docs/bags.md``): each problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning`
-and a line in :attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
+Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk,
+with the definitions the bag carries (an old bag keeps decoding after a message changes), else
+ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (``docs/bags.md``): each
+problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
+:attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
 """
 
 from __future__ import annotations
@@ -32,12 +32,12 @@ from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import BagLayout, channel_msgtype, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
-from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, StorageFormat, merge_in_time
+from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, dependencies, rig_typestore
 from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
 
-
+StorageFormat = McapFormat | Sqlite3Format
 STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sqlite3Format()}
 """The storage formats this project reads, by ``storage_identifier`` (see :mod:`.storage`)."""
 
@@ -162,8 +162,6 @@ class BagReader:
                 f"`bearing-rig bag repair {self.path}` rewrites it)"
             )
 
-    # -- public API -------------------------------------------------------------------------
-
     @property
     def files(self) -> list[Path]:
         """The storage files read."""
@@ -263,8 +261,6 @@ class BagReader:
     ) -> Literal[False]:
         self.close()
         return False
-
-    # -- internals --------------------------------------------------------------------------
 
     def _report(self, problem: str) -> None:
         if self.strict:

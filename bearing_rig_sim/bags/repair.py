@@ -150,7 +150,7 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
                 register_topic(writer, schema_by_name, topic, store)
         for log_time, channel_id, publish_time, data in iter_file_messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
-        writer.finish()
+        writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
     except BaseException:
         sink.close()
         target.unlink(missing_ok=True)

@@ -1,11 +1,6 @@
-"""rosbag2 bags with SQLite 3 storage (``.db3`` files), read through rosbags' rosbag2 reader.
-
-SQLite 3 was rosbag2's default storage before Iron; bags older benches recorded use it. A bag is
-read as a whole (one :class:`~.storage.FileIndex` for all its ``.db3`` files): topics, counts and
-the time range as its ``metadata.yaml`` states them, message definitions from the database
-(rosbag2 stores them since Iron), messages in time order. Such a bag is finished when written
-(every message is a committed row), so there is nothing to repair.
-"""
+"""rosbag2 bags with SQLite 3 storage (``.db3``, rosbag2's default before Iron, what older benches
+record), read through rosbags as one :class:`~.storage.FileIndex` per bag. Every message is a
+committed row, so there is nothing to repair."""
 
 from __future__ import annotations
 
@@ -28,7 +23,7 @@ class Sqlite3Format:
     identifier = "sqlite3"
 
     def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
-        """The bag's topics, definitions and statistics (see the module documentation).
+        """The bag's topics, definitions and statistics.
 
         Raises:
             BagError: rosbags cannot open the bag (a database missing or not SQLite).
@@ -59,14 +54,13 @@ class Sqlite3Format:
         stop_ns: int | None = None,
         report: ProblemSink = lambda _msg: None,
     ) -> Iterator[MessageTuple]:
-        """Messages in time order, as rosbags reads them from the databases."""
+        """Messages with ``start_ns <= log_time < stop_ns`` in time order, as rosbags reads them."""
         wanted = None if channel_ids is None else set(channel_ids)
         try:
             with Reader(index.path) as reader:
                 connections = [c for c in reader.connections if wanted is None or c.id in wanted]
-                if not connections:
-                    return
-                for conn, log_time, data in reader.messages(connections, start=start_ns, stop=stop_ns):
-                    yield log_time, conn.id, log_time, data
+                if connections:
+                    for conn, log_time, data in reader.messages(connections, start=start_ns, stop=stop_ns):
+                        yield log_time, conn.id, log_time, data
         except ReaderError as exc:
             report(f"{index.path}: reading stopped ({exc})")

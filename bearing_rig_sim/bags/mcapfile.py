@@ -26,7 +26,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, merge_in_time
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, ignore_problems, merge_in_time
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
 """What the mcap library raises on bytes that are not records (a CRC mismatch is a ValueError)."""
@@ -333,37 +333,6 @@ def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool
         report(f"{label}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
 
 
-def iter_file_messages(
-    index: McapIndex,
-    channel_ids: Iterable[int] | None = None,
-    start_ns: int | None = None,
-    stop_ns: int | None = None,
-    report: ProblemSink = lambda _msg: None,
-) -> Iterator[MessageTuple]:
-    """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
-    in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged chunks
-    are reported through ``report`` and skipped."""
-    wanted = None if channel_ids is None else frozenset(channel_ids)
-    low = -1 if start_ns is None else start_ns
-    high = 2**64 if stop_ns is None else stop_ns
-
-    def keep(channel_id: int, log_time: int) -> bool:
-        return (wanted is None or channel_id in wanted) and low <= log_time < high
-
-    refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
-    refs.sort(key=lambda r: (r.start_ns, r.offset))
-    try:
-        stream = open(index.path, "rb")  # closed in finally
-    except OSError as exc:
-        report(f"{index.path}: cannot open ({exc.strerror or exc})")
-        return
-    try:
-        chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
-        yield from (m for m in merge_in_time(chunks) if m[1] >= 0)
-    finally:
-        stream.close()
-
-
 class McapFormat:
     """MCAP storage files (https://mcap.dev/spec), one index per file."""
 
@@ -374,13 +343,26 @@ class McapFormat:
         return [index_file(f) for f in files]
 
     def messages(
-        self,
-        index: FileIndex,
-        channel_ids: Iterable[int] | None = None,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        report: ProblemSink = lambda _msg: None,
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = ignore_problems
     ) -> Iterator[MessageTuple]:
-        """As :func:`iter_file_messages`."""
+        """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
+        in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged
+        chunks are reported through ``report`` and skipped."""
         assert isinstance(index, McapIndex)
-        return iter_file_messages(index, channel_ids, start_ns, stop_ns, report)
+        wanted = None if channel_ids is None else frozenset(channel_ids)
+        low = -1 if start_ns is None else start_ns
+        high = 2**64 if stop_ns is None else stop_ns
+
+        def keep(channel_id: int, log_time: int) -> bool:
+            return (wanted is None or channel_id in wanted) and low <= log_time < high
+
+        refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
+        refs.sort(key=lambda r: (r.start_ns, r.offset))
+        try:
+            stream = open(index.path, "rb")  # closed by the with below
+        except OSError as exc:
+            report(f"{index.path}: cannot open ({exc.strerror or exc})")
+            return
+        with stream:
+            chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
+            yield from (m for m in merge_in_time(chunks) if m[1] >= 0)

@@ -164,12 +164,7 @@ class BagReader:
         return all(i.indexed for i in self._indexes) and not self.problems
 
     def messages(
-        self,
-        topics: Iterable[str] | None = None,
-        *,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        raw: bool = False,
+        self, topics: Iterable[str] | None = None, *, start_ns: int | None = None, stop_ns: int | None = None, raw: bool = False
     ) -> Iterator[BagMessage]:
         """Messages in log-time order, streamed.
 
@@ -202,12 +197,7 @@ class BagReader:
     def __enter__(self) -> BagReader:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> Literal[False]:
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None, traceback: TracebackType | None) -> Literal[False]:
         self.close()
         return False
 

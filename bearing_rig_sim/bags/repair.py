@@ -17,7 +17,7 @@ from typing import Literal
 
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import METADATA_FILE, BagLayout, layout_from_indexes, layout_to_dict, read_layout, storage_file_index, write_layout
-from bearing_rig_sim.bags.mcapfile import McapIndex, check_chunks, index_file, iter_file_messages
+from bearing_rig_sim.bags.mcapfile import McapFormat, McapIndex, check_chunks, index_file
 from bearing_rig_sim.bags.typestore import rig_typestore, type_hash
 from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink, register_topic, start_mcap
 
@@ -122,7 +122,7 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
         for topic in previous.topics if previous is not None else []:
             if topic.name not in present and topic.msgtype in store.fielddefs:
                 register_topic(writer, schema_by_name, topic, store)
-        for log_time, channel_id, publish_time, data in iter_file_messages(index, report=problems.append):
+        for log_time, channel_id, publish_time, data in McapFormat().messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
     except BaseException:

@@ -184,13 +184,8 @@ class BagWriter:
         return self._mcap is None
 
     def add_topic(self, name: str, msgtype: str, qos: str | QosSpec = "reliable") -> None:
-        """Declare a topic before writing to it.
-
-        Args:
-            name: fully qualified topic name, e.g. ``/rig/speeds``.
-            msgtype: ``pkg/msg/Name`` (or ``pkg/Name``), a ROS 2 Jazzy or ``bearing_rig_msgs`` type.
-            qos: the offered QoS: a name of :data:`~bearing_rig_sim.bags.qos.QOS_PROFILES` or a
-                :class:`~bearing_rig_sim.bags.qos.QosSpec`.
+        """Declare a topic (``/name``, ``pkg/msg/Name`` or ``pkg/Name``, offered QoS: a name of
+        :data:`~bearing_rig_sim.bags.qos.QOS_PROFILES` or a ``QosSpec``) before writing to it.
 
         Raises:
             BagError: bag closed, bad name, unknown type, or the topic exists with another type or QoS.
@@ -232,11 +227,8 @@ class BagWriter:
         self._append(entry, log_time_ns, data)
 
     def write_message(self, topic: str, log_time_ns: int, message: object) -> None:
-        """Serialize a rosbags message object with the type store and record it.
-
-        Raises:
-            BagError: as :meth:`write`, or the message is not of the topic's type.
-        """
+        """Serialize a rosbags message object and record it; BagError as :meth:`write`, or for a
+        message not of the topic's type."""
         entry = self._topic(topic)
         msgtype = getattr(message, "__msgtype__", None)
         if msgtype != entry.entry.msgtype:
@@ -256,11 +248,8 @@ class BagWriter:
         self._write_layout()
 
     def close(self) -> None:
-        """Finalise: the last chunk, the summary, the final ``metadata.yaml``; again does nothing.
-
-        Raises:
-            BagError: the file could not be completed (disk full...).
-        """
+        """Finalise: the last chunk, the summary, the final ``metadata.yaml`` (BagError if the file
+        cannot be completed); again does nothing."""
         if self._mcap is None:
             return
         try:

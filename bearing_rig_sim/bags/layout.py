@@ -186,12 +186,8 @@ def read_layout(bag_dir: Path) -> BagLayout:
     try:
         text = path.read_bytes()
     except FileNotFoundError:
-        hint = (
-            f" (if a recording was interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
-            if bag_dir.is_dir() and any(bag_dir.glob("*.mcap"))
-            else ""
-        )
-        raise BagError(f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory{hint}") from None
+        hint = f" (if a recording was interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
+        raise BagError(f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory{hint if any(bag_dir.glob('*.mcap')) else ''}") from None
     except OSError as exc:
         raise BagError(f"{source}: cannot read ({exc})") from None
     try:
@@ -216,11 +212,8 @@ def read_layout(bag_dir: Path) -> BagLayout:
     files = []
     for name in (PurePath(str(raw)).name for raw in paths):
         entry = file_info.get(name, {})
-        files.append(
-            FileEntry(
-                name, ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds"), int(entry.get("message_count", 0) or 0)
-            )
-        )
+        start, duration = ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds")
+        files.append(FileEntry(name, start, duration, int(entry.get("message_count", 0) or 0)))
     topics = []
     for index, item in enumerate(_get(info, "topics_with_message_count", source, list, where)):
         at = f"{where}topics_with_message_count[{index}]."
@@ -296,15 +289,7 @@ def layout_from_indexes(
     for entry in topics.values():
         if not entry.type_hash and entry.msgtype:
             entry.type_hash = type_hash_of(entry.msgtype)
-    files = [
-        FileEntry(
-            index.path.name,
-            index.start_ns if index.message_count else 0,
-            index.end_ns - index.start_ns if index.message_count else 0,
-            index.message_count,
-        )
-        for index in indexes
-    ]
+    files = [FileEntry(i.path.name, i.start_ns, i.end_ns - i.start_ns, i.message_count) if i.message_count else FileEntry(i.path.name) for i in indexes]
     custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), None)
     if custom is None:
         custom = dict(previous.custom_data) if previous is not None else {}

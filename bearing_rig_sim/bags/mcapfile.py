@@ -26,7 +26,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, ignore_problems, merge_in_time
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem, merge_in_time
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
 """What the mcap library raises on bytes that are not records (a CRC mismatch is a ValueError)."""
@@ -172,21 +172,12 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
         index.add_schema(schema)
     for channel in summary.channels.values():
         index.add_channel(channel, summary.schemas)
-    index.chunks = [
-        ChunkRef(
-            c.chunk_start_offset,
-            c.chunk_start_offset + c.chunk_length,
-            c.message_start_time,
-            c.message_end_time,
-            frozenset(c.message_index_offsets) if c.message_index_offsets else None,
-        )
-        for c in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
-    ]
+    for c in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+        channels = frozenset(c.message_index_offsets) if c.message_index_offsets else None
+        index.chunks.append(ChunkRef(c.chunk_start_offset, c.chunk_start_offset + c.chunk_length, c.message_start_time, c.message_end_time, channels))
     index.compression = summary.chunk_indexes[0].compression if summary.chunk_indexes else ""
-    index.message_count = stats.message_count
-    index.channel_counts = dict(stats.channel_message_counts)
-    index.start_ns = stats.message_start_time
-    index.end_ns = stats.message_end_time
+    index.message_count, index.channel_counts = stats.message_count, dict(stats.channel_message_counts)
+    index.start_ns, index.end_ns = stats.message_start_time, stats.message_end_time
     for entry in summary.metadata_indexes:
         try:
             record = _one_record(stream, entry.offset)
@@ -288,9 +279,8 @@ def index_file(path: Path) -> McapIndex:
                 index.has_header = True  # its data are readable: the header holds only two names
                 index.problems.append(f"{path.name}: the MCAP header record is damaged; read through the file's summary")
             else:
-                index.problems.append(
-                    f"{path.name}: file ends after {index.file_size} bytes, before its header is complete (recording interrupted as it started?): no data"
-                )
+                cut = f"file ends after {index.file_size} bytes, before its header is complete (recording interrupted as it started?)"
+                index.problems.append(f"{path.name}: {cut}: no data")
             return index
         assert isinstance(header, Header)  # checked by its opcode above
         index.has_header = True
@@ -343,7 +333,7 @@ class McapFormat:
         return [index_file(f) for f in files]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = ignore_problems
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = drop_problem
     ) -> Iterator[MessageTuple]:
         """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
         in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged

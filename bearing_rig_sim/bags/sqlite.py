@@ -12,7 +12,7 @@ from rosbags.rosbag2 import Reader, ReaderError
 
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import qos_yaml
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, ignore_problems
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem
 
 _ENCODINGS = {MessageDefinitionFormat.MSG: "ros2msg", MessageDefinitionFormat.IDL: "ros2idl"}
 
@@ -47,7 +47,7 @@ class Sqlite3Format:
         return [index]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = ignore_problems
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = drop_problem
     ) -> Iterator[MessageTuple]:
         """Messages with ``start_ns <= log_time < stop_ns`` in time order, as rosbags reads them."""
         wanted = None if channel_ids is None else set(channel_ids)

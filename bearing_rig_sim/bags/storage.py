@@ -15,7 +15,7 @@ ProblemSink = Callable[[str], None]
 """Receives a one-line description of each problem met while reading."""
 
 
-def ignore_problems(_problem: str) -> None:
+def drop_problem(_problem: str) -> None:
     """A :data:`ProblemSink` that drops the problems."""
 
 MessageTuple = tuple[int, int, int, bytes]

@@ -333,7 +333,8 @@ class McapFormat:
         return [index_file(f) for f in files]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = drop_problem
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
+        report: ProblemSink = drop_problem,
     ) -> Iterator[MessageTuple]:
         """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
         in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged

@@ -47,7 +47,8 @@ class Sqlite3Format:
         return [index]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None, report: ProblemSink = drop_problem
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
+        report: ProblemSink = drop_problem,
     ) -> Iterator[MessageTuple]:
         """Messages with ``start_ns <= log_time < stop_ns`` in time order, as rosbags reads them."""
         wanted = None if channel_ids is None else set(channel_ids)

@@ -252,14 +252,19 @@ def layout_from_indexes(
     previous: BagLayout | None,
     report: Callable[[str], None],
     type_hash_of: Callable[[str], str] = lambda _msgtype: "",
+    accepted: list[dict[int, str]] | None = None,
 ) -> BagLayout:
     """The ``metadata.yaml`` content matching what the storage files hold: topics from their
     channels, completed by ``previous`` (the existing ``metadata.yaml``) for topics without
     messages or values the files lack, hashes still missing from ``type_hash_of``; a channel whose
-    type contradicts the topic's is reported and left out. The run context is the first
-    :data:`RUN_METADATA_RECORD` record, else ``previous``'s ``custom_data``."""
+    type contradicts the topic's is reported and left out (``accepted`` receives the topic of each
+    channel kept, per file). The run context is the first :data:`RUN_METADATA_RECORD` record, else
+    ``previous``'s ``custom_data``."""
     topics: dict[str, TopicEntry] = {}
     for index in indexes:
+        kept: dict[int, str] = {}
+        if accepted is not None:
+            accepted.append(kept)
         for channel_id in sorted(index.channels):
             channel = index.channels[channel_id]
             msgtype = channel_msgtype(index, channel_id, previous)
@@ -276,6 +281,7 @@ def layout_from_indexes(
                 continue
             entry.msgtype = entry.msgtype or msgtype
             entry.message_count += index.channel_counts.get(channel_id, 0)
+            kept[channel_id] = channel.topic
     if previous is not None:
         for old in previous.topics:
             entry = topics.get(old.name)

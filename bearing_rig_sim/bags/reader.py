@@ -140,11 +140,11 @@ class BagReader:
             for problem in index.problems:
                 self._report(problem)
         self.typestore = self._build_typestore()
-        self._found = layout_from_indexes(self._indexes, self.layout, self._report)  # what the files hold
+        self._channel_topics: list[dict[int, str]] = []  # per file, the topic of each channel read
+        self._found = layout_from_indexes(self._indexes, self.layout, self._report, accepted=self._channel_topics)  # what the files hold
         self.message_count, self.start_ns, self.end_ns = self._found.message_count, self._found.start_ns, self._found.end_ns
         self.duration_ns = self._found.duration_ns
         self.run_metadata = self._found.custom_data
-        self._channel_topics: list[dict[int, str]] = []
         self.topics = self._collect_topics()
         if self.layout is not None and self.layout.message_count != self.message_count:
             self._report(
@@ -242,11 +242,6 @@ class BagReader:
         return store
 
     def _collect_topics(self) -> dict[str, TopicInfo]:
-        types = {t.name: t.msgtype for t in self._found.topics}
-        for index in self._indexes:
-            self._channel_topics.append(
-                {cid: channel.topic for cid, channel in index.channels.items() if channel_msgtype(index, cid, self.layout) == types.get(channel.topic)}
-            )
         topics = {}
         for entry in sorted(self._found.topics, key=lambda t: t.name):
             cdr = entry.serialization_format == "cdr"

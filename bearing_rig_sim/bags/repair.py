@@ -124,7 +124,7 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
                 register_topic(writer, schema_by_name, topic, store)
         for log_time, channel_id, publish_time, data in McapFormat().messages(index, report=problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
-        writer.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+        writer.finish()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
     except BaseException:
         sink.close()
         target.unlink(missing_ok=True)

@@ -244,7 +244,7 @@ class BagWriter:
         survives a kill. Each call costs a smaller chunk (less compression)."""
         self._check_open()
         assert self._mcap is not None
-        self._mcap.flush()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+        self._mcap.flush()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
         self._write_layout()
 
     def close(self) -> None:
@@ -327,7 +327,7 @@ class BagWriter:
     def _finish_file(self) -> None:
         assert self._mcap is not None and self._sink is not None
         try:
-            self._mcap.finish()  # type: ignore[no-untyped-call]  # mcap leaves it unannotated
+            self._mcap.finish()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
         except OSError as exc:
             raise BagError(f"{self._sink.path}: cannot finish the file ({exc.strerror or exc})") from None
         finally:

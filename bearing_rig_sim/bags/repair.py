@@ -104,8 +104,7 @@ def _storage_files(bag_dir: Path, previous: BagLayout | None) -> list[Path]:
 def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) -> Path:
     """Write the readable content of a damaged file to ``<name>.repairing``; returns that path."""
     target = index.path.with_name(index.path.name + ".repairing")
-    if target.exists():
-        target.unlink()
+    target.unlink(missing_ok=True)
     sink = CountingSink(target)
     try:
         writer = start_mcap(sink, DEFAULT_CHUNK_SIZE, index.compression, index.profile or "ros2", index.library)
@@ -126,10 +125,10 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
     except BaseException:
-        sink.close()
         target.unlink(missing_ok=True)
         raise
-    sink.close()
+    finally:
+        sink.close()
     return target
 
 

@@ -35,10 +35,10 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Self, TypeVar
 
 import annotated_types
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError, ValidationInfo, field_validator, model_validator
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import ConfigError, config_path, flag_value, integer_value, number_value, read_mapping, ros_parameters
+from bearing_rig_sim.config import ConfigError, check_number, config_path, flag_value, integer_value, number_value, read_mapping, ros_parameters
 
 __all__ = [
     "ConfigFile",
@@ -49,6 +49,7 @@ __all__ = [
     "Number",
     "OptionalConfigFile",
     "ParameterField",
+    "StatedQuantity",
     "Text",
     "field_error",
     "existing_config_file",
@@ -295,9 +296,40 @@ def without_nulls(data: Any) -> Any:
 
 class FileSection(BaseModel):
     """Base of a data file's model (a file or one of its mappings): frozen, an unknown key is
-    refused (a misspelt optional key would otherwise leave its default in force silently)."""
+    refused (a misspelt optional key would otherwise leave its default in force silently).
+
+    A physical parameter (a :func:`quantity`) is written either as a number or as a
+    :class:`StatedQuantity` ``{value, unit, range: [low, high], source}``: then its unit must be
+    the parameter's and its value must lie in the range the file states (besides the model's
+    plausible range)."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _stated_quantity(cls, raw: object, info: ValidationInfo) -> object:
+        extra = cls.model_fields[info.field_name].json_schema_extra if info.field_name else None
+        if not isinstance(raw, Mapping) or not isinstance(extra, dict) or "source" not in extra:
+            return raw
+        stated = validate_mapping(StatedQuantity, raw, "")
+        if stated.unit != extra["unit"]:
+            raise field_error("unit", f"must be {extra['unit']!r}, the unit of this key, got {stated.unit!r}")
+        return stated.value
+
+
+class StatedQuantity(FileSection):
+    """A value with its unit, the plausible range its file states and where both come from (a
+    calibrated value, or a bearing or lubricant datum written with its range)."""
+
+    value: Number = Field(description="the value, in the unit")
+    unit: Text = Field(description="its SI unit")
+    range: Annotated[list[Number], Field(min_length=2, max_length=2)] = Field(description="[low, high], the plausible interval")
+    source: Text = Field(description="where the value and the range come from")
+
+    @model_validator(mode="after")
+    def _value_in_range(self) -> Self:
+        check_number(self.value, "", "value", ge=self.range[0], le=self.range[1])
+        return self
 
 
 def validate_mapping(model: type[M], data: object, source: str, key: str = "") -> M:

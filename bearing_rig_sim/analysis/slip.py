@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import NamedTuple, Self, overload
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import ConfigDict, model_validator
 from scipy.optimize import brentq
 
 from bearing_rig_sim.analysis.inputs import (
@@ -40,10 +40,10 @@ from bearing_rig_sim.analysis.inputs import (
     strictly_increasing,
 )
 from bearing_rig_sim.config import ConfigError, read_mapping
-from bearing_rig_sim.settings_model import Integer, Number, validate_mapping
+from bearing_rig_sim.settings_model import FileSection, Integer, Number, quantity, validate_mapping
 
 
-class _Reading(BaseModel):
+class _Reading(FileSection):
     """The part of a bearing file an analysis reads; the rest of the file is the engine's
     (:class:`~bearing_rig_sim.dynamics.bearing_file.BearingFile`)."""
 
@@ -51,9 +51,9 @@ class _Reading(BaseModel):
 
 
 class _KinematicGeometry(_Reading):
-    ball_diameter_m: Number = Field(gt=0.0, description="ball diameter Dw, m")
-    pitch_diameter_m: Number = Field(gt=0.0, description="pitch diameter dm (above Dw), m")
-    contact_angle_deg: Number = Field(ge=0.0, lt=90.0, description="nominal contact angle, deg")
+    ball_diameter_m: Number = quantity("ball diameter Dw", unit="m", source="a ball", gt=0.0)
+    pitch_diameter_m: Number = quantity("pitch diameter dm (above Dw)", unit="m", source="a pitch circle", gt=0.0)
+    contact_angle_deg: Number = quantity("nominal contact angle", unit="deg", source="a ball bearing (radial to thrust)", ge=0.0, lt=90.0)
 
     @model_validator(mode="after")
     def _pitch_above_ball(self) -> Self:
@@ -67,14 +67,14 @@ class _KinematicsReading(_Reading):
 
 
 class _ContactGeometry(_KinematicGeometry):
-    inner_groove_curvature_ratio: Number = Field(gt=0.5, lt=1.0, description="inner groove radius / Dw, 1")
-    outer_groove_curvature_ratio: Number = Field(gt=0.5, lt=1.0, description="outer groove radius / Dw, 1")
-    ball_count: Integer = Field(ge=1, description="number of balls Z")
+    inner_groove_curvature_ratio: Number = quantity("inner groove radius / Dw", unit="1", source="a groove wider than the ball", gt=0.5, lt=1.0)
+    outer_groove_curvature_ratio: Number = quantity("outer groove radius / Dw", unit="1", source="a groove wider than the ball", gt=0.5, lt=1.0)
+    ball_count: Integer = quantity("number of balls Z", unit="1", source="a count", ge=1)
 
 
 class _Elastic(_Reading):
-    youngs_modulus_pa: Number = Field(gt=0.0, description="Young's modulus, Pa")
-    poisson_ratio: Number = Field(ge=0.0, lt=0.5, description="Poisson ratio, 1")
+    youngs_modulus_pa: Number = quantity("Young's modulus", unit="Pa", source="a solid", gt=0.0)
+    poisson_ratio: Number = quantity("Poisson ratio", unit="1", source="an isotropic solid", ge=0.0, lt=0.5)
 
 
 class _ElasticMaterials(_Reading):

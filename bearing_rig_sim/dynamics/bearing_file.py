@@ -21,7 +21,7 @@ from typing import Annotated, Any, Self
 from pydantic import BeforeValidator, ConfigDict, Field, model_validator
 
 from bearing_rig_sim.config import check_number
-from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, field_error, one_of, quantity, validate_mapping
+from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, StatedQuantity, Text, field_error, one_of, quantity, validate_mapping
 
 FRICTION_MODELS = {"paper": 0.0, "coulomb_step": 0.0, "ehl_traction": 1.0, "rheology": 2.0}
 """Traction laws (``friction.model``) and their kernel codes: ``paper`` (alias ``coulomb_step``)
@@ -419,23 +419,9 @@ class LubricantFile(FileSection):
 # ---------------------------------------------------------------------------------------------
 # The calibration file (config/calibration/*.yaml)
 # ---------------------------------------------------------------------------------------------
-class CalibratedQuantity(FileSection):
-    """A calibrated value as a physical quantity: its value must lie in its plausible range."""
-
-    value: Number = Field(description="the calibrated value")
-    unit: Text = Field(description="its unit")
-    range: Annotated[list[Number], Field(min_length=2, max_length=2)] = Field(description="[low, high], the plausible interval")
-    source: Text = Field(description="where the value and the range come from")
-
-    @model_validator(mode="after")
-    def _value_in_range(self) -> Self:
-        check_number(self.value, "", "value", ge=self.range[0], le=self.range[1])
-        return self
-
-
 def _calibrated_values(raw: object) -> dict[str, float]:
     """``parameters:`` of a calibration file: ``section.key`` -> a number (>= 0) or a
-    :class:`CalibratedQuantity`; only the keys of :data:`CALIBRATABLE`."""
+    :class:`~bearing_rig_sim.settings_model.StatedQuantity`; only the keys of :data:`CALIBRATABLE`."""
     if not isinstance(raw, Mapping):
         raise ValueError(f"must be a mapping, got {type(raw).__name__}")
     allowed = sorted(f"{sec}.{key}" for sec, key in CALIBRATABLE.values())
@@ -444,7 +430,7 @@ def _calibrated_values(raw: object) -> dict[str, float]:
         if name not in allowed:
             raise field_error(str(name), f"not a calibratable parameter; allowed: {', '.join(allowed)}")
         if isinstance(entry, Mapping):
-            values[name] = validate_mapping(CalibratedQuantity, entry, "", name).value
+            values[name] = validate_mapping(StatedQuantity, entry, "", name).value
         else:
             values[name] = check_number(entry, "", name, ge=0.0)
     return values

@@ -135,15 +135,16 @@ def test_nan_passed_directly_is_refused() -> None:
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        ('"fast"', "must be a number, got 'fast'"),
-        ("true", "must be a number, got True"),
-        ("[1, 2]", "must be a number, got [1, 2]"),
-        ("{a: 1}", "must be a number, got {'a': 1}"),
+        ('"fast"', "axial_load_n: must be a number, got 'fast'"),
+        ("true", "axial_load_n: must be a number, got True"),
+        ("[1, 2]", "axial_load_n: must be a number, got [1, 2]"),
+        # a mapping is a quantity written with its stated range (settings_model.StatedQuantity)
+        ("{a: 1}", "axial_load_n.a: unknown key; allowed keys: range, source, unit, value"),
     ],
 )
 def test_wrong_type_for_a_number(tmp_path: Path, text: str, expected: str) -> None:
     path = write(tmp_path, f"axial_load_n: {text}\n")
-    assert str(error_of(read, Load, path)) == f"{path}: axial_load_n: {expected}"
+    assert str(error_of(read, Load, path)) == f"{path}: {expected}"
 
 
 def test_unsigned_exponent_reads_as_a_number(tmp_path: Path) -> None:

@@ -22,7 +22,17 @@ A settings class derives from :class:`NodeSettings` and declares each parameter 
   the project's words (``load_controller.yaml: state_rate_hz: must be > 0.0, got 0``);
 * :meth:`NodeSettings.parameter_fields` lists what the ROS descriptors are made from.
 
-The defaults live only in the shipped files under ``config/``: every parameter is required.
+The defaults of a node live only in the shipped files under ``config/``: every parameter is
+required.
+
+The data files (bearing, lubricant and calibration files, sweep specifications) are models of
+the same kinds and words: a :class:`FileSection` per mapping (unknown keys refused), a
+:func:`quantity` per physical parameter (description, SI unit, the source of its plausible range,
+the range, a default where the key may be left out), checks across keys in model validators
+raising :func:`field_error`, and :func:`validate_mapping` / :func:`read_file` giving the one-line
+error naming the file and the full dotted key. A quantity may be written with the range its file
+states (:class:`StatedQuantity`). The rig file's records (:mod:`bearing_rig_sim.rig.parameters`)
+and the test programs (:mod:`bearing_rig_sim.rig.program`) are built on the same kinds.
 No ROS import.
 """
 

@@ -128,7 +128,7 @@ class ChunkAverage:
     ``drive_work`` (J: the integral of :meth:`BearingDynamics.drive_torque` times the inner-ring
     speed, step by step), the heat the bearing dissipated over it, ``heat`` (J: the integral of
     :meth:`BearingDynamics.power_loss`, step by step), and ``damping_heat`` (J: the pocket
-    contacts' Hunt-Crossley damping and the cage rim's damping, reduced model)."""
+    and land contacts' Hunt-Crossley damping and the cage rim's damping, reduced model)."""
 
     duration: float
     cage_speed: float

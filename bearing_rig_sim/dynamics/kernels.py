@@ -115,7 +115,7 @@ NO = 11
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
 S_DRIVE = 3  # drive work, J
 S_HEAT = 4  # heat dissipated (the engine's power loss, step by step), J
-S_DAMP = 5  # heat of the pocket contacts' Hunt-Crossley damping and the cage rim's damping, J
+S_DAMP = 5  # heat of the pocket and land contacts' Hunt-Crossley damping and the cage rim's damping, J
 NS = 6
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
@@ -1001,6 +1001,8 @@ def step_reduced(
         # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
         # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
         centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        heat = 0.0
+        damp = 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
         if centre:
             omega_c = 0.0
@@ -1008,6 +1010,11 @@ def step_reduced(
                 omega_c += cage[k, C_OMEGA]
             fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
             pocket_directions(cage, work[:, w0 + 20], work[:, w0 + 21], pitch_c, pitch_s)
+            ecc = math.sqrt(cx * cx + cy * cy)
+            if land_n > 0.0 and ecc > p[P_LAND_CLEAR]:
+                # the land contact's Hunt-Crossley damping k d 1.5 a_e v_r, times v_r
+                vr = (cvx * cx + cvy * cy) / ecc
+                damp += p[P_LAND_K] * (ecc - p[P_LAND_CLEAR]) * 1.5 * p[P_HC_A] * vr * vr
         else:
             ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
             work[:, w0 + 20] = 0.0
@@ -1021,8 +1028,6 @@ def step_reduced(
         rcx = fcx + dt * (kxx * cvx + kxy * cvy)
         rcy = fcy + dt * (kyx * cvx + kyy * cvy)
         drive = 0.0
-        heat = 0.0
-        damp = 0.0
         inner_scale = inner_speed_scale(omega_i)
         for j in range(z):
             rb = ball[j, B_R]

@@ -140,7 +140,7 @@ class HeatSources:
         land: the cage land's film (or grease) shear.
         rolling_and_pockets: the rest: rolling resistance (hysteresis, EHL rolling) and pocket
             friction.
-        damping: the pocket contacts' Hunt-Crossley damping and the cage rim's damping (the
+        damping: the pocket and land contacts' Hunt-Crossley damping and the cage rim's damping (the
             engine's :attr:`~bearing_rig_sim.dynamics.engine.ChunkAverage.damping_heat` over an
             interval; 0 at an instant or a steady state).
     """

@@ -15,23 +15,37 @@ TP2275 = CONFIG / "bearings" / "tp2275.yaml"
 MIL = CONFIG / "lubricants" / "mil_l_23699.yaml"
 
 
+REPORT = {28000.0: (350.0, 413.0), 48000.0: (700.0, 425.0), 64000.0: (1100.0, 435.0), 72000.0: (1400.0, 443.0)}
+"""Measured heat generation (W) and outer-ring temperature (K) of the 35 mm bore bearing at
+667 N thrust, MIL-L-23699 in at 394 K, by shaft speed (rpm): R. J. Parker, NASA TP-2275
+(1984), Fig. 3, as digitised (about +-3 %) in the ADORE manuscript of the public repository
+YUXinluhk/BallBearing-Dynamics (paper/manuscript.tex at commit 6953d26, table "Selected NASA
+TP-2275 experimental measurements"; also paper/data/nasa_validation.csv). A secondary source:
+the report itself could not be read."""
+
+
 @pytest.mark.slow
-def test_tp2275_heat_generation_rises_with_speed_and_the_oil_carries_it(capsys: pytest.CaptureFixture[str]) -> None:
-    """28 000 and 72 000 rpm at 667 N, oil in at 394 K: the heat grows with speed; the jet
-    carries at most all of it (housing and shaft lead the rest to the colder ambient), so the
-    lubricant's rise over the inlet is below power / (rho Q c_p); at 72 000 rpm it is above the
-    inlet; no calibration is laid over it (no interval)."""
-    argv = ["predict", "--bearing", str(TP2275), "--lubricant", str(MIL), "--rpm", "28000", "72000", "--load", "667", "--thermal", "--json"]
+def test_tp2275_heat_generation_against_the_reports_measurements(capsys: pytest.CaptureFixture[str]) -> None:
+    """28 000-72 000 rpm at 667 N, oil in at 394 K, no tuning and no calibration: the heat is
+    within a factor of 2 of the report's measured heat generation at every speed (SHABERTH's own
+    comparison in the report is of that order; the twin gives 0.6-1.6 x, docs/thermal.md), it
+    grows with speed, and the jet carries at most all of it (housing and shaft lead the rest to
+    the colder ambient), so the lubricant's rise over the inlet is below power / (rho Q c_p)."""
+    speeds = [f"{rpm:.0f}" for rpm in REPORT]
+    argv = ["predict", "--bearing", str(TP2275), "--lubricant", str(MIL), "--rpm", *speeds, "--load", "667", "--thermal", "--json"]
     assert main(argv) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
-    assert rows[1]["power_loss_w"] > rows[0]["power_loss_w"] > 0.0
+    powers = [r["power_loss_w"] for r in rows]
+    assert powers == sorted(powers) and powers[0] > 0.0
     jet = 1000.0 * 3.15e-5 * 2000.0  # rho Q c_p of the file's jet, W/K (density at 15 degC: an upper bound)
     for r in rows:
+        measured_w, _ = REPORT[r["rpm"]]
+        assert 0.5 <= r["power_loss_w"] / measured_w <= 2.0, (r["rpm"], r["power_loss_w"], measured_w)
         assert "slip_pct_low" not in r
         rise = r["lubricant_temperature_c"] - 120.85
         assert rise < 1.05 * r["power_loss_w"] / jet
         assert sum(r["heat_w"].values()) == pytest.approx(r["power_loss_w"], rel=2e-3)
-    assert rows[1]["lubricant_temperature_c"] > 120.85
+    assert rows[-1]["lubricant_temperature_c"] > 120.85
 
 
 @pytest.mark.parametrize(

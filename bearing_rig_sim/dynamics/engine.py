@@ -125,12 +125,16 @@ class ChunkAverage:
     """Time averages over one :meth:`BearingDynamics.advance` call: cage and inner-ring
     speed (rad/s) over ``duration`` (s), and the work the drive did on the inner ring over it,
     ``drive_work`` (J: the integral of :meth:`BearingDynamics.drive_torque` times the inner-ring
-    speed, step by step)."""
+    speed, step by step), the heat the bearing dissipated over it, ``heat`` (J: the integral of
+    :meth:`BearingDynamics.power_loss`, step by step), and ``damping_heat`` (J: the pocket
+    and land contacts' Hunt-Crossley damping and the cage rim's damping, reduced model)."""
 
     duration: float
     cage_speed: float
     inner_ring_speed: float
     drive_work: float = 0.0
+    heat: float = 0.0
+    damping_heat: float = 0.0
 
 
 def _finite(name: str, value: float, lo: float | None = None) -> float:
@@ -185,6 +189,11 @@ class BearingDynamics:
         self.ring = np.zeros(kn.NR)
         self.out = np.zeros((z, kn.NO))
         self.stats = np.zeros(kn.NS)
+        self.dissipated = 0.0
+        """Heat dissipated since the engine was built, J (:attr:`ChunkAverage.heat` and
+        :attr:`ChunkAverage.damping_heat` summed over every :meth:`advance`)."""
+        self.damping_dissipated = 0.0
+        """The damping's share of :attr:`dissipated`, J."""
         self.work = np.zeros((z, kn.NW))
         self.record_every = 0
         self.axial_load = 0.0
@@ -343,7 +352,10 @@ class BearingDynamics:
         t = self.stats[kn.S_TIME]
         if t <= 0.0:
             return ChunkAverage(0.0, self.cage_speed, self.inner_ring_speed)
-        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t, float(self.stats[kn.S_DRIVE]))
+        heat, damping = float(self.stats[kn.S_HEAT]), float(self.stats[kn.S_DAMP])
+        self.dissipated += heat + damping
+        self.damping_dissipated += damping
+        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t, float(self.stats[kn.S_DRIVE]), heat, damping)
 
     def check_state(self) -> None:
         """Raise if the state is one no bearing can be in (a numerical fault).

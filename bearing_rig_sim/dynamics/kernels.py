@@ -114,7 +114,9 @@ O_DRIVE = 10  # torque the drive applies to the inner ring against ball j's inne
 NO = 11
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
 S_DRIVE = 3  # drive work, J
-NS = 4
+S_HEAT = 4  # heat dissipated (the engine's power loss, step by step), J
+S_DAMP = 5  # heat of the pocket and land contacts' Hunt-Crossley damping and the cage rim's damping, J
+NS = 6
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
 
@@ -999,6 +1001,8 @@ def step_reduced(
         # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
         # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
         centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        heat = 0.0
+        damp = 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
         if centre:
             omega_c = 0.0
@@ -1006,6 +1010,11 @@ def step_reduced(
                 omega_c += cage[k, C_OMEGA]
             fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
             pocket_directions(cage, work[:, w0 + 20], work[:, w0 + 21], pitch_c, pitch_s)
+            ecc = math.sqrt(cx * cx + cy * cy)
+            if land_n > 0.0 and ecc > p[P_LAND_CLEAR]:
+                # the land contact's Hunt-Crossley damping k d 1.5 a_e v_r, times v_r
+                vr = (cvx * cx + cvy * cy) / ecc
+                damp += p[P_LAND_K] * (ecc - p[P_LAND_CLEAR]) * 1.5 * p[P_HC_A] * vr * vr
         else:
             ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
             work[:, w0 + 20] = 0.0
@@ -1033,6 +1042,7 @@ def step_reduced(
             gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
             rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
             fs, ku, cu = pocket_force(p, gap, rate)
+            damp += cu * rate * rate  # Hunt-Crossley: the damping force c u_dot times u_dot
             omega_roll = wa + cb * wm
             sg = smooth_sign(omega_roll)
             sroll = sg
@@ -1086,9 +1096,11 @@ def step_reduced(
                 rcy += ny * fp
             work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
             work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+                out[j, O_POWER] = power
                 out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         diag = work[:, w0 + 7]
         rhs = work[:, w0 + 8]
@@ -1097,6 +1109,11 @@ def step_reduced(
             km = z - 1 if k == 0 else k - 1
             kp = 0 if k == z - 1 else k + 1
             tau, dtl = cage_segment_torque(p, cage, k, z, land_f, land_n)
+            w = cage[k, C_OMEGA]
+            tl, _ = cage_land_torque(p, w, z, land_f, land_n)
+            heat += abs(tl * w)
+            dw = cage[kp, C_OMEGA] - w
+            damp += cl * dw * dw  # the rim's damping between segments k and k+1
             e = work[k, w0 + 4]
             gc = rm * work[k, w0 + 6] + tau
             diag[k] = jseg + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
@@ -1147,6 +1164,8 @@ def step_reduced(
             cage[j, C_PHI] += dt * cage[j, C_OMEGA]
             cage_sum += cage[j, C_OMEGA]
         stats[S_DRIVE] += drive * omega_i * dt
+        stats[S_HEAT] += heat * dt
+        stats[S_DAMP] += damp * dt
         finish_step(ring, stats, omega_i_old, omega_i, cage_sum / z, dt)
     return worst_iter
 
@@ -1193,6 +1212,7 @@ def step_stiff(
         delta_a, vdelta = ring[R_DELTA], ring[R_VDELTA]
         ring_force = axial_load
         drive = 0.0
+        heat = 0.0
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
             rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
@@ -1241,14 +1261,19 @@ def step_stiff(
             ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
             ring_force += qi * niz
             torque[j] = rm * fs
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+                out[j, O_POWER] = power
                 out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
         stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)
             torque[k] += tau
+            tl, _ = cage_land_torque(p, cage[k, C_OMEGA], z)
+            heat += abs(tl * cage[k, C_OMEGA])
+        stats[S_HEAT] += heat * dt
         cage_sum = 0.0
         for k in range(z):
             cage[k, C_OMEGA] += dt * torque[k] / jseg

@@ -145,6 +145,9 @@ class HeatSources:
         land: the cage land's film (or grease) shear.
         rolling_and_pockets: the rest: rolling resistance (hysteresis, EHL rolling) and pocket
             friction.
+        damping: the pocket and land contacts' Hunt-Crossley damping and the cage rim's damping (the
+            engine's :attr:`~bearing_rig_sim.dynamics.engine.ChunkAverage.damping_heat` over an
+            interval; 0 at an instant or a steady state).
     """
 
     inner_contacts: float
@@ -152,11 +155,21 @@ class HeatSources:
     drag: float
     land: float
     rolling_and_pockets: float
+    damping: float = 0.0
 
     @property
     def total(self) -> float:
-        """All of it, W (the engine's :meth:`~BearingDynamics.power_loss`)."""
-        return self.inner_contacts + self.outer_contacts + self.drag + self.land + self.rolling_and_pockets
+        """All of it, W (the engine's :meth:`~BearingDynamics.power_loss` plus the damping)."""
+        return self.inner_contacts + self.outer_contacts + self.drag + self.land + self.rolling_and_pockets + self.damping
+
+    def scaled(self, power: float, damping: float) -> HeatSources:
+        """These proportions carrying ``power`` W (all into ``rolling_and_pockets`` when every
+        term is 0), with ``damping`` W of damping."""
+        friction = self.total - self.damping
+        if friction <= 0.0:
+            return HeatSources(0.0, 0.0, 0.0, 0.0, power, damping)
+        f = power / friction
+        return HeatSources(f * self.inner_contacts, f * self.outer_contacts, f * self.drag, f * self.land, f * self.rolling_and_pockets, damping)
 
 
 @njit(cache=True)
@@ -181,7 +194,8 @@ def _split(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, out: np.ndarray, r
         fd, _ = kn.ball_drag(p, rb * wm)
         drag += abs(fd * rb * wm)
         w = cage[j, kn.C_OMEGA]
-        tl, _ = kn.cage_land_torque(p, w, z)
+        # the whirling cage's film: its eccentricity's shear factor and the land contact's force
+        tl, _ = kn.cage_land_torque(p, w, z, ring[kn.R_LAND_F] or 1.0, ring[kn.R_LAND_N])
         land += abs(tl * w)
         total += out[j, kn.O_POWER]
     return pin, pout, drag, land, total + land
@@ -201,8 +215,8 @@ def node_heat(sources: HeatSources) -> dict[str, float]:
     return {
         "inner_ring": 0.5 * s.inner_contacts + 0.25 * s.rolling_and_pockets,
         "outer_ring": 0.5 * s.outer_contacts + 0.25 * s.rolling_and_pockets + 0.5 * s.land,
-        "balls": 0.5 * (s.inner_contacts + s.outer_contacts) + 0.5 * s.rolling_and_pockets,
-        "cage": 0.5 * s.land,
+        "balls": 0.5 * (s.inner_contacts + s.outer_contacts) + 0.5 * s.rolling_and_pockets + 0.25 * s.damping,
+        "cage": 0.5 * s.land + 0.75 * s.damping,
         "lubricant": s.drag,
     }
 

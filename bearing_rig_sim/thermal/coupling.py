@@ -323,10 +323,11 @@ class ThermalCoupling:
         self._operating = (max(engine.inner_ring_speed, 1.0), engine.axial_load)
         self.network = build_network(self.params, config, *self._operating, initial=initial)
         self._pending = 0.0
+        self._dissipated = (engine.dissipated, engine.damping_dissipated)
         self.applied_temperature = self.params.lubricant_temperature
         """The lubricant temperature the engine's resistances are set to, degC."""
         self.sources = HeatSources(0.0, 0.0, 0.0, 0.0, 0.0)
-        """The latest heat split, W."""
+        """The latest interval's mean heat, split, W."""
         self.table_temperature = self.params.lubricant_temperature
         """The temperature the engine's traction table stands for, degC."""
         self.grid: TractionTableGrid | None = None
@@ -347,7 +348,13 @@ class ThermalCoupling:
 
     def advance(self, h: float) -> bool:
         """Account ``h`` seconds of the engine's running (call after each chunk); returns True
-        when the network stepped."""
+        when the network stepped.
+
+        The network takes the interval's mean dissipation: the heat the engine accumulated step
+        by step since the last network step (:attr:`BearingDynamics.dissipated`) over the
+        interval's length, split by the proportions of the engine's terms at its last step
+        (:func:`heat_sources`). The heat into the network is the dissipated heat exactly; a
+        power sampled at the interval's end would lag a run-up by half an interval."""
         self._pending += h
         if self.grid is not None and self.grid.busy:
             self._slice_pending += h
@@ -366,7 +373,10 @@ class ThermalCoupling:
             rebuilt.heat_in, rebuilt.heat_out, rebuilt.time = self.network.heat_in, self.network.heat_out, self.network.time
             self.network = rebuilt
             self._operating = (speed, load)
-        self.sources = heat_sources(engine) if engine.inner_ring_speed > 0.0 else HeatSources(0.0, 0.0, 0.0, 0.0, 0.0)
+        heat, damping = engine.dissipated - self._dissipated[0], engine.damping_dissipated - self._dissipated[1]
+        self._dissipated = (engine.dissipated, engine.damping_dissipated)
+        split = heat_sources(engine) if engine.inner_ring_speed > 0.0 else HeatSources(0.0, 0.0, 0.0, 0.0, 0.0)
+        self.sources = split.scaled((heat - damping) / self._pending, damping / self._pending)
         self.network.step(self.network.heat_vector(node_heat(self.sources)), self._pending)
         self._pending = 0.0
         t_lub = self.network.temperature("lubricant")
@@ -385,6 +395,7 @@ class ThermalCoupling:
         re-calibration); its lubricant is set to the network's temperature. The traction grid
         is rebuilt for the new parameters when they change the film's rheology."""
         self.engine = engine
+        self._dissipated = (engine.dissipated, engine.damping_dissipated)
         if engine.params != self.params:
             self.params = engine.params
             if self.grid is not None:

@@ -81,6 +81,7 @@ class Snapshot:
     ring: np.ndarray
     axial_load: float
     radial_load: float = 0.0
+    radial_angle: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -101,7 +102,8 @@ class Observation:
         axial_load: applied axial load, N.
         cage_whirl_radius: distance of the cage centre from the bearing axis, m (reduced model;
             0 for the concentric stiff model).
-        cage_centre: the cage centre's (x, y) displacement, m (x along the radial load).
+        cage_centre: the cage centre's (x, y) displacement, m, in the bearing's frame (the
+            radial load's azimuth is :attr:`BearingDynamics.radial_angle` from x).
     """
 
     time: float
@@ -190,7 +192,9 @@ class BearingDynamics:
         self.record_every = 0
         self.axial_load = 0.0
         self.radial_load = 0.0
-        """Radial load on the inner ring along +x, N (reduced model; tilts held)."""
+        """Radial load on the inner ring, N (reduced model; tilts held), at :attr:`radial_angle`."""
+        self.radial_angle = 0.0
+        """Azimuth of the radial load from the bearing's x axis, rad (the load zone's azimuth)."""
         self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
         self._peak_speed = 0.0
         self.envelope = envelope if envelope is not None else _shipped_envelope()
@@ -228,9 +232,9 @@ class BearingDynamics:
         return StepLimit(self.model, best, why)
 
     # -- set-up --------------------------------------------------------------------------------
-    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0, radial_load: float = 0.0) -> None:
-        """Start from the static equilibrium under ``axial_load`` (N; and ``radial_load``, N along
-        +x, reduced model only) with the balls and cage at
+    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0, radial_load: float = 0.0, radial_angle: float = 0.0) -> None:
+        """Start from the static equilibrium under ``axial_load`` (N; and ``radial_load``, N at the
+        azimuth ``radial_angle`` from x, rad, reduced model only) with the balls and cage at
         the kinematic (rolling) speeds for ``inner_ring_speed`` (rad/s) at the loaded contact
         angle, each ball touching the driving side of its pocket. The dynamics then find the real
         operating point.
@@ -238,6 +242,7 @@ class BearingDynamics:
         omega = _finite("inner_ring_speed", inner_ring_speed, 0.0)
         load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
         radial = self._radial(radial_load)
+        angle = _finite("radial_angle", radial_angle)
         v, p = self.vector, self.params
         z = p.ball_count
         rm = v[kn.P_RM]
@@ -258,8 +263,8 @@ class BearingDynamics:
             geo, scratch = self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 6]
             # 1e-11 of the load; under a few newtons that is below the rounding of the contact
             # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there.
-            if kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-11, 200, radial) > 200 and (
-                kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-9, 200, radial) > 200
+            if kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-11, 200, radial, angle) > 200 and (
+                kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-9, 200, radial, angle) > 200
             ):
                 raise DynamicsInputError(f"no static equilibrium found for axial load {load} N, radial load {radial} N at {omega} rad/s")
             self._set_rolling_speeds(omega)
@@ -269,6 +274,7 @@ class BearingDynamics:
         self.cage[:, kn.C_OMEGA] = np.mean(self.ball[:, kn.B_OMEGA])
         self.axial_load = load
         self.radial_load = radial
+        self.radial_angle = angle
         self.stats[:] = 0.0
         self.out[:] = 0.0
 
@@ -298,16 +304,24 @@ class BearingDynamics:
 
     # -- integration ---------------------------------------------------------------------------
     def advance(
-        self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0, radial_load: float | None = None
+        self,
+        duration: float,
+        *,
+        axial_load: float | None = None,
+        inner_ring_acceleration: float = 0.0,
+        radial_load: float | None = None,
+        radial_angle: float | None = None,
     ) -> ChunkAverage:
         """Integrate for ``duration`` seconds (rounded to whole steps).
 
         Args:
             duration: s, >= 0.
             axial_load: N applied to the inner ring during the interval (default: unchanged).
-            radial_load: N along +x on the inner ring during the interval (default: unchanged;
+            radial_load: N on the inner ring during the interval (default: unchanged;
                 reduced model only): each ball's loads follow from the ring's quasi-static
                 balance at its orbital position, so they vary around the orbit.
+            radial_angle: the radial load's azimuth from the bearing's x axis, rad, where the
+                load zone is centred (default: unchanged).
             inner_ring_acceleration: rad/s^2, constant during the interval; the speed stops at
                 zero rather than reverse.
 
@@ -319,6 +333,8 @@ class BearingDynamics:
             self.axial_load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
         if radial_load is not None:
             self.radial_load = self._radial(radial_load)
+        if radial_angle is not None:
+            self.radial_angle = _finite("radial_angle", radial_angle)
         accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
         n = int(round(duration / self.time_step))
         if accel < 0.0:
@@ -339,6 +355,7 @@ class BearingDynamics:
                 accel,
                 0,
                 self.radial_load,
+                self.radial_angle,
             )
         self.check_state()
         t = self.stats[kn.S_TIME]
@@ -393,7 +410,7 @@ class BearingDynamics:
     # -- state ---------------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:
         """A copy of the complete state."""
-        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load, self.radial_load)
+        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load, self.radial_load, self.radial_angle)
 
     def restore(self, snap: Snapshot) -> None:
         """Return to a state taken by :meth:`snapshot` (same model and bearing)."""
@@ -404,6 +421,7 @@ class BearingDynamics:
         self.ring[:] = snap.ring
         self.axial_load = snap.axial_load
         self.radial_load = snap.radial_load
+        self.radial_angle = snap.radial_angle
         # A snapshot was taken of an accepted state: its speeds are within the bounds it had.
         carried = max(float(np.max(snap.cage[:, kn.C_OMEGA])), float(np.max(snap.ball[:, kn.B_OMEGA])))
         self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]), carried)

@@ -289,9 +289,11 @@ def solve_quasi_static(
     tol: float,
     max_iter: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
 ) -> int:
     """Newton solution of the normal (radial-axial) equilibrium of every ball and of the inner
-    ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, along +x), with centrifugal
+    ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, >= 0, at the azimuth
+    ``radial_angle`` from +x, rad: the load zone's azimuth), with centrifugal
     force m omega_m^2 r_b; gyroscopic moments neglected; tilts held at zero. Ring unknowns:
     axial displacement and, with a radial load (or a displacement left by one), the radial
     displacement (x, y); each ball's 2x2 block is eliminated onto them (a 3x3 Schur system).
@@ -305,9 +307,10 @@ def solve_quasi_static(
     ki, ko = p[P_K_IN], p[P_K_OUT]
     scale = tol * max(axial_load, abs(radial_load), 1.0)
     radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
+    load_x, load_y = radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle)
     for it in range(max_iter + 1):
         delta_a, dx, dy = ring[R_DELTA], ring[R_DX], ring[R_DY]
-        ga, gx, gy = axial_load, radial_load, 0.0
+        ga, gx, gy = axial_load, load_x, load_y
         # Schur system S du = r of the ring's (delta_a, delta_x, delta_y), S symmetric in value
         s00 = s01 = s02 = s10 = s11 = s12 = s20 = s22 = 0.0
         r0 = r1 = r2 = 0.0
@@ -954,6 +957,7 @@ def step_reduced(
     inner_acceleration: float,
     record_every: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
 ) -> int:
     """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
 
@@ -989,7 +993,7 @@ def step_reduced(
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
-        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load)
+        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load, radial_angle)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
@@ -1170,6 +1174,7 @@ def step_stiff(
     inner_acceleration: float,
     record_every: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
 ) -> int:
     """Advance the stiff reference model by ``n_steps`` explicit steps of ``dt`` seconds.
 
@@ -1178,7 +1183,8 @@ def step_stiff(
     applied load, friction and resistances as in the reduced model. Symplectic Euler in the
     canonical polar coordinates (momenta first, then positions), so that with friction and
     damping off the energy error stays bounded. Needs steps well below a microsecond.
-    ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric). Returns 0.
+    ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric; ``radial_angle``
+    unused). Returns 0.
     """
     z = ball.shape[0]
     rm = p[P_RM]

@@ -22,8 +22,10 @@ Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, his
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
 and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped in the bearing's frame: force.z the
-axial load, N; the magnitude of force.x and force.y the radial load, N, applied along the
-engine's fixed load direction; a moment in torque.x or torque.y is ignored, the inner ring's
+axial load, N; the magnitude of force.x and force.y the radial load, N, at the azimuth
+atan2(force.y, force.x), where the engine centres its load zone, and refused (ERROR, the last
+accepted loads kept) above the rig file's ``combined_loading.max_radial_setpoint_n`` (0 for the
+paper's axially loaded bench); a moment in torque.x or torque.y is ignored, the inner ring's
 tilts being held, with a WARN on /diagnostics; read best effort from its reliable publisher;
 1 kHz, so its queue is taken by the loop, not dispatched message by message: the latest force
 queued is the one applied). Bad input is refused with a
@@ -47,6 +49,7 @@ configures and activates at once.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from typing import Any
@@ -402,8 +405,9 @@ class SimulatorNode(ManagedNode):
 
     def _take_forces(self) -> None:
         """Apply the latest force queued since the last call: force.z the axial load, the
-        magnitude of (force.x, force.y) the radial load (:meth:`RigTwin.set_loads`); a moment in
-        torque.x or torque.y is ignored with a WARN.
+        magnitude of (force.x, force.y) the radial load at its azimuth (:meth:`RigTwin.set_loads`:
+        refused above the rig file's radial limit); a moment in torque.x or torque.y is ignored
+        with a WARN.
 
         The queue is taken serialized and only its last sample is decoded and applied: the ones
         before it would be replaced before the next chunk anyway.
@@ -472,6 +476,7 @@ class SimulatorNode(ManagedNode):
             "axial_load_n": f"{twin.axial_load:.6g}",
             "requested_axial_load_n": f"{twin.requested_axial_load:.6g}",
             "radial_load_n": f"{twin.radial_load:.6g}",
+            "radial_load_azimuth_deg": f"{math.degrees(twin.radial_angle):.6g}",
             "spindle_pulses": self._pulses["spindle"],
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,

@@ -1,10 +1,11 @@
 """A bench that loads radially drives the simulator through the topic contract.
 
 ``/rig/bearing/axial_force`` carries the axial load in force.z and the radial load's components
-in force.x and force.y (its azimuth atan2(force.y, force.x) places the load zone); a moment
-(torque.x, torque.y) is ignored with a WARN. The rig file is the authority on what the loading
-chain can give: a radial force above its ``combined_loading.max_radial_setpoint_n`` is refused
-(the paper's bench, 0 N, loads only axially; this test's bench states 800 N). The simulator runs
+in force.x and force.y (its azimuth atan2(force.y, force.x) places the load zone), a moment
+across the axis in torque.x and torque.y (it frees the inner ring's tilts; none holds them and
+the reaction is reported). The rig file is the authority on what the loading chain can give: a
+radial force or a moment above its ``combined_loading`` limits is refused (the paper's bench,
+0 N and 0 N m, loads only axially; this test's bench states 800 N and 5 N m). The simulator runs
 in its own process with ``--no-realtime`` on the test's isolated ROS domain; every wait is for a
 message, bounded.
 
@@ -13,7 +14,10 @@ the axis (the bearing is axisymmetric); under F_a = 163 N, F_r = 500 N (F_a = 1.
 with a = 15 deg: the half-loaded ring) the largest ball load is Stribeck/Sjovall's
 Q_max = 4.37 F_r / (Z cos a) (Harris and Kotzalas vol. 1, ch. 7), 141.4 N for the H7006C's 16
 balls, and the balls' pocket forces push the cage off the axis. The radial force here is
-(300, 400) N: 500 N at atan2(400, 300) = 53.130 deg.
+(300, 400) N: 500 N at atan2(400, 300) = 53.130 deg. With the tilts held the reaction moment is
+that of the contact lines through the pressure centre, R_i tan a0 from the plane of the inner
+groove's curvature centres (Harris and Kotzalas, vol. 1, ch. 1): F_r R_i tan a0 = 2.86 N m, about
+the axis across the load (torque 2.86 (sin phi, -cos phi) for the load pushing the ring along +z).
 """
 
 from __future__ import annotations
@@ -45,6 +49,8 @@ RADIAL_N = 500.0
 """|(300, 400)| N."""
 RADIAL_LIMIT_N = 800.0
 """The test bench's radial loading chain: ``combined_loading.max_radial_setpoint_n``."""
+MOMENT_LIMIT_N_M = 5.0
+"""The test bench's moment limit: ``combined_loading.max_moment_setpoint_n_m``."""
 TRUTH_PERIOD_S = 0.01
 """/rig/truth every 10 ms simulated (``truth_rate_hz`` 100 in config/simulator.yaml)."""
 
@@ -78,15 +84,21 @@ class Bench:
     def time(self) -> float:
         return from_stamp(self.truth[-1].header.stamp) if self.truth else -1.0
 
-    def send(self, z: float, x: float = 0.0, y: float = 0.0, torque_x: float = 0.0) -> None:
+    def send(self, z: float, x: float = 0.0, y: float = 0.0, torque: tuple[float, float] = (0.0, 0.0)) -> None:
         self.wait(lambda: self.force.get_subscription_count() > 0, "the simulator's force subscription")
         msg = WrenchStamped()
         msg.header.frame_id = "bearing"
-        msg.wrench.force.z, msg.wrench.force.x, msg.wrench.force.y, msg.wrench.torque.x = z, x, y, torque_x
+        msg.wrench.force.z, msg.wrench.force.x, msg.wrench.force.y = z, x, y
+        msg.wrench.torque.x, msg.wrench.torque.y = torque
         self.force.publish(msg)
 
     def status_with(self, level: bytes, text: str) -> bool:
         return any(d.level == level and text in d.message for d in self.diagnostics)
+
+    def pair(self, key: str) -> tuple[float, float]:
+        """The latest report's two-number value of ``key`` ((nan, nan) before any)."""
+        text = self.value(key).split()
+        return (float(text[0]), float(text[1])) if len(text) == 2 else (math.nan, math.nan)
 
     def value(self, key: str) -> str:
         """The latest report's value of ``key`` ('' before any)."""
@@ -97,10 +109,20 @@ class Bench:
         return ""
 
 
+def hand_reaction_moment(radial: float) -> float:
+    """F_r R_i tan a0, N m, R_i = d_m/2 + (f_i - 1/2) D_w cos a0 for the shipped bearing."""
+    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    a0 = math.radians(g["contact_angle_deg"])
+    r_i = 0.5 * g["pitch_diameter_m"] + (g["inner_groove_curvature_ratio"] - 0.5) * g["ball_diameter_m"] * math.cos(a0)
+    return radial * r_i * math.tan(a0)
+
+
 def radial_rig_file(directory: Path) -> Path:
-    """The shipped rig file with a radial loading chain of :data:`RADIAL_LIMIT_N`."""
+    """The shipped rig file with a radial loading chain of :data:`RADIAL_LIMIT_N` and
+    :data:`MOMENT_LIMIT_N_M`."""
     doc = yaml.safe_load(config_path("rig.yaml").read_text())
     doc["combined_loading"]["max_radial_setpoint_n"] = RADIAL_LIMIT_N
+    doc["combined_loading"]["max_moment_setpoint_n_m"] = MOMENT_LIMIT_N_M
     path = directory / "rig.yaml"
     path.write_text(yaml.safe_dump(doc))
     return path
@@ -136,13 +158,32 @@ def test_radial_force_on_the_topic_loads_the_twin_within_the_rig_files_limit(ros
     bench.wait(lambda: bench.value("radial_load_n") == "500", "the radial load in the report")
     assert float(bench.value("radial_load_azimuth_deg")) == pytest.approx(math.degrees(math.atan2(RADIAL_Y_N, RADIAL_X_N)), abs=1e-3)
 
-    # a moment is ignored: the node stays up and WARNs naming the topic and the field
-    bench.send(AXIAL_N, RADIAL_X_N, RADIAL_Y_N, torque_x=5.0)
-    bench.wait(lambda: bench.status_with(DiagnosticStatus.WARN, f"{FORCE_TOPIC}: moment in torque.x ignored"), "WARN for the moment")
-    warned = bench.time()
-    bench.wait(lambda: bench.time() > warned + 0.05, "the simulation going on")
+    # no moment: the tilts held and the reaction moment reported, across the load direction
+    phi = math.atan2(RADIAL_Y_N, RADIAL_X_N)
+    reaction = hand_reaction_moment(RADIAL_N)
+    assert bench.value("moment_n_m") == "0 0"
+    held = bench.pair("ring_moment_n_m")
+    assert held == pytest.approx((reaction * math.sin(phi), -reaction * math.cos(phi)), abs=0.03 * reaction)
+
+    # a moment within the rig file's limit frees the tilts: the balls' moment on the ring balances it
+    torque = (2.0, -1.5)
+    bench.send(AXIAL_N, RADIAL_X_N, RADIAL_Y_N, torque)
+    bench.wait(lambda: bench.value("moment_n_m") == "2 -1.5", "the moment in the report")
+    bench.wait(lambda: bench.pair("ring_moment_n_m") == pytest.approx(torque, abs=1e-3), "the ring balancing the moment")
     assert process.poll() is None
     assert bench.truth[-1].cage_whirl_radius_um > 1.0  # the radial load still applied
+
+    # a moment above the rig file's limit is refused naming it; the moment in force is kept
+    bench.send(AXIAL_N, RADIAL_X_N, RADIAL_Y_N, (6.0, 0.0))
+    moment_refusal = (
+        f"moment refused: moment: 6 N m is above the rig's limit of {MOMENT_LIMIT_N_M:g} N m (combined_loading.max_moment_setpoint_n_m in rig.yaml)"
+    )
+    bench.wait(lambda: bench.status_with(DiagnosticStatus.ERROR, moment_refusal), "ERROR for 6 N m above the 5 N m limit")
+    assert bench.value("moment_n_m") == "2 -1.5"
+
+    # the moment released: the tilts held again, the reaction as before
+    bench.send(AXIAL_N, RADIAL_X_N, RADIAL_Y_N)
+    bench.wait(lambda: bench.pair("ring_moment_n_m") == pytest.approx(held, abs=0.01 * reaction), "the held reaction again")
 
     # above the rig file's radial limit: refused naming the limit and the value, the node stays
     # up and keeps the last accepted loads (axial and radial), and the truth goes on unbroken

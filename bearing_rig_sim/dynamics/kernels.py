@@ -15,7 +15,10 @@ Conventions (every kernel):
   reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)); the cage
   centre's displacement (m) and velocity (m/s) along x and y (dynamic, reduced model only), the
   cage-land contact force (N) and the eccentricity factor of the land's viscous torque (1) of
-  the last step.
+  the last step; the tilts theta_x, theta_y (rad; quasi-static, reduced model, free only under
+  an applied moment: the inner groove curvature centre of ball j moves axially by
+  R_i (theta_x cos theta_j + theta_y sin theta_j), R_i = CI_R, as in dynamics/quasi_static.py)
+  and the balls' moment on the ring at the last recorded step (N m; :func:`ring_moment`).
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
 * ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time,
@@ -108,7 +111,9 @@ C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
 R_CX, R_CY, R_CVX, R_CVY, R_LAND_N, R_LAND_F = 7, 8, 9, 10, 11, 12
-NR = 13
+R_TX, R_TY = 13, 14  # inner-ring tilts theta_x, theta_y (rad; free only under an applied moment)
+R_MX, R_MY = 15, 16  # moment of the balls' inner contact loads on the ring, N m (last recorded step)
+NR = 17
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 O_DRIVE = 10  # torque the drive applies to the inner ring against ball j's inner traction, N m
 NO = 11
@@ -278,6 +283,76 @@ def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> 
     return (-dq * nr * nr - t * (1.0 - nr * nr), -dq * nr * nz + t * nr * nz, -dq * nz * nz - t * (1.0 - nz * nz))
 
 
+@njit(cache=True, inline="always")
+def ball_normal_residual(p: np.ndarray, ball: np.ndarray, j: int, delta_a: float, shift: float, geo: np.ndarray) -> tuple:
+    """Ball j's raceway contacts with the inner groove's curvature centre moved ``delta_a`` (m)
+    axially and ``shift`` (m) radially: writes the loads, normals and penetrations into
+    ``geo[j]`` and returns (Q_i, n_ir, n_iz, f_r, f_z, contact), f the ball's unbalanced radial
+    and axial force (N; centrifugal force m omega_m^2 r_b included), ``contact`` what
+    :func:`ball_normal_block` needs: the square roots of the penetrations (floored) and the two
+    centre distances."""
+    rb, zb = ball[j, B_R], ball[j, B_Z]
+    di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
+    sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
+    sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
+    qi = p[P_K_IN] * di * sdi if di > 0.0 else 0.0
+    qo = p[P_K_OUT] * do * sdo if do > 0.0 else 0.0
+    geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
+    geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
+    w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
+    fr = -qi * nir - qo * nor + p[P_MBALL] * w2 * rb
+    fz = -qi * niz - qo * noz
+    return qi, nir, niz, fr, fz, (sdi, sdo, disti, disto)
+
+
+@njit(cache=True, inline="always")
+def ball_normal_block(p: np.ndarray, ball: np.ndarray, j: int, geo: np.ndarray, work: np.ndarray, fr: float, fz: float, contact: tuple) -> tuple:
+    """Eliminate ball j's 2x2 Newton block (after :func:`ball_normal_residual`) onto the inner
+    ring's local moves in the ball's plane, axial a and radial r of the inner curvature centre.
+
+    Writes into ``work[j]`` the ball's step u = J^-1 f and its sensitivities w = J^-1 b to a
+    unit axial (b = -H_i e_z) and v to a unit radial (b = -H_i e_r) move of the ring. Returns
+    (rho_a, rho_r, K_aa, K_ar, K_ra, K_rr): the right side and the 2x2 stiffness D - C J^-1 B
+    of the ring's local (axial a, radial r) balance, rows the force, columns the move.
+    """
+    m = p[P_MBALL]
+    ki, ko = p[P_K_IN], p[P_K_OUT]
+    sdi, sdo, disti, disto = contact
+    w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
+    qi, qo = geo[j, G_QI], geo[j, G_QO]
+    nir, niz, nor, noz = geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
+    hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
+    horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
+    a11 = hirr + horr + m * w2
+    a12 = hirz + horz
+    a22 = hizz + hozz
+    det = a11 * a22 - a12 * a12
+    if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
+        # both contacts barely touching along parallel normals at rest (the ball on the
+        # line of the curvature centres, no centrifugal force): free across that line;
+        # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
+        eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
+        a11 -= eps
+        a22 -= eps
+        det = a11 * a22 - a12 * a12
+    # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
+    ux = (a22 * fr - a12 * fz) / det
+    uz = (-a12 * fr + a11 * fz) / det
+    wx = (-a22 * hirz + a12 * hizz) / det
+    wz = (a12 * hirz - a11 * hizz) / det
+    vx = (-a22 * hirr + a12 * hirz) / det
+    vz = (a12 * hirr - a11 * hirz) / det
+    work[j, 0], work[j, 1], work[j, 2], work[j, 3], work[j, 4], work[j, 5] = ux, uz, wx, wz, vx, vz
+    # ring rows C = d(ring force)/d(ball): axial -(hirz, hizz), radial -(hirr, hirz)
+    ca_u = -(hirz * ux + hizz * uz)
+    cr_u = -(hirr * ux + hirz * uz)
+    s_zz = hizz + hirz * wx + hizz * wz
+    ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
+    cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
+    cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
+    return ca_u, cr_u, s_zz, ca_v, cr_w, cr_v
+
+
 @njit(cache=True)
 def solve_quasi_static(
     p: np.ndarray,
@@ -303,8 +378,6 @@ def solve_quasi_static(
     Returns the number of iterations used (max_iter + 1 if not converged).
     """
     z = ball.shape[0]
-    m = p[P_MBALL]
-    ki, ko = p[P_K_IN], p[P_K_OUT]
     scale = tol * max(axial_load, abs(radial_load), 1.0)
     radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
     load_x, load_y = radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle)
@@ -316,21 +389,11 @@ def solve_quasi_static(
         r0 = r1 = r2 = 0.0
         worst = 0.0
         for j in range(z):
-            rb, zb = ball[j, B_R], ball[j, B_Z]
             cth = sth = shift = 0.0
             if radial:
                 cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
                 shift = dx * cth + dy * sth
-            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
-            sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
-            sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
-            qi = ki * di * sdi if di > 0.0 else 0.0
-            qo = ko * do * sdo if do > 0.0 else 0.0
-            geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
-            geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
-            w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
-            fr = -qi * nir - qo * nor + m * w2 * rb
-            fz = -qi * niz - qo * noz
+            qi, nir, niz, fr, fz, contact = ball_normal_residual(p, ball, j, delta_a, shift, geo)
             worst = max(worst, abs(fr), abs(fz))
             ga += qi * niz
             if radial:
@@ -338,39 +401,12 @@ def solve_quasi_static(
                 gy += qi * nir * sth
             if it == max_iter:
                 continue
-            hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
-            horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
-            a11 = hirr + horr + m * w2
-            a12 = hirz + horz
-            a22 = hizz + hozz
-            det = a11 * a22 - a12 * a12
-            if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
-                # both contacts barely touching along parallel normals at rest (the ball on the
-                # line of the curvature centres, no centrifugal force): free across that line;
-                # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
-                eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
-                a11 -= eps
-                a22 -= eps
-                det = a11 * a22 - a12 * a12
-            # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
-            ux = (a22 * fr - a12 * fz) / det
-            uz = (-a12 * fr + a11 * fz) / det
-            wx = (-a22 * hirz + a12 * hizz) / det
-            wz = (a12 * hirz - a11 * hizz) / det
-            vx = (-a22 * hirr + a12 * hirz) / det
-            vz = (a12 * hirr - a11 * hirz) / det
-            work[j, 0], work[j, 1], work[j, 2], work[j, 3] = ux, uz, wx, wz
-            # ring rows C = d(ring force)/d(ball): axial -(hirz, hizz), radial -(hirr, hirz) x direction
-            ca_u = -(hirz * ux + hizz * uz)
-            cr_u = -(hirr * ux + hirz * uz)
+            ca_u, cr_u, s_zz, ca_v, cr_w, cr_v = ball_normal_block(p, ball, j, geo, work, fr, fz, contact)
             r0 += ca_u
-            s00 += hizz + hirz * wx + hizz * wz
+            s00 += s_zz
             if radial:
                 r1 += cr_u * cth
                 r2 += cr_u * sth
-                ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
-                cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
-                cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
                 s01 += ca_v * cth
                 s02 += ca_v * sth
                 s10 += cr_w * cth
@@ -378,7 +414,6 @@ def solve_quasi_static(
                 s11 += cr_v * cth * cth
                 s12 += cr_v * cth * sth
                 s22 += cr_v * sth * sth
-                work[j, 4], work[j, 5] = vx, vz
         if worst < scale and abs(ga) < scale and abs(gx) < scale and abs(gy) < scale:
             return it
         if it == max_iter:
@@ -415,6 +450,119 @@ def solve_quasi_static(
                 ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd), -lim), lim)
                 ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd), -lim), lim)
     return max_iter + 1
+
+
+@njit(cache=True)
+def gauss_solve(a: np.ndarray, b: np.ndarray) -> None:
+    """Solve a x = b in place (x into ``b``; ``a`` destroyed) by Gaussian elimination with
+    partial pivoting, for the ring's small Schur systems."""
+    n = b.shape[0]
+    for k in range(n):
+        piv = k
+        for i in range(k + 1, n):
+            if abs(a[i, k]) > abs(a[piv, k]):
+                piv = i
+        if piv != k:
+            for c in range(n):
+                a[k, c], a[piv, c] = a[piv, c], a[k, c]
+            b[k], b[piv] = b[piv], b[k]
+        for i in range(k + 1, n):
+            f = a[i, k] / a[k, k]
+            for c in range(k, n):
+                a[i, c] -= f * a[k, c]
+            b[i] -= f * b[k]
+    for k in range(n - 1, -1, -1):
+        acc = b[k]
+        for c in range(k + 1, n):
+            acc -= a[k, c] * b[c]
+        b[k] = acc / a[k, k]
+
+
+@njit(cache=True)
+def solve_quasi_static_tilted(
+    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, loads: np.ndarray, tol: float, max_iter: int
+) -> int:
+    """:func:`solve_quasi_static` with the inner ring's two tilts free under an applied moment.
+    ``loads`` holds (F_a, F_x, F_y, M_x, M_y), N and N m (the radial load by its components), the
+    moments counted as in dynamics/quasi_static.py: M_x = sum Q_i sin a_i R_i cos psi,
+    M_y with sin psi (an axial force at psi = 0 gives M_x > 0). Ring unknowns (delta_a, delta_x,
+    delta_y, theta_x, theta_y); ball j at orbital angle theta_j sees its inner curvature centre
+    moved axially by a_j = delta_a + R_i (theta_x c_j + theta_y s_j) and radially by
+    r_j = delta_x c_j + delta_y s_j (c_j, s_j the cosine and sine of theta_j). Each ball's block
+    is eliminated onto (a_j, r_j) (:func:`ball_normal_block`) and mapped onto the five unknowns,
+    S = sum B_j^T K_j B_j, a 5x5 Schur system. Updates ball B_R, B_Z and ring R_DELTA, R_DX,
+    R_DY, R_TX, R_TY.
+
+    Returns the number of iterations used (max_iter + 1 if not converged).
+    """
+    z = ball.shape[0]
+    ri = p[P_CI_R]
+    target = np.array([loads[0], loads[1], loads[2], loads[3] / ri, loads[4] / ri])
+    scale = tol * max(np.max(np.abs(target)), 1.0)
+    s = np.empty((5, 5))
+    g = np.empty(5)
+    ba = np.empty(5)  # d a_j / d(unknowns), lengths per R_i for the tilts
+    br = np.empty(5)
+    lim = 2e-6
+    for it in range(max_iter + 1):
+        delta_a, dx, dy, tx, ty = ring[R_DELTA], ring[R_DX], ring[R_DY], ring[R_TX], ring[R_TY]
+        g[:] = target
+        s[:] = 0.0
+        rhs = np.zeros(5)
+        worst = 0.0
+        for j in range(z):
+            cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+            lift = ri * (tx * cth + ty * sth)
+            qi, nir, niz, fr, fz, contact = ball_normal_residual(p, ball, j, delta_a + lift, dx * cth + dy * sth, geo)
+            worst = max(worst, abs(fr), abs(fz))
+            # the ring's generalised forces, moments per R_i (unknowns: tilts times R_i)
+            ba[0], ba[1], ba[2], ba[3], ba[4] = 1.0, 0.0, 0.0, cth, sth
+            br[0], br[1], br[2], br[3], br[4] = 0.0, cth, sth, 0.0, 0.0
+            for k in range(5):
+                g[k] += qi * (niz * ba[k] + nir * br[k])
+            if it == max_iter:
+                continue
+            rho_a, rho_r, k_aa, k_ar, k_ra, k_rr = ball_normal_block(p, ball, j, geo, work, fr, fz, contact)
+            for k in range(5):
+                rhs[k] += ba[k] * rho_a + br[k] * rho_r
+                for c in range(5):
+                    s[k, c] += ba[k] * (k_aa * ba[c] + k_ar * br[c]) + br[k] * (k_ra * ba[c] + k_rr * br[c])
+        if worst < scale and np.max(np.abs(g)) < scale:
+            return it
+        if it == max_iter:
+            break
+        for k in range(5):
+            rhs[k] -= g[k]
+        gauss_solve(s, rhs)
+        for k in range(5):
+            rhs[k] = min(max(rhs[k], -lim), lim)
+        ring[R_DELTA] = delta_a + rhs[0]
+        ring[R_DX] = dx + rhs[1]
+        ring[R_DY] = dy + rhs[2]
+        ring[R_TX] = tx + rhs[3] / ri
+        ring[R_TY] = ty + rhs[4] / ri
+        for j in range(z):
+            cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+            da = rhs[0] + rhs[3] * cth + rhs[4] * sth
+            dr = rhs[1] * cth + rhs[2] * sth
+            ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * da + work[j, 4] * dr), -lim), lim)
+            ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * da + work[j, 5] * dr), -lim), lim)
+    return max_iter + 1
+
+
+@njit(cache=True)
+def ring_moment(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray) -> None:
+    """The moment of the balls' inner contact loads on the inner ring (N m) into ring R_MX, R_MY,
+    counted as in dynamics/quasi_static.py: M_x = sum Q_i sin a_i R_i cos theta_j, M_y with
+    sin theta_j (sin a_i = -n_iz), from the contact state in ``geo`` solved at the balls' angles.
+    With the tilts held it is the reaction moment the spindle's second bearing supplies; with
+    them free it balances the applied moment."""
+    mx = my = 0.0
+    for j in range(ball.shape[0]):
+        fa = -geo[j, G_QI] * geo[j, G_NIZ] * p[P_CI_R]
+        mx += fa * math.cos(ball[j, B_THETA])
+        my += fa * math.sin(ball[j, B_THETA])
+    ring[R_MX], ring[R_MY] = mx, my
 
 
 @njit(cache=True)
@@ -958,6 +1106,9 @@ def step_reduced(
     record_every: int,
     radial_load: float = 0.0,
     radial_angle: float = 0.0,
+    moment_x: float = 0.0,
+    moment_y: float = 0.0,
+    tilt_free: bool = False,
 ) -> int:
     """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
 
@@ -969,8 +1120,11 @@ def step_reduced(
     cage centre, t_j the pocket's circumferential direction): the pockets push the cage centre
     along t_j, and pocket friction along the pocket's radial direction (the ball's surface
     moves radially there). The inner ring turns at the prescribed speed, changing at
-    ``inner_acceleration`` (rad/s^2). ``work`` is scratch of shape (Z, NW). Diagnostics go to
-    ``out`` on the last step and every ``record_every`` steps.
+    ``inner_acceleration`` (rad/s^2). With ``tilt_free`` the inner ring's tilts are unknowns of
+    the normal solve under the moment (``moment_x``, ``moment_y``, N m;
+    :func:`solve_quasi_static_tilted`); otherwise they stay where they are (held). ``work`` is
+    scratch of shape (Z, NW). Diagnostics go to ``out`` on the last step and every
+    ``record_every`` steps.
 
     Returns the largest number of quasi-static Newton iterations used.
     """
@@ -987,22 +1141,28 @@ def step_reduced(
     qs_work = work[:, NG : NG + 6]  # the quasi-static solve's scratch, free again after it
     tri_work = work[:, NG + 4 : NG + 8]
     w0 = NG + 8  # per-ball elimination data
+    loads = np.array([axial_load, radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle), moment_x, moment_y])
     worst_iter = 0
     lc = cl + dt * kl
     pitch_c, pitch_s = math.cos(2.0 * math.pi / z), math.sin(2.0 * math.pi / z)
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
-        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load, radial_angle)
+        if tilt_free:
+            it = solve_quasi_static_tilted(p, ball, ring, geo, qs_work, loads, 1e-9, 30)
+        else:
+            it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load, radial_angle)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        if keep:
+            ring_moment(p, ball, ring, geo)
         cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
         # the cage centre moves once something pushes it off the axis: a radial load or a state
         # left off it; a centred cage under a purely axial load is an exact equilibrium (the
         # pockets' forces cancel, the film has none) and skips the centre's terms. The cage's
         # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
         # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
-        centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        centre = radial_load != 0.0 or tilt_free or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
         if centre:
             omega_c = 0.0
@@ -1175,6 +1335,9 @@ def step_stiff(
     record_every: int,
     radial_load: float = 0.0,
     radial_angle: float = 0.0,
+    moment_x: float = 0.0,
+    moment_y: float = 0.0,
+    tilt_free: bool = False,
 ) -> int:
     """Advance the stiff reference model by ``n_steps`` explicit steps of ``dt`` seconds.
 
@@ -1184,7 +1347,7 @@ def step_stiff(
     canonical polar coordinates (momenta first, then positions), so that with friction and
     damping off the energy error stays bounded. Needs steps well below a microsecond.
     ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric; ``radial_angle``
-    unused). Returns 0.
+    and the moment unused, ``tilt_free`` False). Returns 0.
     """
     z = ball.shape[0]
     rm = p[P_RM]

@@ -344,7 +344,8 @@ class BearingDynamics:
         for j in range(self.params.ball_count):
             rb, zb, theta = self.ball[j, kn.B_R], self.ball[j, kn.B_Z], self.ball[j, kn.B_THETA]
             shift = self.ring[kn.R_DX] * math.cos(theta) + self.ring[kn.R_DY] * math.sin(theta)
-            _, nir, niz, _, _, nor, noz, _ = kn.shifted_raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA], shift)
+            lift = v[kn.P_CI_R] * (self.ring[kn.R_TX] * math.cos(theta) + self.ring[kn.R_TY] * math.sin(theta))
+            _, nir, niz, _, _, nor, noz, _ = kn.shifted_raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA] + lift, shift)
             r_ci, _, _, _, aim, aia, aom, aoa, _ = kn.ball_kinematics(v, nir, niz, nor, noz, rb)
             # s_i = 0 and s_o = 0: a 2x2 linear system in (omega_m, omega_a)
             det = aim * aoa + aia * aom

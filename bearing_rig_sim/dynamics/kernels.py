@@ -283,76 +283,6 @@ def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> 
     return (-dq * nr * nr - t * (1.0 - nr * nr), -dq * nr * nz + t * nr * nz, -dq * nz * nz - t * (1.0 - nz * nz))
 
 
-@njit(cache=True, inline="always")
-def ball_normal_residual(p: np.ndarray, ball: np.ndarray, j: int, delta_a: float, shift: float, geo: np.ndarray) -> tuple:
-    """Ball j's raceway contacts with the inner groove's curvature centre moved ``delta_a`` (m)
-    axially and ``shift`` (m) radially: writes the loads, normals and penetrations into
-    ``geo[j]`` and returns (Q_i, n_ir, n_iz, f_r, f_z, contact), f the ball's unbalanced radial
-    and axial force (N; centrifugal force m omega_m^2 r_b included), ``contact`` what
-    :func:`ball_normal_block` needs: the square roots of the penetrations (floored) and the two
-    centre distances."""
-    rb, zb = ball[j, B_R], ball[j, B_Z]
-    di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
-    sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
-    sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
-    qi = p[P_K_IN] * di * sdi if di > 0.0 else 0.0
-    qo = p[P_K_OUT] * do * sdo if do > 0.0 else 0.0
-    geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
-    geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
-    w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
-    fr = -qi * nir - qo * nor + p[P_MBALL] * w2 * rb
-    fz = -qi * niz - qo * noz
-    return qi, nir, niz, fr, fz, (sdi, sdo, disti, disto)
-
-
-@njit(cache=True, inline="always")
-def ball_normal_block(p: np.ndarray, ball: np.ndarray, j: int, geo: np.ndarray, work: np.ndarray, fr: float, fz: float, contact: tuple) -> tuple:
-    """Eliminate ball j's 2x2 Newton block (after :func:`ball_normal_residual`) onto the inner
-    ring's local moves in the ball's plane, axial a and radial r of the inner curvature centre.
-
-    Writes into ``work[j]`` the ball's step u = J^-1 f and its sensitivities w = J^-1 b to a
-    unit axial (b = -H_i e_z) and v to a unit radial (b = -H_i e_r) move of the ring. Returns
-    (rho_a, rho_r, K_aa, K_ar, K_ra, K_rr): the right side and the 2x2 stiffness D - C J^-1 B
-    of the ring's local (axial a, radial r) balance, rows the force, columns the move.
-    """
-    m = p[P_MBALL]
-    ki, ko = p[P_K_IN], p[P_K_OUT]
-    sdi, sdo, disti, disto = contact
-    w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
-    qi, qo = geo[j, G_QI], geo[j, G_QO]
-    nir, niz, nor, noz = geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-    hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
-    horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
-    a11 = hirr + horr + m * w2
-    a12 = hirz + horz
-    a22 = hizz + hozz
-    det = a11 * a22 - a12 * a12
-    if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
-        # both contacts barely touching along parallel normals at rest (the ball on the
-        # line of the curvature centres, no centrifugal force): free across that line;
-        # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
-        eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
-        a11 -= eps
-        a22 -= eps
-        det = a11 * a22 - a12 * a12
-    # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
-    ux = (a22 * fr - a12 * fz) / det
-    uz = (-a12 * fr + a11 * fz) / det
-    wx = (-a22 * hirz + a12 * hizz) / det
-    wz = (a12 * hirz - a11 * hizz) / det
-    vx = (-a22 * hirr + a12 * hirz) / det
-    vz = (a12 * hirr - a11 * hirz) / det
-    work[j, 0], work[j, 1], work[j, 2], work[j, 3], work[j, 4], work[j, 5] = ux, uz, wx, wz, vx, vz
-    # ring rows C = d(ring force)/d(ball): axial -(hirz, hizz), radial -(hirr, hirz)
-    ca_u = -(hirz * ux + hizz * uz)
-    cr_u = -(hirr * ux + hirz * uz)
-    s_zz = hizz + hirz * wx + hizz * wz
-    ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
-    cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
-    cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
-    return ca_u, cr_u, s_zz, ca_v, cr_w, cr_v
-
-
 @njit(cache=True)
 def solve_quasi_static(
     p: np.ndarray,
@@ -378,6 +308,8 @@ def solve_quasi_static(
     Returns the number of iterations used (max_iter + 1 if not converged).
     """
     z = ball.shape[0]
+    m = p[P_MBALL]
+    ki, ko = p[P_K_IN], p[P_K_OUT]
     scale = tol * max(axial_load, abs(radial_load), 1.0)
     radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
     load_x, load_y = radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle)
@@ -389,11 +321,21 @@ def solve_quasi_static(
         r0 = r1 = r2 = 0.0
         worst = 0.0
         for j in range(z):
+            rb, zb = ball[j, B_R], ball[j, B_Z]
             cth = sth = shift = 0.0
             if radial:
                 cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
                 shift = dx * cth + dy * sth
-            qi, nir, niz, fr, fz, contact = ball_normal_residual(p, ball, j, delta_a, shift, geo)
+            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
+            sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
+            sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
+            qi = ki * di * sdi if di > 0.0 else 0.0
+            qo = ko * do * sdo if do > 0.0 else 0.0
+            geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
+            geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
+            w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
+            fr = -qi * nir - qo * nor + m * w2 * rb
+            fz = -qi * niz - qo * noz
             worst = max(worst, abs(fr), abs(fz))
             ga += qi * niz
             if radial:
@@ -401,12 +343,39 @@ def solve_quasi_static(
                 gy += qi * nir * sth
             if it == max_iter:
                 continue
-            ca_u, cr_u, s_zz, ca_v, cr_w, cr_v = ball_normal_block(p, ball, j, geo, work, fr, fz, contact)
+            hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
+            horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
+            a11 = hirr + horr + m * w2
+            a12 = hirz + horz
+            a22 = hizz + hozz
+            det = a11 * a22 - a12 * a12
+            if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
+                # both contacts barely touching along parallel normals at rest (the ball on the
+                # line of the curvature centres, no centrifugal force): free across that line;
+                # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
+                eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
+                a11 -= eps
+                a22 -= eps
+                det = a11 * a22 - a12 * a12
+            # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
+            ux = (a22 * fr - a12 * fz) / det
+            uz = (-a12 * fr + a11 * fz) / det
+            wx = (-a22 * hirz + a12 * hizz) / det
+            wz = (a12 * hirz - a11 * hizz) / det
+            vx = (-a22 * hirr + a12 * hirz) / det
+            vz = (a12 * hirr - a11 * hirz) / det
+            work[j, 0], work[j, 1], work[j, 2], work[j, 3] = ux, uz, wx, wz
+            # ring rows C = d(ring force)/d(ball): axial -(hirz, hizz), radial -(hirr, hirz) x direction
+            ca_u = -(hirz * ux + hizz * uz)
+            cr_u = -(hirr * ux + hirz * uz)
             r0 += ca_u
-            s00 += s_zz
+            s00 += hizz + hirz * wx + hizz * wz
             if radial:
                 r1 += cr_u * cth
                 r2 += cr_u * sth
+                ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
+                cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
+                cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
                 s01 += ca_v * cth
                 s02 += ca_v * sth
                 s10 += cr_w * cth
@@ -414,6 +383,7 @@ def solve_quasi_static(
                 s11 += cr_v * cth * cth
                 s12 += cr_v * cth * sth
                 s22 += cr_v * sth * sth
+                work[j, 4], work[j, 5] = vx, vz
         if worst < scale and abs(ga) < scale and abs(gx) < scale and abs(gy) < scale:
             return it
         if it == max_iter:
@@ -489,7 +459,7 @@ def solve_quasi_static_tilted(
     delta_y, theta_x, theta_y); ball j at orbital angle theta_j sees its inner curvature centre
     moved axially by a_j = delta_a + R_i (theta_x c_j + theta_y s_j) and radially by
     r_j = delta_x c_j + delta_y s_j (c_j, s_j the cosine and sine of theta_j). Each ball's block
-    is eliminated onto (a_j, r_j) (:func:`ball_normal_block`) and mapped onto the five unknowns,
+    is eliminated onto (a_j, r_j) and mapped onto the five unknowns,
     S = sum B_j^T K_j B_j, a 5x5 Schur system. Updates ball B_R, B_Z and ring R_DELTA, R_DX,
     R_DY, R_TX, R_TY.
 
@@ -497,6 +467,7 @@ def solve_quasi_static_tilted(
     """
     z = ball.shape[0]
     ri = p[P_CI_R]
+    m, ki, ko = p[P_MBALL], p[P_K_IN], p[P_K_OUT]
     target = np.array([loads[0], loads[1], loads[2], loads[3] / ri, loads[4] / ri])
     scale = tol * max(np.max(np.abs(target)), 1.0)
     s = np.empty((5, 5))
@@ -513,8 +484,16 @@ def solve_quasi_static_tilted(
         for j in range(z):
             cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
             lift = ri * (tx * cth + ty * sth)
-            qi, nir, niz, fr, fz, contact = ball_normal_residual(p, ball, j, delta_a + lift, dx * cth + dy * sth, geo)
-            worst = max(worst, abs(fr), abs(fz))
+            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, ball[j, B_R], ball[j, B_Z], delta_a + lift, dx * cth + dy * sth)
+            root_i, root_o = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN)), math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
+            qi = ki * di * root_i if di > 0.0 else 0.0
+            qo = ko * do * root_o if do > 0.0 else 0.0
+            geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
+            geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
+            spin2 = m * ball[j, B_OMEGA] ** 2
+            res_r = spin2 * ball[j, B_R] - qi * nir - qo * nor
+            res_z = -qi * niz - qo * noz
+            worst = max(worst, abs(res_r), abs(res_z))
             # the ring's generalised forces, moments per R_i (unknowns: tilts times R_i)
             ba[0], ba[1], ba[2], ba[3], ba[4] = 1.0, 0.0, 0.0, cth, sth
             br[0], br[1], br[2], br[3], br[4] = 0.0, cth, sth, 0.0, 0.0
@@ -522,7 +501,27 @@ def solve_quasi_static_tilted(
                 g[k] += qi * (niz * ba[k] + nir * br[k])
             if it == max_iter:
                 continue
-            rho_a, rho_r, k_aa, k_ar, k_ra, k_rr = ball_normal_block(p, ball, j, geo, work, fr, fz, contact)
+            # the ball's 2x2 Jacobian J = H_i + H_o + m omega^2 e_r e_r and its inverse
+            h_rr, h_rz, h_zz = contact_jacobian(qi, 1.5 * ki * root_i, nir, niz, disti)
+            o_rr, o_rz, o_zz = contact_jacobian(qo, 1.5 * ko * root_o, nor, noz, disto)
+            j_rr, j_rz, j_zz = h_rr + o_rr + spin2, h_rz + o_rz, h_zz + o_zz
+            det = j_rr * j_zz - j_rz * j_rz
+            if abs(det) <= 1e-12 * (j_rr * j_rr + j_zz * j_zz):  # free across the contact line (see solve_quasi_static)
+                soft = 1e-6 * (abs(j_rr) + abs(j_zz)) + 1e-12
+                j_rr -= soft
+                j_zz -= soft
+                det = j_rr * j_zz - j_rz * j_rz
+            inv_rr, inv_rz, inv_zz = j_zz / det, -j_rz / det, j_rr / det
+            # the ball's step u = J^-1 f and its response to a unit local move of the inner
+            # curvature centre, axial (w = -J^-1 H_i e_z) and radial (v = -J^-1 H_i e_r)
+            u_r, u_z = inv_rr * res_r + inv_rz * res_z, inv_rz * res_r + inv_zz * res_z
+            w_r, w_z = -(inv_rr * h_rz + inv_rz * h_zz), -(inv_rz * h_rz + inv_zz * h_zz)
+            v_r, v_z = -(inv_rr * h_rr + inv_rz * h_rz), -(inv_rz * h_rr + inv_zz * h_rz)
+            work[j, 0], work[j, 1], work[j, 2], work[j, 3], work[j, 4], work[j, 5] = u_r, u_z, w_r, w_z, v_r, v_z
+            # the ring's local balance (axial a, radial r): right side -H_i u, stiffness H_i (I + [w v])
+            rho_a, rho_r = -(h_rz * u_r + h_zz * u_z), -(h_rr * u_r + h_rz * u_z)
+            k_aa, k_ar = h_zz + h_rz * w_r + h_zz * w_z, h_rz + h_rz * v_r + h_zz * v_z
+            k_ra, k_rr = h_rz + h_rr * w_r + h_rz * w_z, h_rr + h_rr * v_r + h_rz * v_z
             for k in range(5):
                 rhs[k] += ba[k] * rho_a + br[k] * rho_r
                 for c in range(5):

@@ -186,7 +186,7 @@ BEARING_AXIAL_FORCE = Topic(
     "each `/clock` advance (up to 1 kHz)",
     "N",
     "load controller -> simulator",
-    note="force.z axial, force.x/y radial (their magnitude); torque.x/y ignored with a WARN",
+    note="force.z axial, force.x/y radial (magnitude and azimuth), torque.x/y a moment (frees the tilts); up to the rig file's limits",
 )
 SLIP_STATUS = Topic(
     "/rig/slip_status",

@@ -1,6 +1,7 @@
 """``bearing-rig predict --radial-load N [--moment M_X M_Y]``: the quasi-static load distribution
-beside the steady slip (dynamics/quasi_static.py; the closed forms are tested in
-test_dynamics_quasi_static.py)."""
+(dynamics/quasi_static.py; the closed forms are tested in test_dynamics_quasi_static.py) beside
+the engine's steady slip under the combined load, averaged over whole ball-pass periods
+(test_dynamics_steady_periodic.py)."""
 
 from __future__ import annotations
 
@@ -16,8 +17,9 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
     """F_r = 500 N, F_a = 163 N at 900 rpm (a half-loaded ring, Stribeck/Sjovall
     Q_max = 4.37 F_r / (Z cos 15 deg) = 141.4 N; the centrifugal force at 900 rpm, 0.03 N,
     changes nothing measurable): the keys of the contract, Q_max within 3 %, half the balls loaded,
-    the tilt held with a reaction moment about the axis across the load (M_x > 0, M_y = 0), and
-    no cage whirl (not modelled)."""
+    the tilt held with a reaction moment about the axis across the load (M_x > 0, M_y = 0), the
+    cage pushed off the axis within its land clearance, and a slip other than the axial load's
+    alone."""
     assert main(["predict", "--rpm", "900", "--load", "163", "--radial-load", "500", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["ball_load_max_n"] == pytest.approx(4.37 * 500 / (16 * math.cos(math.radians(15.0))), rel=0.03)
@@ -26,13 +28,15 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
     assert 10.0 < row["contact_angle_max_load_deg"] < 20.0
     mx, my = row["reaction_moment_n_m"]
     assert mx > 0.0 and abs(my) < 1e-6
-    assert "cage_whirl_radius_um" not in row
-    assert "slip_pct" in row  # the steady slip as before
+    assert 1.0 < row["cage_whirl_radius_um"] < 100.0  # the H7006C's land clearance: 100 um
+    assert main(["predict", "--rpm", "900", "--load", "163", "--json"]) == 0
+    axial = json.loads(capsys.readouterr().out)
+    assert abs(row["slip_pct"] - axial["slip_pct"]) > 0.1
 
 
 def test_a_given_moment_tilts_the_ring_instead(capsys: pytest.CaptureFixture[str]) -> None:
     """With --moment the tilt is free and reported; no radial load and no moment: every ball
-    alike (pure thrust)."""
+    alike (pure thrust), and the slip that of the axial load alone within 0.01 pp."""
     assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--radial-load", "0", "--moment", "0", "0", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     for row in rows:
@@ -40,6 +44,10 @@ def test_a_given_moment_tilts_the_ring_instead(capsys: pytest.CaptureFixture[str
         assert row["ball_load_min_n"] == pytest.approx(row["ball_load_max_n"], rel=0.05)  # outer carries F_c too
         assert max(abs(t) for t in row["tilt_mrad"]) < 1e-6
         assert "reaction_moment_n_m" not in row
+    assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--json"]) == 0
+    axial = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    for row, plain in zip(rows, axial, strict=True):
+        assert row["slip_pct"] == pytest.approx(plain["slip_pct"], abs=0.01)
 
 
 @pytest.mark.parametrize(

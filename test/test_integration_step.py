@@ -182,10 +182,8 @@ class _DivergingEngine(BearingDynamics):
     """An engine whose state is made impossible once the ring turns (the cage runs backwards):
     the divergence check must catch it whatever produced it."""
 
-    def advance(
-        self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0, radial_load: float | None = None
-    ) -> ChunkAverage:
-        avg = super().advance(duration, axial_load=axial_load, inner_ring_acceleration=inner_ring_acceleration, radial_load=radial_load)
+    def advance(self, duration: float, **loads: Any) -> ChunkAverage:
+        avg = super().advance(duration, **loads)
         if self.inner_ring_speed > 0.1:
             self.cage[:, kn.C_OMEGA] = -self.inner_ring_speed
             self.check_state()

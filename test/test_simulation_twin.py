@@ -23,7 +23,7 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
-from bearing_rig_sim.simulation.twin import AxialLoadError, RadialLoadError, RigTwin, TwinError
+from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RadialLoadError, RigTwin, TwinError
 
 RPM = math.pi / 30.0
 BEARING = config_path("bearings", "h7006c.yaml")
@@ -201,6 +201,7 @@ def test_radial_load_is_the_magnitude_of_its_components_and_reaches_the_engine(p
     assert twin.set_loads(163.0, 300.0, -400.0) == (163.0, 500.0)
     twin.tick()
     assert twin.engine.radial_load == 500.0
+    assert twin.engine.radial_angle == pytest.approx(math.atan2(-4.0, 3.0), abs=1e-15)  # the load zone's azimuth
     with pytest.raises(RadialLoadError, match="force.y must be a finite"):
         twin.set_loads(200.0, 0.0, math.inf)
     with pytest.raises(AxialLoadError, match=">= 0"):
@@ -213,6 +214,29 @@ def test_radial_load_is_the_magnitude_of_its_components_and_reaches_the_engine(p
     with pytest.raises(RadialLoadError, match="reduced model"):
         stiff.set_loads(163.0, 1.0, 0.0)
     assert stiff.set_loads(170.0, 0.0, 0.0) == (170.0, 0.0)
+
+
+def test_the_rig_files_radial_limit_bounds_the_radial_force(tmp_path):
+    """The rig file is the authority on the loading chain: the shipped one (the paper's bench
+    loads only axially, combined_loading limits 0 N and 0 N m) refuses any radial force or
+    moment, naming the limit and the value, and keeps the loads it had; a rig file stating a
+    radial loader of 800 N takes 800 N and refuses 800.5 N."""
+    shipped = RigTwin.from_files(initial_axial_load=163.0)
+    with pytest.raises(RadialLoadError, match=r"radial force: 5 N is above the rig's limit of 0 N \(combined_loading\.max_radial_setpoint_n in rig\.yaml\)"):
+        shipped.set_loads(200.0, 3.0, 4.0)
+    with pytest.raises(MomentError, match=r"moment: 1 N m is above the rig's limit of 0 N m \(combined_loading\.max_moment_setpoint_n_m in rig\.yaml\)"):
+        shipped.set_loads(200.0, 0.0, 0.0, 0.0, 1.0)
+    assert (shipped.axial_load, shipped.radial_load, shipped.moment) == (163.0, 0.0, (0.0, 0.0))
+    assert shipped.set_loads(200.0, 0.0, 0.0) == (200.0, 0.0)
+    doc = yaml.safe_load(config_path("rig.yaml").read_text())
+    doc["combined_loading"]["max_radial_setpoint_n"] = 800.0
+    radial_rig = tmp_path / "radial_rig.yaml"
+    radial_rig.write_text(yaml.safe_dump(doc))
+    twin = RigTwin.from_files(None, None, radial_rig, initial_axial_load=163.0)
+    assert twin.set_loads(163.0, 0.0, 800.0) == (163.0, 800.0)
+    with pytest.raises(RadialLoadError, match=r"800\.5 N is above the rig's limit of 800 N \(combined_loading\.max_radial_setpoint_n in radial_rig\.yaml\)"):
+        twin.set_loads(163.0, 0.0, 800.5)
+    assert twin.radial_load == 800.0
 
 
 def test_deceleration_to_rest_keeps_whole_chunks_and_the_counters_fall_to_zero(params):

@@ -16,8 +16,12 @@ the bearing file's lubricant (the calibration's lubricant values are laid over i
 With ``--radial-load`` (and ``--moment``) each point also gets the quasi-static load
 distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max_n``,
 ``ball_load_min_n``, ``loaded_balls``, ``contact_angle_max_load_deg`` and, with the tilt held
-(no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. The slip is still that of the axial load
-(the dynamic engine is axisymmetric); ``cage_whirl_radius_um`` is not computed (no cage whirl).
+(no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. Such a point's slip, torque and power are
+the engine's under the combined load, averaged over whole ball-pass periods (the steady state is
+periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`), with
+``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end (and no
+uncertainty interval: the calibration's is an axial-load one). ``--thermal`` and
+``--transient`` take the axial load only.
 """
 
 from __future__ import annotations
@@ -33,9 +37,10 @@ from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
+from bearing_rig_sim.dynamics.steady import solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.settings_model import read_file
-from bearing_rig_sim.studies.calibration import steady_states
+from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 
 
 def register(subparsers: Any) -> None:
@@ -94,13 +99,22 @@ def run(args: argparse.Namespace) -> int:
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
     unc = _uncertainty(args)
     for k, s in enumerate(states):
+        combined = radial is not None and (radial[k] > 0.0 or args.moment is not None)
+        whirl = None
+        if radial is not None and combined:
+            solver = solver_for(params)
+            pt = solver.periodic(s.inner_ring_speed, s.axial_load, radial[k], moment=None if args.moment is None else (args.moment[0], args.moment[1]))
+            s = SteadyState(pt.inner_ring_speed, pt.axial_load, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+            whirl = solver.engine.cage_whirl_radius
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
-        if unc is not None:
+        if unc is not None and not combined:
             _add_interval(row, params, unc, s.inner_ring_speed, s.axial_load, s.slip_pct)
         row.update(s.losses_row(params.composite_roughness))
         if radial is not None:
             row.update(load_distribution_row(params, s.inner_ring_speed, s.axial_load, radial[k], args.moment))
+        if whirl is not None:
+            row["cage_whirl_radius_um"] = round(whirl * 1e6, 3)
         _print(row, args.json)
     return 0
 

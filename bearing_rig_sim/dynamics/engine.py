@@ -80,6 +80,8 @@ class Snapshot:
     ring: np.ndarray
     axial_load: float
     radial_load: float = 0.0
+    radial_angle: float = 0.0
+    moment: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -100,7 +102,13 @@ class Observation:
         axial_load: applied axial load, N.
         cage_whirl_radius: distance of the cage centre from the bearing axis, m (reduced model;
             0 for the concentric stiff model).
-        cage_centre: the cage centre's (x, y) displacement, m (x along the radial load).
+        cage_centre: the cage centre's (x, y) displacement, m, in the bearing's frame (the
+            radial load's azimuth is :attr:`BearingDynamics.radial_angle` from x).
+        inner_ring_tilt: (theta_x, theta_y), rad (0 while held: no moment applied).
+        ring_moment: (M_x, M_y), N m, the moment of the balls' inner contact loads on the inner
+            ring (M_x = sum Q_i sin a_i R_i cos psi, M_y with sin psi, as
+            :mod:`.quasi_static` counts it): with the tilts held, the reaction moment the
+            spindle's second bearing supplies; under an applied moment, equal to it.
     """
 
     time: float
@@ -118,6 +126,8 @@ class Observation:
     axial_load: float
     cage_whirl_radius: float = 0.0
     cage_centre: tuple[float, float] = (0.0, 0.0)
+    inner_ring_tilt: tuple[float, float] = (0.0, 0.0)
+    ring_moment: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -198,7 +208,13 @@ class BearingDynamics:
         self.record_every = 0
         self.axial_load = 0.0
         self.radial_load = 0.0
-        """Radial load on the inner ring along +x, N (reduced model; tilts held)."""
+        """Radial load on the inner ring, N (reduced model; tilts held), at :attr:`radial_angle`."""
+        self.radial_angle = 0.0
+        """Azimuth of the radial load from the bearing's x axis, rad (the load zone's azimuth)."""
+        self.moment: tuple[float, float] | None = None
+        """Applied moment (M_x, M_y) on the inner ring, N m (counted as :mod:`.quasi_static`
+        does), or None: the tilts held at zero, as the spindle's second bearing holds them
+        (:meth:`set_moment`)."""
         self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
         self._peak_speed = 0.0
         self.envelope = envelope if envelope is not None else _shipped_envelope()
@@ -236,9 +252,19 @@ class BearingDynamics:
         return StepLimit(self.model, best, why)
 
     # -- set-up --------------------------------------------------------------------------------
-    def initialise(self, inner_ring_speed: float, axial_load: float, *, time: float = 0.0, radial_load: float = 0.0) -> None:
-        """Start from the static equilibrium under ``axial_load`` (N; and ``radial_load``, N along
-        +x, reduced model only) with the balls and cage at
+    def initialise(
+        self,
+        inner_ring_speed: float,
+        axial_load: float,
+        *,
+        time: float = 0.0,
+        radial_load: float = 0.0,
+        radial_angle: float = 0.0,
+        moment: tuple[float, float] | None = None,
+    ) -> None:
+        """Start from the static equilibrium under ``axial_load`` (N; and ``radial_load``, N at the
+        azimuth ``radial_angle`` from x, rad, reduced model only; and ``moment``, N m, with the
+        tilts free, see :meth:`set_moment`) with the balls and cage at
         the kinematic (rolling) speeds for ``inner_ring_speed`` (rad/s) at the loaded contact
         angle, each ball touching the driving side of its pocket. The dynamics then find the real
         operating point.
@@ -246,6 +272,8 @@ class BearingDynamics:
         omega = _finite("inner_ring_speed", inner_ring_speed, 0.0)
         load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
         radial = self._radial(radial_load)
+        angle = _finite("radial_angle", radial_angle)
+        applied = self._moment(moment)
         v, p = self.vector, self.params
         z = p.ball_count
         rm = v[kn.P_RM]
@@ -263,22 +291,54 @@ class BearingDynamics:
         self.ball[:, kn.B_R] = rm
         self.ball[:, kn.B_OMEGA] = omega * p.epicyclic_ratio
         for _ in range(3):  # speeds and loaded angle depend on each other through centrifugal force
-            geo, scratch = self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 6]
             # 1e-11 of the load; under a few newtons that is below the rounding of the contact
-            # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there.
-            if kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-11, 200, radial) > 200 and (
-                kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, 1e-9, 200, radial) > 200
-            ):
+            # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there,
+            # with more iterations: at low speed the balls outside a load zone slide down the
+            # outer groove under their centrifugal force of milli-newtons, a few thousand Newton
+            # iterations from the start at 100 rpm, 40 000 at 50 rpm (one-off, 1 us each).
+            if self._solve_normal(load, radial, angle, applied, 1e-11, 200) > 200 and self._solve_normal(load, radial, angle, applied, 1e-9, 50_000) > 50_000:
                 raise DynamicsInputError(f"no static equilibrium found for axial load {load} N, radial load {radial} N at {omega} rad/s")
             self._set_rolling_speeds(omega)
+        kn.ring_moment(v, self.ball, self.ring, self.work[:, : kn.NG])
         # Balls just touching the driving side of their pockets (zero force): the cage is
         # carried from the first step instead of crossing the clearance and striking the balls.
         self.cage[:, kn.C_PHI] = theta - v[kn.P_POCKET_CLEAR] / rm
         self.cage[:, kn.C_OMEGA] = np.mean(self.ball[:, kn.B_OMEGA])
         self.axial_load = load
         self.radial_load = radial
+        self.radial_angle = angle
+        self.moment = applied
         self.stats[:] = 0.0
         self.out[:] = 0.0
+
+    def _solve_normal(self, load: float, radial: float, angle: float, moment: tuple[float, float] | None, tol: float, max_iter: int) -> int:
+        """The normal problem (:func:`.kernels.solve_quasi_static`, or its tilted form under a
+        moment) at the current ball positions and speeds; the Newton iterations used."""
+        v, geo, scratch = self.vector, self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 6]
+        if moment is None:
+            return int(kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, tol, max_iter, radial, angle))
+        loads = np.array([load, radial * math.cos(angle), radial * math.sin(angle), *moment])
+        return int(kn.solve_quasi_static_tilted(v, self.ball, self.ring, geo, scratch, loads, tol, max_iter))
+
+    def _moment(self, moment: tuple[float, float] | None) -> tuple[float, float] | None:
+        if moment is None:
+            return None
+        if len(moment) != 2:
+            raise DynamicsInputError(f"moment must be (M_x, M_y) in N m or None, got {moment!r}")
+        mx, my = _finite("moment M_x", moment[0]), _finite("moment M_y", moment[1])
+        if self.model != "reduced":
+            raise DynamicsInputError(f"moment needs the reduced model (the {self.model} model is axisymmetric), got {moment!r}")
+        return mx, my
+
+    def set_moment(self, moment: tuple[float, float] | None) -> None:
+        """Apply the moment (M_x, M_y) (N m, counted as :mod:`.quasi_static` does:
+        M_x = sum Q_i sin a_i R_i cos psi) on the inner ring from the next step on, its two tilts
+        then free unknowns of the normal solve made every step; None holds the tilts at zero again
+        (as the spindle's second bearing holds them) and the ring's moment is the reaction
+        (:attr:`Observation.ring_moment`). Reduced model only."""
+        self.moment = self._moment(moment)
+        if self.moment is None:
+            self.ring[kn.R_TX] = self.ring[kn.R_TY] = 0.0
 
     def _radial(self, radial_load: float) -> float:
         radial = _finite("radial_load", radial_load, 0.0)
@@ -292,7 +352,8 @@ class BearingDynamics:
         for j in range(self.params.ball_count):
             rb, zb, theta = self.ball[j, kn.B_R], self.ball[j, kn.B_Z], self.ball[j, kn.B_THETA]
             shift = self.ring[kn.R_DX] * math.cos(theta) + self.ring[kn.R_DY] * math.sin(theta)
-            _, nir, niz, _, _, nor, noz, _ = kn.shifted_raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA], shift)
+            lift = v[kn.P_CI_R] * (self.ring[kn.R_TX] * math.cos(theta) + self.ring[kn.R_TY] * math.sin(theta))
+            _, nir, niz, _, _, nor, noz, _ = kn.shifted_raceway_geometry(v, rb, zb, self.ring[kn.R_DELTA] + lift, shift)
             r_ci, _, _, _, aim, aia, aom, aoa, _ = kn.ball_kinematics(v, nir, niz, nor, noz, rb)
             # s_i = 0 and s_o = 0: a 2x2 linear system in (omega_m, omega_a)
             det = aim * aoa + aia * aom
@@ -306,16 +367,24 @@ class BearingDynamics:
 
     # -- integration ---------------------------------------------------------------------------
     def advance(
-        self, duration: float, *, axial_load: float | None = None, inner_ring_acceleration: float = 0.0, radial_load: float | None = None
+        self,
+        duration: float,
+        *,
+        axial_load: float | None = None,
+        inner_ring_acceleration: float = 0.0,
+        radial_load: float | None = None,
+        radial_angle: float | None = None,
     ) -> ChunkAverage:
         """Integrate for ``duration`` seconds (rounded to whole steps).
 
         Args:
             duration: s, >= 0.
             axial_load: N applied to the inner ring during the interval (default: unchanged).
-            radial_load: N along +x on the inner ring during the interval (default: unchanged;
+            radial_load: N on the inner ring during the interval (default: unchanged;
                 reduced model only): each ball's loads follow from the ring's quasi-static
                 balance at its orbital position, so they vary around the orbit.
+            radial_angle: the radial load's azimuth from the bearing's x axis, rad, where the
+                load zone is centred (default: unchanged).
             inner_ring_acceleration: rad/s^2, constant during the interval; the speed stops at
                 zero rather than reverse.
 
@@ -327,6 +396,8 @@ class BearingDynamics:
             self.axial_load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
         if radial_load is not None:
             self.radial_load = self._radial(radial_load)
+        if radial_angle is not None:
+            self.radial_angle = _finite("radial_angle", radial_angle)
         accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
         n = int(round(duration / self.time_step))
         if accel < 0.0:
@@ -347,6 +418,9 @@ class BearingDynamics:
                 accel,
                 0,
                 self.radial_load,
+                self.radial_angle,
+                *(self.moment or (0.0, 0.0)),
+                self.moment is not None,
             )
         self.check_state()
         t = self.stats[kn.S_TIME]
@@ -404,7 +478,7 @@ class BearingDynamics:
     # -- state ---------------------------------------------------------------------------------
     def snapshot(self) -> Snapshot:
         """A copy of the complete state."""
-        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load, self.radial_load)
+        return Snapshot(self.model, self.ball.copy(), self.cage.copy(), self.ring.copy(), self.axial_load, self.radial_load, self.radial_angle, self.moment)
 
     def restore(self, snap: Snapshot) -> None:
         """Return to a state taken by :meth:`snapshot` (same model and bearing)."""
@@ -415,6 +489,8 @@ class BearingDynamics:
         self.ring[:] = snap.ring
         self.axial_load = snap.axial_load
         self.radial_load = snap.radial_load
+        self.radial_angle = snap.radial_angle
+        self.moment = snap.moment
         # A snapshot was taken of an accepted state: its speeds are within the bounds it had.
         carried = max(float(np.max(snap.cage[:, kn.C_OMEGA])), float(np.max(snap.ball[:, kn.B_OMEGA])))
         self._peak_speed = max(self._peak_speed, float(snap.ring[kn.R_OMEGA]), carried)
@@ -517,4 +593,6 @@ class BearingDynamics:
             axial_load=self.axial_load,
             cage_whirl_radius=self.cage_whirl_radius,
             cage_centre=(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY])),
+            inner_ring_tilt=(float(self.ring[kn.R_TX]), float(self.ring[kn.R_TY])),
+            ring_moment=(float(self.ring[kn.R_MX]), float(self.ring[kn.R_MY])),
         )

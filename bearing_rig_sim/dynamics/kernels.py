@@ -15,7 +15,10 @@ Conventions (every kernel):
   reduced model only; ball j's radial direction is (cos theta_j, sin theta_j)); the cage
   centre's displacement (m) and velocity (m/s) along x and y (dynamic, reduced model only), the
   cage-land contact force (N) and the eccentricity factor of the land's viscous torque (1) of
-  the last step.
+  the last step; the tilts theta_x, theta_y (rad; quasi-static, reduced model, free only under
+  an applied moment: the inner groove curvature centre of ball j moves axially by
+  R_i (theta_x cos theta_j + theta_y sin theta_j), R_i = CI_R, as in dynamics/quasi_static.py)
+  and the balls' moment on the ring at the last recorded step (N m; :func:`ring_moment`).
 * ``out``: shape (Z, NO), per-ball diagnostics ``O_*`` (contact loads N, angles rad, pocket
   force N, sliding velocities m/s, tractions N), written by every step.
 * ``stats``: shape (NS,), running integrals ``S_*`` (cage speed x dt, inner speed x dt, time,
@@ -108,7 +111,9 @@ C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
 R_CX, R_CY, R_CVX, R_CVY, R_LAND_N, R_LAND_F = 7, 8, 9, 10, 11, 12
-NR = 13
+R_TX, R_TY = 13, 14  # inner-ring tilts theta_x, theta_y (rad; free only under an applied moment)
+R_MX, R_MY = 15, 16  # moment of the balls' inner contact loads on the ring, N m (last recorded step)
+NR = 17
 O_QI, O_QO, O_AI, O_AO, O_FP, O_SI, O_SO, O_FI, O_FO, O_POWER = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9
 O_DRIVE = 10  # torque the drive applies to the inner ring against ball j's inner traction, N m
 NO = 11
@@ -291,9 +296,11 @@ def solve_quasi_static(
     tol: float,
     max_iter: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
 ) -> int:
     """Newton solution of the normal (radial-axial) equilibrium of every ball and of the inner
-    ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, along +x), with centrifugal
+    ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, >= 0, at the azimuth
+    ``radial_angle`` from +x, rad: the load zone's azimuth), with centrifugal
     force m omega_m^2 r_b; gyroscopic moments neglected; tilts held at zero. Ring unknowns:
     axial displacement and, with a radial load (or a displacement left by one), the radial
     displacement (x, y); each ball's 2x2 block is eliminated onto them (a 3x3 Schur system).
@@ -307,9 +314,10 @@ def solve_quasi_static(
     ki, ko = p[P_K_IN], p[P_K_OUT]
     scale = tol * max(axial_load, abs(radial_load), 1.0)
     radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
+    load_x, load_y = radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle)
     for it in range(max_iter + 1):
         delta_a, dx, dy = ring[R_DELTA], ring[R_DX], ring[R_DY]
-        ga, gx, gy = axial_load, radial_load, 0.0
+        ga, gx, gy = axial_load, load_x, load_y
         # Schur system S du = r of the ring's (delta_a, delta_x, delta_y), S symmetric in value
         s00 = s01 = s02 = s10 = s11 = s12 = s20 = s22 = 0.0
         r0 = r1 = r2 = 0.0
@@ -414,6 +422,148 @@ def solve_quasi_static(
                 ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * dd), -lim), lim)
                 ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * dd), -lim), lim)
     return max_iter + 1
+
+
+@njit(cache=True)
+def gauss_solve(a: np.ndarray, b: np.ndarray) -> None:
+    """Solve a x = b in place (x into ``b``; ``a`` destroyed) by Gaussian elimination with
+    partial pivoting, for the ring's small Schur systems."""
+    n = b.shape[0]
+    for k in range(n):
+        piv = k
+        for i in range(k + 1, n):
+            if abs(a[i, k]) > abs(a[piv, k]):
+                piv = i
+        if piv != k:
+            for c in range(n):
+                a[k, c], a[piv, c] = a[piv, c], a[k, c]
+            b[k], b[piv] = b[piv], b[k]
+        for i in range(k + 1, n):
+            f = a[i, k] / a[k, k]
+            for c in range(k, n):
+                a[i, c] -= f * a[k, c]
+            b[i] -= f * b[k]
+    for k in range(n - 1, -1, -1):
+        acc = b[k]
+        for c in range(k + 1, n):
+            acc -= a[k, c] * b[c]
+        b[k] = acc / a[k, k]
+
+
+@njit(cache=True)
+def solve_quasi_static_tilted(
+    p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray, work: np.ndarray, loads: np.ndarray, tol: float, max_iter: int
+) -> int:
+    """:func:`solve_quasi_static` with the inner ring's two tilts free under an applied moment.
+    ``loads`` holds (F_a, F_x, F_y, M_x, M_y), N and N m (the radial load by its components), the
+    moments counted as in dynamics/quasi_static.py: M_x = sum Q_i sin a_i R_i cos psi,
+    M_y with sin psi (an axial force at psi = 0 gives M_x > 0). Ring unknowns (delta_a, delta_x,
+    delta_y, theta_x, theta_y); ball j at orbital angle theta_j sees its inner curvature centre
+    moved axially by a_j = delta_a + R_i (theta_x c_j + theta_y s_j) and radially by
+    r_j = delta_x c_j + delta_y s_j (c_j, s_j the cosine and sine of theta_j). Each ball's block
+    is eliminated onto (a_j, r_j) and mapped onto the five unknowns,
+    S = sum B_j^T K_j B_j, a 5x5 Schur system. Updates ball B_R, B_Z and ring R_DELTA, R_DX,
+    R_DY, R_TX, R_TY.
+
+    Returns the number of iterations used (max_iter + 1 if not converged).
+    """
+    z = ball.shape[0]
+    ri = p[P_CI_R]
+    m, ki, ko = p[P_MBALL], p[P_K_IN], p[P_K_OUT]
+    target = np.array([loads[0], loads[1], loads[2], loads[3] / ri, loads[4] / ri])
+    scale = tol * max(np.max(np.abs(target)), 1.0)
+    s = np.empty((5, 5))
+    g = np.empty(5)
+    ba = np.empty(5)  # d a_j / d(unknowns), lengths per R_i for the tilts
+    br = np.empty(5)
+    lim = 2e-6
+    for it in range(max_iter + 1):
+        delta_a, dx, dy, tx, ty = ring[R_DELTA], ring[R_DX], ring[R_DY], ring[R_TX], ring[R_TY]
+        g[:] = target
+        s[:] = 0.0
+        rhs = np.zeros(5)
+        worst = 0.0
+        for j in range(z):
+            cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+            lift = ri * (tx * cth + ty * sth)
+            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, ball[j, B_R], ball[j, B_Z], delta_a + lift, dx * cth + dy * sth)
+            root_i, root_o = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN)), math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
+            qi = ki * di * root_i if di > 0.0 else 0.0
+            qo = ko * do * root_o if do > 0.0 else 0.0
+            geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
+            geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
+            spin2 = m * ball[j, B_OMEGA] ** 2
+            res_r = spin2 * ball[j, B_R] - qi * nir - qo * nor
+            res_z = -qi * niz - qo * noz
+            worst = max(worst, abs(res_r), abs(res_z))
+            # the ring's generalised forces, moments per R_i (unknowns: tilts times R_i)
+            ba[0], ba[1], ba[2], ba[3], ba[4] = 1.0, 0.0, 0.0, cth, sth
+            br[0], br[1], br[2], br[3], br[4] = 0.0, cth, sth, 0.0, 0.0
+            for k in range(5):
+                g[k] += qi * (niz * ba[k] + nir * br[k])
+            if it == max_iter:
+                continue
+            # the ball's 2x2 Jacobian J = H_i + H_o + m omega^2 e_r e_r and its inverse
+            h_rr, h_rz, h_zz = contact_jacobian(qi, 1.5 * ki * root_i, nir, niz, disti)
+            o_rr, o_rz, o_zz = contact_jacobian(qo, 1.5 * ko * root_o, nor, noz, disto)
+            j_rr, j_rz, j_zz = h_rr + o_rr + spin2, h_rz + o_rz, h_zz + o_zz
+            det = j_rr * j_zz - j_rz * j_rz
+            if abs(det) <= 1e-12 * (j_rr * j_rr + j_zz * j_zz):  # free across the contact line (see solve_quasi_static)
+                soft = 1e-6 * (abs(j_rr) + abs(j_zz)) + 1e-12
+                j_rr -= soft
+                j_zz -= soft
+                det = j_rr * j_zz - j_rz * j_rz
+            inv_rr, inv_rz, inv_zz = j_zz / det, -j_rz / det, j_rr / det
+            # the ball's step u = J^-1 f and its response to a unit local move of the inner
+            # curvature centre, axial (w = -J^-1 H_i e_z) and radial (v = -J^-1 H_i e_r)
+            u_r, u_z = inv_rr * res_r + inv_rz * res_z, inv_rz * res_r + inv_zz * res_z
+            w_r, w_z = -(inv_rr * h_rz + inv_rz * h_zz), -(inv_rz * h_rz + inv_zz * h_zz)
+            v_r, v_z = -(inv_rr * h_rr + inv_rz * h_rz), -(inv_rz * h_rr + inv_zz * h_rz)
+            work[j, 0], work[j, 1], work[j, 2], work[j, 3], work[j, 4], work[j, 5] = u_r, u_z, w_r, w_z, v_r, v_z
+            # the ring's local balance (axial a, radial r): right side -H_i u, stiffness H_i (I + [w v])
+            rho_a, rho_r = -(h_rz * u_r + h_zz * u_z), -(h_rr * u_r + h_rz * u_z)
+            k_aa, k_ar = h_zz + h_rz * w_r + h_zz * w_z, h_rz + h_rz * v_r + h_zz * v_z
+            k_ra, k_rr = h_rz + h_rr * w_r + h_rz * w_z, h_rr + h_rr * v_r + h_rz * v_z
+            for k in range(5):
+                rhs[k] += ba[k] * rho_a + br[k] * rho_r
+                for c in range(5):
+                    s[k, c] += ba[k] * (k_aa * ba[c] + k_ar * br[c]) + br[k] * (k_ra * ba[c] + k_rr * br[c])
+        if worst < scale and np.max(np.abs(g)) < scale:
+            return it
+        if it == max_iter:
+            break
+        for k in range(5):
+            rhs[k] -= g[k]
+        gauss_solve(s, rhs)
+        for k in range(5):
+            rhs[k] = min(max(rhs[k], -lim), lim)
+        ring[R_DELTA] = delta_a + rhs[0]
+        ring[R_DX] = dx + rhs[1]
+        ring[R_DY] = dy + rhs[2]
+        ring[R_TX] = tx + rhs[3] / ri
+        ring[R_TY] = ty + rhs[4] / ri
+        for j in range(z):
+            cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
+            da = rhs[0] + rhs[3] * cth + rhs[4] * sth
+            dr = rhs[1] * cth + rhs[2] * sth
+            ball[j, B_R] += min(max(-(work[j, 0] + work[j, 2] * da + work[j, 4] * dr), -lim), lim)
+            ball[j, B_Z] += min(max(-(work[j, 1] + work[j, 3] * da + work[j, 5] * dr), -lim), lim)
+    return max_iter + 1
+
+
+@njit(cache=True)
+def ring_moment(p: np.ndarray, ball: np.ndarray, ring: np.ndarray, geo: np.ndarray) -> None:
+    """The moment of the balls' inner contact loads on the inner ring (N m) into ring R_MX, R_MY,
+    counted as in dynamics/quasi_static.py: M_x = sum Q_i sin a_i R_i cos theta_j, M_y with
+    sin theta_j (sin a_i = -n_iz), from the contact state in ``geo`` solved at the balls' angles.
+    With the tilts held it is the reaction moment the spindle's second bearing supplies; with
+    them free it balances the applied moment."""
+    mx = my = 0.0
+    for j in range(ball.shape[0]):
+        fa = -geo[j, G_QI] * geo[j, G_NIZ] * p[P_CI_R]
+        mx += fa * math.cos(ball[j, B_THETA])
+        my += fa * math.sin(ball[j, B_THETA])
+    ring[R_MX], ring[R_MY] = mx, my
 
 
 @njit(cache=True)
@@ -956,6 +1106,10 @@ def step_reduced(
     inner_acceleration: float,
     record_every: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
+    moment_x: float = 0.0,
+    moment_y: float = 0.0,
+    tilt_free: bool = False,
 ) -> int:
     """Advance the default (reduced) model by ``n_steps`` steps of ``dt`` seconds.
 
@@ -967,8 +1121,11 @@ def step_reduced(
     cage centre, t_j the pocket's circumferential direction): the pockets push the cage centre
     along t_j, and pocket friction along the pocket's radial direction (the ball's surface
     moves radially there). The inner ring turns at the prescribed speed, changing at
-    ``inner_acceleration`` (rad/s^2). ``work`` is scratch of shape (Z, NW). Diagnostics go to
-    ``out`` on the last step and every ``record_every`` steps.
+    ``inner_acceleration`` (rad/s^2). With ``tilt_free`` the inner ring's tilts are unknowns of
+    the normal solve under the moment (``moment_x``, ``moment_y``, N m;
+    :func:`solve_quasi_static_tilted`); otherwise they stay where they are (held). ``work`` is
+    scratch of shape (Z, NW). Diagnostics go to ``out`` on the last step and every
+    ``record_every`` steps.
 
     Returns the largest number of quasi-static Newton iterations used.
     """
@@ -985,22 +1142,28 @@ def step_reduced(
     qs_work = work[:, NG : NG + 6]  # the quasi-static solve's scratch, free again after it
     tri_work = work[:, NG + 4 : NG + 8]
     w0 = NG + 8  # per-ball elimination data
+    loads = np.array([axial_load, radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle), moment_x, moment_y])
     worst_iter = 0
     lc = cl + dt * kl
     pitch_c, pitch_s = math.cos(2.0 * math.pi / z), math.sin(2.0 * math.pi / z)
     for step in range(n_steps):
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
-        it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load)
+        if tilt_free:
+            it = solve_quasi_static_tilted(p, ball, ring, geo, qs_work, loads, 1e-9, 30)
+        else:
+            it = solve_quasi_static(p, ball, ring, geo, qs_work, axial_load, 1e-9, 30, radial_load, radial_angle)
         worst_iter = max(worst_iter, it)
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
+        if keep:
+            ring_moment(p, ball, ring, geo)
         cx, cy, cvx, cvy = ring[R_CX], ring[R_CY], ring[R_CVX], ring[R_CVY]
         # the cage centre moves once something pushes it off the axis: a radial load or a state
         # left off it; a centred cage under a purely axial load is an exact equilibrium (the
         # pockets' forces cancel, the film has none) and skips the centre's terms. The cage's
         # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
         # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
-        centre = radial_load != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        centre = radial_load != 0.0 or tilt_free or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
         heat = 0.0
         damp = 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
@@ -1189,6 +1352,10 @@ def step_stiff(
     inner_acceleration: float,
     record_every: int,
     radial_load: float = 0.0,
+    radial_angle: float = 0.0,
+    moment_x: float = 0.0,
+    moment_y: float = 0.0,
+    tilt_free: bool = False,
 ) -> int:
     """Advance the stiff reference model by ``n_steps`` explicit steps of ``dt`` seconds.
 
@@ -1197,7 +1364,8 @@ def step_stiff(
     applied load, friction and resistances as in the reduced model. Symplectic Euler in the
     canonical polar coordinates (momenta first, then positions), so that with friction and
     damping off the energy error stays bounded. Needs steps well below a microsecond.
-    ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric). Returns 0.
+    ``work`` is scratch of shape (Z, NW). ``radial_load`` must be 0 (axisymmetric; ``radial_angle``
+    and the moment unused, ``tilt_free`` False). Returns 0.
     """
     z = ball.shape[0]
     rm = p[P_RM]

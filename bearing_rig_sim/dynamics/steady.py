@@ -79,6 +79,12 @@ FALLBACK_CHUNK_S = 0.005
 """Integration fallback: Newton is tried again after each chunk of this length, s."""
 AVERAGE_S = 0.05
 """Integration: averaging window of the steady cage speed, s."""
+PERIODIC_SETTLE_S = 0.3
+"""Combined load: settling time before averaging, s. Under a radial load the cage centre moves
+off the axis to where its land film carries the pockets' net push; it gets there in about
+0.2 s (docs/model.md, Cage whirl)."""
+METHOD_PERIODIC = "integration-periodic"
+"""Combined load: integration averaged over whole ball-pass periods (:meth:`SteadySolver.periodic`)."""
 
 _CONVERGED, _UNSTABLE, _NOT_CONVERGED = 0, 1, 2
 _STEP_TOL = 1e-11
@@ -232,8 +238,8 @@ class SteadyPoint:
             m (:meth:`BearingDynamics.minimum_films`; NaN without a lubricant file).
         state: :data:`STATE_ROLLING` or :data:`STATE_SKID`.
         origin: :data:`ORIGIN_ROLLING_START` or :data:`ORIGIN_CONTINUATION`.
-        method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON` or
-            :data:`METHOD_INTEGRATION`.
+        method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON`,
+            :data:`METHOD_INTEGRATION` or :data:`METHOD_PERIODIC`.
         iterations: Newton iterations of the last Newton run (0 if none converged).
         stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
             False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
@@ -336,6 +342,34 @@ class SteadySolver:
         self.engine.advance(SETTLE_S)
         return self._averaged(omega, axial_load, ORIGIN_ROLLING_START)
 
+    def periodic(
+        self, inner_ring_speed: float, axial_load: float, radial_load: float, *, radial_angle: float = 0.0, moment: tuple[float, float] | None = None
+    ) -> SteadyPoint:
+        """The steady state under a combined load (N; ``moment`` N m with the tilts free, see
+        :meth:`BearingDynamics.set_moment`), averaged over whole ball-pass periods.
+
+        Under a radial load (or a moment) the load zone is fixed in space while the balls orbit
+        through it: the steady state is periodic at the ball-pass frequency Z Omega / (2 pi),
+        not a fixed point, so the four-number solve of :meth:`solve` does not apply. The engine
+        is integrated from the rolling start for :data:`PERIODIC_SETTLE_S`, then over the
+        fewest whole ball-pass periods 2 pi / (Z Omega) covering :data:`AVERAGE_S` (to the step:
+        0.4 % of a period at 900 rpm): cage speed, slip and the friction torque (the drive's
+        work over the window) are averages over whole periods; ball speeds, pocket offset and
+        films are the window's last state.
+
+        Raises:
+            DynamicsInputError: a non-finite or out-of-range input.
+        """
+        omega, axial_load = self._inputs(inner_ring_speed, axial_load)
+        e = self.engine
+        e.initialise(omega, axial_load, radial_load=radial_load, radial_angle=radial_angle, moment=moment)
+        e.advance(PERIODIC_SETTLE_S)
+        period = 2.0 * math.pi / (self.params.ball_count * max(e.cage_speed, 1e-9))
+        avg = e.advance(math.ceil(AVERAGE_S / period) * period)
+        x = self._vector_of_engine()
+        x[2] = avg.cage_speed
+        return self._engine_point(x, omega, axial_load, avg.drive_work / avg.duration, ORIGIN_ROLLING_START, METHOD_PERIODIC, 0, False)
+
     def _averaged(self, omega: float, axial_load: float, origin: str) -> SteadyPoint:
         avg = self.engine.advance(AVERAGE_S, axial_load=axial_load)
         x = self._vector_of_engine()
@@ -384,8 +418,11 @@ class SteadySolver:
         # the engine's own diagnostics (power loss, films) at the solution: one step from it
         self._load_engine(x, omega)
         e.advance(e.time_step, axial_load=load)
-        power = e.power_loss()
-        film_inner, film_outer = e.minimum_films()
+        return self._engine_point(x, omega, load, e.power_loss(), origin, method, iterations, stable)
+
+    def _engine_point(self, x: np.ndarray, omega: float, load: float, power: float, origin: str, method: str, iterations: int, stable: bool) -> SteadyPoint:
+        """The point of the state ``x`` with the engine's films as they stand, power ``power`` W."""
+        film_inner, film_outer = self.engine.minimum_films()
         slip = float(self.kinematics.slip_rate(float(x[2]), omega))
         return SteadyPoint(
             inner_ring_speed=omega,

@@ -22,9 +22,12 @@ Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, his
 
 Subscribes ``/rig/spindle/command`` (bearing_rig_msgs/SpindleCommand, reliable, transient local)
 and ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped in the bearing's frame: force.z the
-axial load, N; the magnitude of force.x and force.y the radial load, N, applied along the
-engine's fixed load direction; a moment in torque.x or torque.y is ignored, the inner ring's
-tilts being held, with a WARN on /diagnostics; read best effort from its reliable publisher;
+axial load, N; the magnitude of force.x and force.y the radial load, N, at the azimuth
+atan2(force.y, force.x), where the engine centres its load zone, and refused (ERROR, the last
+accepted loads kept) above the rig file's ``combined_loading.max_radial_setpoint_n`` (0 for the
+paper's axially loaded bench); torque.x and torque.y a moment across the axis, N m, which
+frees the inner ring's tilts (both 0: the tilts held, the reaction reported), refused above
+``combined_loading.max_moment_setpoint_n_m``; read best effort from its reliable publisher;
 1 kHz, so its queue is taken by the loop, not dispatched message by message: the latest force
 queued is the one applied). Bad input is refused with a
 logged reason and an ERROR on /diagnostics; the node goes on.
@@ -47,6 +50,7 @@ configures and activates at once.
 
 from __future__ import annotations
 
+import math
 import sys
 import time
 from typing import Any
@@ -87,7 +91,7 @@ from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
-from bearing_rig_sim.simulation.twin import AxialLoadError, RigTwin, TickOutput
+from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RigTwin, TickOutput
 
 NO_REALTIME_FLAG = "--no-realtime"
 """Command-line flag: run as fast as possible (parameter ``realtime`` false)."""
@@ -175,8 +179,6 @@ class SimulatorNode(ManagedNode):
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
         self._anchor = True
-        self._moment_logged: set[str] = set()
-        """Moment fields (``torque.x``, ``torque.y``) already logged as ignored."""
 
         self._clock_pub = self.publisher(ClockMsg, CLOCK.name, qos_profile(CLOCK))
         self._pulse_pubs = {
@@ -402,8 +404,9 @@ class SimulatorNode(ManagedNode):
 
     def _take_forces(self) -> None:
         """Apply the latest force queued since the last call: force.z the axial load, the
-        magnitude of (force.x, force.y) the radial load (:meth:`RigTwin.set_loads`); a moment in
-        torque.x or torque.y is ignored with a WARN.
+        magnitude of (force.x, force.y) the radial load at its azimuth (:meth:`RigTwin.set_loads`:
+        refused above the rig file's radial limit); torque.x and torque.y the moment (refused
+        above the rig file's moment limit).
 
         The queue is taken serialized and only its last sample is decoded and applied: the ones
         before it would be replaced before the next chunk anyway.
@@ -414,26 +417,13 @@ class SimulatorNode(ManagedNode):
         wrench = deserialize_message(queued[-1][0], WrenchStamped).wrench
         force = wrench.force
         try:
-            self.twin.set_loads(force.z, force.x, force.y)
+            self.twin.set_loads(force.z, force.x, force.y, wrench.torque.x, wrench.torque.y)
         except AxialLoadError as exc:
             self._refuse("axial force", str(exc))
+        except MomentError as exc:
+            self._refuse("moment", str(exc))
         except Exception as exc:
             self._refuse("radial force", str(exc))
-        self._note_moment(wrench.torque.x, wrench.torque.y)
-
-    def _note_moment(self, torque_x: float, torque_y: float) -> None:
-        """A moment across the axis (torque.x, torque.y) is ignored (the engine holds the inner
-        ring's tilts): WARN on /diagnostics while the latest force carries one, logged once per
-        field."""
-        fields = [f"torque.{name}" for name, value in (("x", torque_x), ("y", torque_y)) if value != 0.0]
-        if not fields:
-            self.health.ignored = ""
-            return
-        self.health.ignored = f"{BEARING_AXIAL_FORCE.name}: moment in {' and '.join(fields)} ignored (the engine holds the inner ring's tilts)"
-        new = [f for f in fields if f not in self._moment_logged]
-        if new:
-            self._moment_logged.update(new)
-            self.get_logger().warning(self.health.ignored)
 
     def _refuse(self, kind: str, reason: str) -> None:
         self.get_logger().error(f"{kind} refused: {reason}", throttle_duration_sec=1.0)
@@ -472,6 +462,9 @@ class SimulatorNode(ManagedNode):
             "axial_load_n": f"{twin.axial_load:.6g}",
             "requested_axial_load_n": f"{twin.requested_axial_load:.6g}",
             "radial_load_n": f"{twin.radial_load:.6g}",
+            "radial_load_azimuth_deg": f"{math.degrees(twin.radial_angle):.6g}",
+            "moment_n_m": " ".join(f"{m:.6g}" for m in twin.moment),
+            "ring_moment_n_m": " ".join(f"{m:.6g}" for m in twin.ring_moment),
             "spindle_pulses": self._pulses["spindle"],
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,

@@ -4,9 +4,8 @@ diverged engine), with the reasons.
 * ERROR while the engine has diverged (for good: the twin cannot continue), and for
   ``fault_hold`` seconds after the latest refused spindle command or axial force (so that a reader
   at 1 Hz sees a refusal even when valid messages follow at once).
-* WARN while the loop has overrun since the previous report, while the axial force asked for
-  is below the engine's minimum and has been raised to it, or while the latest force carries a
-  moment the engine cannot take (ignored: the inner ring's tilts are held).
+* WARN while the loop has overrun since the previous report, or while the axial force asked
+  for is below the engine's minimum and has been raised to it.
 * OK otherwise.
 
 Times are the wall clock's (s), given by the caller.
@@ -50,8 +49,6 @@ class SimulatorHealth:
         acknowledged nothing for the give-up time, and went on without it."""
         self._stalled = ""
         self._reported_stalls = 0
-        self.ignored = ""
-        """What the latest input carries that the twin ignores (e.g. a moment), "" if nothing."""
 
     def refuse(self, kind: str, reason: str, now: float) -> None:
         """Note a refused input of ``kind`` (e.g. "spindle command", "axial force") at ``now``."""
@@ -87,8 +84,6 @@ class SimulatorHealth:
             warnings.append(f"{new} overrun(s): the loop fell behind the wall clock")
         if self.reader_stalls > self._reported_stalls:
             warnings.append(f"went on without a reliable reader: {self._stalled}")
-        if self.ignored:
-            warnings.append(self.ignored)
         if load_clamped:
             warnings.append(f"axial force below the engine's minimum; {min_load:g} N applied")
         if warnings:

@@ -38,6 +38,7 @@ from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
+from bearing_rig_sim.rig.program import RigLimits
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling
@@ -54,9 +55,14 @@ class AxialLoadError(RigError):
     """An axial force the twin refuses (non-finite or negative); the load stays as it was."""
 
 
+class MomentError(RigError):
+    """A moment the twin refuses (non-finite components, above the rig file's moment limit, or
+    any moment on the axisymmetric ``stiff`` model); the loads stay as they were."""
+
+
 class RadialLoadError(RigError):
-    """A radial force the twin refuses (non-finite components, or any radial load on the
-    axisymmetric ``stiff`` model); the loads stay as they were."""
+    """A radial force the twin refuses (non-finite components, above the rig file's radial
+    limit, or any radial load on the axisymmetric ``stiff`` model); the loads stay as they were."""
 
 
 @dataclass(frozen=True)
@@ -173,6 +179,13 @@ class RigTwin:
         max_speed: highest spindle target speed, rad/s (see :class:`SpindleDrive`).
         max_acceleration: highest spindle acceleration, rad/s^2.
         max_command_lead: how far ahead a command's time may lie, s.
+        max_radial_load: largest radial force accepted, N (>= 0; :meth:`from_files` takes it
+            from the rig file's ``combined_loading.max_radial_setpoint_n``: 0 for a loading
+            chain that loads only axially). Default: no limit.
+        radial_limit_source: where ``max_radial_load`` comes from, named in a refusal.
+        max_moment: largest moment accepted, N m (>= 0; :meth:`from_files`: the rig file's
+            ``combined_loading.max_moment_setpoint_n_m``). Default: no limit.
+        moment_limit_source: where ``max_moment`` comes from, named in a refusal.
 
     Raises:
         TwinError: an option out of range.
@@ -193,6 +206,10 @@ class RigTwin:
         max_speed: float = math.inf,
         max_acceleration: float = math.inf,
         max_command_lead: float = math.inf,
+        max_radial_load: float = math.inf,
+        radial_limit_source: str = "max_radial_load",
+        max_moment: float = math.inf,
+        moment_limit_source: str = "max_moment",
     ) -> None:
         self.engine = engine
         self.kinematics = kinematics
@@ -200,6 +217,16 @@ class RigTwin:
         if isinstance(counter_timeout, bool) or not isinstance(counter_timeout, (int, float)) or not counter_timeout > 0.0:
             raise TwinError(f"counter_timeout: must be > 0 s, got {counter_timeout!r}")
         self.counter_timeout = float(counter_timeout)
+        if isinstance(max_radial_load, bool) or not isinstance(max_radial_load, (int, float)) or not max_radial_load >= 0.0:
+            raise TwinError(f"max_radial_load: must be >= 0 N, got {max_radial_load!r}")
+        self.max_radial_load = float(max_radial_load)
+        """Largest radial force accepted, N (:meth:`set_loads`)."""
+        self.radial_limit_source = radial_limit_source
+        if isinstance(max_moment, bool) or not isinstance(max_moment, (int, float)) or not max_moment >= 0.0:
+            raise TwinError(f"max_moment: must be >= 0 N m, got {max_moment!r}")
+        self.max_moment = float(max_moment)
+        """Largest moment accepted, N m (:meth:`set_loads`)."""
+        self.moment_limit_source = moment_limit_source
         self.drive = SpindleDrive(initial_speed, 0.0, max_speed=max_speed, max_acceleration=max_acceleration, max_lead=max_command_lead)
         self.load_clamped = False
         """Whether the latest axial force asked for was below the engine's minimum
@@ -208,6 +235,8 @@ class RigTwin:
         """The latest axial force asked for, N (before raising it to the minimum)."""
         self._load = self._checked_load(initial_axial_load)
         self._radial = 0.0
+        self._radial_angle = 0.0
+        self._moment = (0.0, 0.0)
         engine.initialise(self.drive.speed_at(0.0), self._load, time=0.0)
         self.spindle_sensor: FibreOpticSensor = sensors.sensor("spindle")
         self.cage_sensor: FibreOpticSensor = sensors.sensor("cage")
@@ -243,7 +272,7 @@ class RigTwin:
         rig_file: str | Path | None = None,
         *,
         model: str = "reduced",
-        **options: float,
+        **options: Any,
     ) -> RigTwin:
         """A twin from a bearing file, an optional calibration overlay and a rig file.
 
@@ -252,7 +281,9 @@ class RigTwin:
             calibration_file: calibration laid over it (None: none).
             rig_file: rig data with the ``sensors`` section (default: ``config/rig.yaml``).
             model: the engine's model, ``"reduced"`` (real time) or ``"stiff"``.
-            options: the keyword options of :class:`RigTwin`.
+            options: the keyword options of :class:`RigTwin`; ``max_radial_load`` and
+                ``max_moment`` default to the rig file's ``combined_loading`` limits (absent:
+                0 N and 0 N m).
 
         Raises:
             ConfigError: a file is missing or malformed (naming the file and key).
@@ -263,6 +294,13 @@ class RigTwin:
         params = BearingParameters.from_yaml(bearing, calibration_file)
         engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file))
         sensors = FibreOpticConfig.from_yaml(rig_file)
+        limits = RigLimits.from_rig_file(rig_file)
+        if "max_radial_load" not in options:
+            options["max_radial_load"] = limits.max_radial_load_n
+            options.setdefault("radial_limit_source", f"combined_loading.max_radial_setpoint_n in {limits.source}")
+        if "max_moment" not in options:
+            options["max_moment"] = limits.max_moment_n_m
+            options.setdefault("moment_limit_source", f"combined_loading.max_moment_setpoint_n_m in {limits.source}")
         return cls(engine, sensors, BearingKinematics.from_config(bearing), **options)
 
     def _check_chunk(self, chunk: float) -> float:
@@ -308,37 +346,83 @@ class RigTwin:
 
     @property
     def radial_load(self) -> float:
-        """The radial load the engine applies, N (>= 0; along the engine's +x, see
+        """The radial load the engine applies, N (>= 0; at :attr:`radial_angle`, see
         :meth:`set_loads`)."""
         return self._radial
 
-    def _checked_radial(self, force_x: float, force_y: float) -> float:
-        for name, value in (("x", force_x), ("y", force_y)):
+    @property
+    def radial_angle(self) -> float:
+        """The radial load's azimuth from the bearing's x axis, rad (the load zone's azimuth;
+        kept from the last non-zero radial force)."""
+        return self._radial_angle
+
+    @property
+    def moment(self) -> tuple[float, float]:
+        """The moment applied across the axis, (torque.x, torque.y) about the bearing frame's x
+        and y axes, N m; (0, 0): none, the inner ring's tilts held (see :meth:`set_loads`)."""
+        return self._moment
+
+    @property
+    def ring_moment(self) -> tuple[float, float]:
+        """The moment of the balls' contact loads on the inner ring about the frame's x and y
+        axes, N m (same convention as :attr:`moment`): with the tilts held, the reaction the
+        spindle's second bearing supplies; under an applied moment, balancing it."""
+        mx, my = self.engine.observe().ring_moment
+        return my, -mx
+
+    def _checked_pair(self, error: type[RigError], what: str, field: str, unit: str, pair: tuple[float, float], limit: float, source: str) -> float:
+        """The magnitude of a load across the axis (``field``.x, ``field``.y), refused with
+        ``error`` if a component is not a finite number, above ``limit`` (from ``source``) or
+        on the axisymmetric stiff model."""
+        for name, value in zip("xy", pair):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise RadialLoadError(f"radial force: force.{name} must be a finite number of newtons, got {value!r}")
-        radial = math.hypot(force_x, force_y)
-        if radial > 0.0 and self.engine.model != "reduced":
-            raise RadialLoadError(f"radial force: {radial:g} N needs the reduced model (the {self.engine.model} model is axisymmetric)")
-        return radial
+                raise error(f"{what}: {field}.{name} must be a finite number of {unit}, got {value!r}")
+        size = math.hypot(*pair)
+        symbol = "N" if unit == "newtons" else "N m"
+        if size > limit:
+            raise error(f"{what}: {size:g} {symbol} is above the rig's limit of {limit:g} {symbol} ({source})")
+        if size > 0.0 and self.engine.model != "reduced":
+            raise error(f"{what}: {size:g} {symbol} needs the reduced model (the {self.engine.model} model is axisymmetric)")
+        return size
 
-    def set_loads(self, axial_n: float, radial_x_n: float = 0.0, radial_y_n: float = 0.0) -> tuple[float, float]:
-        """Apply an axial force and a radial force (its x and y components in the bearing's
-        frame, N) from the next chunk on; returns the axial and radial loads applied, N.
+    def set_loads(
+        self, axial_n: float, radial_x_n: float = 0.0, radial_y_n: float = 0.0, torque_x_n_m: float = 0.0, torque_y_n_m: float = 0.0
+    ) -> tuple[float, float]:
+        """Apply an axial force, a radial force (its x and y components in the bearing's frame,
+        N) and a moment across the axis (about the frame's x and y axes, N m) from the next
+        chunk on; returns the axial and radial loads applied, N.
 
-        The radial load is the components' magnitude, applied as the engine's radial load: the
-        engine puts it along its fixed +x, so the load zone's azimuth is the engine's, whatever
-        the force's direction in the bearing's frame (the bearing is axisymmetric: only the
-        load zone's position relative to the cage sensor's strip would differ). The axial force
-        is handled as by :meth:`set_axial_load`. Both are checked before either is applied.
+        The radial load is the components' magnitude, at the azimuth atan2(y, x) from the
+        bearing's x axis: the engine centres its load zone there (the bearing's frame is the
+        engine's, so the zone's place relative to the cage sensor's strip is the bench's). A
+        radial force above :attr:`max_radial_load` (the rig file's loading chain) is refused.
+        A moment frees the inner ring's two tilts in the engine (``BearingDynamics.set_moment``;
+        the engine counts M_x = sum Q_i sin a_i R_i cos psi, which is -torque.y for the axial
+        load pushing the ring along +z, and M_y = torque.x); none (both 0) holds them, as the
+        spindle's second bearing does, and :attr:`ring_moment` is the reaction. A moment above
+        :attr:`max_moment` is refused. The axial force is handled as by
+        :meth:`set_axial_load`. All are checked before any is applied.
 
         Raises:
             AxialLoadError: a non-finite or negative axial force.
-            RadialLoadError: a non-finite component, or a radial load on the stiff model.
-            Either way both loads stay as they were.
+            RadialLoadError: a non-finite component, a radial force above the limit, or a
+                radial load on the stiff model.
+            MomentError: a non-finite component, a moment above the limit, or a moment on the
+                stiff model.
+            Either way all loads stay as they were.
         """
-        radial = self._checked_radial(radial_x_n, radial_y_n)
+        radial = self._checked_pair(
+            RadialLoadError, "radial force", "force", "newtons", (radial_x_n, radial_y_n), self.max_radial_load, self.radial_limit_source
+        )
+        self._checked_pair(MomentError, "moment", "torque", "newton metres", (torque_x_n_m, torque_y_n_m), self.max_moment, self.moment_limit_source)
+        moment = (float(torque_x_n_m), float(torque_y_n_m))
         self.set_axial_load(axial_n)
+        if moment != self._moment:
+            self.engine.set_moment(None if moment == (0.0, 0.0) else (-moment[1], moment[0]))
+            self._moment = moment
         self._radial = radial
+        if radial > 0.0:
+            self._radial_angle = math.atan2(radial_y_n, radial_x_n)
         return self._load, self._radial
 
     def command_spindle(self, command: SpindleCommand) -> None:
@@ -375,13 +459,13 @@ class RigTwin:
         steps = int(round(h / engine.time_step))
         t_end = t0 + steps * engine.time_step
         accel = self.drive.chunk_acceleration(t0, h, engine.inner_ring_speed)
-        engine.advance(h, axial_load=self._load, inner_ring_acceleration=accel, radial_load=self._radial)
+        engine.advance(h, axial_load=self._load, inner_ring_acceleration=accel, radial_load=self._radial, radial_angle=self._radial_angle)
         remaining = t_end - engine.time
         if remaining > 0.5 * engine.time_step:
             # A deceleration that reaches rest inside the chunk: the engine stops integrating
             # there rather than reverse; the rest of the chunk is spent at the profile's speed.
             engine.set_inner_ring_speed(max(self.drive.speed_at(t_end), 0.0))
-            engine.advance(remaining, axial_load=self._load, radial_load=self._radial)
+            engine.advance(remaining, axial_load=self._load, radial_load=self._radial, radial_angle=self._radial_angle)
         self.step_count += steps
         self._acceleration = accel
         if self.thermal is not None:

@@ -23,6 +23,8 @@ from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, from_stamp  #
 from bearing_rig_sim.thermal.sensors import THERMOCOUPLE_NOISE_K  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
+AMBIENT_C = 22.0
+"""Ambient temperature, degC (config/bearings/h7006c.yaml, thermal section)."""
 WAIT = 120.0
 """Longest wait, wall s."""
 
@@ -56,8 +58,12 @@ def test_thermocouple_warms_and_torque_meter_reads_the_friction_torque(ros_graph
     assert all(m.header.frame_id == "outer_ring" and m.variance == pytest.approx(THERMOCOUPLE_NOISE_K**2) for m in temps)
     first = statistics.mean(m.temperature for m in temps[:10])
     last = statistics.mean(m.temperature for m in temps[-10:])
-    assert 21.0 < first < 24.0  # ambient 22 degC (bearing file), the lag and noise aside
-    assert last > first + 10 * THERMOCOUPLE_NOISE_K  # warming, well beyond the noise
+    # The probe may match the simulator's publisher a few simulated seconds late on a busy host
+    # (the run without real time waits only for readers it has discovered), so the warming is
+    # judged against the ambient the bearing file states, not against the first reading seen.
+    assert first > AMBIENT_C - 1.0  # never below ambient beyond the noise
+    assert last > AMBIENT_C + 10 * THERMOCOUPLE_NOISE_K  # warmed, well beyond the noise
+    assert last > first + 3 * THERMOCOUPLE_NOISE_K / math.sqrt(10)  # and still warming
     tq = [m.wrench.torque.z for m in torques[-50:]]
     friction = statistics.mean(m.friction_torque for m in truth[-5:])
     assert statistics.mean(tq) == pytest.approx(friction, rel=0.02)

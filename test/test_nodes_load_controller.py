@@ -71,7 +71,9 @@ class Harness:
             timeout=30.0,
         )
         assert ready, self.failure("the load controller did not come up")
-        self.tick()  # the first clock reading starts the node's count
+        # The first clock reading starts the node's count; it is repeated until the node, active
+        # and matched to this probe's subscription (slow on a busy host), answers it.
+        self.tick(attempts=120)
 
     def failure(self, what: str) -> str:
         if self.process.poll() is not None:
@@ -88,11 +90,11 @@ class Harness:
     def spin_until(self, condition: Any, timeout: float = 10.0) -> bool:
         return self.graph.spin_until(condition, timeout=timeout, executor=self.executor)
 
-    def tick(self) -> float:
+    def tick(self, attempts: int = 20) -> float:
         """One clock tick; returns the bearing force the node published for it."""
         self.time += TICK
         key = round(self.time / TICK)
-        for _ in range(20):  # the node's time source reads /clock best effort: repeat a lost tick
+        for _ in range(attempts):  # the node's time source reads /clock best effort: repeat a lost tick
             self.clock.publish(Clock(clock=to_stamp(self.time)))
             if self.spin_until(lambda: key in self.forces, timeout=0.5):
                 return self.forces[key]

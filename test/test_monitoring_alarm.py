@@ -48,3 +48,18 @@ def test_a_steep_fall_raises_the_alarm_at_once_and_an_unresolved_one_does_not() 
     assert first_state(-1.5, 0.1) is SlipState.SLIPPING
     assert first_state(-0.2, 0.07) is SlipState.UNKNOWN
     assert first_state(0.05, 0.04) is SlipState.STABLE  # 0.05 - 1.72 * 0.04 = -0.019 >= k
+
+
+def test_a_first_verdict_may_come_between_slip_points_and_is_then_held() -> None:
+    """``refresh`` with a newer phase estimate between two windows decides a first verdict
+    (0.01 - 1.72 * 0.01 >= k: STABLE) and, once one is held, leaves it to the next point's
+    overturn rules (a refresh at -1.0 +- 0.01 changes nothing)."""
+    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0)
+    trailing.refresh((0.0, 0.01, DOF))  # before any point: nothing
+    assert trailing.state is SlipState.UNKNOWN
+    trailing.add(0.0, 2.0, (0.0, 0.05, DOF))  # 0 - 1.72 * 0.05 < k: undecided
+    assert trailing.state is SlipState.UNKNOWN
+    trailing.refresh((0.01, 0.01, DOF))
+    assert trailing.state is SlipState.STABLE
+    trailing.refresh((-1.0, 0.01, DOF))
+    assert trailing.state is SlipState.STABLE

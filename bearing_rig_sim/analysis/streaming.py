@@ -252,6 +252,17 @@ class TrailingSlope:
         self._verdict = self._make_verdict()
         return changed
 
+    def refresh(self, external: tuple[float, float, int] | tuple[float, float, int, bool]) -> None:
+        """A newer finer estimate (``external`` of :meth:`add`) between two points: decides
+        afresh on it while no verdict is held (a first verdict need not wait for the next slip
+        point); nothing before the first point, or once a verdict is held (its overturn rules
+        count points)."""
+        if not self._x or self._state is not SlipState.UNKNOWN:
+            return
+        self._fit(external)
+        self._decide()
+        self._verdict = self._make_verdict()
+
     def _test_change(self, u: float, y: float) -> bool:
         line = self._line
         if line is None:

@@ -290,9 +290,16 @@ class SlipMonitor:
             return
         if self.counter.epoch != self._phase_epoch:
             self._reset_phase()
+        added = None
         for t, index, strip, angle in points:
             if t > self._phase_from:
                 self.phase.add(t, index, strip, angle)
+                added = t
+        if added is not None and self._latest is not None and self.slope.state is SlipState.UNKNOWN:
+            # no verdict yet: every cage pulse is a look, not only every window (O(strips^2))
+            external = self._phase_external(added)
+            if external is not None:
+                self.slope.refresh(external)
 
     def _take_events(self) -> None:
         for kind, when, text in self.counter.events:
@@ -386,22 +393,28 @@ class SlipMonitor:
             if verdict is not None:
                 self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
+    def _phase_external(self, t1: float) -> tuple[float, float, int, bool] | None:
+        """The phase's slope up to ``t1`` (s) for the slope criterion: (slope, standard error,
+        degrees of freedom, whether to check it against the windows' line); None without one."""
+        if self.phase is None or self.criterion != "time":
+            return None
+        change = self.slope.verdict().change_at
+        estimate = self.phase.estimate(t1, since=change)
+        if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
+            # no verdict yet at a steady speed: the phase since the speed settled (the more
+            # data, the surer a first verdict, which no hysteresis protects)
+            since = self._steady_since if change is None else max(change, self._steady_since)
+            longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
+            if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
+                estimate = longer
+        if estimate is None:
+            return None
+        full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
+        alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
+        return estimate.slope, estimate.standard_error, estimate.dof, not alone
+
     def _add_point(self, t1: float, x: float, slip: float) -> None:
-        external: tuple[float, float, int, bool] | None = None
-        if self.phase is not None and self.criterion == "time":
-            change = self.slope.verdict().change_at
-            estimate = self.phase.estimate(t1, since=change)
-            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
-                # no verdict yet at a steady speed: the phase since the speed settled (the more
-                # data, the surer a first verdict, which no hysteresis protects)
-                since = self._steady_since if change is None else max(change, self._steady_since)
-                longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
-                if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
-                    estimate = longer
-            if estimate is not None:
-                full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
-                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
-                external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)
+        external = self._phase_external(t1)
         try:
             if self.slope.add(x, slip, external):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))

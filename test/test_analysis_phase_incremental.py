@@ -46,14 +46,15 @@ def stream(rng: np.random.Generator, duration: float) -> list[tuple[float, int, 
 def batch(points: list[tuple[float, int, int, float]], end: float, since: float, span: float) -> tuple[float, float, float, int] | None:
     """(slope %/s, standard error, Durbin-Watson / 2, pulses) by lstsq over the stretch the
     docstring of ``estimate`` names: pulses in [since, end], the last ``span`` of them, extended
-    back to MIN_PHASE_REVOLUTIONS cage revolutions."""
+    back to MIN_PHASE_REVOLUTIONS cage revolutions and to three pulses more than the fit's
+    STRIPS + 2 parameters."""
     rows = [p for p in points if since <= p[0] <= end]
     if len(rows) < 2:
         return None
     need = MIN_PHASE_REVOLUTIONS * STRIPS
     chosen = [rows[-1]]
     for row in reversed(rows[:-1]):
-        if end - row[0] <= span or rows[-1][1] - chosen[0][1] < need:
+        if end - row[0] <= span or rows[-1][1] - chosen[0][1] < need or len(chosen) < STRIPS + 5:
             chosen.insert(0, row)
         else:
             break

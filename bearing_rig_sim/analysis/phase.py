@@ -43,6 +43,10 @@ MIN_PHASE_REVOLUTIONS = 2.0
 """A stretch covers at least this many cage revolutions (reaching back beyond the span if need
 be), so that the strips' offsets are told apart from the curvature (1)."""
 
+MIN_DOF = 3
+"""... and at least this many pulses more than the fit's parameters (strips + 2), reaching back
+beyond the span if lost pulses leave fewer (1)."""
+
 WHITE_CHECK = 0.75
 """Below this ratio of the residuals' lag-one variogram to twice their variance (the
 Durbin-Watson statistic over 2: 1 for white residuals, its standard deviation about
@@ -205,7 +209,7 @@ class PhaseSlope:
             return 0.0
         return 2.0 * math.pi * (self._index[-1] - self._index[self._head]) / self.strips / (self._t[-1] - self._t[self._head])
 
-    def _stretch(self, end: float, since: float | None, span: float | None) -> tuple[int, int] | None:
+    def _stretch(self, end: float, since: float | None, span: float | None, min_points: int = 0) -> tuple[int, int] | None:
         """First and last kept point (list positions) of the stretch :meth:`estimate` fits."""
         start = -math.inf if since is None else since
         stretch = self.span if span is None else min(span, self.max_span)
@@ -217,22 +221,23 @@ class PhaseSlope:
         need = MIN_PHASE_REVOLUTIONS * self.strips
         by_time = min(bisect.bisect_left(t, end - stretch, lo, hi + 1), hi)
         by_index = bisect.bisect_right(index, index[hi] - need, lo, hi + 1) - 1
-        first = max(lo, min(by_time, by_index))
+        by_count = hi + 1 - max(self.strips + 2 + MIN_DOF, min_points)  # pulses received: lost ones count for nothing
+        first = max(lo, min(by_time, by_index, by_count))
         if index[hi] - index[first] < need:
             return None
         return first, hi
 
-    def estimate(self, end: float, since: float | None = None, span: float | None = None) -> PhaseEstimate | None:
+    def estimate(self, end: float, since: float | None = None, span: float | None = None, min_points: int = 0) -> PhaseEstimate | None:
         """The slope over the pulses of the last ``span`` (s; default the one given at
         construction, at most ``max_span``) up to ``end`` (s), or back to
-        :data:`MIN_PHASE_REVOLUTIONS` cage revolutions if the span holds fewer, none before
-        ``since`` (s: a change in the slip); None with too few pulses for the fit (three more
-        than its parameters).
+        :data:`MIN_PHASE_REVOLUTIONS` cage revolutions and to ``min_points`` pulses (at least
+        :data:`MIN_DOF` more than the fit's parameters) if the span holds fewer, none before
+        ``since`` (s: a change in the slip); None with too few pulses for the fit.
 
         From the running sums (the normal equations); when the residuals' lag-one variogram
         says they are not white (:data:`WHITE_CHECK`), the two-noise standard error of the
         stretch's pulses (module docstring) instead."""
-        found = self._stretch(end, since, span)
+        found = self._stretch(end, since, span, min_points)
         if found is None:
             return None
         first, last = found
@@ -243,7 +248,7 @@ class PhaseSlope:
         present = [2 + s for s in range(self.strips) if gram[2 + s, 2 + s] > 0.5]
         columns = [0, 1, *present]
         n, p = last - first + 1, len(columns)
-        if n < p + 3:
+        if n < p + MIN_DOF:
             return None
         a = gram[np.ix_(columns, columns)]
         b = gram[columns, -1]

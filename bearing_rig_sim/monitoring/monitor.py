@@ -55,7 +55,9 @@ windows' line, whose scatter is pooled over 64 windows (1)."""
 
 PHASE_MIN_PULSES = 20
 """... and it has at least this many cage pulses: on fewer, a wandering phase cannot be told from
-jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1) ..."""
+jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1); the
+trailing stretch reaches back to this many (a slow cage early in a run-up gives some 8 a second,
+and its two revolutions alone left 10 us of jitter undecided for up to 1.8 s) ..."""
 
 PHASE_FULL_SPAN = 0.95
 """... over at least this fraction of ``slope_span_s`` (1): at the start of a hold the first
@@ -399,7 +401,9 @@ class SlipMonitor:
         if self.phase is None or self.criterion != "time":
             return None
         change = self.slope.verdict().change_at
-        estimate = self.phase.estimate(t1, since=change)
+        # back to PHASE_MIN_PULSES pulses if the span holds fewer (a slow cage early in a
+        # run-up, or one that lost some): older, steeper slip makes the slope only more negative
+        estimate = self.phase.estimate(t1, since=change, min_points=PHASE_MIN_PULSES)
         if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
             # no verdict yet at a steady speed: the phase since the speed settled (the more
             # data, the surer a first verdict, which no hysteresis protects)

@@ -245,21 +245,21 @@ class PhaseSlope:
         sums = self._sums[last + 1] - self._sums[first]
         gram = sums[:d2].reshape(dim, dim)
         pairs = (self._sums[last + 1, d2:] - self._sums[first + 1, d2:]).reshape(dim, dim)
-        present = [2 + s for s in range(self.strips) if gram[2 + s, 2 + s] > 0.5]
-        columns = [0, 1, *present]
+        columns = np.flatnonzero(np.diag(gram)[:-1] > 0.0)  # u, u^2 and the strips present
         n, p = last - first + 1, len(columns)
         if n < p + MIN_DOF:
             return None
-        a = gram[np.ix_(columns, columns)]
+        a = gram[columns][:, columns]
         b = gram[columns, -1]
-        scale = 1.0 / np.sqrt(np.diag(a))
-        scaled = a * np.outer(scale, scale)
-        if not np.linalg.cond(scaled) < 1e12:
+        root = 1.0 / np.sqrt(np.diag(a))
+        scale = np.outer(root, root)
+        eigenvalues, vectors = np.linalg.eigh(a * scale)  # equilibrated: eigenvalues of order 1
+        if not eigenvalues[0] > 1e-12 * eigenvalues[-1]:
             return None
-        inverse = np.linalg.inv(scaled) * np.outer(scale, scale)
+        inverse = (vectors / eigenvalues) @ vectors.T * scale
         coef = inverse @ b
         sse = max(float(gram[-1, -1] - b @ coef), 0.0)
-        da, db = pairs[np.ix_(columns, columns)], pairs[columns, -1]
+        da, db = pairs[columns][:, columns], pairs[columns, -1]
         near = max(float(pairs[-1, -1] - 2.0 * db @ coef + coef @ da @ coef), 0.0)
         s2 = sse / (n - p)
         # residuals' lag-one variogram against their variance: 1 for white residuals (the

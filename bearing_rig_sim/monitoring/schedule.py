@@ -174,8 +174,8 @@ class PulseMerger:
 
     A subscriber gets each topic from its own queue; after a hold-up the backlogs come one
     message per topic in turn, so the sparser cage pulses run ahead in time of the spindle's (0.7 s
-    was seen), and a check on that clock finds the spindle silent. A bag is already in log-time
-    order and needs none of this. Rule: a pulse goes on once it is no later than the other
+    was seen), and a check on that clock finds the spindle silent. A bag's log order is the
+    recorder's reception order, held up the same way: ``analyze`` uses :class:`StampOrder`. Rule: a pulse goes on once it is no later than the other
     shaft's latest pulse plus twice that shaft's last pulse interval (the other's next pulse is
     due by then), or the other shaft has not been heard of for ``max_wait_s`` of the steady
     clock (silent, which the schedule's checks then judge); pulses go on in time order.

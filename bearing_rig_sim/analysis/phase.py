@@ -113,12 +113,13 @@ class PhaseSlope:
         self._strip: list[int] = []
         self._inner: list[float] = []
         self._head = 0  # first kept point of the lists
+        self._summed = 0  # points (from the lists' start) taken into the sums
         self._z_last: FloatArray | None = None
         # row j + 1: sums over points head..j of z z' and of dz dz' (dz: z minus the previous
         # point's z), flattened; row 0 zero
         self._sums = np.zeros((64, 2 * self._dim * self._dim))
         self._ref: tuple[float, int] = (0.0, 0)  # spindle angle and cage index of the reference
-        self._trend = np.zeros(self._dim - 1)  # taken out of y: coefficients of (u, u^2, strips)
+        self._trend: FloatArray = np.zeros(self._dim - 1)  # taken out of y: coefficients of (u, u^2, strips)
         self._ref_time, self._rebuilt_at = -math.inf, 0
 
     @property
@@ -128,8 +129,9 @@ class PhaseSlope:
 
     def add(self, time: float, cage_index: int, strip: int, spindle_angle: float) -> None:
         """One cage pulse: its time (s, increasing), pulse index (increasing) and strip, and the
-        spindle's angle then (rad, spacing-corrected). O(strips^2), and now and then (once a
-        ``span`` of pulses) a rebuild of the sums on a new reference, O(pulses kept)."""
+        spindle's angle then (rad, spacing-corrected). Kept as given: the sums take it in at
+        the next :meth:`estimate` (with the others since, in one vectorised step), and now and
+        then (once a ``span``) they are rebuilt on a new reference, O(pulses kept)."""
         if self.points and not (time > self._t[-1] and cage_index > self._index[-1]):
             self.reset()
         self._t.append(time)
@@ -141,68 +143,57 @@ class PhaseSlope:
             self._head += 1
         if time - self._ref_time > self.span or self.points >= 2 * self._rebuilt_at or 2 * self._head > len(self._t):
             self._rebuild()
-        else:
-            self._append_sums(self._z(len(self._t) - 1))
 
-    def _z(self, j: int) -> FloatArray:
-        """The row (u, u^2, strip indicators, y) of point ``j`` on the present reference."""
+    def _rows(self, lo: int, hi: int) -> FloatArray:
+        """The rows z = (u, u^2, strip indicators, y) of points ``lo`` to ``hi - 1`` on the
+        present reference, the trend taken out of y."""
         inner_ref, index_ref = self._ref
-        u = self._inner[j] - inner_ref
-        z = np.zeros(self._dim)
-        z[0], z[1], z[2 + self._strip[j]] = u, u * u, 1.0
-        z[-1] = 2.0 * math.pi / self.strips * (self._index[j] - index_ref) - self.ratio * u - float(z[:-1] @ self._trend)
+        n = hi - lo
+        u = np.asarray(self._inner[lo:hi]) - inner_ref
+        z = np.zeros((n, self._dim))
+        z[:, 0], z[:, 1] = u, u * u
+        z[np.arange(n), 2 + np.asarray(self._strip[lo:hi], dtype=np.intp)] = 1.0
+        y = 2.0 * math.pi / self.strips * (np.asarray(self._index[lo:hi], dtype=np.float64) - index_ref) - self.ratio * u
+        z[:, -1] = y - z[:, :-1] @ self._trend
         return z
 
-    def _append_sums(self, z: FloatArray) -> None:
-        row = len(self._t)  # point j's sums are in row j + 1 (the lists start at the last rebuild)
-        if row >= self._sums.shape[0]:
-            grown = np.zeros((2 * self._sums.shape[0], self._sums.shape[1]))
-            grown[:row] = self._sums[:row]
+    def _sync(self) -> None:
+        """Take the pulses added since into the sums (vectorised)."""
+        lo, hi = self._summed, len(self._t)
+        if hi <= lo:
+            return
+        z = self._rows(lo, hi)
+        dz = np.diff(z, axis=0, prepend=(z[:1] if self._z_last is None else self._z_last[None, :]))
+        if hi + 1 > self._sums.shape[0]:
+            grown = np.zeros((max(64, 1 << (hi + 1).bit_length()), self._sums.shape[1]))
+            grown[: lo + 1] = self._sums[: lo + 1]
             self._sums = grown
-        d2 = self._dim * self._dim
-        new = self._sums[row]
-        new[:] = self._sums[row - 1]
-        new[:d2] += np.outer(z, z).ravel()
-        if self._z_last is not None and row > 1:
-            dz = z - self._z_last
-            new[d2:] += np.outer(dz, dz).ravel()
-        self._z_last = z
+        n = hi - lo
+        outer = np.concatenate((np.einsum("ki,kj->kij", z, z).reshape(n, -1), np.einsum("ki,kj->kij", dz, dz).reshape(n, -1)), axis=1)
+        self._sums[lo + 1 : hi + 1] = self._sums[lo] + np.cumsum(outer, axis=0)
+        self._summed, self._z_last = hi, z[-1]
 
     def _rebuild(self) -> None:
         """Drop the pulses left behind, put the reference at the latest pulse (the estimates end
         near it: the sums stay well conditioned) and take out of y the fit of the latest
         ``span`` (parabola and strip offsets), so that the residuals' sum of squares is not the
-        small difference of large sums; then the sums afresh."""
+        small difference of large sums; the sums start afresh."""
         head = self._head
         for kept in (self._t, self._index, self._strip, self._inner):
             del kept[:head]
         self._head = 0
-        n, dim = len(self._t), self._dim
-        t = np.asarray(self._t)
-        strip = np.asarray(self._strip)
-        inner_ref, index_ref = self._inner[-1], self._index[-1]
-        u = np.asarray(self._inner) - inner_ref
-        y = 2.0 * math.pi / self.strips * (np.asarray(self._index, dtype=np.float64) - index_ref) - self.ratio * u
-        z = np.zeros((n, dim))
-        z[:, 0], z[:, 1] = u, u * u
-        z[np.arange(n), 2 + strip] = 1.0
-        recent = t >= t[-1] - self.span
-        trend = np.zeros(dim - 1)
-        if int(np.count_nonzero(recent)) > dim:
-            fit, _res, rank, _sv = np.linalg.lstsq(z[recent, :-1], y[recent], rcond=None)
-            if rank == dim - 1:
-                trend = fit
-        self._trend = trend
-        self._ref = (inner_ref, index_ref)
+        n = len(self._t)
+        self._ref = (self._inner[-1], self._index[-1])
+        self._trend = np.zeros(self._dim - 1)
+        first = bisect.bisect_left(self._t, self._t[-1] - self.span)
+        if n - first > self._dim:
+            recent = self._rows(first, n)
+            fit, _res, rank, _sv = np.linalg.lstsq(recent[:, :-1], recent[:, -1], rcond=None)
+            if rank == self._dim - 1:
+                self._trend = np.asarray(fit, dtype=np.float64)
         self._ref_time, self._rebuilt_at = self._t[-1], n
-        z[:, -1] = y - z[:, :-1] @ trend
-        dz = np.zeros_like(z)
-        dz[1:] = z[1:] - z[:-1]
-        rows = max(64, 1 << (n + 1).bit_length())
-        self._sums = np.zeros((rows, 2 * dim * dim))
-        outer = np.concatenate((np.einsum("ki,kj->kij", z, z).reshape(n, -1), np.einsum("ki,kj->kij", dz, dz).reshape(n, -1)), axis=1)
-        self._sums[1 : n + 1] = np.cumsum(outer, axis=0)
-        self._z_last = z[-1]
+        self._sums = np.zeros((max(64, 1 << (n + 1).bit_length()), 2 * self._dim * self._dim))
+        self._summed, self._z_last = 0, None
 
     def _cage_speed(self) -> float:
         if self.points < 2 or self._t[-1] <= self._t[self._head]:
@@ -238,6 +229,7 @@ class PhaseSlope:
         says they are not white (:data:`WHITE_CHECK`), the two-noise standard error of the
         stretch's pulses (module docstring) instead."""
         found = self._stretch(end, since, span, min_points)
+        self._sync()
         if found is None:
             return None
         first, last = found

@@ -64,10 +64,11 @@ PHASE_FULL_SPAN = 0.95
 spindle spacing estimate is one revolution's, as scattered as the jitter, and shorter stretches
 of 50 us jitter at 900 rpm made false SLIPPING verdicts."""
 
-PHASE_LOOKS_PER_STATUS = 4.0
+PHASE_LOOKS_PER_STATUS = 10.0
 """Before the first verdict, the phase slope is looked at on the cage pulses, at most this many
 times per status period (1 / ``status_rate_hz``): a first STABLE then waits for no window, and at
-9000 rpm (260 cage pulses a second) it costs some 40 looks a second, not 260."""
+9000 rpm (260 cage pulses a second) it costs some 100 looks a second, not 260 (at 4, a look every
+25 ms, 3000 rpm holds lost up to 0.13 s against a look at every pulse)."""
 
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""

@@ -491,14 +491,16 @@ def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float,
 def test_run_ups_with_sensor_imperfections_are_judged_stable_after_the_onset(acceleration: float, changes: dict) -> None:
     """The same run-ups with 0.5 % of the pulses lost, a burst of 8 lost cage pulses (2 revolutions)
     just after the onset, or 10 us of jitter: no FAULT, never stable before the onset, stable
-    within 2 s after it (the burst costs the phase its stretch; 10 us of jitter at 20-40 rad/s^2
-    took up to 1.8 s in 10 seeds) and kept."""
+    within ONSET_DELAY_S after it and kept. (Seeds 100-119 of each case at 20-80 rad/s^2:
+    0.53-1.43 s; but a burst of 2 cage revolutions 0.1 s after the onset at 20 rad/s^2, where the
+    cage gives some 8 pulses a second, leaves too few pulses for 1.5 s: 1.83 s. Before the
+    phase's stretch reached back to PHASE_MIN_PULSES pulses, 10 us of jitter took up to 1.8 s.)"""
     scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, **changes)
     onset = table7_onset(acceleration, K2)
     out = run(scenario)
     assert SlipState.FAULT not in out.states
     stable = out.times[out.states == SlipState.STABLE]
-    assert stable.size and onset <= stable[0] <= onset + 2.0
+    assert stable.size and onset <= stable[0] <= onset + ONSET_DELAY_S
     assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
 
 

@@ -55,12 +55,20 @@ windows' line, whose scatter is pooled over 64 windows (1)."""
 
 PHASE_MIN_PULSES = 20
 """... and it has at least this many cage pulses: on fewer, a wandering phase cannot be told from
-jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1) ..."""
+jitter (a scattered slip's first nine pulses, judged alone, made a false SLIPPING) (1); the
+trailing stretch reaches back to this many (a slow cage early in a run-up gives some 8 a second,
+and its two revolutions alone left 10 us of jitter undecided for up to 1.8 s) ..."""
 
 PHASE_FULL_SPAN = 0.95
 """... over at least this fraction of ``slope_span_s`` (1): at the start of a hold the first
 spindle spacing estimate is one revolution's, as scattered as the jitter, and shorter stretches
 of 50 us jitter at 900 rpm made false SLIPPING verdicts."""
+
+PHASE_LOOKS_PER_STATUS = 10.0
+"""Before the first verdict, the phase slope is looked at on the cage pulses, at most this many
+times per status period (1 / ``status_rate_hz``): a first STABLE then waits for no window, and at
+9000 rpm (260 cage pulses a second) it costs some 100 looks a second, not 260 (at 4, a look every
+25 ms, 3000 rpm holds lost up to 0.13 s against a look at every pulse)."""
 
 LOAD_HISTORY = 16384
 """Load-cell samples kept for the windows' mean load (16 s at the load cell's 1 kHz)."""
@@ -276,6 +284,7 @@ class SlipMonitor:
             self.phase.reset()
         self._phase_from = since
         self._phase_epoch = self.counter.epoch
+        self._phase_look = -math.inf
 
     def _take_phase(self, shaft: str, pulse: Pulse) -> None:
         """Give the phase slope the cage pulses whose spindle angle is now known."""
@@ -290,9 +299,19 @@ class SlipMonitor:
             return
         if self.counter.epoch != self._phase_epoch:
             self._reset_phase()
+        added = None
         for t, index, strip, angle in points:
             if t > self._phase_from:
                 self.phase.add(t, index, strip, angle)
+                added = t
+        look = PHASE_LOOKS_PER_STATUS * st.status_rate_hz
+        if added is not None and self._latest is not None and self.slope.state is SlipState.UNKNOWN and (added - self._phase_look) * look >= 1.0:
+            # no verdict yet: a look at every cage pulse, or PHASE_LOOKS_PER_STATUS per status
+            # period at high speed, not only at every window (O(strips^2) each)
+            self._phase_look = added
+            external = self._phase_external(added)
+            if external is not None:
+                self.slope.refresh(external)
 
     def _take_events(self) -> None:
         for kind, when, text in self.counter.events:
@@ -386,22 +405,30 @@ class SlipMonitor:
             if verdict is not None:
                 self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))
 
+    def _phase_external(self, t1: float) -> tuple[float, float, int, bool] | None:
+        """The phase's slope up to ``t1`` (s) for the slope criterion: (slope, standard error,
+        degrees of freedom, whether to check it against the windows' line); None without one."""
+        if self.phase is None or self.criterion != "time":
+            return None
+        change = self.slope.verdict().change_at
+        # back to PHASE_MIN_PULSES pulses if the span holds fewer (a slow cage early in a
+        # run-up, or one that lost some): older, steeper slip makes the slope only more negative
+        estimate = self.phase.estimate(t1, since=change, min_points=PHASE_MIN_PULSES)
+        if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
+            # no verdict yet at a steady speed: the phase since the speed settled (the more
+            # data, the surer a first verdict, which no hysteresis protects)
+            since = self._steady_since if change is None else max(change, self._steady_since)
+            longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
+            if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
+                estimate = longer
+        if estimate is None:
+            return None
+        full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
+        alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
+        return estimate.slope, estimate.standard_error, estimate.dof, not alone
+
     def _add_point(self, t1: float, x: float, slip: float) -> None:
-        external: tuple[float, float, int, bool] | None = None
-        if self.phase is not None and self.criterion == "time":
-            change = self.slope.verdict().change_at
-            estimate = self.phase.estimate(t1, since=change)
-            if self._steady_since is not None and self.slope.state is SlipState.UNKNOWN:
-                # no verdict yet at a steady speed: the phase since the speed settled (the more
-                # data, the surer a first verdict, which no hysteresis protects)
-                since = self._steady_since if change is None else max(change, self._steady_since)
-                longer = self.phase.estimate(t1, since=since, span=self.settings.slope_max_span_s)
-                if longer is not None and (longer.points > (estimate.points if estimate is not None else 0)):
-                    estimate = longer
-            if estimate is not None:
-                full = estimate.end - estimate.start >= PHASE_FULL_SPAN * self.settings.slope_span_s
-                alone = estimate.white_share >= PHASE_WHITE_SHARE and estimate.points >= PHASE_MIN_PULSES and full
-                external = (estimate.slope, estimate.standard_error, estimate.dof, not alone)
+        external = self._phase_external(t1)
         try:
             if self.slope.add(x, slip, external):
                 self._notes.append((t1, "a change in the slip: slope window restarted"))

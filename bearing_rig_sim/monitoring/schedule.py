@@ -174,8 +174,8 @@ class PulseMerger:
 
     A subscriber gets each topic from its own queue; after a hold-up the backlogs come one
     message per topic in turn, so the sparser cage pulses run ahead in time of the spindle's (0.7 s
-    was seen), and a check on that clock finds the spindle silent. A bag is already in log-time
-    order and needs none of this. Rule: a pulse goes on once it is no later than the other
+    was seen), and a check on that clock finds the spindle silent. A bag's log order is the
+    recorder's reception order, held up the same way: ``analyze`` uses :class:`StampOrder`. Rule: a pulse goes on once it is no later than the other
     shaft's latest pulse plus twice that shaft's last pulse interval (the other's next pulse is
     due by then), or the other shaft has not been heard of for ``max_wait_s`` of the steady
     clock (silent, which the schedule's checks then judge); pulses go on in time order.
@@ -219,5 +219,72 @@ class PulseMerger:
             due = self._latest[other] + 2.0 * self._interval[other]
             silent = wall_now - self._heard[other] > self.max_wait_s
             if not (self._held[other] or t <= due or silent):
+                return out
+            out.append((name, self._held[name].popleft()))
+
+
+ORDER_MAX_LEAD_S = 5.0
+""":class:`StampOrder` holds a pulse until the other shaft's stamps reach it, or its own shaft's
+run this far past it (the other is then silent), rig s: well beyond the 0.7 s by which one topic
+was seen to run ahead of the other after a hold-up, and a few thousand pulses at most."""
+
+
+class StampOrder:
+    """Puts the two pulse streams of a recording (each in its own order) into one order by their
+    stamps alone, so that what is computed from them depends on the data, not on when it was
+    received (``analyze``'s use).
+
+    A bag is in log-time order, the order the recorder received the messages in; after a hold-up
+    its subscriber, like the monitor's, gets the two topics' backlogs one message per topic in
+    turn, and the sparse cage pulses run ahead of the spindle's (0.7 s was seen). Replayed in that
+    order, the schedule's checks found the spindle silent for that long, a FAULT the live
+    monitor, whose :class:`PulseMerger` reorders, never reported. Rule: a pulse goes on once the
+    other shaft has a pulse stamped at or after it, or its own shaft has run more than
+    :data:`ORDER_MAX_LEAD_S` past it (the other is silent, which the schedule's checks then judge
+    on the same stamps); pulses go on in stamp order, each shaft's in its own order. Unlike
+    :class:`PulseMerger` it waits for the other shaft's next pulse, which costs latency live but
+    nothing offline. Pulses without a finite stamp go on at once (the monitor reports them).
+
+    Args:
+        max_lead_s: the silence after which a shaft's pulses no longer wait for the other's, rig s.
+    """
+
+    def __init__(self, max_lead_s: float = ORDER_MAX_LEAD_S) -> None:
+        self.max_lead_s = max_lead_s
+        self._held: dict[str, deque[Pulse]] = {"spindle": deque(), "cage": deque()}
+        self._latest: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
+
+    def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
+        """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
+        t = pulse.time
+        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+            return [(shaft, pulse)]
+        self._latest[shaft] = max(self._latest[shaft], float(t))
+        self._held[shaft].append(pulse)
+        return self._release(-math.inf)
+
+    @property
+    def clock(self) -> float:
+        """The latest stamp received, held or not, rig s (-inf before any)."""
+        return max(self._latest.values())
+
+    def release_until(self, until: float) -> list[tuple[str, Pulse]]:
+        """The pulses that may go on now, and every held one stamped at or before ``until`` (rig
+        s: something else, such as a program segment's start, marks the time there)."""
+        return self._release(until)
+
+    def flush(self) -> list[tuple[str, Pulse]]:
+        """Every held pulse, in order (the end of the recording)."""
+        return self._release(math.inf)
+
+    def _release(self, until: float) -> list[tuple[str, Pulse]]:
+        out: list[tuple[str, Pulse]] = []
+        while True:
+            heads = [(float(q[0].time), name) for name, q in self._held.items() if q]
+            if not heads:
+                return out
+            t, name = min(heads)
+            other = "cage" if name == "spindle" else "spindle"
+            if not (t <= until or self._latest[other] >= t or self._latest[name] - t > self.max_lead_s):
                 return out
             out.append((name, self._held[name].popleft()))

@@ -97,7 +97,8 @@ pulse, so a spindle turned by hand at rest, or a stray edge of a strip standing 
 is no fault. Once one shaft runs, each is judged by its own silence."""
 
 SPACING_AVERAGE_REVOLUTIONS = 32
-"""Revolutions over which each strip's spacing error is averaged (exponential weight 1/32)."""
+"""Revolutions over which each strip's spacing error is averaged: the plain mean of the first 32
+samples, then an exponential weight of 1/32."""
 
 
 @dataclass(frozen=True)
@@ -226,6 +227,7 @@ class SlipWindows:
         malformed pulse, discarded), "gap" (lost pulses), "note" (an out-of-order pulse or a
         restart) or "reset" (a clock jump: the caller resets what it derived)."""
         self._spacing: dict[int, float] = {}
+        self._spacing_samples: dict[int, int] = {}  # samples of each strip's spacing error taken
         self.phase: list[tuple[float, int, int, float]] = []
         """Cage pulses with the spindle's angle at their time, since the caller last cleared
         it: (time s, cage pulse_index, cage strip, spindle angle rad); the series restarts
@@ -406,8 +408,13 @@ class SlipWindows:
         for (index, _), dm in zip(middle, d):
             strip = (index + s.offset) % n
             sample = dm - mean
-            old = self._spacing.get(strip)
-            self._spacing[strip] = sample if old is None else old + (sample - old) / SPACING_AVERAGE_REVOLUTIONS
+            # the mean of the samples so far, then an exponential average over the last
+            # SPACING_AVERAGE_REVOLUTIONS (the first sample alone is as scattered as the jitter,
+            # and an exponential weight of 1/32 kept 60 % of it for 15 revolutions)
+            count = self._spacing_samples.get(strip, 0) + 1
+            self._spacing_samples[strip] = count
+            old = self._spacing.get(strip, 0.0)
+            self._spacing[strip] = old + (sample - old) / min(count, SPACING_AVERAGE_REVOLUTIONS)
 
     def _add_cage_pulse(self, cage: _Shaft, t: float, index: int) -> list[SlipWindow]:
         assert cage.strip_count is not None and cage.offset is not None

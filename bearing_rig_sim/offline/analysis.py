@@ -44,6 +44,7 @@ Units: SI inside (s, rad/s, N), slip in percent; the CSV files speak rpm, percen
 from __future__ import annotations
 
 import dataclasses
+from collections import deque
 import functools
 import math
 import warnings
@@ -56,7 +57,7 @@ from collections.abc import Callable
 from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
-from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
+from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -198,25 +199,44 @@ class OfflineResult:
 # ---------------------------------------------------------------------------------------------
 class _Latest:
     """The latest message of a topic, decoded only when asked for (a message that does not
-    decode is counted in :attr:`failed` and leaves the value unknown)."""
+    decode is counted in :attr:`failed` and leaves the value unknown); :meth:`get` ``before`` a
+    message's place in the bag gives the latest read before it (a status is computed on pulses
+    put in stamp order, which may be released after later context messages were read)."""
+
+    KEPT = 4096
+    """Messages kept for :meth:`get` before an earlier place (1)."""
 
     def __init__(self, decode: Callable[[bytes], Any]) -> None:
         self._decode = decode
-        self._raw: bytes | None = None
-        self._value: Any = None
+        self._kept: deque[tuple[int, bytes]] = deque(maxlen=self.KEPT)  # (place read, raw)
+        self._decoded: tuple[int, bytes, Any] | None = None
+        self._bad: set[int] = set()  # places of messages that did not decode
         self.failed = 0
 
-    def put(self, _log_time_ns: int, raw: bytes) -> None:
-        self._raw, self._value = raw, None
+    def put(self, place: int, raw: bytes) -> None:
+        """The message read ``place``-th in the bag."""
+        self._kept.append((place, raw))
 
-    def get(self) -> Any:
-        if self._value is None and self._raw is not None:
-            try:
-                self._value = self._decode(self._raw)
-            except BagError:
-                self._raw = None
-                self.failed += 1
-        return self._value
+    def get(self, before: int | None = None) -> Any:
+        """The latest message, or the latest read before the ``before``-th (of the last
+        :attr:`KEPT`); None if none (or it does not decode)."""
+        entry = None
+        for kept in reversed(self._kept):  # the pulses are held briefly: a few steps back at most
+            if before is None or kept[0] < before:
+                entry = kept
+                break
+        if entry is None or entry[0] in self._bad:
+            return None
+        if self._decoded is not None and self._decoded[:2] == entry:
+            return self._decoded[2]
+        try:
+            value = self._decode(entry[1])
+        except BagError:
+            self.failed += 1
+            self._bad.add(entry[0])
+            return None
+        self._decoded = (*entry, value)
+        return value
 
 
 def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> MonitorSettings | None:
@@ -288,6 +308,14 @@ class OfflineAnalysis:
         self._last_row: StatusRow | None = None
         self._recorded: Any = None
         self._segments = SegmentTracker(self.result.segment_source == "program", program_segment_names(self.result.run_metadata), settings)
+        self._order = StampOrder()
+        """The pulses in stamp order, not the log's reception order (a held-up recorder)."""
+        self._read = 0
+        """Messages read from the bag so far."""
+        self._read_at: dict[int, int] = {}
+        """Place in the bag of each pulse held in :attr:`_order`, by id."""
+        self._context_before: int | None = None
+        """Statuses take the context read before this place (the pulse computing them); None: all."""
         self._commands_ahead: list[tuple[float, Any]] = []
         """Spindle commands read before their stamp: (stamp s, message), in order."""
         self._sinks: list[CsvWriter] = []
@@ -342,16 +370,19 @@ class OfflineAnalysis:
         """Read the bag once and return the result; CSV files are closed whatever happens."""
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
         for name in self._context:
-            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, self._latest[name].put)
+            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, functools.partial(self._on_context, name))
             if name == LOAD_CELL:  # the load sweep's abscissa and the kinematic slip's contact angle
                 handlers[name] = self._on_load_cell
         try:
             for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
                 while self._commands_ahead and self._commands_ahead[0][0] <= log_time_ns * 1e-9:
                     start, command = self._commands_ahead.pop(0)
+                    for shaft, pulse in self._order.release_until(start):
+                        self._feed(shaft, pulse)
                     for scheduled in self.schedule.advance_to(start):  # the ticks of the ending segment
                         self._emit(scheduled.time, scheduled.reason, scheduled.status)
                     self._start_segment(start, command)
+                self._read += 1
                 handlers[topic](log_time_ns, cast(bytes, data))  # raw=True: the CDR bytes
             self._finish()
         finally:
@@ -388,6 +419,20 @@ class OfflineAnalysis:
             pulse = dataclasses.replace(pulse, time=log_time_ns * 1e-9)
         shaft = self._shaft_of[topic]
         self.result.pulses[shaft] += 1
+        self._read_at[id(pulse)] = self._read
+        for ordered in self._order.push(shaft, pulse):
+            self._feed(*ordered)
+
+    def _feed(self, shaft: str, pulse: Pulse) -> None:
+        """One pulse, in stamp order, through the schedule; its statuses take the context read
+        before it."""
+        self._context_before = self._read_at.pop(id(pulse), None)
+        try:
+            self._schedule_pulse(shaft, pulse)
+        finally:
+            self._context_before = None
+
+    def _schedule_pulse(self, shaft: str, pulse: Pulse) -> None:
         for scheduled in self.schedule.on_pulse(shaft, pulse):
             if scheduled.reason == "window":
                 latest = self.monitor.latest_window
@@ -412,6 +457,8 @@ class OfflineAnalysis:
             self.monitor.add_load(stamp, float(message.wrench.force.z))
 
     def _finish(self) -> None:
+        for shaft, pulse in self._order.flush():
+            self._feed(shaft, pulse)
         final = self.schedule.finish()
         if final is not None:
             self._emit(final.time, final.reason, final.status)
@@ -426,14 +473,21 @@ class OfflineAnalysis:
         clock (or, before the first pulse, from the log time): a stamp on another clock, such as
         the monitor's status before its first window. The pulse clock (or log time) is used then."""
         latest = self._latest[topic]
-        latest.put(log_time_ns, data)
+        latest.put(self._read, data)
         message = latest.get()
         if message is None:
             return None, _NAN
         stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-        clock = self.schedule.clock
+        clock = self._pulse_clock()
         reference = clock if math.isfinite(clock) else log_time_ns * 1e-9
         return message, stamp if abs(stamp - reference) <= PLAUSIBLE_STAMP_S else reference
+
+    def _pulse_clock(self) -> float:
+        """The latest pulse stamp read, held in :class:`StampOrder` or not, s (-inf before any)."""
+        return max(self.schedule.clock, self._order.clock)
+
+    def _on_context(self, name: str, _log_time_ns: int, data: bytes) -> None:
+        self._latest[name].put(self._read, data)
 
     def _on_recorded_status(self, log_time_ns: int, data: bytes) -> None:
         message, stamp = self._decoded(STATUS, log_time_ns, data)
@@ -482,8 +536,10 @@ class OfflineAnalysis:
 
     # -- rows ----------------------------------------------------------------------------------
     def _context_values(self) -> dict[str, Any]:
+        """The context topics' latest values read before the pulse computing the status."""
         values: dict[str, Any] = {}
-        get = {name: latest.get() for name, latest in self._latest.items() if name not in (STATUS, COMMAND)}
+        before = self._context_before
+        get = {name: latest.get(before) for name, latest in self._latest.items() if name not in (STATUS, COMMAND)}
         speeds = get.get(SPEEDS)
         if speeds is not None:
             velocity = dict(zip(speeds.name, speeds.velocity))

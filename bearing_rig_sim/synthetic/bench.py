@@ -173,9 +173,10 @@ def true_verdict(scenario: BenchScenario, times: np.ndarray, critical_slope: flo
     return np.where(slope >= critical_slope, int(SlipState.STABLE), int(SlipState.SLIPPING))
 
 
-def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
+def write_bench_bag(path: str | Path, scenario: BenchScenario, log_lag_s: dict[str, float] | None = None) -> Path:
     """Write the scenario's pulses (and load cell, if any) as a bag like the bench's: the pulse
-    topics and ``/rig/axial_load/force`` only, log times on the bench clock. Returns the path."""
+    topics and ``/rig/axial_load/force`` only, log times on the bench clock, each shaft's pulses
+    logged ``log_lag_s[shaft]`` (s) after their stamps (a recorder held up). Returns the path."""
     from bearing_rig_sim.bags import BagWriter, rig_typestore  # bag I/O only for this function
 
     store = rig_typestore()
@@ -197,7 +198,7 @@ def write_bench_bag(path: str | Path, scenario: BenchScenario) -> Path:
             revolution=p.revolution,
             pulse_index=p.pulse_index,
         )
-        messages.append((p.time, PULSE_TOPICS[shaft].name, message))
+        messages.append((p.time + (log_lag_s or {}).get(shaft, 0.0), PULSE_TOPICS[shaft].name, message))
     vector = types["geometry_msgs/msg/Vector3"]
     for when, force in load_samples(scenario):
         wrench = types["geometry_msgs/msg/Wrench"](force=vector(x=0.0, y=0.0, z=force), torque=vector(x=0.0, y=0.0, z=0.0))

@@ -157,6 +157,29 @@ def test_bag_from_an_independent_writer(tmp_path: Path) -> None:
     assert reader.complete
 
 
+def test_a_channel_contradicting_its_topics_type_is_neither_counted_nor_read(tmp_path: Path) -> None:
+    """A split bag from another writer whose second file carries /x as Int32 where the first and
+    metadata.yaml say Float64: the second file's /x is left out of the count and of the messages
+    alike (10 Float64 values 0.5, 1.5, ... 9.5 from the first file, by construction)."""
+    bag = tmp_path / "split"
+    bag.mkdir()
+    for number, (msgtype, text, fmt) in enumerate([("std_msgs/msg/Float64", "float64 data\n", "<d"), ("std_msgs/msg/Int32", "int32 data\n", "<i")]):
+        with open(bag / f"split_{number}.mcap", "wb") as stream:
+            writer = McapWriter(stream)
+            writer.start(profile="ros2", library="test")
+            schema = writer.register_schema(msgtype, "ros2msg", text.encode())
+            channel = writer.register_channel("/x", "cdr", schema)
+            for index in range(10):
+                data = b"\x00\x01\x00\x00" + struct.pack(fmt, index + 0.5 if fmt == "<d" else index)
+                writer.add_message(channel, number * 1000 + index, data, number * 1000 + index)
+            writer.finish()
+    write_foreign_metadata(bag, [("/x", "std_msgs/msg/Float64", 20)], ["split_0.mcap", "split_1.mcap"])
+    with pytest.warns(BagWarning, match="carries std_msgs/msg/Int32 here but std_msgs/msg/Float64 before; left out"):
+        reader = open_bag(bag)
+    assert reader.topics["/x"].message_count == 10
+    assert [m.message.data for m in reader.messages()] == [index + 0.5 for index in range(10)]
+
+
 def test_padded_bytes_from_ros2_bag_record_decode(tmp_path: Path) -> None:
     """rosbag2 stores what the middleware hands over, Fast-CDR padding included."""
     from rclpy.serialization import serialize_message

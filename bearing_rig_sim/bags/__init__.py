@@ -1,14 +1,7 @@
-"""Recording runs to rosbag2 bags with MCAP storage, reading them back, repairing them.
-
-* :class:`BagWriter` (:mod:`.writer`): the recorder; raw CDR or rosbags message objects in,
-  a rosbag2 v9 bag directory out (zstd chunks, ``ros2msg`` schemas, offered QoS, run context).
-* :func:`open_bag` / :class:`BagReader` (:mod:`.reader`): topics, counts, time range, run context,
-  messages decoded in time order, streamed; damaged bags read as far as they go, with warnings;
-  MCAP (:mod:`.mcapfile`) or SQLite 3 (:mod:`.sqlite`) storage behind one seam (:mod:`.storage`).
-* :func:`repair_bag` (:mod:`.repair`): restores the index of a bag whose recording was killed.
-* :func:`rig_typestore` (:mod:`.typestore`): ROS 2 Jazzy types plus ``bearing_rig_msgs``.
-
-No ROS import anywhere in this package: bags are written and read with ``mcap`` and ``rosbags``.
+"""Recording runs to rosbag2 bags with MCAP storage (:class:`BagWriter`), reading them back with
+MCAP or SQLite 3 storage (:func:`open_bag`), repairing a killed recording (:func:`repair_bag`);
+the types are ROS 2 Jazzy's plus ``bearing_rig_msgs`` (:func:`rig_typestore`). No ROS import:
+bags are written and read with ``mcap`` and ``rosbags``.
 """
 
 from bearing_rig_sim.bags.errors import BagError, BagWarning

@@ -1,20 +1,13 @@
 """CDR bytes as stored in bags: the project's one CDR module.
 
-* :func:`make_decoder`: any message type into a rosbags message object, leniently (below).
-* :func:`make_normaliser`: what the recorder stores, trailing padding trimmed (below).
-* :func:`decode_pulse`: the hand-tuned decoder of the ``FibreOpticPulse`` fields the slip monitor
-  uses (offline analysis reads hundreds of thousands of them: no message objects are built).
-* :func:`header_stamp_ns`: the leading ``builtin_interfaces/Time`` of a message, not decoded.
-
-Fast-CDR (the middleware's serializer, behind ``rclpy.serialization.serialize_message`` and raw
-subscriptions) sizes its buffer with the worst-case alignment of every empty sequence of 8-byte
-elements (``float64[]``...), so such a message carries 4 to 12 bytes of padding after its last
-field. rosbags' ``deserialize_cdr`` refuses more than 3 bytes after the end ("CDR message size
-mismatch"). The length a message really occupies is therefore found by walking its bytes along
-the type's field definitions (:func:`length_function`: lengths and alignment only, a few
-microseconds); the recorder stores messages of types with sequences cut to that length, and the
-reader decodes the cut bytes with rosbags' public ``Typestore.deserialize_cdr``. Bags written by
-other tools (``ros2 bag record`` on the physical bench) keep the padding and decode all the same.
+Fast-CDR (behind ``rclpy.serialization.serialize_message`` and raw subscriptions) sizes its buffer
+with the worst-case alignment of every empty sequence of 8-byte elements, so such a message
+carries 4 to 12 bytes of padding after its last field, and rosbags' ``deserialize_cdr`` refuses
+more than 3 ("CDR message size mismatch"). :func:`length_function` finds the length a message
+really occupies by walking its bytes along the type's fields (lengths and alignment only, a few
+microseconds): the recorder stores messages cut to it (:func:`make_normaliser`) and the reader
+decodes the cut bytes (:func:`make_decoder`), so padded bags from ``ros2 bag record`` decode too.
+:func:`decode_pulse` and :func:`header_stamp_ns` read fields by hand, building no message object.
 """
 
 from __future__ import annotations
@@ -32,7 +25,6 @@ from bearing_rig_sim.bags.typestore import dependencies
 from bearing_rig_sim.interfaces import CAGE_PULSES
 
 PULSE_TYPE = CAGE_PULSES.msgtype
-"""``bearing_rig_msgs/msg/FibreOpticPulse``."""
 
 CdrBytes = bytes | memoryview
 """Serialized message: 4-byte encapsulation header, then the CDR body."""
@@ -41,11 +33,9 @@ LITTLE_ENDIAN = b"\x00\x01"
 BIG_ENDIAN = b"\x00\x00"
 
 _MALFORMED = (SerdeError, struct.error, IndexError, ValueError, UnicodeDecodeError)
-"""What walking or decoding bytes that are not a message of the type raises."""
 
 _SIZES = {"bool": 1, "byte": 1, "char": 1, "int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4,
           "uint32": 4, "int64": 8, "uint64": 8, "float32": 4, "float64": 8}  # fmt: skip
-"""Bytes (and CDR alignment) of the primitive types."""
 
 _U32 = {True: struct.Struct("<I").unpack_from, False: struct.Struct(">I").unpack_from}
 Walk = Callable[[memoryview, int, Callable[..., tuple[int, ...]]], int]
@@ -115,11 +105,7 @@ def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
 
 
 def little_endian(msgtype: str, data: CdrBytes | bytearray) -> bool:
-    """True for little-endian CDR, False for big-endian.
-
-    Raises:
-        BagError: the bytes do not start with a plain CDR encapsulation header.
-    """
+    """True for little-endian CDR, False for big-endian; BagError for another encapsulation."""
     header = bytes(data[:2])
     if len(data) < 4 or header not in (LITTLE_ENDIAN, BIG_ENDIAN):
         raise BagError(f"{msgtype}: {len(data)} bytes are not a CDR message (bad encapsulation header {bytes(data[:4]).hex()})")
@@ -127,9 +113,8 @@ def little_endian(msgtype: str, data: CdrBytes | bytearray) -> bool:
 
 
 def length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], int] | None:
-    """A function giving the bytes a message of ``msgtype`` really occupies, header included
-    (<= ``len(data)``; it raises :class:`BagError` for bytes that end before the message does or
-    are not CDR); None when the type holds a field the walk does not know (``wstring``)."""
+    """A function giving the bytes a message of ``msgtype`` occupies, header included (BagError
+    for bytes that end before the message does); None for a type with ``wstring`` fields."""
     try:
         walk = _walker(typestore, Nodetype.NAME, msgtype)
     except KeyError:
@@ -148,11 +133,9 @@ def length_function(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], 
 
 
 def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], CdrBytes]:
-    """A function returning serialized messages of ``msgtype`` as the recorder stores them:
-    trailing padding trimmed for a type with sequences; as received for a type without (its
-    Fast-CDR size is exact), once its encapsulation header is checked.
-
-    The function raises :class:`BagError` for bytes that are not a (complete) message."""
+    """A function returning messages of ``msgtype`` as the recorder stores them: padding trimmed
+    for a type with sequences, else as received (the Fast-CDR size is exact) once the header is
+    checked; BagError for bytes that are not a complete message."""
     length = length_function(typestore, msgtype) if has_sequences(typestore, msgtype) else None
 
     def normalise(data: CdrBytes) -> CdrBytes:
@@ -166,9 +149,8 @@ def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], 
 
 
 def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], object]:
-    """A function decoding serialized messages of ``msgtype`` into rosbags message objects with
-    rosbags' ``deserialize_cdr``; bytes after the end of the message (Fast-CDR padding) are
-    ignored. A malformed or truncated message raises :class:`BagError`."""
+    """A function decoding messages of ``msgtype`` with rosbags' ``deserialize_cdr``, ignoring
+    bytes after the message (padding); BagError for a malformed or cut message."""
     length = length_function(typestore, msgtype)
     deserialize = typestore.deserialize_cdr
 
@@ -183,10 +165,7 @@ def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], obj
 
 
 PulseFields = tuple[float, int, int, int, int, str]
-"""The fields of a ``FibreOpticPulse`` the slip monitor uses: ``header.stamp`` as
-``sec + nanosec * 1e-9`` (s), ``strip_id``, ``strip_count``, ``revolution``, ``pulse_index``,
-``sensor_id`` (a plain tuple: it is built hundreds of thousands of times per analysis)."""
-
+"""``header.stamp`` (s), ``strip_id``, ``strip_count``, ``revolution``, ``pulse_index``, ``sensor_id``."""
 
 _PULSE_HEAD = struct.Struct("<iII")  # stamp.sec, stamp.nanosec, frame_id length
 _STRIPS = struct.Struct("<HH")
@@ -194,11 +173,8 @@ _COUNTS = struct.Struct("<QQ")
 
 
 def decode_pulse(data: CdrBytes) -> PulseFields:
-    """A little-endian CDR ``FibreOpticPulse``, decoded by hand (no message object is built).
-
-    Raises:
-        BagError: not little-endian CDR, or the bytes end before the message does.
-    """
+    """The fields of a little-endian CDR ``FibreOpticPulse`` the slip monitor uses (offline analysis
+    reads hundreds of thousands); BagError for other bytes."""
     if not little_endian(PULSE_TYPE, data):
         raise BagError(f"{PULSE_TYPE}: not little-endian CDR (encapsulation {bytes(data[:4]).hex()})")
     try:
@@ -216,8 +192,7 @@ def decode_pulse(data: CdrBytes) -> PulseFields:
 
 
 def header_stamp_ns(data: CdrBytes | bytearray) -> int | None:
-    """The leading ``builtin_interfaces/Time`` of a CDR message, ns; None when ``data`` is too
-    short or its encapsulation is not plain CDR (big or little endian)."""
+    """The leading ``builtin_interfaces/Time`` of a CDR message (ns); None when too short or not CDR."""
     if len(data) < 12:
         return None
     try:

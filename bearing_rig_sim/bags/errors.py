@@ -1,10 +1,5 @@
-"""Errors and warnings of the recording package.
-
-:class:`BagError` is raised for anything a user can cause and fix (a path that is not a bag, an
-unreadable ``metadata.yaml``, a topic written before it was added); the command line prints it as
-one line. :class:`BagWarning` reports a problem the reader or the repair worked around (a damaged
-chunk skipped, a topic whose type is unknown): the data that could be read is still returned.
-"""
+"""Errors and warnings of the recording package: :class:`BagError` for what a user can cause and fix
+(printed as one line), :class:`BagWarning` for damage worked around (what could be read is returned)."""
 
 from __future__ import annotations
 

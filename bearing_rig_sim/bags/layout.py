@@ -1,10 +1,6 @@
-"""The rosbag2 bag directory: ``metadata.yaml`` (format version 9) and the storage file names.
-
-A bag is a directory ``<name>/`` holding ``metadata.yaml`` and the storage files ``<name>_0.mcap``,
-``<name>_1.mcap``... (split by size); ``metadata.yaml`` lists the files and every topic with its
-type, serialization format, offered QoS profiles, RIHS01 type hash and message count, the time
-range and ``custom_data`` (string pairs: the project puts its run context there too).
-"""
+"""The rosbag2 bag directory ``<name>/``: ``metadata.yaml`` (format version 9: files, topics with
+type, serialization format, offered QoS, RIHS01 type hash and count, time range, ``custom_data``
+where the project puts its run context too) and the storage files ``<name>_0.mcap``, ``<name>_1.mcap``..."""
 
 from __future__ import annotations
 
@@ -32,16 +28,8 @@ ROS_DISTRO = "jazzy"
 
 @dataclass
 class TopicEntry:
-    """One topic of ``metadata.yaml``.
-
-    Attributes:
-        name: topic name, e.g. ``/rig/speeds``.
-        msgtype: message type, e.g. ``sensor_msgs/msg/JointState``.
-        qos: offered QoS profiles (usually one), kept exactly as stored.
-        type_hash: RIHS01 type description hash, empty when unknown.
-        message_count: messages stored on the topic.
-        serialization_format: ``cdr`` for every bag the project reads.
-    """
+    """One topic of ``metadata.yaml``: offered QoS profiles kept as stored, RIHS01 type hash
+    (empty when unknown)."""
 
     name: str
     msgtype: str
@@ -63,7 +51,8 @@ class FileEntry:
 
 @dataclass
 class BagLayout:
-    """The content of a ``metadata.yaml``."""
+    """The content of a ``metadata.yaml``; ``stated_message_count`` is the top-level count of one
+    that was read (None when built)."""
 
     topics: list[TopicEntry] = field(default_factory=list)
     files: list[FileEntry] = field(default_factory=list)
@@ -72,7 +61,6 @@ class BagLayout:
     version: int = BAG_VERSION
     ros_distro: str = ROS_DISTRO
     stated_message_count: int | None = None
-    """The top-level ``message_count`` of a ``metadata.yaml`` that was read (None when built)."""
 
     @property
     def message_count(self) -> int:
@@ -92,12 +80,12 @@ class BagLayout:
 
     @property
     def duration_ns(self) -> int:
-        """Time from the earliest to the latest message (ns)."""
+        """``end_ns - start_ns``."""
         return self.end_ns - self.start_ns
 
 
 def storage_file_name(bag_dir: Path, index: int) -> str:
-    """Name of the ``index``-th storage file of a bag, rosbag2 style: ``<dir name>_<index>.mcap``."""
+    """Name of the ``index``-th storage file of a bag: ``<dir name>_<index>.mcap``."""
     return f"{bag_dir.name}_{index}.mcap"
 
 
@@ -117,7 +105,7 @@ def qos_yaml(profiles: list[Qos]) -> str:
 
 
 def parse_qos_profiles(value: Any, source: str) -> list[Qos]:
-    """QoS profiles from ``metadata.yaml`` (v9 list, v8 YAML text) or MCAP channel metadata.
+    """QoS profiles from ``metadata.yaml`` (v9 list, v8 YAML) or MCAP channel metadata.
 
     Raises:
         BagError: the text is not a list of QoS profiles.
@@ -191,20 +179,15 @@ def read_layout(bag_dir: Path) -> BagLayout:
     """Parse ``<bag_dir>/metadata.yaml``.
 
     Raises:
-        BagError: the file is missing, not YAML, or misses keys a reader needs; the bag uses
-            rosbag2 file or message compression.
+        BagError: missing, not YAML, keys a reader needs missing, or rosbag2 file/message compression.
     """
     path = bag_dir / METADATA_FILE
     source = str(path)
     try:
         text = path.read_bytes()
     except FileNotFoundError:
-        hint = (
-            f" (if a recording was interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
-            if bag_dir.is_dir() and any(bag_dir.glob("*.mcap"))
-            else ""
-        )
-        raise BagError(f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory{hint}") from None
+        hint = f" (if a recording was interrupted, `bearing-rig bag repair {bag_dir}` rebuilds it from the .mcap files)"
+        raise BagError(f"{bag_dir}: no {METADATA_FILE}, so not a rosbag2 bag directory{hint if any(bag_dir.glob('*.mcap')) else ''}") from None
     except OSError as exc:
         raise BagError(f"{source}: cannot read ({exc})") from None
     try:
@@ -229,11 +212,8 @@ def read_layout(bag_dir: Path) -> BagLayout:
     files = []
     for name in (PurePath(str(raw)).name for raw in paths):
         entry = file_info.get(name, {})
-        files.append(
-            FileEntry(
-                name, ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds"), int(entry.get("message_count", 0) or 0)
-            )
-        )
+        start, duration = ns(entry, "starting_time", "nanoseconds_since_epoch"), ns(entry, "duration", "nanoseconds")
+        files.append(FileEntry(name, start, duration, int(entry.get("message_count", 0) or 0)))
     topics = []
     for index, item in enumerate(_get(info, "topics_with_message_count", source, list, where)):
         at = f"{where}topics_with_message_count[{index}]."
@@ -256,8 +236,7 @@ def read_layout(bag_dir: Path) -> BagLayout:
 
 
 def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | None = None) -> str:
-    """Message type of a channel: as its storage gives it, else the type ``metadata.yaml`` gives the
-    topic, else empty."""
+    """Message type of a channel: from its storage, else from ``metadata.yaml``, else empty."""
     channel = index.channels[channel_id]
     if channel.msgtype:
         return channel.msgtype
@@ -273,18 +252,19 @@ def layout_from_indexes(
     previous: BagLayout | None,
     report: Callable[[str], None],
     type_hash_of: Callable[[str], str] = lambda _msgtype: "",
+    accepted: list[dict[int, str]] | None = None,
 ) -> BagLayout:
-    """The ``metadata.yaml`` content that matches what the storage files really hold.
-
-    Topics come from the files' channels (type from the schema, QoS and type hash from the
-    channel metadata), completed by ``previous`` (the existing ``metadata.yaml``, if any) for
-    topics without messages or values the files lack; ``type_hash_of`` fills hashes still
-    missing. A channel whose type contradicts an earlier one of the same topic is reported and
-    left out. Counts and times come from the file indexes; the run context from the first MCAP
-    metadata record :data:`RUN_METADATA_RECORD`, else ``previous``'s ``custom_data``.
-    """
+    """The ``metadata.yaml`` content matching what the storage files hold: topics from their
+    channels, completed by ``previous`` (the existing ``metadata.yaml``) for topics without
+    messages or values the files lack, hashes still missing from ``type_hash_of``; a channel whose
+    type contradicts the topic's is reported and left out (``accepted`` receives the topic of each
+    channel kept, per file). The run context is the first :data:`RUN_METADATA_RECORD` record, else
+    ``previous``'s ``custom_data``."""
     topics: dict[str, TopicEntry] = {}
     for index in indexes:
+        kept: dict[int, str] = {}
+        if accepted is not None:
+            accepted.append(kept)
         for channel_id in sorted(index.channels):
             channel = index.channels[channel_id]
             msgtype = channel_msgtype(index, channel_id, previous)
@@ -301,6 +281,7 @@ def layout_from_indexes(
                 continue
             entry.msgtype = entry.msgtype or msgtype
             entry.message_count += index.channel_counts.get(channel_id, 0)
+            kept[channel_id] = channel.topic
     if previous is not None:
         for old in previous.topics:
             entry = topics.get(old.name)
@@ -314,15 +295,7 @@ def layout_from_indexes(
     for entry in topics.values():
         if not entry.type_hash and entry.msgtype:
             entry.type_hash = type_hash_of(entry.msgtype)
-    files = [
-        FileEntry(
-            index.path.name,
-            index.start_ns if index.message_count else 0,
-            index.end_ns - index.start_ns if index.message_count else 0,
-            index.message_count,
-        )
-        for index in indexes
-    ]
+    files = [FileEntry(i.path.name, i.start_ns, i.end_ns - i.start_ns, i.message_count) if i.message_count else FileEntry(i.path.name) for i in indexes]
     custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), None)
     if custom is None:
         custom = dict(previous.custom_data) if previous is not None else {}

@@ -1,12 +1,10 @@
-"""One MCAP storage file, read robustly with the ``mcap`` library: its index, its chunks, its
-messages in time order.
+"""One MCAP storage file read with the ``mcap`` library: its index, its chunks, its messages in
+time order.
 
-A finished file ends with a summary (schemas, channels, chunk indexes, statistics) and a footer;
-the index comes from there (``SeekingReader.get_summary``). A file whose recording was killed has
-no summary: it is then read record by record from the start (``StreamReader`` with
-``emit_chunks``), each chunk opened and checksummed (``breakup_chunk``); a damaged chunk is
-skipped, and the scan stops at the first record cut by the end of the file, saying how many
-bytes are lost. The same index serves both cases, so reading and repairing share one code path.
+The index comes from the summary of a finished file (``SeekingReader.get_summary``); a file
+whose recording was killed has none and is scanned record by record (``StreamReader`` with
+``emit_chunks``, each chunk checksummed by ``breakup_chunk``): a damaged chunk is skipped, the
+scan stops at the first record cut by the end of the file. Reading and repairing share this index.
 """
 
 from __future__ import annotations
@@ -28,11 +26,10 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, merge_in_time
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem, merge_in_time
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
-"""What the mcap library raises on bytes that are not the records they should be (a CRC mismatch
-is a ValueError)."""
+"""What the mcap library raises on bytes that are not records (a CRC mismatch is a ValueError)."""
 
 
 class DamagedRecord(Exception):
@@ -41,15 +38,8 @@ class DamagedRecord(Exception):
 
 @dataclass(frozen=True)
 class ChunkRef:
-    """Where a group of messages lies in a file.
-
-    Attributes:
-        offset: file offset of the chunk record (or of the first loose message record).
-        stop: file offset after the chunk record (or after the last loose message record).
-        start_ns / end_ns: earliest and latest log time in the group (ns).
-        channel_ids: channels with messages in the group; None when not indexed.
-        loose: True for messages written outside chunks (a run of message records).
-    """
+    """A chunk record, or a run of message records outside chunks (``loose``), from ``offset``
+    to ``stop`` in the file: its log-time range and channels (None when not indexed)."""
 
     offset: int
     stop: int
@@ -61,16 +51,9 @@ class ChunkRef:
 
 @dataclass
 class McapIndex(FileIndex):
-    """What one MCAP file holds, from its summary or from a scan (see :class:`.storage.FileIndex`).
-
-    Attributes:
-        profile / library: from the header record.
-        chunks: message groups, in file order.
-        readable_bytes: offset after the last record that could be read (file size if intact).
-        file_size: size of the file in bytes.
-        compression: compression of the first chunk (``zstd``, ``lz4`` or ``""``).
-        damaged_bytes: bytes of the chunks :func:`check_chunks` found damaged.
-    """
+    """What one MCAP file holds, from its summary or a scan: besides :class:`.storage.FileIndex`,
+    the header's profile and library, the message groups in file order, the offset after the last
+    readable record, the first chunk's compression and the bytes :func:`check_chunks` found damaged."""
 
     profile: str = ""
     library: str = ""
@@ -117,10 +100,9 @@ _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publis
 
 
 def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageTuple]:
-    """The wanted message records of a run of records (a decompressed chunk, or messages written
-    outside chunks). ``breakup_chunk`` builds a record object for every message (2 us each: an
-    hour of the rig's traffic took 13 s to read instead of 3 s); this loop slices out only the
-    messages ``keep`` accepts."""
+    """The message records ``keep`` accepts in a run of records (a decompressed chunk, or messages
+    outside chunks), sliced out: ``breakup_chunk`` builds an object per message (an hour of the
+    rig's traffic took 13 s to read instead of 3 s)."""
     out = []
     position, end = 0, len(data)
     head, message = _RECORD_HEAD.unpack_from, _MESSAGE_HEAD.unpack_from
@@ -137,8 +119,7 @@ def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageT
 
 
 def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool] = lambda _c, _t: True) -> list[MessageTuple]:
-    """Messages of one chunk (or loose run) that ``keep(channel_id, log_time)`` accepts, sorted
-    by log time (stable).
+    """Messages of one group that ``keep(channel_id, log_time)`` accepts, stably sorted by log time.
 
     Raises:
         DamagedRecord: the chunk is truncated, corrupt or does not decompress.
@@ -162,8 +143,8 @@ def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, in
 
 
 def _record_head(head: bytes) -> tuple[str, str]:
-    """The kind (``"chunk"``, ``"message index"``...) and `` of <size>`` of a record, from its
-    first bytes (the size is left empty when the length field itself is cut)."""
+    """The kind (``"chunk"``...) and `` of <size>`` of a record from its first bytes (no size
+    when the length field itself is cut)."""
     try:
         kind = Opcode(head[0]).name.lower().replace("_", " ")
     except (ValueError, IndexError):
@@ -191,21 +172,12 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
         index.add_schema(schema)
     for channel in summary.channels.values():
         index.add_channel(channel, summary.schemas)
-    index.chunks = [
-        ChunkRef(
-            c.chunk_start_offset,
-            c.chunk_start_offset + c.chunk_length,
-            c.message_start_time,
-            c.message_end_time,
-            frozenset(c.message_index_offsets) if c.message_index_offsets else None,
-        )
-        for c in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset)
-    ]
+    for c in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
+        channels = frozenset(c.message_index_offsets) if c.message_index_offsets else None
+        index.chunks.append(ChunkRef(c.chunk_start_offset, c.chunk_start_offset + c.chunk_length, c.message_start_time, c.message_end_time, channels))
     index.compression = summary.chunk_indexes[0].compression if summary.chunk_indexes else ""
-    index.message_count = stats.message_count
-    index.channel_counts = dict(stats.channel_message_counts)
-    index.start_ns = stats.message_start_time
-    index.end_ns = stats.message_end_time
+    index.message_count, index.channel_counts = stats.message_count, dict(stats.channel_message_counts)
+    index.start_ns, index.end_ns = stats.message_start_time, stats.message_end_time
     for entry in summary.metadata_indexes:
         try:
             record = _one_record(stream, entry.offset)
@@ -221,8 +193,7 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
 
 
 def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> None:
-    """Fill ``index`` from the records after the header: a damaged chunk is skipped, the scan
-    stops at the first record that cannot be read (cut by the end of the file)."""
+    """Fill ``index`` from the records after the header (see the module documentation)."""
     name = index.path.name
     start = run_start = stream.tell()
     schemas: dict[int, Schema] = {}
@@ -308,9 +279,8 @@ def index_file(path: Path) -> McapIndex:
                 index.has_header = True  # its data are readable: the header holds only two names
                 index.problems.append(f"{path.name}: the MCAP header record is damaged; read through the file's summary")
             else:
-                index.problems.append(
-                    f"{path.name}: file ends after {index.file_size} bytes, before its header is complete (recording interrupted as it started?): no data"
-                )
+                cut = f"file ends after {index.file_size} bytes, before its header is complete (recording interrupted as it started?)"
+                index.problems.append(f"{path.name}: {cut}: no data")
             return index
         assert isinstance(header, Header)  # checked by its opcode above
         index.has_header = True
@@ -329,8 +299,8 @@ def index_file(path: Path) -> McapIndex:
 
 
 def check_chunks(index: McapIndex) -> list[str]:
-    """Decompress and checksum every chunk of an indexed file: one line per damaged chunk. The
-    bytes those chunks occupy (bounded by the end of the file) are left in ``index.damaged_bytes``."""
+    """Decompress and checksum every chunk: one line per damaged chunk, whose bytes (within the
+    file) are left in ``index.damaged_bytes``."""
     problems = []
     index.damaged_bytes = 0
     with open(index.path, "rb") as stream:
@@ -344,52 +314,13 @@ def check_chunks(index: McapIndex) -> list[str]:
 
 
 def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool], report: ProblemSink, label: str) -> Iterator[MessageTuple]:
-    """A chunk's wanted messages; the first item is a marker (channel -1) at the chunk's start
-    time, so a merge can hold many chunks without reading them."""
+    """A chunk's wanted messages after a marker (channel -1) at its start time, so that a merge
+    holds many chunks without reading them."""
     yield (ref.start_ns, -1, 0, b"")
     try:
         yield from read_chunk_messages(stream, ref, keep)
     except DamagedRecord as exc:
         report(f"{label}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
-
-
-def iter_file_messages(
-    index: McapIndex,
-    channel_ids: Iterable[int] | None = None,
-    start_ns: int | None = None,
-    stop_ns: int | None = None,
-    report: ProblemSink = lambda _msg: None,
-) -> Iterator[MessageTuple]:
-    """Messages of one file in log-time order.
-
-    Streams chunk by chunk: memory holds the chunks whose time ranges overlap, one for files
-    written in time order. Damaged chunks are reported through ``report`` and skipped.
-
-    Args:
-        index: the file's index (:func:`index_file`).
-        channel_ids: channels to read; None for all.
-        start_ns / stop_ns: keep messages with ``start_ns <= log_time < stop_ns``.
-        report: receives a line per damaged chunk.
-    """
-    wanted = None if channel_ids is None else frozenset(channel_ids)
-    low = -1 if start_ns is None else start_ns
-    high = 2**64 if stop_ns is None else stop_ns
-
-    def keep(channel_id: int, log_time: int) -> bool:
-        return (wanted is None or channel_id in wanted) and low <= log_time < high
-
-    refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
-    refs.sort(key=lambda r: (r.start_ns, r.offset))
-    try:
-        stream = open(index.path, "rb")  # closed in finally
-    except OSError as exc:
-        report(f"{index.path}: cannot open ({exc.strerror or exc})")
-        return
-    try:
-        chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
-        yield from (m for m in merge_in_time(chunks) if m[1] >= 0)
-    finally:
-        stream.close()
 
 
 class McapFormat:
@@ -398,17 +329,31 @@ class McapFormat:
     identifier = "mcap"
 
     def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
-        """See :func:`index_file`."""
+        """One index per file (:func:`index_file`)."""
         return [index_file(f) for f in files]
 
     def messages(
-        self,
-        index: FileIndex,
-        channel_ids: Iterable[int] | None = None,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        report: ProblemSink = lambda _msg: None,
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
+        report: ProblemSink = drop_problem,
     ) -> Iterator[MessageTuple]:
-        """See :func:`iter_file_messages`."""
+        """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
+        in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged
+        chunks are reported through ``report`` and skipped."""
         assert isinstance(index, McapIndex)
-        return iter_file_messages(index, channel_ids, start_ns, stop_ns, report)
+        wanted = None if channel_ids is None else frozenset(channel_ids)
+        low = -1 if start_ns is None else start_ns
+        high = 2**64 if stop_ns is None else stop_ns
+
+        def keep(channel_id: int, log_time: int) -> bool:
+            return (wanted is None or channel_id in wanted) and low <= log_time < high
+
+        refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
+        refs.sort(key=lambda r: (r.start_ns, r.offset))
+        try:
+            stream = open(index.path, "rb")  # closed by the with below
+        except OSError as exc:
+            report(f"{index.path}: cannot open ({exc.strerror or exc})")
+            return
+        with stream:
+            chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
+            yield from (m for m in merge_in_time(chunks) if m[1] >= 0)

@@ -1,10 +1,6 @@
-"""The quality of service a recorded topic was offered with (rosbag2 ``offered_qos_profiles``), so
-that a replay can offer the same again.
-
-The named profiles are the contract's (:data:`bearing_rig_sim.interfaces.QOS_TABLE`, names
-:data:`~bearing_rig_sim.interfaces.QosName`); deadline, lifespan and liveliness lease are stored
-as 0 s, the middleware's "default" (none).
-"""
+"""The QoS a recorded topic was offered with (rosbag2 ``offered_qos_profiles``), so that a replay
+offers it again. The named profiles are the contract's (:data:`bearing_rig_sim.interfaces.QOS_TABLE`);
+deadline, lifespan and liveliness lease are stored as 0 s, the middleware's default (none)."""
 
 from __future__ import annotations
 
@@ -23,17 +19,8 @@ History = Literal["keep_last", "keep_all"]
 
 @dataclass(frozen=True)
 class QosSpec:
-    """The QoS a publisher offered on a topic.
-
-    Attributes:
-        reliability: ``"reliable"`` or ``"best_effort"``.
-        durability: ``"volatile"`` or ``"transient_local"`` (late joiners get the last messages).
-        depth: history depth (messages), >= 1 for ``keep_last``.
-        history: ``"keep_last"`` or ``"keep_all"``.
-
-    Raises:
-        BagError: a value outside those.
-    """
+    """The QoS a publisher offered on a topic (depth >= 1 with ``keep_last``); BagError for a value
+    outside the literals."""
 
     reliability: Reliability = "reliable"
     durability: Durability = "volatile"
@@ -64,8 +51,7 @@ class QosSpec:
 
     @classmethod
     def from_rosbags(cls, qos: Qos) -> QosSpec | None:
-        """The profile stored in a bag, or None when it uses values this project does not offer
-        (system default, best available, unknown)."""
+        """The profile stored in a bag; None for values this project does not offer (system default...)."""
         names = (qos.reliability.name.lower(), qos.durability.name.lower(), int(qos.depth), qos.history.name.lower())
         try:
             return cls(*names)  # type: ignore[arg-type]  # enum names, checked by QosSpec itself
@@ -78,11 +64,7 @@ QOS_PROFILES: dict[str, QosSpec] = {name: QosSpec(QOS_TABLE[name].reliability, Q
 
 
 def qos_spec(qos: str | QosSpec) -> QosSpec:
-    """Resolve a profile name (a key of :data:`QOS_PROFILES`) or pass a :class:`QosSpec` through.
-
-    Raises:
-        BagError: unknown profile name.
-    """
+    """The profile of a name of :data:`QOS_PROFILES` (BagError for another), or a :class:`QosSpec` as is."""
     if isinstance(qos, QosSpec):
         return qos
     try:

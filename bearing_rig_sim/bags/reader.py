@@ -7,11 +7,11 @@
         for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]):
             ...
 
-Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk.
-Types are decoded with the definitions the bag carries (an old bag keeps decoding after a message
-changes), else with ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (what is
-still read: ``docs/bags.md``): each problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning`
-and a line in :attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
+Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk,
+with the definitions the bag carries (an old bag keeps decoding after a message changes), else
+ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (``docs/bags.md``): each
+problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
+:attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
 """
 
 from __future__ import annotations
@@ -32,12 +32,12 @@ from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import BagLayout, channel_msgtype, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
-from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, StorageFormat, merge_in_time
+from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, dependencies, rig_typestore
 from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
 
-
+StorageFormat = McapFormat | Sqlite3Format
 STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sqlite3Format()}
 """The storage formats this project reads, by ``storage_identifier`` (see :mod:`.storage`)."""
 
@@ -66,17 +66,9 @@ class BagMessage(NamedTuple):
 
 @dataclass(frozen=True)
 class TopicInfo:
-    """A topic of a bag.
-
-    Attributes:
-        name: topic name.
-        msgtype: message type (``pkg/msg/Name``).
-        message_count: messages readable on the topic.
-        qos: first offered QoS profile, None when not stored or not modelled.
-        type_hash: RIHS01 type hash from the bag, empty when not stored.
-        decodable: False when the type is unknown (no definition in the bag, not a known type):
-            :meth:`BagReader.messages` skips the topic unless ``raw=True``.
-    """
+    """A topic of a bag: messages readable on it, first offered QoS (None when not stored or not
+    modelled), RIHS01 hash (empty when not stored); not ``decodable`` when the type is unknown
+    (:meth:`BagReader.messages` then skips it unless ``raw=True``)."""
 
     name: str
     msgtype: str
@@ -93,37 +85,34 @@ def _same_fields(a: tuple[Constdefs, Fielddefs], b: tuple[Constdefs, Fielddefs])
 def _parse_definition(msgtype: str, encoding: str, text: str) -> Typesdict:
     if encoding == "ros2msg":
         return get_types_from_msg(text, msgtype)
+    separator = SCHEMA_SEPARATOR + "\n"  # rosbag2's ros2idl schema: sections headed "IDL: <type>"
+    sections = [s.split("\n", 1)[1] for s in text.split(separator)[1:]] if text.startswith(separator + "IDL: ") else [text]
     types: Typesdict = {}
-    separator = SCHEMA_SEPARATOR + "\n"
-    if text.startswith(separator + "IDL: "):
-        for section in text.split(separator)[1:]:
-            _header, idl = section.split("\n", 1)
-            types.update(get_types_from_idl(idl))
-    else:
-        types.update(get_types_from_idl(text))
+    for idl in sections:
+        types.update(get_types_from_idl(idl))
     return types
 
 
 class BagReader:
-    """An open bag (see the module documentation); use :func:`open_bag`.
+    """An open bag (see the module documentation and :func:`open_bag`).
 
-    Args:
-        path: a bag directory (with ``metadata.yaml``) or a single ``.mcap`` file.
-        strict: raise :class:`BagError` on any damage instead of warning.
-
-    Raises:
-        BagError: the path does not exist or is not a bag, ``metadata.yaml`` is missing or
-            corrupt, names a storage format this project does not read, a storage file is not of
-            its format, or (strict) anything is damaged.
+    Attributes:
+        files: the storage files read.
+        topics: by name.
+        message_count / start_ns / end_ns / duration_ns: readable messages (all topics), their
+            log-time range (ns; 0 for an empty bag).
+        run_metadata: the run context: the MCAP metadata record ``bearing_rig_sim``, else
+            ``metadata.yaml``'s ``custom_data``.
+        typestore: the types the messages are decoded with.
+        layout: the parsed ``metadata.yaml`` (None for a bare ``.mcap`` file).
+        problems: every problem met so far, one line each (also issued as :class:`BagWarning`).
     """
 
     def __init__(self, path: str | Path, *, strict: bool = False) -> None:
         self.path = Path(path)
         self.strict = strict
         self.problems: list[str] = []
-        """Every problem met so far, one line each (also issued as :class:`BagWarning`)."""
         self.layout: BagLayout | None = None
-        """The parsed ``metadata.yaml`` (None for a bare ``.mcap`` file)."""
         self._closed = False
         if not self.path.exists():
             raise BagError(f"{self.path}: no such bag (the path does not exist)")
@@ -143,63 +132,26 @@ class BagReader:
             files = [f for f in files if f not in missing]
         else:
             files = [self.path]
-        self._files = files
+        self.files = files
         self._indexes: list[FileIndex] = self._format.indexes(self.path, files) if files else []
         if self._indexes and not any(i.has_header for i in self._indexes):
             raise BagError(f"{self.path}: nothing readable: " + "; ".join(p for i in self._indexes for p in i.problems))
         for index in self._indexes:
             for problem in index.problems:
                 self._report(problem)
-        self._store = self._build_typestore()
-        self._found = layout_from_indexes(self._indexes, self.layout, self._report)
-        """What the files hold, as a ``metadata.yaml`` would state it."""
-        self._channel_topics: list[dict[int, str]] = []
-        self._topics = self._collect_topics()
+        self.typestore = self._build_typestore()
+        self._channel_topics: list[dict[int, str]] = []  # per file, the topic of each channel read
+        self._found = layout_from_indexes(self._indexes, self.layout, self._report, accepted=self._channel_topics)  # what the files hold
+        self.message_count, self.start_ns, self.end_ns = self._found.message_count, self._found.start_ns, self._found.end_ns
+        self.duration_ns = self._found.duration_ns
+        self.run_metadata = self._found.custom_data
+        self.topics = self._collect_topics()
         if self.layout is not None and self.layout.message_count != self.message_count:
             self._report(
                 f"{self.path / 'metadata.yaml'}: states {self.layout.message_count} messages but the files hold "
                 f"{self.message_count} readable ones (stale metadata after an interrupted recording? "
                 f"`bearing-rig bag repair {self.path}` rewrites it)"
             )
-
-    # -- public API -------------------------------------------------------------------------
-
-    @property
-    def files(self) -> list[Path]:
-        """The storage files read."""
-        return list(self._files)
-
-    @property
-    def topics(self) -> dict[str, TopicInfo]:
-        """Topics by name."""
-        return dict(self._topics)
-
-    @property
-    def message_count(self) -> int:
-        """Messages readable in all files (all topics, decodable or not)."""
-        return self._found.message_count
-
-    @property
-    def start_ns(self) -> int:
-        """Log time of the earliest message (ns); 0 for an empty bag."""
-        return self._found.start_ns
-
-    @property
-    def end_ns(self) -> int:
-        """Log time of the latest message (ns); 0 for an empty bag."""
-        return self._found.end_ns
-
-    @property
-    def duration_ns(self) -> int:
-        """``end_ns - start_ns``."""
-        return self._found.duration_ns
-
-    @property
-    def run_metadata(self) -> dict[str, str]:
-        """The run context (configuration, calibration, test program, project version...): the
-        MCAP metadata record ``bearing_rig_sim``, else ``metadata.yaml``'s ``custom_data``;
-        empty when the bag has neither."""
-        return dict(self._found.custom_data)
 
     def verify(self) -> BagCheck:
         """Read every chunk: checksums, unreadable messages, log-time outliers (see
@@ -211,18 +163,8 @@ class BagReader:
         """True when every file was finished properly and nothing was found damaged."""
         return all(i.indexed for i in self._indexes) and not self.problems
 
-    @property
-    def typestore(self) -> Typestore:
-        """The types the messages are decoded with."""
-        return self._store
-
     def messages(
-        self,
-        topics: Iterable[str] | None = None,
-        *,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        raw: bool = False,
+        self, topics: Iterable[str] | None = None, *, start_ns: int | None = None, stop_ns: int | None = None, raw: bool = False
     ) -> Iterator[BagMessage]:
         """Messages in log-time order, streamed.
 
@@ -238,14 +180,14 @@ class BagReader:
         if self._closed:
             raise BagError(f"{self.path}: the bag is closed")
         if topics is None:
-            selected = {name for name, info in self._topics.items() if raw or info.decodable}
+            selected = {name for name, info in self.topics.items() if raw or info.decodable}
         else:
             selected = set([topics] if isinstance(topics, str) else topics)
-            unknown = sorted(selected - self._topics.keys())
+            unknown = sorted(selected - self.topics.keys())
             if unknown:
-                raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self._topics)) or 'none'})")
+                raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self.topics)) or 'none'})")
             if not raw:
-                selected = {name for name in selected if self._topics[name].decodable}
+                selected = {name for name in selected if self.topics[name].decodable}
         return self._iterate(selected, start_ns, stop_ns, raw)
 
     def close(self) -> None:
@@ -255,16 +197,9 @@ class BagReader:
     def __enter__(self) -> BagReader:
         return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        traceback: TracebackType | None,
-    ) -> Literal[False]:
+    def __exit__(self, exc_type: type[BaseException] | None, exc: BaseException | None, traceback: TracebackType | None) -> Literal[False]:
         self.close()
         return False
-
-    # -- internals --------------------------------------------------------------------------
 
     def _report(self, problem: str) -> None:
         if self.strict:
@@ -307,15 +242,10 @@ class BagReader:
         return store
 
     def _collect_topics(self) -> dict[str, TopicInfo]:
-        types = {t.name: t.msgtype for t in self._found.topics}
-        for index in self._indexes:
-            self._channel_topics.append(
-                {cid: channel.topic for cid, channel in index.channels.items() if channel_msgtype(index, cid, self.layout) == types.get(channel.topic)}
-            )
         topics = {}
         for entry in sorted(self._found.topics, key=lambda t: t.name):
             cdr = entry.serialization_format == "cdr"
-            decodable = cdr and bool(entry.msgtype) and entry.msgtype in self._store.fielddefs
+            decodable = cdr and bool(entry.msgtype) and entry.msgtype in self.typestore.fielddefs
             if not decodable:
                 why = (
                     f"message encoding {entry.serialization_format!r} is not cdr"
@@ -337,8 +267,8 @@ class BagReader:
             if wanted and index.message_count:
                 messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
                 streams.append((index.start_ns, index.end_ns, named(messages, wanted)))
-        types = {name: self._topics[name].msgtype for name in selected}
-        decoders = {} if raw else {name: make_decoder(self._store, msgtype) for name, msgtype in types.items()}
+        types = {name: self.topics[name].msgtype for name in selected}
+        decoders = {} if raw else {name: make_decoder(self.typestore, msgtype) for name, msgtype in types.items()}
         failed: dict[str, int] = {}
         for log_time, name, data in merge_in_time(streams):
             if raw:
@@ -358,9 +288,10 @@ class BagReader:
 
 
 def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:
-    """Open a bag for reading (see :class:`BagReader`).
+    """Open a bag directory (with ``metadata.yaml``) or a single ``.mcap`` file for reading.
 
     Raises:
-        BagError: not a bag, unreadable metadata, a storage file that is not MCAP.
+        BagError: not a bag, ``metadata.yaml`` missing or corrupt, a storage format this project
+            does not read, a storage file not of its format, or (``strict``) any damage.
     """
     return BagReader(path, strict=strict)

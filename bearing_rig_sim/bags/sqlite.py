@@ -1,11 +1,6 @@
-"""rosbag2 bags with SQLite 3 storage (``.db3`` files), read through rosbags' rosbag2 reader.
-
-SQLite 3 was rosbag2's default storage before Iron; bags older benches recorded use it. A bag is
-read as a whole (one :class:`~.storage.FileIndex` for all its ``.db3`` files): topics, counts and
-the time range as its ``metadata.yaml`` states them, message definitions from the database
-(rosbag2 stores them since Iron), messages in time order. Such a bag is finished when written
-(every message is a committed row), so there is nothing to repair.
-"""
+"""rosbag2 bags with SQLite 3 storage (``.db3``, rosbag2's default before Iron, what older benches
+record), read through rosbags as one :class:`~.storage.FileIndex` per bag. Every message is a
+committed row, so there is nothing to repair."""
 
 from __future__ import annotations
 
@@ -17,7 +12,7 @@ from rosbags.rosbag2 import Reader, ReaderError
 
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import qos_yaml
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem
 
 _ENCODINGS = {MessageDefinitionFormat.MSG: "ros2msg", MessageDefinitionFormat.IDL: "ros2idl"}
 
@@ -28,7 +23,7 @@ class Sqlite3Format:
     identifier = "sqlite3"
 
     def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
-        """The bag's topics, definitions and statistics (see the module documentation).
+        """The bag's topics, definitions and statistics.
 
         Raises:
             BagError: rosbags cannot open the bag (a database missing or not SQLite).
@@ -52,21 +47,16 @@ class Sqlite3Format:
         return [index]
 
     def messages(
-        self,
-        index: FileIndex,
-        channel_ids: Iterable[int] | None = None,
-        start_ns: int | None = None,
-        stop_ns: int | None = None,
-        report: ProblemSink = lambda _msg: None,
+        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
+        report: ProblemSink = drop_problem,
     ) -> Iterator[MessageTuple]:
-        """Messages in time order, as rosbags reads them from the databases."""
+        """Messages with ``start_ns <= log_time < stop_ns`` in time order, as rosbags reads them."""
         wanted = None if channel_ids is None else set(channel_ids)
         try:
             with Reader(index.path) as reader:
                 connections = [c for c in reader.connections if wanted is None or c.id in wanted]
-                if not connections:
-                    return
-                for conn, log_time, data in reader.messages(connections, start=start_ns, stop=stop_ns):
-                    yield log_time, conn.id, log_time, data
+                if connections:
+                    for conn, log_time, data in reader.messages(connections, start=start_ns, stop=stop_ns):
+                        yield log_time, conn.id, log_time, data
         except ReaderError as exc:
             report(f"{index.path}: reading stopped ({exc})")

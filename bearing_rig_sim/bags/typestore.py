@@ -1,9 +1,6 @@
-"""The message types a rig bag may hold: ROS 2 Jazzy's plus ``bearing_rig_msgs``.
-
-The recorder and the readers never import the generated ``bearing_rig_msgs`` Python package: the
-custom types are built into a rosbags type store from their ``.msg`` text, found in the source tree
-(``msg_defs/msg``) or, in an installed ROS package, under ``share/bearing_rig_msgs/msg``.
-"""
+"""The message types a rig bag may hold: ROS 2 Jazzy's plus ``bearing_rig_msgs``, built into a
+rosbags type store from their ``.msg`` text (``msg_defs/msg`` in the source tree, else the
+installed ``share/bearing_rig_msgs/msg``), never from the generated Python package."""
 
 from __future__ import annotations
 
@@ -20,19 +17,13 @@ from rosbags.typesys.store import Typestore
 from bearing_rig_sim.bags.errors import BagError
 
 RIG_MSG_PACKAGE = "bearing_rig_msgs"
-"""ROS package name of the project's custom messages."""
 
 SCHEMA_SEPARATOR = "=" * 80
 """Line between a type's definition and each of its dependencies in a ``ros2msg`` schema."""
 
 
 def msg_folder() -> Path:
-    """Folder holding the ``bearing_rig_msgs`` ``.msg`` files: the source tree's ``msg_defs/msg``,
-    else the installed ``share/bearing_rig_msgs/msg`` (through the ament index).
-
-    Raises:
-        BagError: neither exists.
-    """
+    """Folder of the ``bearing_rig_msgs`` ``.msg`` files (see the module documentation); BagError if none."""
     local = Path(__file__).resolve().parents[2] / "msg_defs" / "msg"
     if local.is_dir():
         return local
@@ -55,12 +46,8 @@ def rig_message_texts() -> dict[str, str]:
 
 @functools.cache
 def rig_typestore() -> Typestore:
-    """ROS 2 Jazzy's types plus the ``bearing_rig_msgs`` types (cached and shared: treat it as
-    read-only).
-
-    Raises:
-        BagError: a ``.msg`` file does not parse.
-    """
+    """ROS 2 Jazzy's types plus ``bearing_rig_msgs`` (cached and shared: read-only); BagError when a
+    ``.msg`` file does not parse."""
     store = get_typestore(Stores.ROS2_JAZZY)
     types: Typesdict = {}
     for name, text in rig_message_texts().items():
@@ -73,15 +60,9 @@ def rig_typestore() -> Typestore:
 
 
 def msg_definition_text(msgtype: str, typestore: Typestore | None = None) -> str:
-    """The ``ros2msg`` schema text of a type, as rosbag2 stores it in MCAP files.
-
-    The type's own definition, then for each type it uses a line of 80 ``=``, a line
-    ``MSG: pkg/Name`` and that type's definition. For ``bearing_rig_msgs`` types the original
-    ``.msg`` text is kept, comments (units) included, so that a bag viewer shows them.
-
-    Raises:
-        BagError: the type is unknown to the store.
-    """
+    """The ``ros2msg`` schema text of a type as rosbag2 stores it (its definition, then each type it
+    uses after :data:`SCHEMA_SEPARATOR` and ``MSG: pkg/Name``); ``bearing_rig_msgs`` types keep
+    their ``.msg`` text, comments (units) included. BagError for an unknown type."""
     store = typestore if typestore is not None else rig_typestore()
     if msgtype not in store.fielddefs:
         raise BagError(f"unknown message type {msgtype!r}: not a ROS 2 Jazzy type nor one of {RIG_MSG_PACKAGE}")
@@ -95,8 +76,7 @@ def msg_definition_text(msgtype: str, typestore: Typestore | None = None) -> str
 
 
 def type_hash(msgtype: str, typestore: Typestore | None = None) -> str:
-    """The type's RIHS01 hash (the ``type_description_hash`` rosidl generates); empty for a type
-    the store does not know."""
+    """The type's RIHS01 hash (rosidl's ``type_description_hash``); empty for an unknown type."""
     store = typestore if typestore is not None else rig_typestore()
     return store.hash_rihs01(msgtype) if msgtype in store.fielddefs else ""
 

@@ -1,12 +1,10 @@
-"""A full check of a bag's contents: every chunk decompressed and checksummed, the timeline looked at.
+"""A full check of a bag: every chunk decompressed and checksummed, the timeline looked at.
 
-Opening a bag reads its index only; a chunk damaged after the recording (a bad disk, a truncated
-copy) still looks fine there. :func:`verify_indexes` reads every message once, through the bag's
-storage format: a chunk that fails is named, and the messages the index promised but no chunk
-delivered are counted as unreadable. The log times are grouped into stretches with no gap longer
-than :data:`TIMELINE_GAP_NS`; a healthy recording is one stretch, every other one is reported as
-log-time outliers (a stamp from another clock, a ``/clock`` far in the future that became the
-recording's time). Memory stays bounded: messages come in log-time order, only stretches are kept.
+Opening a bag reads its index only, where a chunk damaged after the recording still looks fine.
+:func:`verify_indexes` reads every message once: a chunk that fails is named, messages the index
+counts but no chunk delivers are unreadable, and log times are grouped into stretches with no gap
+over :data:`TIMELINE_GAP_NS`; every stretch but the largest is a log-time outlier (a stamp from
+another clock). Memory stays bounded: messages come in time order, only stretches are kept.
 """
 
 from __future__ import annotations
@@ -18,8 +16,7 @@ from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.clock_guard import DEFAULT_MAX_STEP_NS
 
 TIMELINE_GAP_NS = DEFAULT_MAX_STEP_NS
-"""A gap of more than this (10 s) between two consecutive log times splits the timeline: the
-largest step the clock guard accepts as the same clock."""
+"""A gap over this (10 s, the largest step the clock guard accepts) splits the timeline."""
 
 
 @dataclass
@@ -33,14 +30,8 @@ class Stretch:
 
 @dataclass
 class BagCheck:
-    """What :func:`verify_indexes` found.
-
-    Attributes:
-        damaged: one line per chunk that failed to decompress or whose checksum did not match.
-        messages_read: messages delivered by the chunks.
-        messages_indexed: messages the files' indexes (statistics) count.
-        stretches: the timeline's stretches, in time order.
-    """
+    """What :func:`verify_indexes` found: a line per damaged chunk, messages read and counted by
+    the indexes, the timeline's stretches in time order."""
 
     damaged: list[str] = field(default_factory=list)
     messages_read: int = 0
@@ -53,10 +44,14 @@ class BagCheck:
         return max(0, self.messages_indexed - self.messages_read)
 
     @property
+    def main(self) -> Stretch | None:
+        """The stretch with the most messages."""
+        return max(self.stretches, key=lambda s: s.count, default=None)
+
+    @property
     def outliers(self) -> list[Stretch]:
-        """Every stretch but the one with the most messages."""
-        main = max(self.stretches, key=lambda s: s.count, default=None)
-        return [s for s in self.stretches if s is not main]
+        """Every stretch but the main one."""
+        return [s for s in self.stretches if s is not self.main]
 
     def problems(self) -> list[str]:
         """One line per finding (empty for a sound bag)."""
@@ -64,7 +59,7 @@ class BagCheck:
         if self.messages_unreadable:
             share = 100.0 * self.messages_unreadable / self.messages_indexed
             lines.append(f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that cannot be read")
-        main = max(self.stretches, key=lambda s: s.count, default=None)
+        main = self.main
         for s in self.outliers:
             assert main is not None  # there are outliers only beside a main stretch
             after = s.start_ns > main.end_ns
@@ -78,8 +73,7 @@ class BagCheck:
 
 
 def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
-    """Read every message of the indexed files with their storage format's ``messages`` (see
-    the module documentation)."""
+    """Read every message of the files with their format's ``messages`` (see the module documentation)."""
     check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
     streams = [(i.start_ns, i.end_ns, messages(i, report=check.damaged.append)) for i in indexes]
     for log_time, _channel, _publish, _data in merge_in_time(streams):

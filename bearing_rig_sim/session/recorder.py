@@ -32,7 +32,7 @@ from typing import Protocol
 from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.bags.cdr import header_stamp_ns
-from bearing_rig_sim.clock_guard import ClockGuard
+from bearing_rig_sim.clock_guard import DEFAULT_MAX_STEP_NS, ClockGuard
 from bearing_rig_sim.interfaces import CLOCK, SPINDLE_COMMAND, TOPICS, Topic
 
 __all__ = [
@@ -45,8 +45,9 @@ __all__ = [
     "header_stamp_ns",
 ]
 
-PLAUSIBLE_SPAN_NS = 10_000_000_000
-"""A stamp more than 10 s from the last ``/clock`` is not sim time: the clock's time is used."""
+PLAUSIBLE_SPAN_NS = DEFAULT_MAX_STEP_NS
+"""A stamp further than this (10 s) from the last ``/clock`` is not sim time: the clock's time is
+used (the largest step the clock guard accepts as the same clock)."""
 
 
 RecordedTopic = Topic

@@ -1,13 +1,16 @@
-"""Validated YAML configuration.
+"""Reading YAML configuration safely, and the project's configuration error.
 
-Every configuration file of the project (bearing data, rig data, test programs, node
-parameters) is read through :class:`Section`, so that every error a user can make names the
-file, the dotted key and what was allowed::
+Every configuration file of the project (bearing, lubricant and calibration data, rig data, test
+programs, sweep specifications, node parameters) is read here (:func:`read_mapping`: no Python
+objects, no aliases, bounded size and depth) and validated by its declarative model
+(:mod:`bearing_rig_sim.settings_model`), so that every error a user can make is one line naming
+the file, the dotted key and what was allowed::
 
-    config/bearings/h7006c.yaml: geometry.ball_diameter_m: must be > 0, got -0.0063
+    config/bearings/h7006c.yaml: geometry.ball_diameter_m: must be > 0.0, got -0.0063
 
-Defaults live in ``config/``, not in code: a missing key is an error unless the caller gives
-an explicit default.
+The value kinds of those models (:func:`number_value`, :func:`integer_value`,
+:func:`flag_value`) and :func:`check_number` for a value checked outside a model (a command-line
+argument) are here too. Defaults live in ``config/``, not in code.
 """
 
 from __future__ import annotations
@@ -15,7 +18,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 from typing import Any
-from collections.abc import Iterator, Sequence
+from collections.abc import Mapping, Sequence
 
 import yaml
 
@@ -146,7 +149,7 @@ def read_yaml_file(path: str | Path) -> Any:
     return parse_yaml(raw, source)
 
 
-def load_yaml(path: str | Path) -> Section:
+def read_mapping(path: str | Path) -> dict[str, Any]:
     """Read a YAML file whose top level is a mapping (see :func:`parse_yaml` for the limits).
 
     Raises:
@@ -156,131 +159,26 @@ def load_yaml(path: str | Path) -> Section:
     data = read_yaml_file(path)
     if not isinstance(data, dict):
         raise ConfigError(str(path), "", f"top level must be a mapping, got {type(data).__name__}")
-    return Section(data, str(path))
+    return data
 
 
-_MISSING = object()
+def mapping_at(data: Mapping[str, Any], keys: Sequence[str], source: str) -> dict[str, Any]:
+    """The mapping at ``keys`` inside ``data`` (read from ``source``), e.g. ``("monitor",
+    "ros__parameters")``.
 
-
-class Section:
-    """A mapping read from a configuration source, with typed, range-checked accessors.
-
-    Args:
-        data: the mapping.
-        source: file name (or other origin) used in error messages.
-        prefix: dotted path of this mapping inside the source.
+    Raises:
+        ConfigError: a key is missing or null, or its value is not a mapping.
     """
-
-    def __init__(self, data: dict[str, Any], source: str, prefix: str = "") -> None:
-        self.data = data
-        self.source = source
-        self.prefix = prefix
-
-    # -- helpers -----------------------------------------------------------------------------
-    def key_path(self, key: str) -> str:
-        """Dotted path of ``key`` inside the source."""
-        return f"{self.prefix}.{key}" if self.prefix else key
-
-    def error(self, key: str, problem: str) -> ConfigError:
-        """A :class:`ConfigError` for ``key`` of this section."""
-        return ConfigError(self.source, self.key_path(key), problem)
-
-    def _get(self, key: str, default: Any) -> Any:
-        if key in self.data and self.data[key] is not None:
-            return self.data[key]
-        if default is _MISSING:
-            raise self.error(key, "missing (required)")
-        return default
-
-    def __contains__(self, key: str) -> bool:
-        return key in self.data
-
-    def keys(self) -> Iterator[str]:
-        """Keys of the mapping."""
-        return iter(self.data.keys())
-
-    def reject_unknown(self, allowed: Sequence[str]) -> None:
-        """Raise on keys not in ``allowed`` (catches misspelt keys)."""
-        for key in self.data:
-            if key not in allowed:
-                raise self.error(str(key), f"unknown key; allowed keys: {', '.join(sorted(allowed))}")
-
-    # -- accessors ---------------------------------------------------------------------------
-    def section(self, key: str, default: Any = _MISSING) -> Section:
-        """A nested mapping as a :class:`Section`."""
-        value = self._get(key, default)
+    here: Any = data
+    for depth, key in enumerate(keys):
+        value = here.get(key)
+        path = ".".join(keys[: depth + 1])
+        if value is None:
+            raise ConfigError(source, path, "missing (required)")
         if not isinstance(value, dict):
-            raise self.error(key, f"must be a mapping, got {type(value).__name__}")
-        return Section(value, self.source, self.key_path(key))
-
-    def number(
-        self,
-        key: str,
-        *,
-        gt: float | None = None,
-        ge: float | None = None,
-        lt: float | None = None,
-        le: float | None = None,
-        default: Any = _MISSING,
-    ) -> float:
-        """A finite real number within the given bounds (``gt`` means strictly greater, ...)."""
-        value = self._get(key, default)
-        return check_number(value, self.source, self.key_path(key), gt=gt, ge=ge, lt=lt, le=le)
-
-    def integer(self, key: str, *, ge: int | None = None, le: int | None = None, default: Any = _MISSING) -> int:
-        """An integer within ``[ge, le]``."""
-        value = self._get(key, default)
-        try:
-            value = integer_value(value)
-        except ValueError as exc:
-            raise self.error(key, str(exc)) from None
-        if ge is not None and value < ge:
-            raise self.error(key, f"must be >= {ge}, got {value}")
-        if le is not None and value > le:
-            raise self.error(key, f"must be <= {le}, got {value}")
-        return value
-
-    def boolean(self, key: str, default: Any = _MISSING) -> bool:
-        """A YAML boolean."""
-        value = self._get(key, default)
-        try:
-            return flag_value(value)
-        except ValueError as exc:
-            raise self.error(key, str(exc)) from None
-
-    def string(self, key: str, default: Any = _MISSING) -> str:
-        """A non-empty string."""
-        value = self._get(key, default)
-        if not isinstance(value, str) or not value:
-            raise self.error(key, f"must be a non-empty string, got {value!r}")
-        return value
-
-    def choice(self, key: str, allowed: Sequence[str], default: Any = _MISSING) -> str:
-        """A string out of ``allowed``."""
-        value = self._get(key, default)
-        if value not in allowed:
-            raise self.error(key, f"must be one of {', '.join(map(str, allowed))}, got {value!r}")
-        return str(value)
-
-    def number_list(self, key: str, *, gt: float | None = None, ge: float | None = None, min_len: int = 1, default: Any = _MISSING) -> list[float]:
-        """A list of finite numbers, each within the bounds."""
-        value = self._get(key, default)
-        if not isinstance(value, list) or len(value) < min_len:
-            raise self.error(key, f"must be a list of at least {min_len} number(s), got {value!r}")
-        path = self.key_path(key)
-        return [check_number(v, self.source, f"{path}[{i}]", gt=gt, ge=ge) for i, v in enumerate(value)]
-
-    def sections(self, key: str) -> list[Section]:
-        """A list of mappings, each as a :class:`Section` (``key[i]`` in error paths)."""
-        value = self._get(key, _MISSING)
-        if not isinstance(value, list) or not value:
-            raise self.error(key, "must be a non-empty list of mappings")
-        out = []
-        for i, item in enumerate(value):
-            if not isinstance(item, dict):
-                raise ConfigError(self.source, f"{self.key_path(key)}[{i}]", "must be a mapping")
-            out.append(Section(item, self.source, f"{self.key_path(key)}[{i}]"))
-        return out
+            raise ConfigError(source, path, f"must be a mapping, got {type(value).__name__}")
+        here = value
+    return dict(here)
 
 
 def number_value(value: object) -> float:
@@ -355,9 +253,13 @@ def check_number(
     return x
 
 
-def ros_parameters(doc: Section, node_name: str) -> Section:
-    """The ``node_name: ros__parameters:`` block of a ROS 2 parameter file."""
-    return doc.section(node_name).section("ros__parameters")
+def ros_parameters(doc: Mapping[str, Any], node_name: str, source: str) -> dict[str, Any]:
+    """The ``node_name: ros__parameters:`` block of a ROS 2 parameter file read from ``source``.
+
+    Raises:
+        ConfigError: the block is missing or not a mapping.
+    """
+    return mapping_at(doc, (node_name, "ros__parameters"), source)
 
 
 RPM_TO_RAD_S: float = 2.0 * math.pi / 60.0

@@ -17,12 +17,22 @@ A settings class derives from :class:`NodeSettings` and declares each parameter 
   exist (absolute, or relative to ``config/``); :func:`one_of` restricts a text to a few words;
 * :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``) and
   whether the parameter may change while the node runs;
-* :meth:`NodeSettings.from_section` (and ``from_values``, ``from_yaml``) validates a mapping and
+* :meth:`NodeSettings.from_mapping` (and ``from_values``, ``from_yaml``) validates a mapping and
   raises :class:`~bearing_rig_sim.config.ConfigError` for the first problem in field order, in
   the project's words (``load_controller.yaml: state_rate_hz: must be > 0.0, got 0``);
 * :meth:`NodeSettings.parameter_fields` lists what the ROS descriptors are made from.
 
-The defaults live only in the shipped files under ``config/``: every parameter is required.
+The defaults of a node live only in the shipped files under ``config/``: every parameter is
+required.
+
+The data files (bearing, lubricant and calibration files, sweep specifications) are models of
+the same kinds and words: a :class:`FileSection` per mapping (unknown keys refused), a
+:func:`quantity` per physical parameter (description, SI unit, the source of its plausible range,
+the range, a default where the key may be left out), checks across keys in model validators
+raising :func:`field_error`, and :func:`validate_mapping` / :func:`read_file` giving the one-line
+error naming the file and the full dotted key. A quantity may be written with the range its file
+states (:class:`StatedQuantity`). The rig file's records (:mod:`bearing_rig_sim.rig.parameters`)
+and the test programs (:mod:`bearing_rig_sim.rig.program`) are built on the same kinds.
 No ROS import.
 """
 
@@ -32,27 +42,35 @@ import typing
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Self
+from typing import Annotated, Any, ClassVar, Self, TypeVar
 
 import annotated_types
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError, ValidationInfo, field_validator, model_validator
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import ConfigError, Section, config_path, flag_value, integer_value, load_yaml, number_value, ros_parameters
+from bearing_rig_sim.config import ConfigError, check_number, config_path, flag_value, integer_value, number_value, read_mapping, ros_parameters
 
 __all__ = [
     "ConfigFile",
+    "FileSection",
     "Flag",
     "Integer",
     "NodeSettings",
     "Number",
     "OptionalConfigFile",
     "ParameterField",
+    "StatedQuantity",
+    "Text",
+    "field_error",
     "existing_config_file",
     "first_error",
     "one_of",
     "param",
+    "quantity",
+    "read_file",
     "resolve_config_file",
+    "validate_mapping",
+    "without_nulls",
 ]
 
 
@@ -64,6 +82,16 @@ Integer = Annotated[int, BeforeValidator(integer_value)]
 
 Flag = Annotated[bool, BeforeValidator(flag_value)]
 """A YAML boolean (``true`` or ``false``, nothing that merely converts to one)."""
+
+
+def _text(raw: object) -> str:
+    if not isinstance(raw, str) or not raw:
+        raise ValueError(f"must be a non-empty string, got {raw!r}")
+    return raw
+
+
+Text = Annotated[str, BeforeValidator(_text)]
+"""A non-empty string."""
 
 
 def resolve_config_file(value: str) -> Path | None:
@@ -127,6 +155,23 @@ def param(
     ``""`` for text, files and flags), its allowed range, and whether it may be set while the
     node runs (``live``; otherwise it is read at configure and read-only to ROS)."""
     return Field(description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "live": live})
+
+
+def quantity(
+    description: str,
+    *,
+    unit: str,
+    source: str,
+    gt: float | None = None,
+    ge: float | None = None,
+    lt: float | None = None,
+    le: float | None = None,
+    default: Any = ...,
+) -> Any:
+    """One physical parameter of a data file (bearing, lubricant, calibration, sweep): what it
+    is, its SI unit (``"1"`` for a pure number), where its plausible range (``gt``, ``ge``,
+    ``lt``, ``le``) comes from, and its default where the key may be left out."""
+    return Field(default, description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "source": source})
 
 
 @dataclass(frozen=True)
@@ -201,6 +246,9 @@ def _problem(error: ErrorDetails) -> str:
         return cause.problem if isinstance(cause, ConfigError) else str(cause)
     if kind in ("model_type", "model_attributes_type", "dict_type"):
         return f"must be a mapping, got {type(error['input']).__name__}"
+    if kind in ("too_short", "too_long"):
+        bound = f"at least {ctx['min_length']}" if kind == "too_short" else f"at most {ctx['max_length']}"
+        return f"must be a list of {bound} item(s), got {error['input']!r}"
     if kind == "list_type":
         return f"must be a list, got {type(error['input']).__name__}"
     return str(error["msg"])
@@ -230,12 +278,95 @@ def first_error(model: type[BaseModel], exc: ValidationError) -> tuple[str, str]
     problem = _problem(error)
     if error["type"] == "extra_forbidden":
         owner = _model_at(model, [part for part in error["loc"][:-1] if not isinstance(part, int)])
-        allowed = ", ".join(sorted(owner.model_fields)) if owner is not None else ""
+        allowed = ", ".join(sorted(info.alias or name for name, info in owner.model_fields.items())) if owner is not None else ""
         problem = f"unknown key; allowed keys: {allowed}"
     cause = error.get("ctx", {}).get("error")
     if isinstance(cause, ConfigError):
         loc, problem = [*loc, cause.key] if cause.key else loc, cause.problem
     return ".".join(loc).replace(".[", "["), problem
+
+
+M = TypeVar("M", bound=BaseModel)
+
+
+def field_error(key: str, problem: str) -> ConfigError:
+    """The error a check across fields raises inside a model's validator: ``key`` relative to
+    the model's mapping; :func:`validate_mapping` names the file and the full dotted key."""
+    return ConfigError("", key, problem)
+
+
+def without_nulls(data: Any) -> Any:
+    """A YAML ``null`` is an absent key (its default, or "missing"), also in mappings in lists."""
+    if isinstance(data, Mapping):
+        return {k: without_nulls(v) for k, v in data.items() if v is not None}
+    if isinstance(data, list):
+        return [without_nulls(v) for v in data]
+    return data
+
+
+class FileSection(BaseModel):
+    """Base of a data file's model (a file or one of its mappings): frozen, an unknown key is
+    refused (a misspelt optional key would otherwise leave its default in force silently).
+
+    A physical parameter (a :func:`quantity`) is written either as a number or as a
+    :class:`StatedQuantity` ``{value, unit, range: [low, high], source}``: then its unit must be
+    the parameter's and its value must lie in the range the file states (besides the model's
+    plausible range)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    @field_validator("*", mode="before")
+    @classmethod
+    def _stated_quantity(cls, raw: object, info: ValidationInfo) -> object:
+        extra = cls.model_fields[info.field_name].json_schema_extra if info.field_name else None
+        if not isinstance(raw, Mapping) or not isinstance(extra, dict) or "source" not in extra:
+            return raw
+        stated = validate_mapping(StatedQuantity, raw, "")
+        if stated.unit != extra["unit"]:
+            raise field_error("unit", f"must be {extra['unit']!r}, the unit of this key, got {stated.unit!r}")
+        return stated.value
+
+
+class StatedQuantity(FileSection):
+    """A value with its unit, the plausible range its file states and where both come from (a
+    calibrated value, or a bearing or lubricant datum written with its range)."""
+
+    value: Number = Field(description="the value, in the unit")
+    unit: Text = Field(description="its SI unit")
+    range: Annotated[list[Number], Field(min_length=2, max_length=2)] = Field(description="[low, high], the plausible interval")
+    source: Text = Field(description="where the value and the range come from")
+
+    @model_validator(mode="after")
+    def _value_in_range(self) -> Self:
+        check_number(self.value, "", "value", ge=self.range[0], le=self.range[1])
+        return self
+
+
+def validate_mapping(model: type[M], data: object, source: str, key: str = "") -> M:
+    """Validate a mapping read from ``source`` (at dotted ``key`` inside it) against ``model``;
+    a ``null`` counts as absent.
+
+    Raises:
+        ConfigError: the first problem in field order (a misspelt key first), naming the source,
+            the full dotted key and the allowed range.
+    """
+    if not isinstance(data, Mapping):
+        raise ConfigError(source, key, f"must be a mapping, got {type(data).__name__}")
+    try:
+        return model.model_validate(without_nulls(data))
+    except ValidationError as exc:
+        where, problem = first_error(model, exc)
+        raise ConfigError(source, ".".join(part for part in (key, where) if part).replace(".[", "["), problem) from None
+
+
+def read_file(model: type[M], path: str | Path) -> M:
+    """Read a YAML file (:func:`~bearing_rig_sim.config.read_mapping`) and validate it against
+    ``model`` (:func:`validate_mapping`).
+
+    Raises:
+        ConfigError: naming the file, the dotted key and the allowed range.
+    """
+    return validate_mapping(model, read_mapping(path), str(path))
 
 
 class NodeSettings(BaseModel):
@@ -252,23 +383,28 @@ class NodeSettings(BaseModel):
     OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
 
     @classmethod
-    def check_other_keys(cls, s: Section) -> None:
-        """Check the values of :attr:`OTHER_KEYS` in ``s`` (none by default); raise ``s.error``."""
+    def check_other_keys(cls, values: Mapping[str, Any]) -> None:
+        """Check the values of :attr:`OTHER_KEYS` in ``values`` (none by default); raise
+        :func:`field_error`."""
 
     @classmethod
-    def from_section(cls, s: Section) -> Self:
-        """Validate the parameters in ``s``: every parameter required, no unknown key.
+    def from_mapping(cls, values: Mapping[str, Any], source: str, key: str = "") -> Self:
+        """Validate the parameters in ``values`` (read from ``source``, at dotted ``key`` in it):
+        every parameter required, no unknown key.
 
         Raises:
             ConfigError: the first problem, naming the source, the key and the allowed range.
         """
-        s.reject_unknown([*cls.model_fields, *cls.OTHER_KEYS])
-        cls.check_other_keys(s)
-        values = {k: v for k, v in s.data.items() if k in cls.model_fields and v is not None}
+        allowed = [*cls.model_fields, *cls.OTHER_KEYS]
         try:
-            return cls.model_validate(values)
-        except ValidationError as exc:
-            raise s.error(*first_error(cls, exc)) from None
+            for name in values:
+                if name not in allowed:
+                    raise field_error(str(name), f"unknown key; allowed keys: {', '.join(sorted(allowed))}")
+            cls.check_other_keys(values)
+        except ConfigError as exc:
+            raise ConfigError(source, ".".join(part for part in (key, exc.key) if part), exc.problem) from None
+        own = {k: v for k, v in values.items() if k in cls.model_fields}
+        return validate_mapping(cls, own, source, key)
 
     @classmethod
     def from_values(cls, values: Mapping[str, Any], source: str | None = None) -> Self:
@@ -277,7 +413,12 @@ class NodeSettings(BaseModel):
         Raises:
             ConfigError: naming the key and the allowed range.
         """
-        return cls.from_section(Section(dict(values), source or f"{cls.NODE_NAME} parameters"))
+        return cls.from_mapping(values, source or f"{cls.NODE_NAME} parameters")
+
+    @classmethod
+    def _parameter_block(cls, path: str | Path) -> dict[str, Any]:
+        """The ``<node>: ros__parameters:`` mapping of a parameter file."""
+        return ros_parameters(read_mapping(path), cls.NODE_NAME, str(path))
 
     @classmethod
     def from_yaml(cls, path: str | Path | None = None) -> Self:
@@ -286,7 +427,8 @@ class NodeSettings(BaseModel):
         Raises:
             ConfigError: naming the file and the key.
         """
-        return cls.from_section(ros_parameters(load_yaml(path or config_path(cls.SHIPPED_FILE)), cls.NODE_NAME))
+        path = path or config_path(cls.SHIPPED_FILE)
+        return cls.from_mapping(cls._parameter_block(path), str(path), f"{cls.NODE_NAME}.ros__parameters")
 
     @classmethod
     def shipped_parameters(cls) -> dict[str, Any]:
@@ -295,9 +437,10 @@ class NodeSettings(BaseModel):
         Raises:
             ConfigError: the shipped file is missing or malformed.
         """
-        section = ros_parameters(load_yaml(config_path(cls.SHIPPED_FILE)), cls.NODE_NAME)
-        cls.from_section(section)  # the defaults themselves must be valid
-        return dict(section.data)
+        path = config_path(cls.SHIPPED_FILE)
+        values = cls._parameter_block(path)
+        cls.from_mapping(values, str(path), f"{cls.NODE_NAME}.ros__parameters")  # the defaults themselves must be valid
+        return dict(values)
 
     def replace(self, **changes: Any) -> Self:
         """A copy with some values changed, not validated again (for tests and for a value the

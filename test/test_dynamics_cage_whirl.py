@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from scipy.integrate import quad
 
-from bearing_rig_sim.config import ConfigError, Section, load_yaml
+from bearing_rig_sim.config import ConfigError, read_mapping
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.parameters import derive
@@ -142,15 +142,14 @@ def test_land_contact_at_the_clearance(oil_land: np.ndarray) -> None:
 def test_land_values_outside_their_range_are_refused() -> None:
     """A land clearance outside [1e-5, 1e-3] m, or a land count other than 1 or 2, is refused
     naming the key and the range."""
-    doc = load_yaml(BEARING_FILE)
-    data = {k: dict(v) if isinstance(v, dict) else v for k, v in doc.data.items()}
+    data = read_mapping(BEARING_FILE)
     data["cage"]["land_radial_clearance_m"] = 0.002
     with pytest.raises(ConfigError, match=r"land_radial_clearance_m.*0\.001"):
-        BearingParameters.from_section(Section(data, "h7006c.yaml"))
+        BearingParameters.from_mapping(data, "h7006c.yaml")
     data["cage"]["land_radial_clearance_m"] = 1e-4
     data["cage"]["land_count"] = 3
     with pytest.raises(ConfigError, match="land_count"):
-        BearingParameters.from_section(Section(data, "h7006c.yaml"))
+        BearingParameters.from_mapping(data, "h7006c.yaml")
 
 
 def test_a_centred_cage_stays_centred_under_pure_axial_load(params: BearingParameters) -> None:

@@ -29,12 +29,12 @@ from hypothesis import strategies as st
 
 import numpy as np
 
-from bearing_rig_sim.config import config_path, load_yaml
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, OperatingEnvelope
 from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.rig.spindle import SpindleConfig
 
 ENVELOPE = OperatingEnvelope.from_rig_file()
-MAX_ACCELERATION = load_yaml(config_path("rig.yaml")).section("spindle").number("max_acceleration_rad_s2", gt=0.0)
+MAX_ACCELERATION = SpindleConfig.from_yaml().max_acceleration_rad_s2
 TOLERANCE = 0.2
 """rad/s: the engine's absolute speed tolerance (engine.SPEED_TOLERANCE)."""
 PIECE = 5e-3

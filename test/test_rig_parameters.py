@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import pytest
 
-from bearing_rig_sim.config import ConfigError, Section, load_yaml
+from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.rig.parameters import ParameterRecord, bounded
 
 
@@ -35,10 +35,10 @@ class Stage(ParameterRecord):
             raise error("high_m", f"must be > low_m ({self.low_m}), got {self.high_m}")
 
 
-def section(text: str, tmp_path: Path) -> Section:
+def rig_file(text: str, tmp_path: Path) -> Path:
     path = tmp_path / "rig.yaml"
     path.write_text(text)
-    return load_yaml(path)
+    return path
 
 
 GOOD = """
@@ -53,10 +53,9 @@ stage:
 
 
 def test_reads_nested_record_with_optional_default(tmp_path: Path) -> None:
-    stage = Stage.from_section(section(GOOD, tmp_path).section("stage"))
+    stage = Stage.from_mapping({"turns": 3, "enabled": True, "low_m": -0.001, "high_m": 0.002, "spring": {"stiffness_n_per_m": 2.0e5}}, "code")
     assert stage == Stage(turns=3, enabled=True, low_m=-0.001, high_m=0.002, spring=Spring(2.0e5, 0.0))
-    path = tmp_path / "rig.yaml"
-    assert Stage.from_yaml(path) == stage  # only its own top-level section is read
+    assert Stage.from_yaml(rig_file(GOOD, tmp_path)) == stage  # only its own top-level section is read
 
 
 @pytest.mark.parametrize(
@@ -74,9 +73,9 @@ def test_reads_nested_record_with_optional_default(tmp_path: Path) -> None:
 )
 def test_yaml_errors_name_file_and_key(tmp_path: Path, old: str, new: str, key: str, problem: str) -> None:
     assert old in GOOD
-    doc = section(GOOD.replace(old, new), tmp_path)
+    path = rig_file(GOOD.replace(old, new), tmp_path)
     with pytest.raises(ConfigError) as info:
-        Stage.from_section(doc.section("stage"))
+        Stage.from_yaml(path)
     assert info.value.source == str(tmp_path / "rig.yaml")
     assert info.value.key == key
     assert problem in info.value.problem
@@ -110,9 +109,9 @@ def test_errors_are_the_parameter_models_one_line_wording(tmp_path: Path) -> Non
         "turns: 3": ("turns: '3'", "stage.turns: must be an integer, got '3'"),
     }
     for old, (new, message) in cases.items():
-        doc = section(GOOD.replace(old, new), tmp_path)
+        path = rig_file(GOOD.replace(old, new), tmp_path)
         with pytest.raises(ConfigError) as info:
-            Stage.from_section(doc.section("stage"))
+            Stage.from_yaml(path)
         assert str(info.value) == f"{tmp_path / 'rig.yaml'}: {message}"
     with pytest.raises(ConfigError) as info:
         Spring(stiffness_n_per_m=1.0, preload_n=-1.0)

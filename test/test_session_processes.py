@@ -116,10 +116,10 @@ def test_run_id_and_run_context() -> None:
 def test_the_programs_bearing_is_the_one_the_nodes_use(tmp_path: Path) -> None:
     """A program naming another bearing file gets it passed to the simulator and the monitor,
     uncalibrated (the shipped calibration is the H7006C's); the shipped bearing needs nothing."""
-    from bearing_rig_sim.config import load_yaml, ros_parameters
     from bearing_rig_sim.session.context import node_parameters
+    from bearing_rig_sim.simulation.settings import shipped_parameters
 
-    defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
+    defaults = shipped_parameters()
     shipped = load_program(config_path("programs", "validation.yaml"))
     assert node_parameters(shipped, defaults) == {}
     other = tmp_path / "h7006c_copy.yaml"

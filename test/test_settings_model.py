@@ -8,7 +8,7 @@ from typing import Annotated, ClassVar
 
 import pytest
 
-from bearing_rig_sim.config import ConfigError, Section, config_path
+from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.load_control.settings import LoadControllerSettings
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.settings_model import (
@@ -42,7 +42,7 @@ GOOD = {"rate_hz": 100, "count": 3, "gain": 0.5, "enabled": True}
 
 def error_of(values: dict[str, object]) -> str:
     with pytest.raises(ConfigError) as caught:
-        Toy.from_section(Section(values, "config/toy.yaml", "toy.ros__parameters"))
+        Toy.from_mapping(values, "config/toy.yaml", "toy.ros__parameters")
     return str(caught.value)
 
 

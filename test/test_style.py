@@ -30,13 +30,16 @@ STRICT = (
     "bearing_rig_sim/bags",
     "bearing_rig_sim/interfaces.py",
     "bearing_rig_sim/settings_model.py",
+    "bearing_rig_sim/dynamics/bearing_file.py",
+    "bearing_rig_sim/sweep/spec.py",
     "bearing_rig_sim/rig/parameters.py",
     "bearing_rig_sim/rig/program.py",
     "bearing_rig_sim/nodes/parameters.py",
 )
 """Modules held to ``mypy --strict`` (the modules they import are checked by the plain run):
 the bag storage, the contract every other part imports, and the parameter model with what is
-built on it (the rig file's records, the test programs, the nodes' ROS descriptors)."""
+built on it (the bearing, lubricant and calibration files, the sweep specifications, the rig
+file's records, the test programs, the nodes' ROS descriptors)."""
 
 
 def test_mypy_strict_passes_on_the_bags_the_contract_and_the_parameter_model() -> None:

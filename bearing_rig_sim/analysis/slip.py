@@ -25,9 +25,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import NamedTuple, overload
+from typing import NamedTuple, Self, overload
 
 import numpy as np
+from pydantic import ConfigDict, model_validator
 from scipy.optimize import brentq
 
 from bearing_rig_sim.analysis.inputs import (
@@ -38,7 +39,52 @@ from bearing_rig_sim.analysis.inputs import (
     same_length,
     strictly_increasing,
 )
-from bearing_rig_sim.config import Section, load_yaml
+from bearing_rig_sim.config import ConfigError, read_mapping
+from bearing_rig_sim.settings_model import FileSection, Integer, Number, quantity, validate_mapping
+
+
+class _Reading(FileSection):
+    """The part of a bearing file an analysis reads; the rest of the file is the engine's
+    (:class:`~bearing_rig_sim.dynamics.bearing_file.BearingFile`)."""
+
+    model_config = ConfigDict(frozen=True, extra="ignore")
+
+
+class _KinematicGeometry(_Reading):
+    ball_diameter_m: Number = quantity("ball diameter Dw", unit="m", source="a ball", gt=0.0)
+    pitch_diameter_m: Number = quantity("pitch diameter dm (above Dw)", unit="m", source="a pitch circle", gt=0.0)
+    contact_angle_deg: Number = quantity("nominal contact angle", unit="deg", source="a ball bearing (radial to thrust)", ge=0.0, lt=90.0)
+
+    @model_validator(mode="after")
+    def _pitch_above_ball(self) -> Self:
+        if not self.pitch_diameter_m > self.ball_diameter_m:
+            raise ConfigError("", "pitch_diameter_m", f"must exceed ball_diameter_m = {self.ball_diameter_m}, got {self.pitch_diameter_m}")
+        return self
+
+
+class _KinematicsReading(_Reading):
+    geometry: _KinematicGeometry
+
+
+class _ContactGeometry(_KinematicGeometry):
+    inner_groove_curvature_ratio: Number = quantity("inner groove radius / Dw", unit="1", source="a groove wider than the ball", gt=0.5, lt=1.0)
+    outer_groove_curvature_ratio: Number = quantity("outer groove radius / Dw", unit="1", source="a groove wider than the ball", gt=0.5, lt=1.0)
+    ball_count: Integer = quantity("number of balls Z", unit="1", source="a count", ge=1)
+
+
+class _Elastic(_Reading):
+    youngs_modulus_pa: Number = quantity("Young's modulus", unit="Pa", source="a solid", gt=0.0)
+    poisson_ratio: Number = quantity("Poisson ratio", unit="1", source="an isotropic solid", ge=0.0, lt=0.5)
+
+
+class _ElasticMaterials(_Reading):
+    ball: _Elastic
+    ring: _Elastic
+
+
+class _ContactReading(_Reading):
+    geometry: _ContactGeometry
+    materials: _ElasticMaterials
 
 
 @dataclass(frozen=True)
@@ -73,24 +119,18 @@ class BearingKinematics:
             raise AnalysisError(f"contact_angle: must be in [0, pi/2) rad, got {self.contact_angle!r}")
 
     @classmethod
-    def from_config(cls, source: Section | str | Path) -> BearingKinematics:
+    def from_config(cls, source: str | Path) -> BearingKinematics:
         """Read ``geometry.ball_diameter_m``, ``geometry.pitch_diameter_m`` and
         ``geometry.contact_angle_deg`` (the nominal angle, degrees) from a bearing file.
 
         Args:
-            source: the bearing file's path, or its top-level :class:`Section`.
+            source: the bearing file's path.
 
         Raises:
             ConfigError: naming the file and key of a missing or out-of-range value.
         """
-        doc = source if isinstance(source, Section) else load_yaml(source)
-        geometry = doc.section("geometry")
-        ball = geometry.number("ball_diameter_m", gt=0.0)
-        pitch = geometry.number("pitch_diameter_m", gt=0.0)
-        angle_deg = geometry.number("contact_angle_deg", ge=0.0, lt=90.0)
-        if not pitch > ball:
-            raise geometry.error("pitch_diameter_m", f"must exceed ball_diameter_m = {ball}, got {pitch}")
-        return cls(ball, pitch, math.radians(angle_deg))
+        g = validate_mapping(_KinematicsReading, read_mapping(source), str(source)).geometry
+        return cls(g.ball_diameter_m, g.pitch_diameter_m, math.radians(g.contact_angle_deg))
 
     def at_contact_angle(self, contact_angle: float) -> BearingKinematics:
         """The same bearing at another contact angle (rad), e.g. the loaded one."""
@@ -287,7 +327,7 @@ class ThrustContact:
     combined_constant: float
 
     @classmethod
-    def from_config(cls, source: Section | str | Path) -> ThrustContact:
+    def from_config(cls, source: str | Path) -> ThrustContact:
         """From a bearing file: ``geometry`` (ball diameter, pitch diameter, ball count, nominal
         angle, groove curvature ratios) and ``materials`` (ring and ball moduli, Poisson ratios).
 
@@ -296,26 +336,13 @@ class ThrustContact:
         """
         from bearing_rig_sim.dynamics.hertz import raceway_contacts  # the elliptical Hertz solution
 
-        doc = source if isinstance(source, Section) else load_yaml(source)
-        g = doc.section("geometry")
-        dw = g.number("ball_diameter_m", gt=0.0)
-        dm = g.number("pitch_diameter_m", gt=dw)
-        a0 = math.radians(g.number("contact_angle_deg", ge=0.0, lt=90.0))
-        fi = g.number("inner_groove_curvature_ratio", gt=0.5, lt=1.0)
-        fo = g.number("outer_groove_curvature_ratio", gt=0.5, lt=1.0)
-        z = g.integer("ball_count", ge=1)
-        m = doc.section("materials")
-        ball, ring = m.section("ball"), m.section("ring")
+        doc = validate_mapping(_ContactReading, read_mapping(source), str(source))
+        g, ball, ring = doc.geometry, doc.materials.ball, doc.materials.ring
+        dw, fi, fo = g.ball_diameter_m, g.inner_groove_curvature_ratio, g.outer_groove_curvature_ratio
+        a0 = math.radians(g.contact_angle_deg)
+        z = g.ball_count
         inner, outer = raceway_contacts(
-            dw,
-            dm,
-            a0,
-            fi,
-            fo,
-            ball.number("youngs_modulus_pa", gt=0.0),
-            ball.number("poisson_ratio", ge=0.0, lt=0.5),
-            ring.number("youngs_modulus_pa", gt=0.0),
-            ring.number("poisson_ratio", ge=0.0, lt=0.5),
+            dw, g.pitch_diameter_m, a0, fi, fo, ball.youngs_modulus_pa, ball.poisson_ratio, ring.youngs_modulus_pa, ring.poisson_ratio
         )
         k_n = (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** -1.5
         return cls(z, a0, fi + fo - 1.0, dw, k_n)

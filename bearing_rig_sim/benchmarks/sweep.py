@@ -96,16 +96,15 @@ def _cluster_rows(loads: list[float], method: str, repeats: int) -> Iterator[dic
     from bearing_rig_sim.sweep.points import INTEGRATE, SOLVE
     from bearing_rig_sim.executors import open_client
     from bearing_rig_sim.sweep.runner import run_sweep
-    from bearing_rig_sim.sweep.spec import spec_from_section
-    from bearing_rig_sim.config import Section
+    from bearing_rig_sim.sweep.spec import spec_from_mapping
 
     doc = {
         "sweep": {"name": "bench", "continuation": False},
         "grid": {"inner_ring_speed_rpm": list(SPEEDS_RPM), "axial_load_n": loads},
     }
-    spec = spec_from_section(Section(doc, "<bench sweep>"))
+    spec = spec_from_mapping(doc, "<bench sweep>")
     warm_doc = {"sweep": {"name": "bench-warm-up"}, "grid": {"inner_ring_speed_rpm": [1000.0, 9000.0], "axial_load_n": [100.0]}}
-    warm = spec_from_section(Section(warm_doc, "<bench sweep warm-up>"))
+    warm = spec_from_mapping(warm_doc, "<bench sweep warm-up>")
     chosen = INTEGRATE if method == "integrate" else SOLVE
     walls: dict[int, float] = {}
     for workers in (1, 2):

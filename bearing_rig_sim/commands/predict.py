@@ -28,11 +28,13 @@ import math
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import check_number, config_path, load_yaml, rpm_to_rad_s
+from bearing_rig_sim.config import check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.settings_model import read_file
 from bearing_rig_sim.studies.calibration import steady_states
 
 
@@ -60,19 +62,17 @@ def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: P
     file in place of the bearing file's (the calibration then only when named explicitly). The
     shipped calibration belongs to the shipped bearing: another bearing file gets it only when
     named."""
-    doc = load_yaml(bearing or config_path("bearings", "h7006c.yaml"))
-    if bearing is not None and calibration is None:
-        if lubricant is not None:
-            doc.section("lubricant").data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
-        return BearingParameters.from_section(doc)
+    path = bearing or config_path("bearings", "h7006c.yaml")
+    doc, source = read_mapping(path), str(path)
     if lubricant is not None:
-        lub = doc.section("lubricant")
-        lub.data["file"] = str(lubricant.resolve()) if lubricant.suffix else lubricant.name
-        if calibration is not None:
-            doc = overlay_calibration(doc, load_yaml(calibration))
-    else:
-        doc = overlay_calibration(doc, load_yaml(calibration or config_path("calibration", "h7006c_table3.yaml")))
-    return BearingParameters.from_section(doc)
+        lub = mapping_at(doc, ("lubricant",), source)
+        doc["lubricant"] = {**lub, "file": str(lubricant.resolve()) if lubricant.suffix else lubricant.name}
+    if bearing is not None and calibration is None:
+        return BearingParameters.from_mapping(doc, source)
+    if lubricant is None or calibration is not None:
+        calibration = calibration or config_path("calibration", "h7006c_table3.yaml")
+        doc, source = overlay_calibration(doc, read_file(CalibrationFile, calibration)), f"{source} + {calibration}"
+    return BearingParameters.from_mapping(doc, source)
 
 
 def run(args: argparse.Namespace) -> int:
@@ -119,8 +119,7 @@ def _thermal_calibration(args: argparse.Namespace) -> bool:
     (``calibration.thermal`` of its file)."""
     if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
         return False
-    doc = load_yaml(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
-    return "calibration" in doc and bool(doc.section("calibration").data.get("thermal", False))
+    return read_file(CalibrationFile, args.calibration or config_path("calibration", "h7006c_table3.yaml")).calibration.thermal
 
 
 def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float, thermal: Any = None) -> None:

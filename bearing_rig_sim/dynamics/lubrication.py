@@ -26,10 +26,11 @@ from typing import Any, cast
 
 from scipy.optimize import brentq
 
-from bearing_rig_sim.config import Section, config_path, load_yaml
+from bearing_rig_sim.config import config_path
+from bearing_rig_sim.dynamics.bearing_file import KINDS as KINDS  # the lubrication modes, re-exported
+from bearing_rig_sim.dynamics.bearing_file import LubricantFile
+from bearing_rig_sim.settings_model import read_file
 
-KINDS = ("oil_air", "oil_bath", "grease")
-"""Lubrication modes: oil-air mist, oil bath or jet (cavity flooded), grease."""
 ABSOLUTE_ZERO_C = -273.15
 ROELANDS_P0 = 1.96e8
 """Roelands' pressure constant, Pa (Roelands 1966)."""
@@ -92,39 +93,33 @@ class Lubricant:
             p = config_path("lubricants", f"{p.name}.yaml")
         elif not p.is_absolute() and not p.exists():
             p = config_path("lubricants", p.name)
-        return cls.from_section(load_yaml(p))
+        return cls.from_file(read_file(LubricantFile, p), str(p))
 
     @classmethod
-    def from_section(cls, doc: Section) -> Lubricant:
-        """Validate a parsed lubricant document; errors name file, key and range."""
-        lub, oil, film, sup = doc.section("lubricant"), doc.section("base_oil"), doc.section("film"), doc.section("supply")
-        kind = lub.choice("kind", KINDS)
-        nu40 = oil.number("viscosity_40c_mm2_s", gt=1.0, lt=5000.0) * 1e-6
-        nu100 = oil.number("viscosity_100c_mm2_s", gt=0.5, lt=nu40 * 1e6) * 1e-6
-        is_grease = kind == "grease"
-        grease = doc.section("grease") if is_grease else Section({}, doc.source, "grease")
+    def from_file(cls, doc: LubricantFile, source: str) -> Lubricant:
+        """The lubricant of a validated lubricant file (:class:`~.bearing_file.LubricantFile`), SI."""
+        oil, film, sup, grease = doc.base_oil, doc.film, doc.supply, doc.grease
         return cls(
-            name=lub.string("name"),
-            kind=kind,
-            viscosity_40c=nu40,
-            viscosity_100c=nu100,
-            density_15c=oil.number("density_15c_kg_m3", gt=600.0, lt=2000.0),
-            pressure_viscosity=oil.number("pressure_viscosity_coefficient_1_pa", ge=5e-9, le=4e-8),
-            thermal_conductivity=oil.number("thermal_conductivity_w_m_k", ge=0.08, le=0.3),
-            eyring_stress=film.number("eyring_stress_pa", ge=1e5, le=5e7),
-            limiting_shear_coefficient=film.number("limiting_shear_coefficient", ge=0.01, le=0.15),
-            shear_modulus=film.number("shear_modulus_pa", ge=1e7, le=1e10),
-            meniscus_ratio=sup.number("meniscus_ratio", gt=1.0, le=1e3),
-            oil_volume_fraction=sup.number("oil_volume_fraction", ge=0.0, le=1.0) if kind == "oil_air" else 1.0,
-            fill_fraction=sup.number("fill_fraction", ge=0.0, le=1.0),
-            yield_stress=grease.number("yield_stress_pa", ge=0.0, le=5e3) if is_grease else 0.0,
-            consistency=grease.number("consistency_pa_sn", gt=0.0, le=1e3) if is_grease else 0.0,
-            flow_index=grease.number("flow_index", gt=0.0, le=1.0) if is_grease else 1.0,
-            source=doc.source,
-            # [1600, 2400] J/(kg K): mineral and ester oils and their greases at 20-150 degC
-            specific_heat=oil.number("specific_heat_j_kg_k", ge=1600.0, le=2400.0, default=1900.0),
+            name=doc.lubricant.name,
+            kind=doc.lubricant.kind,
+            viscosity_40c=oil.viscosity_40c_mm2_s * 1e-6,
+            viscosity_100c=oil.viscosity_100c_mm2_s * 1e-6,
+            density_15c=oil.density_15c_kg_m3,
+            pressure_viscosity=oil.pressure_viscosity_coefficient_1_pa,
+            thermal_conductivity=oil.thermal_conductivity_w_m_k,
+            eyring_stress=film.eyring_stress_pa,
+            limiting_shear_coefficient=film.limiting_shear_coefficient,
+            shear_modulus=film.shear_modulus_pa,
+            meniscus_ratio=sup.meniscus_ratio,
+            oil_volume_fraction=cast(float, sup.oil_volume_fraction) if doc.lubricant.kind == "oil_air" else 1.0,
+            fill_fraction=sup.fill_fraction,
+            yield_stress=grease.yield_stress_pa if grease is not None and doc.lubricant.kind == "grease" else 0.0,
+            consistency=grease.consistency_pa_sn if grease is not None and doc.lubricant.kind == "grease" else 0.0,
+            flow_index=grease.flow_index if grease is not None and doc.lubricant.kind == "grease" else 1.0,
+            source=source,
+            specific_heat=oil.specific_heat_j_kg_k,
             yield_stress_temperature_coefficient=(
-                grease.number("yield_stress_temperature_coefficient_1_k", ge=0.0, le=0.05, default=0.0) if is_grease else 0.0
+                grease.yield_stress_temperature_coefficient_1_k if grease is not None and doc.lubricant.kind == "grease" else 0.0
             ),
         )
 

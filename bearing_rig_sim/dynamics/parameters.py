@@ -35,15 +35,19 @@ import functools
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from collections.abc import Mapping
 from typing import Any, cast
 
 import numpy as np
 
-from bearing_rig_sim.config import Section, config_path, load_yaml
+from bearing_rig_sim.config import config_path, read_mapping
+from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE as CALIBRATABLE  # what a calibration may set, re-exported
+from bearing_rig_sim.dynamics.bearing_file import FRICTION_MODELS, BearingFile, CalibrationFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
+from bearing_rig_sim.settings_model import read_file, validate_mapping
 
 GRAVITY = 9.80665
 """Standard gravity, m/s^2 (CGPM 1901)."""
@@ -56,7 +60,7 @@ class BearingParameters:
     Geometry: ``ball_diameter`` Dw (m), ``pitch_diameter`` dm (m), ``contact_angle`` free
     contact angle (rad), ``ball_count`` Z, groove curvature ratios f_i, f_o (1), cage inner and
     outer diameter, width and pocket diameter (m), land radial clearance and wetted width (m;
-    :data:`LAND_CLEARANCE_RANGE`, :data:`LAND_WIDTH_RANGE`), ``land_count`` (1 or 2 lands sharing
+    :data:`.bearing_file.LAND_CLEARANCE_RANGE`, :data:`.bearing_file.LAND_WIDTH_RANGE`), ``land_count`` (1 or 2 lands sharing
     the width), cage material loss factor (1).
     Materials: densities (kg/m^3), Young's moduli (Pa), Poisson ratios (1).
     Contact: Hunt-Crossley coefficient a_e (s/m) and exponent n (1); full-damping penetration (m).
@@ -133,10 +137,11 @@ class BearingParameters:
     def from_yaml(cls, path: str | Path | None = None, calibration: str | Path | None = None) -> BearingParameters:
         """Load and validate a bearing file (default: the shipped H7006C), optionally with a
         calibration file laid over it (see :func:`overlay_calibration`)."""
-        doc = load_yaml(path or config_path("bearings", "h7006c.yaml"))
+        path = path or config_path("bearings", "h7006c.yaml")
+        data, source = read_mapping(path), str(path)
         if calibration is not None:
-            doc = overlay_calibration(doc, load_yaml(calibration))
-        return cls.from_section(doc)
+            data, source = overlay_calibration(data, read_file(CalibrationFile, calibration)), f"{source} + {calibration}"
+        return cls.from_mapping(data, source)
 
     @classmethod
     def calibrated(cls) -> BearingParameters:
@@ -144,89 +149,77 @@ class BearingParameters:
         return cls.from_yaml(None, config_path("calibration", "h7006c_table3.yaml"))
 
     @classmethod
-    def from_section(cls, doc: Section) -> BearingParameters:
-        """Validate a parsed bearing document; errors name file, key and allowed range."""
-        g, c = doc.section("geometry"), doc.section("cage")
-        mat, con, fr = doc.section("materials"), doc.section("contact"), doc.section("friction")
-        lub, res, integ = doc.section("lubricant"), doc.section("resistances"), doc.section("integration")
-        ring, ball, cagem = mat.section("ring"), mat.section("ball"), mat.section("cage")
-        dw = g.number("ball_diameter_m", gt=0.0, lt=0.1)
-        dm = g.number("pitch_diameter_m", gt=dw, lt=1.0)
-        pocket = c.number("pocket_diameter_m", gt=dw, lt=2.0 * dw)
-        c_in = c.number("inner_diameter_m", gt=0.0, lt=dm)
-        c_out = c.number("outer_diameter_m", gt=dm, lt=2.0 * dm)
-        if doc.section("cage").choice("guidance", ["outer_land"]) != "outer_land":  # pragma: no cover
-            raise c.error("guidance", "only outer_land is modelled")
-        friction_model = fr.choice("model", list(FRICTION_MODELS))
-        v_s = fr.number("stiction_velocity_m_s", gt=0.0)
-        lubricant, temperature = _lubricant(lub)
-        params = cls(
-            name=doc.section("bearing").string("name"),
-            ball_diameter=dw,
-            pitch_diameter=dm,
-            contact_angle=math.radians(g.number("contact_angle_deg", ge=0.0, lt=45.0)),
-            ball_count=g.integer("ball_count", ge=3, le=60),
-            inner_curvature_ratio=g.number("inner_groove_curvature_ratio", gt=0.5, lt=0.6),
-            outer_curvature_ratio=g.number("outer_groove_curvature_ratio", gt=0.5, lt=0.6),
-            cage_inner_diameter=c_in,
-            cage_outer_diameter=c_out,
-            cage_width=c.number("width_m", gt=pocket, lt=0.2),
-            pocket_diameter=pocket,
-            land_clearance=c.number("land_radial_clearance_m", ge=LAND_CLEARANCE_RANGE[0], le=LAND_CLEARANCE_RANGE[1]),
-            land_width=c.number("land_width_m", ge=LAND_WIDTH_RANGE[0], le=LAND_WIDTH_RANGE[1]),
-            cage_loss_factor=c.number("material_loss_factor", ge=0.0, le=1.0),
-            ring_density=ring.number("density_kg_m3", gt=0.0),
-            ring_modulus=ring.number("youngs_modulus_pa", gt=0.0),
-            ring_poisson=ring.number("poisson_ratio", ge=0.0, lt=0.5),
-            ball_density=ball.number("density_kg_m3", gt=0.0),
-            ball_modulus=ball.number("youngs_modulus_pa", gt=0.0),
-            ball_poisson=ball.number("poisson_ratio", ge=0.0, lt=0.5),
-            cage_density=cagem.number("density_kg_m3", gt=0.0),
-            cage_modulus=cagem.number("youngs_modulus_pa", gt=0.0),
-            cage_poisson=cagem.number("poisson_ratio", ge=0.0, lt=0.5),
-            inner_ring_axial_mass=doc.section("inner_ring").number("axial_mass_kg", gt=0.0),
-            hunt_crossley_coefficient=con.number("hunt_crossley_coefficient_s_m", ge=0.0, le=10.0),
-            hunt_crossley_exponent=con.number("hunt_crossley_exponent", ge=1.0, le=2.0),
-            full_damping_penetration=con.number("full_damping_penetration_m", gt=0.0, lt=1e-4),
-            friction_model=friction_model,
-            static_friction=fr.number("static_coefficient", ge=0.0, le=1.0),
-            stiction_velocity=v_s,
-            dynamic_friction=fr.number("dynamic_coefficient", ge=0.0, le=1.0),
-            transition_velocity=fr.number("transition_velocity_m_s", gt=v_s),
-            ehl_max_coefficient=fr.number("ehl_max_coefficient", ge=0.0, le=0.5),
-            ehl_reference_srr=fr.number("ehl_reference_slide_roll_ratio", gt=0.0, le=1.0),
-            pocket_friction=fr.number("pocket_coefficient", ge=0.0, le=1.0),
-            oil_density=lubricant.density(temperature) if lubricant else lub.number("oil_density_kg_m3", gt=0.0),
-            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else lub.number("oil_viscosity_pa_s", gt=0.0),
-            air_density=lub.number("air_density_kg_m3", gt=0.0),
-            air_viscosity=lub.number("air_viscosity_pa_s", gt=0.0),
-            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else lub.number("oil_volume_fraction", ge=0.0, le=1.0),
-            ball_drag_coefficient=res.number("ball_drag_coefficient", ge=0.0, le=5.0),
-            ball_drag_scale=res.number("ball_drag_scale", ge=0.0),
-            cage_land_viscous_scale=res.number("cage_land_viscous_scale", ge=0.0),
-            cage_land_friction=res.number("cage_land_friction_coefficient", ge=0.0, le=1.0),
-            cage_land_boundary_torque_scale=res.number("cage_land_boundary_torque_scale", ge=0.0),
-            rolling_hysteresis_factor=res.number("rolling_hysteresis_factor", ge=0.0, le=0.5),
-            # Plausible ranges only; the engine checks each step against its model's stability
-            # limit over the rig's envelope (dynamics/step_limit.py). Reduced: the stability
-            # limit 1/(mu_max omega_m) is tens of ms; the step is kept short for the accuracy of
-            # transients (pocket and rim contacts are damped, not resolved). Stiff: the Hertz
-            # contact mode of a ball of a few mm under tens to hundreds of newtons has periods
-            # of 10-30 us, so the explicit limit is a few microseconds (4.8e-6 s for H7006C).
-            reduced_time_step=integ.number("reduced_time_step_s", gt=0.0, le=2e-4),
-            stiff_time_step=integ.number("stiff_time_step_s", gt=0.0, le=5e-6),
-            dynamic_load_rating=doc.section("bearing").number("dynamic_load_rating_n", gt=0.0, default=13000.0),
+    def from_mapping(cls, data: Mapping[str, Any], source: str) -> BearingParameters:
+        """Validate a bearing document read from ``source`` (:class:`~.bearing_file.BearingFile`);
+        errors name the file, the key and the allowed range."""
+        return cls.from_file(validate_mapping(BearingFile, data, source), source)
+
+    @classmethod
+    def from_file(cls, doc: BearingFile, source: str) -> BearingParameters:
+        """The parameters of a validated bearing file (SI: the contact angle in radians)."""
+        g, c, mat, lub, fr, res = doc.geometry, doc.cage, doc.materials, doc.lubricant, doc.friction, doc.resistances
+        lubricant = Lubricant.from_yaml(lub.file) if lub.file is not None else None
+        if lubricant is not None and lub.overrides():
+            lubricant = lubricant.replace_rheology(**lub.overrides())
+        temperature = lub.temperature_c
+        return cls(
+            name=doc.bearing.name,
+            ball_diameter=g.ball_diameter_m,
+            pitch_diameter=g.pitch_diameter_m,
+            contact_angle=math.radians(g.contact_angle_deg),
+            ball_count=g.ball_count,
+            inner_curvature_ratio=g.inner_groove_curvature_ratio,
+            outer_curvature_ratio=g.outer_groove_curvature_ratio,
+            cage_inner_diameter=c.inner_diameter_m,
+            cage_outer_diameter=c.outer_diameter_m,
+            cage_width=c.width_m,
+            pocket_diameter=c.pocket_diameter_m,
+            land_clearance=c.land_radial_clearance_m,
+            land_width=c.land_width_m,
+            cage_loss_factor=c.material_loss_factor,
+            ring_density=mat.ring.density_kg_m3,
+            ring_modulus=mat.ring.youngs_modulus_pa,
+            ring_poisson=mat.ring.poisson_ratio,
+            ball_density=mat.ball.density_kg_m3,
+            ball_modulus=mat.ball.youngs_modulus_pa,
+            ball_poisson=mat.ball.poisson_ratio,
+            cage_density=mat.cage.density_kg_m3,
+            cage_modulus=mat.cage.youngs_modulus_pa,
+            cage_poisson=mat.cage.poisson_ratio,
+            inner_ring_axial_mass=doc.inner_ring.axial_mass_kg,
+            hunt_crossley_coefficient=doc.contact.hunt_crossley_coefficient_s_m,
+            hunt_crossley_exponent=doc.contact.hunt_crossley_exponent,
+            full_damping_penetration=doc.contact.full_damping_penetration_m,
+            friction_model=fr.model,
+            static_friction=fr.static_coefficient,
+            stiction_velocity=fr.stiction_velocity_m_s,
+            dynamic_friction=fr.dynamic_coefficient,
+            transition_velocity=fr.transition_velocity_m_s,
+            ehl_max_coefficient=fr.ehl_max_coefficient,
+            ehl_reference_srr=fr.ehl_reference_slide_roll_ratio,
+            pocket_friction=fr.pocket_coefficient,
+            oil_density=lubricant.density(temperature) if lubricant else cast(float, lub.oil_density_kg_m3),
+            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else cast(float, lub.oil_viscosity_pa_s),
+            air_density=lub.air_density_kg_m3,
+            air_viscosity=lub.air_viscosity_pa_s,
+            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else cast(float, lub.oil_volume_fraction),
+            ball_drag_coefficient=res.ball_drag_coefficient,
+            ball_drag_scale=res.ball_drag_scale,
+            cage_land_viscous_scale=res.cage_land_viscous_scale,
+            cage_land_friction=res.cage_land_friction_coefficient,
+            cage_land_boundary_torque_scale=res.cage_land_boundary_torque_scale,
+            rolling_hysteresis_factor=res.rolling_hysteresis_factor,
+            reduced_time_step=doc.integration.reduced_time_step_s,
+            stiff_time_step=doc.integration.stiff_time_step_s,
+            dynamic_load_rating=doc.bearing.dynamic_load_rating_n,
             lubricant=lubricant,
             lubricant_temperature=temperature,
-            ehl_rolling_scale=res.number("ehl_rolling_scale", ge=0.0, default=1.0),
-            composite_roughness=g.number("composite_roughness_rq_m", ge=0.0, lt=1e-5, default=0.0),
-            spindle_axis=doc.section("installation", default={}).choice("spindle_axis", SPINDLE_AXES, default="horizontal"),
-            land_count=c.integer("land_count", ge=1, le=2, default=1),
-            source=doc.source,
+            ehl_rolling_scale=res.ehl_rolling_scale,
+            composite_roughness=g.composite_roughness_rq_m,
+            spindle_axis=doc.installation.spindle_axis,
+            land_count=c.land_count,
+            source=source,
         )
-        if friction_model == "rheology" and lubricant is None:
-            raise fr.error("model", "rheology needs a lubricant file (lubricant.file)")
-        return params
 
     def replace(self, **changes: object) -> BearingParameters:
         """A copy with some fields changed (e.g. calibrated scale factors)."""
@@ -302,90 +295,17 @@ class BearingParameters:
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
 
 
-LAND_CLEARANCE_RANGE = (1e-5, 1e-3)
-"""Plausible radial land clearance of a land-guided cage, m: 0.1-0.5 % of the land diameter
-for machined cages (Harris and Kotzalas, cage design; SKF super-precision catalogue), widened
-to 10 um - 1 mm for small and large bearings."""
-LAND_WIDTH_RANGE = (2e-4, 0.02)
-"""Plausible total wetted width of the guiding land(s), m (a fraction of the bearing width)."""
-
-SPINDLE_AXES = ("horizontal", "vertical")
-"""Orientation of the bearing axis: with a horizontal axis the cage's weight presses it on its
-land (boundary friction mu m_c g r); with a vertical axis the weight acts along the axis and the
-land carries none of it (the balls' and cage's weights, about 0.2 N, are negligible against the
-axial load and are not added to it)."""
-
-FRICTION_MODELS = {"paper": 0.0, "coulomb_step": 0.0, "ehl_traction": 1.0, "rheology": 2.0}
-"""Traction laws (``friction.model``) and their kernel codes: ``paper`` (alias ``coulomb_step``)
-the paper's stepped Coulomb law in the sliding speed; ``ehl_traction`` an exponential fit in the
-slide-to-roll ratio; ``rheology`` the film rheology integrated over the Hertz ellipse
-(:mod:`.traction`), which needs a lubricant file."""
-
-LUBRICANT_OVERRIDES = {
-    "yield_stress_pa": "yield_stress",
-    "consistency_pa_sn": "consistency",
-    "fill_fraction": "fill_fraction",
-    "eyring_stress_pa": "eyring_stress",
-}
-"""Keys of the bearing file's ``lubricant:`` section that override the lubricant file (a
-calibration sets them): key -> :class:`Lubricant` field."""
-
-
-def _lubricant(lub: Section) -> tuple[Lubricant | None, float]:
-    """The lubricant named by ``lubricant.file`` (with overrides) and the operating temperature
-    (degC) of the bearing file's ``lubricant:`` section; (None, 40) for the legacy inline form."""
-    temperature = lub.number("temperature_c", ge=-40.0, le=200.0, default=40.0)
-    if "file" not in lub:
-        return None, temperature
-    lubricant = Lubricant.from_yaml(lub.string("file"))
-    bounds = {"yield_stress_pa": (0.0, 5e3), "consistency_pa_sn": (0.0, 1e3), "fill_fraction": (0.0, 1.0), "eyring_stress_pa": (1e5, 5e7)}
-    changes = {field: lub.number(key, ge=bounds[key][0], le=bounds[key][1]) for key, field in LUBRICANT_OVERRIDES.items() if key in lub}
-    return (lubricant.replace_rheology(**changes) if changes else lubricant), temperature
-
-
-CALIBRATABLE: dict[str, tuple[str, str]] = {
-    "stiction_velocity": ("friction", "stiction_velocity_m_s"),
-    "static_friction": ("friction", "static_coefficient"),
-    "ball_drag_scale": ("resistances", "ball_drag_scale"),
-    "cage_land_viscous_scale": ("resistances", "cage_land_viscous_scale"),
-    "cage_land_boundary_torque_scale": ("resistances", "cage_land_boundary_torque_scale"),
-    "rolling_hysteresis_factor": ("resistances", "rolling_hysteresis_factor"),
-    "oil_volume_fraction": ("lubricant", "oil_volume_fraction"),
-    "yield_stress": ("lubricant", "yield_stress_pa"),
-    "consistency": ("lubricant", "consistency_pa_sn"),
-    "fill_fraction": ("lubricant", "fill_fraction"),
-    "eyring_stress": ("lubricant", "eyring_stress_pa"),
-}
-"""Parameters a calibration file may set: field name -> (section, key) in the bearing file."""
-
-
-def overlay_calibration(bearing: Section, calibration: Section) -> Section:
-    """Lay a calibration file over a bearing document.
-
-    A calibration file has a ``calibration:`` section (provenance: data file, fitted parameter
-    names, RMS) and, under ``parameters:``, entries keyed ``section.key`` as in the bearing file.
-    An entry is either a number or a physical quantity ``{value, unit, range: [lo, hi], source}``
-    whose value must lie in its range (the physically plausible interval). Only the keys of
-    :data:`CALIBRATABLE` are accepted; the merged document is validated as a whole by
-    :meth:`BearingParameters.from_section`.
-    """
-    allowed = {f"{sec}.{key}" for sec, key in CALIBRATABLE.values()}
-    values = calibration.section("parameters")
-    merged = {k: dict(v) if isinstance(v, dict) else v for k, v in bearing.data.items()}
-    for name in values.keys():
-        if name not in allowed:
-            raise values.error(name, f"not a calibratable parameter; allowed: {', '.join(sorted(allowed))}")
+def overlay_calibration(bearing: Mapping[str, Any], calibration: CalibrationFile) -> dict[str, Any]:
+    """Lay a validated calibration file over a bearing document: each entry of its
+    ``parameters:`` (keyed ``section.key`` as in the bearing file, only the keys of
+    :data:`CALIBRATABLE`, a physical quantity within its plausible range;
+    :class:`~.bearing_file.CalibrationFile`) replaces the bearing file's value. The merged
+    document is validated as a whole by :meth:`BearingParameters.from_mapping`."""
+    merged = {k: dict(v) if isinstance(v, dict) else v for k, v in bearing.items()}
+    for name, value in calibration.parameters.items():
         sec, key = name.split(".", 1)
-        if isinstance(values.data[name], dict):
-            entry = values.section(name)
-            lo, hi = entry.number_list("range", min_len=2)[:2]
-            value = entry.number("value", ge=lo, le=hi)
-            entry.string("unit")
-            entry.string("source")
-        else:
-            value = values.number(name, ge=0.0)
         merged.setdefault(sec, {})[key] = value
-    return Section(merged, f"{bearing.source} + {calibration.source}")
+    return merged
 
 
 @functools.lru_cache(maxsize=8)

@@ -47,10 +47,11 @@ from pathlib import Path
 
 import numpy as np
 
-from bearing_rig_sim.config import config_path, load_yaml
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.traction import mu_nodes
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.rig.loading import LoadingChainConfig
+from bearing_rig_sim.rig.spindle import SpindleConfig
 
 STIFF_SAFETY = 0.5
 """Fraction of the stiff model's linear stability limit allowed (see the module docstring)."""
@@ -75,11 +76,7 @@ class OperatingEnvelope:
     def from_rig_file(cls, path: str | Path | None = None) -> OperatingEnvelope:
         """``spindle.max_speed_rad_s`` and ``loading_chain.max_setpoint_n`` of a rig file
         (default: the shipped ``config/rig.yaml``)."""
-        doc = load_yaml(path or config_path("rig.yaml"))
-        return cls(
-            doc.section("spindle").number("max_speed_rad_s", gt=0.0),
-            doc.section("loading_chain").number("max_setpoint_n", gt=0.0),
-        )
+        return cls(SpindleConfig.from_yaml(path).max_speed_rad_s, LoadingChainConfig.from_yaml(path).max_setpoint_n)
 
 
 @dataclass(frozen=True)

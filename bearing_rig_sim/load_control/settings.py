@@ -10,14 +10,15 @@ clutch, PI gains, interlock levels) are in the rig file, section ``loading_chain
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar
 
 from pydantic import field_validator
 
-from bearing_rig_sim.config import Section, config_path
+from bearing_rig_sim.config import config_path
 from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CLOCK, DIAGNOSTICS
-from bearing_rig_sim.settings_model import Flag, NodeSettings, Number, param
+from bearing_rig_sim.settings_model import Flag, NodeSettings, Number, field_error, param
 
 __all__ = ["NODE_NAME", "SHIPPED_FILE", "LoadControllerSettings", "shipped_parameters"]
 
@@ -53,9 +54,9 @@ class LoadControllerSettings(NodeSettings):
     step_period_s: Number = param(f"wall time between two wake-ups stepping the chain to the {CLOCK.name} time", unit="s", ge=0.001, le=0.1)
 
     @classmethod
-    def check_other_keys(cls, s: Section) -> None:
-        if s.data.get("use_sim_time") is False:
-            raise s.error("use_sim_time", "steps the loading chain on the simulation clock: use_sim_time must be true")
+    def check_other_keys(cls, values: Mapping[str, Any]) -> None:
+        if values.get("use_sim_time") is False:
+            raise field_error("use_sim_time", "steps the loading chain on the simulation clock: use_sim_time must be true")
 
     @field_validator("rig_file", mode="before")
     @classmethod

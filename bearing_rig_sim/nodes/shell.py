@@ -53,10 +53,7 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.nodes.parameters import ParameterSpec, spec_for
-
-IMPLICIT = ("use_sim_time",)
-"""Parameters every rclpy node declares by itself."""
+from bearing_rig_sim.nodes.parameters import ParameterSpec, is_standard, spec_for
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -81,14 +78,15 @@ def descriptor_of(spec: ParameterSpec) -> ParameterDescriptor:
 
 
 def declare_described(node: Node, node_name: str, defaults: Mapping[str, Any]) -> None:
-    """Declare each parameter of ``defaults`` (except :data:`IMPLICIT` ones) with its descriptor.
+    """Declare each parameter of ``defaults`` (except those every node declares by itself,
+    :func:`~bearing_rig_sim.nodes.parameters.is_standard`) with its descriptor.
 
     Raises:
         RigError: a value given at start (``-p``, parameter file) is out of the parameter's
             range (one line naming the parameter and the range); a parameter has no spec.
     """
     for name, default in defaults.items():
-        if name in IMPLICIT:
+        if is_standard(name):
             continue
         spec = spec_for(node_name, name)
         try:

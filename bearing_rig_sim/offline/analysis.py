@@ -55,7 +55,7 @@ from collections.abc import Callable
 
 from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
-from bearing_rig_sim.config import ConfigError, Section, parse_yaml, ros_parameters
+from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
@@ -233,7 +233,7 @@ def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> Moni
     doc = parse_yaml(text, source)
     if not isinstance(doc, dict):
         raise ConfigError(source, "", "top level must be a mapping")
-    recorded = ros_parameters(Section(doc, source), NODE_NAME).data
+    recorded = ros_parameters(doc, NODE_NAME, source)
     return MonitorSettings.from_values({**shipped_parameters(), **recorded}, source)
 
 

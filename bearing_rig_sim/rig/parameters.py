@@ -6,7 +6,7 @@ name: ``resistance_ohm``, ``stiffness_n_per_m``) and whose fields carry their al
 (:mod:`bearing_rig_sim.settings_model`): each record class gives a pydantic model of its
 fields (:meth:`ParameterRecord.model`), with the same value kinds (a number is finite and never
 a boolean, an integer is no float, a flag is a YAML boolean) and the same one-line errors. They
-apply whether a record is read from a file (:meth:`ParameterRecord.from_section`, errors name
+apply whether a record is read from a file (:meth:`ParameterRecord.from_mapping`, errors name
 the file and the dotted key) or built in code (``__post_init__``, errors name the class and the
 field). Nested records map to nested YAML mappings. Only the top-level section a record class
 owns (``SECTION``) is read from the file; other top-level sections belong to other parts of the
@@ -26,8 +26,8 @@ from typing import Any, ClassVar, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml
-from bearing_rig_sim.settings_model import Flag, Integer, Number, first_error
+from bearing_rig_sim.config import ConfigError, config_path, mapping_at, read_mapping
+from bearing_rig_sim.settings_model import Flag, Integer, Number, first_error, validate_mapping
 
 R = TypeVar("R", bound="ParameterRecord")
 
@@ -54,13 +54,6 @@ def bounded(
 
 def _is_record(kind: object) -> bool:
     return isinstance(kind, type) and issubclass(kind, ParameterRecord)
-
-
-def _without_nulls(data: Any) -> Any:
-    """A YAML ``null`` is an absent key (its default, or "missing")."""
-    if isinstance(data, dict):
-        return {k: _without_nulls(v) for k, v in data.items() if v is not None}
-    return data
 
 
 def _as_mapping(record: ParameterRecord) -> dict[str, Any]:
@@ -118,30 +111,26 @@ class ParameterRecord:
         """
 
     @classmethod
-    def from_section(cls: type[R], section: Section) -> R:
-        """Read and validate the record from a YAML mapping; unknown keys are refused.
+    def from_mapping(cls: type[R], data: object, source: str, key: str = "") -> R:
+        """Read and validate the record from a YAML mapping read from ``source`` (at dotted
+        ``key`` in it); unknown keys are refused.
 
         Raises:
             ConfigError: naming the file, the dotted key and the allowed range.
         """
-        model = cls.model()
-        try:
-            checked = model.model_validate(_without_nulls(section.data))
-        except ValidationError as exc:
-            raise section.error(*first_error(model, exc)) from None
-        return cls._build(checked, section)
+        return cls._build(validate_mapping(cls.model(), data, source, key), source, key)
 
     @classmethod
-    def _build(cls: type[R], checked: BaseModel, section: Section) -> R:
+    def _build(cls: type[R], checked: BaseModel, source: str, key: str) -> R:
         """The record of a validated model; a cross-field rule's error names the file and key."""
         values: dict[str, Any] = {}
         for name, kind in cls._hints().items():
             value = getattr(checked, name)
-            values[name] = kind._build(value, section.section(name)) if _is_record(kind) else value
+            values[name] = kind._build(value, source, f"{key}.{name}" if key else name) if _is_record(kind) else value
         try:
             return cls(**values)
         except ConfigError as exc:  # a cross-field rule: re-attribute it to the file
-            raise section.error(exc.key, exc.problem) from None
+            raise ConfigError(source, ".".join(part for part in (key, exc.key) if part), exc.problem) from None
 
     @classmethod
     def from_yaml(cls: type[R], path: str | Path | None = None) -> R:
@@ -152,5 +141,5 @@ class ParameterRecord:
         """
         if not cls.SECTION:
             raise TypeError(f"{cls.__name__} is not a top-level section of {RIG_FILE}")
-        doc = load_yaml(path if path is not None else config_path(RIG_FILE))
-        return cls.from_section(doc.section(cls.SECTION))
+        path = path if path is not None else config_path(RIG_FILE)
+        return cls.from_mapping(mapping_at(read_mapping(path), (cls.SECTION,), str(path)), str(path), cls.SECTION)

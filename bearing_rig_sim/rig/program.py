@@ -36,14 +36,14 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, ClassVar
 
-from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field
 
-from bearing_rig_sim.config import ConfigError, Section, config_path, load_yaml, rad_s_to_rpm, rpm_to_rad_s
+from bearing_rig_sim.config import ConfigError, config_path, read_mapping, rad_s_to_rpm, rpm_to_rad_s
 from bearing_rig_sim.rig.loading import LoadingChainConfig
 from bearing_rig_sim.rig.parameters import RIG_FILE, ParameterRecord, bounded
 from bearing_rig_sim.rig.speed_profile import SegmentSpeed, SpeedProfileKind
 from bearing_rig_sim.rig.spindle import SpindleConfig
-from bearing_rig_sim.settings_model import ConfigFile, Flag, Number, first_error, one_of
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Number, one_of, validate_mapping
 
 STABILITY_CRITERIA = ("time", "axial_load")
 """Abscissas of the slope criterion (docs/paper.md section 7): slip vs time, or slip vs axial load."""
@@ -181,8 +181,9 @@ class RigLimits:
         spindle = SpindleConfig.from_yaml(path)
         chain = LoadingChainConfig.from_yaml(path)
         name = Path(path).name if path is not None else RIG_FILE
-        doc = load_yaml(path or config_path(RIG_FILE))
-        combined = CombinedLoadingLimits.from_section(doc.section("combined_loading")) if "combined_loading" in doc.data else CombinedLoadingLimits()
+        rig_file = path or config_path(RIG_FILE)
+        stated = read_mapping(rig_file).get("combined_loading")
+        combined = CombinedLoadingLimits.from_mapping(stated, str(rig_file), "combined_loading") if stated is not None else CombinedLoadingLimits()
         return cls(
             spindle.max_speed_rad_s,
             spindle.max_acceleration_rad_s2,
@@ -206,7 +207,7 @@ def _segment_list(value: object) -> object:
         raise ValueError("must be a non-empty list of mappings")
     if len(value) > MAX_SEGMENTS:
         raise ValueError(f"at most {MAX_SEGMENTS} segments, got {len(value)}")
-    return [{k: v for k, v in item.items() if v is not None} if isinstance(item, dict) else item for item in value]  # null: absent
+    return value
 
 
 def _text(value: object) -> str:
@@ -266,14 +267,12 @@ def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
             limit that was exceeded.
     """
     rig = rig if rig is not None else RigLimits.from_rig_file()
-    doc = load_yaml(path)
-    try:
-        stated = ProgramFile.model_validate({k: v for k, v in doc.data.items() if v is not None})
-    except ValidationError as exc:
-        raise doc.error(*first_error(ProgramFile, exc)) from None
+    source = str(path)
+    stated = validate_mapping(ProgramFile, read_mapping(path), source)
     max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
     if stated.initial_speed_rpm > max_rpm * (1.0 + 1e-12):
-        raise doc.error(
+        raise ConfigError(
+            source,
             "initial_speed_rpm",
             f"{stated.initial_speed_rpm:g} rpm is above the rig's limit of {max_rpm:g} rpm ({_limit(rig, 'spindle.max_speed_rad_s')})",
         )
@@ -282,9 +281,9 @@ def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
     seen: set[str] = set()
     for i, seg_file in enumerate(stated.segments):
         if seg_file.name in seen:
-            raise ConfigError(doc.source, f"segments[{i}].name", f"duplicate segment name {seg_file.name!r}")
+            raise ConfigError(source, f"segments[{i}].name", f"duplicate segment name {seg_file.name!r}")
         seen.add(seg_file.name)
-        seg = _segment(seg_file, Section({}, doc.source, f"segments[{i}]"), rig, start_speed)
+        seg = _segment(seg_file, source, f"segments[{i}]", rig, start_speed)
         segments.append(seg)
         start_speed = seg.target_speed
     return TestProgram(
@@ -294,7 +293,7 @@ def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
         stability_criterion=stated.stability_criterion,
         initial_speed=rpm_to_rad_s(stated.initial_speed_rpm),
         segments=tuple(segments),
-        source=doc.source,
+        source=source,
     )
 
 
@@ -302,13 +301,13 @@ def _limit(rig: RigLimits, key: str) -> str:
     return f"{key} in {rig.source}"
 
 
-def _segment(stated: SegmentFile, s: Section, rig: RigLimits, start_speed: float) -> Segment:
+def _segment(stated: SegmentFile, source: str, where: str, rig: RigLimits, start_speed: float) -> Segment:
     """One segment checked against the rig and the speed it starts from (``start_speed``,
-    rad/s); ``s`` names its place in the file."""
+    rad/s); ``where`` is its place in the file ``source`` (``segments[2]``)."""
     given = stated.model_fields_set
 
     def beyond(key: str, problem: str) -> ConfigError:
-        return s.error(key, f"segment {stated.name!r}: {problem}")
+        return ConfigError(source, f"{where}.{key}", f"segment {stated.name!r}: {problem}")
 
     rpm = stated.speed_rpm
     max_rpm = rad_s_to_rpm(rig.max_speed_rad_s)
@@ -365,7 +364,7 @@ def _segment(stated: SegmentFile, s: Section, rig: RigLimits, start_speed: float
         if "dwell_s" in given:
             raise beyond("dwell_s", "give either dwell_s or until_stable, not both")
         if "timeout_s" not in given:
-            raise s.error("timeout_s", "missing (required)")
+            raise ConfigError(source, f"{where}.timeout_s", "missing (required)")
         dwell, timeout = None, stated.timeout_s
     else:
         if "timeout_s" in given:

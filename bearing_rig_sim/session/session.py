@@ -47,7 +47,7 @@ from typing import Any, TextIO
 from collections.abc import Sequence
 
 from bearing_rig_sim.dds_profile import apply_rig_profile
-from bearing_rig_sim.config import config_path, load_yaml, rad_s_to_rpm, ros_parameters
+from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import CLOCK, SLIP_STATUS, SPEEDS
 from bearing_rig_sim.bags import BagWriter
@@ -65,6 +65,7 @@ from bearing_rig_sim.session.processes import (
 )
 from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, RealTimeFactor, format_progress, format_summary
 from bearing_rig_sim.session.recorder import SessionRecorder
+from bearing_rig_sim.simulation.settings import shipped_parameters as simulator_shipped_parameters
 from bearing_rig_sim.session.runner import COMMAND_LEAD_S, REALTIME_COMMAND_LEAD_S, ProgramRunner, SegmentOutcome, SegmentPlan
 
 __all__ = ["EXIT_CONDITIONS", "EXIT_FAILED", "EXIT_INTERRUPTED", "EXIT_OK", "SessionOptions", "run_session"]
@@ -138,7 +139,7 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     if not options.attach:  # attached, the simulator's own bearing file is the one it uses
         check_bearing_file(program, options.program)
     commands = {} if options.attach else {name: node_command(spec) for name, spec in NODES.items()}
-    simulator_defaults = ros_parameters(load_yaml(config_path("simulator.yaml")), "simulator").data
+    simulator_defaults = simulator_shipped_parameters()
     overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime and not options.attach:
         overrides.setdefault("simulator", {})["realtime"] = False

@@ -34,9 +34,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from bearing_rig_sim.config import ConfigError, Section, load_yaml
+from bearing_rig_sim.config import ConfigError, read_mapping
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
+from bearing_rig_sim.settings_model import read_file
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.shadow.inputs import SpeedPoint
 from bearing_rig_sim.shadow.predictor import MeasuredDrive
@@ -68,9 +70,9 @@ class CalibrationParameter:
     """
 
     def __init__(self, bearing_file: Path, calibration_file: Path, name: str) -> None:
-        self._bearing = load_yaml(bearing_file)
-        calibration = load_yaml(calibration_file)
-        entries = calibration.section("parameters").data
+        self._bearing, self._bearing_source = read_mapping(bearing_file), str(bearing_file)
+        calibration = read_file(CalibrationFile, calibration_file)
+        entries = read_mapping(calibration_file)["parameters"]  # as written: a number or a quantity with unit and range
         key = name or next(iter(entries), "")
         if key not in entries:
             raise RecalibrationError(f"recalibrate_parameter: {name!r} is not a parameter of {calibration_file} (it has {', '.join(entries) or 'none'})")
@@ -83,7 +85,7 @@ class CalibrationParameter:
         self.unit = str(entry.get("unit", "")) if isinstance(entry, dict) else ""
         bounds = entry.get("range") if isinstance(entry, dict) else None
         self.range: tuple[float, float] | None = (float(bounds[0]), float(bounds[1])) if isinstance(bounds, list) and len(bounds) == 2 else None
-        self._calibration = calibration
+        self._calibration, self._calibration_source = calibration, str(calibration_file)
 
     def params(self, value: float) -> BearingParameters:
         """The bearing with this parameter at ``value`` (its other calibrated values kept).
@@ -91,9 +93,9 @@ class CalibrationParameter:
         Raises:
             ConfigError: the bearing file refuses the value (outside its hard limits).
         """
-        data = {k: v for k, v in self._calibration.data.items()}
-        data["parameters"] = {**self._calibration.section("parameters").data, self.name: float(value)}
-        return BearingParameters.from_section(overlay_calibration(self._bearing, Section(data, f"{self._calibration.source} ({self.name}={value:.6g})")))
+        calibration = self._calibration.model_copy(update={"parameters": {**self._calibration.parameters, self.name: float(value)}})
+        source = f"{self._bearing_source} + {self._calibration_source} ({self.name}={value:.6g})"
+        return BearingParameters.from_mapping(overlay_calibration(self._bearing, calibration), source)
 
 
 @dataclass(frozen=True)

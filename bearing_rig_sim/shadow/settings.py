@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 from typing import Annotated, ClassVar
 
 from pydantic import ValidationInfo, field_validator
 
-from bearing_rig_sim.config import load_yaml
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.dynamics.engine import MODELS
-from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param
+from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param, read_file
 
 NODE_NAME = "shadow"
 """The shadow node's name: the key of its block in a ROS 2 parameter file."""
@@ -92,14 +91,7 @@ def calibration_rms(path: Path | None) -> float | None:
     """``calibration.rms_slip_pct`` of a calibration file, percentage points (None if absent)."""
     if path is None:
         return None
-    doc = load_yaml(path)
-    if "calibration" not in doc:
-        return None
-    cal = doc.section("calibration")
-    if "rms_slip_pct" not in cal:
-        return None
-    value = cal.number("rms_slip_pct", ge=0.0)
-    return value if math.isfinite(value) else None
+    return read_file(CalibrationFile, path).calibration.rms_slip_pct
 
 
 def shipped_parameters() -> dict[str, object]:

@@ -1,7 +1,7 @@
 """The simulator's parameters, validated (``config/simulator.yaml``, ``simulator: ros__parameters:``).
 
 The node declares its ROS parameters with the shipped file's values as defaults and hands the
-values it got to :meth:`SimulatorSettings.from_section`, so the same checks, with the same
+values it got to :meth:`SimulatorSettings.from_mapping`, so the same checks, with the same
 messages naming the key and the allowed range, apply to the file, to a user's parameter file and
 to ``-p name:=value`` overrides.
 

@@ -33,7 +33,8 @@ from typing import Any
 
 import numpy as np
 
-from bearing_rig_sim.config import load_yaml
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
+from bearing_rig_sim.settings_model import read_file
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.thermal.bearing import ThermalConfig
@@ -231,10 +232,8 @@ def fit_uncertainty(
 
 def read_uncertainty(calibration_file: str | Path) -> FitUncertainty | None:
     """The ``uncertainty:`` block of a calibration file, or None."""
-    doc = load_yaml(calibration_file)
-    if "uncertainty" not in doc:
-        return None
-    return FitUncertainty.from_dict(doc.data["uncertainty"])
+    block = read_file(CalibrationFile, calibration_file).uncertainty
+    return FitUncertainty.from_dict(block) if block is not None else None
 
 
 def slip_interval(

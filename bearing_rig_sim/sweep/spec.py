@@ -30,12 +30,15 @@ import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from collections.abc import Mapping
+from typing import Annotated, Any, Self
 
 import numpy as np
+from pydantic import BeforeValidator, ConfigDict, Field, model_validator
 
-from bearing_rig_sim.config import ConfigError, Section, check_number, load_yaml
+from bearing_rig_sim.config import check_number, read_mapping
 from bearing_rig_sim.dynamics.engine import MIN_AXIAL_LOAD
+from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, field_error, one_of, quantity, validate_mapping
 
 
 @dataclass(frozen=True)
@@ -155,113 +158,162 @@ class SweepSpec:
         return [{**c, **s} for c in combos for s in self.samples]
 
 
-def axis_values(section: Section, name: str) -> tuple[float, ...]:
-    """The values of grid axis ``name``: a list, or ``{from, to, step}`` (both ends included
-    when ``to`` is a whole number of steps from ``from``), each checked against the axis's
-    range."""
-    definition = _definition(section, name)
-    raw = section.data.get(name)
-    path = section.key_path(name)
-    if isinstance(raw, dict):
-        rng = section.section(name)
-        rng.reject_unknown(["from", "to", "step"])
-        start = rng.number("from")
-        stop = rng.number("to")
-        step = rng.number("step", gt=0.0)
-        if stop < start:
-            raise rng.error("to", f"must be >= from ({start}), got {stop}: the range is empty")
-        count = int(math.floor((stop - start) / step + 1e-9)) + 1
-        values = [start + i * step for i in range(count)]
-        values = [float(round(v, 12)) for v in values]
-    elif isinstance(raw, list):
-        if not raw:
-            raise ConfigError(section.source, path, "must not be empty")
-        values = [check_number(v, section.source, f"{path}[{i}]") for i, v in enumerate(raw)]
-    else:
-        raise ConfigError(section.source, path, f"must be a list of values or a mapping {{from, to, step}}, got {raw!r}")
-    for i, v in enumerate(values):
-        _check_in_range(definition, v, section.source, f"{path}[{i}]")
-    if len(set(values)) != len(values):
-        raise ConfigError(section.source, path, "has repeated values")
-    return tuple(values)
-
-
-def _definition(section: Section, name: str) -> AxisDefinition:
+def _definition(name: str) -> AxisDefinition:
     if name not in AXES:
-        raise section.error(name, f"unknown axis; known axes: {', '.join(AXES)}")
+        raise field_error(name, f"unknown axis; known axes: {', '.join(AXES)}")
     return AXES[name]
 
 
-def _check_in_range(definition: AxisDefinition, value: float, source: str, key: str) -> None:
-    check_number(value, source, key, ge=definition.low, le=definition.high)
+class AxisRange(FileSection):
+    """A grid axis as ``{from, to, step}``: both ends included when ``to`` is a whole number of
+    steps from ``from``."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", populate_by_name=True)
+
+    start: Number = Field(alias="from", description="first value, in the axis's unit")
+    to: Number = Field(description="last value at most, in the axis's unit")
+    step: Number = Field(gt=0.0, description="step, in the axis's unit")
+
+    @model_validator(mode="after")
+    def _not_empty(self) -> Self:
+        if self.to < self.start:
+            raise field_error("to", f"must be >= from ({self.start}), got {self.to}: the range is empty")
+        return self
+
+    def values(self) -> list[float]:
+        """The values, rounded to 12 decimals (no 0.30000000000000004)."""
+        count = int(math.floor((self.to - self.start) / self.step + 1e-9)) + 1
+        return [float(round(self.start + i * self.step, 12)) for i in range(count)]
 
 
-def _samples(section: Section) -> tuple[dict[str, float], ...]:
-    from scipy.stats import qmc
+def axis_values(name: str, raw: object) -> tuple[float, ...]:
+    """The values of grid axis ``name``: a list, or ``{from, to, step}`` (:class:`AxisRange`),
+    each checked against the axis's range.
 
-    section.reject_unknown(["method", "count", "seed", "ranges"])
-    method = section.choice("method", SAMPLE_METHODS)
-    count = section.integer("count", ge=1, le=1_000_000)
-    seed = section.integer("seed", ge=0, default=0)
-    ranges = section.section("ranges")
-    names = list(ranges.keys())
-    if not names:
-        raise section.error("ranges", "must name at least one axis")
-    bounds = []
-    for name in names:
-        definition = _definition(ranges, name)
-        lo_hi = ranges.number_list(name, min_len=2)
-        if len(lo_hi) != 2:
-            raise ranges.error(name, f"must be [low, high], got {ranges.data[name]!r}")
-        lo, hi = lo_hi
+    Raises:
+        ConfigError: naming the key relative to ``grid`` (:func:`~bearing_rig_sim.settings_model.field_error`).
+    """
+    definition = _definition(name)
+    if isinstance(raw, Mapping):
+        values = validate_mapping(AxisRange, raw, "", name).values()
+    elif isinstance(raw, list):
+        if not raw:
+            raise field_error(name, "must not be empty")
+        values = [check_number(v, "", f"{name}[{i}]") for i, v in enumerate(raw)]
+    else:
+        raise field_error(name, f"must be a list of values or a mapping {{from, to, step}}, got {raw!r}")
+    for i, v in enumerate(values):
+        check_number(v, "", f"{name}[{i}]", ge=definition.low, le=definition.high)
+    if len(set(values)) != len(values):
+        raise field_error(name, "has repeated values")
+    return tuple(values)
+
+
+def _grid(raw: object) -> dict[str, tuple[float, ...]]:
+    if not isinstance(raw, Mapping):
+        raise ValueError(f"must be a mapping, got {type(raw).__name__}")
+    if not raw:
+        raise field_error("", "must name at least one axis")
+    return {str(name): axis_values(str(name), values) for name, values in raw.items()}
+
+
+def _ranges(raw: object) -> dict[str, tuple[float, float]]:
+    if not isinstance(raw, Mapping):
+        raise ValueError(f"must be a mapping, got {type(raw).__name__}")
+    if not raw:
+        raise field_error("", "must name at least one axis")
+    bounds: dict[str, tuple[float, float]] = {}
+    for name, lo_hi in raw.items():
+        definition = _definition(str(name))
+        if not isinstance(lo_hi, list) or len(lo_hi) != 2:
+            raise field_error(str(name), f"must be [low, high], got {lo_hi!r}")
+        lo, hi = (check_number(v, "", f"{name}[{i}]", ge=definition.low, le=definition.high) for i, v in enumerate(lo_hi))
         if not hi > lo:
-            raise ranges.error(name, f"high must be > low, got [{lo}, {hi}]: the range is empty")
-        _check_in_range(definition, lo, ranges.source, f"{ranges.key_path(name)}[0]")
-        _check_in_range(definition, hi, ranges.source, f"{ranges.key_path(name)}[1]")
-        bounds.append((lo, hi))
-    engine = qmc.Sobol(d=len(names), scramble=True, seed=seed) if method == "sobol" else qmc.LatinHypercube(d=len(names), seed=seed)
-    unit = engine.random(count)
-    scaled = qmc.scale(unit, [b[0] for b in bounds], [b[1] for b in bounds])
-    return tuple({n: float(v) for n, v in zip(names, row)} for row in np.atleast_2d(scaled))
+            raise field_error(str(name), f"high must be > low, got [{lo}, {hi}]: the range is empty")
+        bounds[str(name)] = (lo, hi)
+    return bounds
 
 
-def spec_from_section(doc: Section) -> SweepSpec:
-    """Validate a parsed spec; errors name the file and the key."""
-    doc.reject_unknown(["sweep", "grid", "samples", "map"])
-    head = doc.section("sweep")
-    head.reject_unknown(["name", "description", "bearing", "calibration", "continuation", "transient_duration_s"])
-    name = head.string("name")
-    bearing = head.string("bearing") if "bearing" in head and head.data["bearing"] is not None else None
-    calibration = head.string("calibration", default="shipped")
-    continuation = head.boolean("continuation", default=False)
-    duration = head.number("transient_duration_s", gt=0.0, le=60.0, default=3.0)
-    grid_section = doc.section("grid")
-    if not list(grid_section.keys()):
-        raise doc.error("grid", "must name at least one axis")
-    grid = {str(k): axis_values(grid_section, str(k)) for k in grid_section.keys()}
-    samples = _samples(doc.section("samples")) if "samples" in doc and doc.data["samples"] is not None else ()
-    sampled = set(samples[0]) if samples else set()
-    for key in sampled & set(grid):
-        raise doc.section("samples").section("ranges").error(key, "is also a grid axis; give it in one place")
-    names = set(grid) | sampled
-    if LOAD_AXIS not in names:
-        raise doc.error("grid", f"must include {LOAD_AXIS} (in grid or samples)")
-    if (SPEED_AXIS in names) == (ACCELERATION_AXIS in names):
-        raise doc.error("grid", f"must include exactly one of {SPEED_AXIS} (steady points) and {ACCELERATION_AXIS} (transient points)")
-    view = doc.section("map", default={})
-    view.reject_unknown(["skid_slip_pct", "minimum_load_factor_kn"])
-    skid = view.number("skid_slip_pct", gt=0.0, lt=100.0, default=20.0)
-    factor = view.number("minimum_load_factor_kn", gt=0.0, lt=1.0, default=0.0025)
+class Samples(FileSection):
+    """``samples:``: random values of some axes, each row crossed with the grid."""
+
+    method: Annotated[str, one_of(SAMPLE_METHODS)] = Field(description="sequence (scipy.stats.qmc)")
+    count: Integer = Field(ge=1, le=1_000_000, description="number of rows")
+    seed: Integer = Field(0, ge=0, description="seed of the sequence")
+    ranges: Annotated[dict[str, tuple[float, float]], BeforeValidator(_ranges)] = Field(description="axis -> [low, high]")
+
+    def draw(self) -> tuple[dict[str, float], ...]:
+        """The rows: the unit-cube sequence scaled to the ranges."""
+        from scipy.stats import qmc
+
+        names = list(self.ranges)
+        engine = qmc.Sobol(d=len(names), scramble=True, seed=self.seed) if self.method == "sobol" else qmc.LatinHypercube(d=len(names), seed=self.seed)
+        unit = engine.random(self.count)
+        scaled = qmc.scale(unit, [self.ranges[n][0] for n in names], [self.ranges[n][1] for n in names])
+        return tuple({n: float(v) for n, v in zip(names, row)} for row in np.atleast_2d(scaled))
+
+
+class SweepHead(FileSection):
+    """``sweep:``"""
+
+    name: Text = Field(description="the sweep's name")
+    description: Text | None = Field(None, description="what the sweep is for")
+    bearing: Text | None = Field(None, description="bearing file (absent: the shipped H7006C)")
+    calibration: Text = Field("shipped", description="shipped, none or a calibration file")
+    continuation: Flag = Field(False, description="also follow each load row upwards from its lowest load")
+    transient_duration_s: Number = quantity(
+        "simulated duration of a transient (acceleration) point", unit="s", source="run-ups of the paper's rig last seconds", gt=0.0, le=60.0, default=3.0
+    )
+
+
+class MapView(FileSection):
+    """``map:`` (the operating map's view)."""
+
+    skid_slip_pct: Number = quantity("slip above which a point counts as skidding", unit="%", source="a share below 100 %", gt=0.0, lt=100.0, default=20.0)
+    minimum_load_factor_kn: Number = quantity(
+        "SKF minimum axial load factor A, F_am = A (n/1000)^2", unit="kN", source="SKF rolling bearings catalogue, Minimum load", gt=0.0, lt=1.0, default=0.0025
+    )
+
+
+class SweepFile(FileSection):
+    """A sweep specification as its file states it (see the module documentation)."""
+
+    sweep: SweepHead
+    grid: Annotated[dict[str, tuple[float, ...]], BeforeValidator(_grid)] = Field(description="axis -> its values")
+    samples: Samples | None = None
+    map: MapView = MapView()
+
+    @model_validator(mode="after")
+    def _axes_of_a_point(self) -> Self:
+        sampled = set(self.samples.ranges) if self.samples is not None else set()
+        for key in sampled & set(self.grid):
+            raise field_error(f"samples.ranges.{key}", "is also a grid axis; give it in one place")
+        names = set(self.grid) | sampled
+        if LOAD_AXIS not in names:
+            raise field_error("grid", f"must include {LOAD_AXIS} (in grid or samples)")
+        if (SPEED_AXIS in names) == (ACCELERATION_AXIS in names):
+            raise field_error("grid", f"must include exactly one of {SPEED_AXIS} (steady points) and {ACCELERATION_AXIS} (transient points)")
+        return self
+
+
+def spec_from_mapping(data: Mapping[str, Any], source: str) -> SweepSpec:
+    """Validate a parsed spec read from ``source``; errors name the file and the key."""
+    doc = validate_mapping(SweepFile, data, source)
+    head, view = doc.sweep, doc.map
+    samples = doc.samples.draw() if doc.samples is not None else ()
     document = {
-        "name": name,
-        "bearing": bearing,
-        "calibration": calibration,
-        "continuation": continuation,
-        "transient_duration_s": duration,
-        "grid": {k: list(v) for k, v in grid.items()},
+        "name": head.name,
+        "bearing": head.bearing,
+        "calibration": head.calibration,
+        "continuation": head.continuation,
+        "transient_duration_s": head.transient_duration_s,
+        "grid": {k: list(v) for k, v in doc.grid.items()},
         "samples": [dict(s) for s in samples],
     }
-    return SweepSpec(name, doc.source, grid, samples, bearing, calibration, continuation, duration, skid, factor, document)
+    return SweepSpec(
+        head.name, source, dict(doc.grid), samples, head.bearing, head.calibration, head.continuation, head.transient_duration_s,
+        view.skid_slip_pct, view.minimum_load_factor_kn, document,
+    )  # fmt: skip
 
 
 def load_spec(path: str | Path) -> SweepSpec:
@@ -270,4 +322,4 @@ def load_spec(path: str | Path) -> SweepSpec:
     Raises:
         ConfigError: naming the file and the key.
     """
-    return spec_from_section(load_yaml(path))
+    return spec_from_mapping(read_mapping(path), str(path))

@@ -43,12 +43,14 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.config import Section, config_path, load_yaml
+from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.dynamics.bearing_file import BearingFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
 from bearing_rig_sim.thermal.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
 from bearing_rig_sim.thermal.network import Conductance, Node, ThermalNetwork
+from bearing_rig_sim.settings_model import read_file
 
 NODES = ("inner_ring", "outer_ring", "balls", "cage", "lubricant", "housing", "shaft")
 AMBIENT = "ambient"
@@ -96,35 +98,39 @@ class ThermalConfig:
     @classmethod
     def from_yaml(cls, path: str | Path | None = None) -> ThermalConfig:
         """The bearing file's thermal data (default: the shipped H7006C)."""
-        return cls.from_section(load_yaml(path or config_path("bearings", "h7006c.yaml")))
+        path = path or config_path("bearings", "h7006c.yaml")
+        return cls.from_file(read_file(BearingFile, path), str(path))
 
     @classmethod
-    def from_section(cls, doc: Section) -> ThermalConfig:
-        """Validate; errors name file, key and range."""
-        g, t = doc.section("geometry"), doc.section("thermal")
-        h, s = t.section("housing"), t.section("shaft")
-        d = g.number("bore_m", gt=0.0, lt=1.0)
-        big_d = g.number("outside_diameter_m", gt=d, lt=2.0)
+    def from_file(cls, doc: BearingFile, source: str) -> ThermalConfig:
+        """The thermal data of a validated bearing file (:class:`~bearing_rig_sim.dynamics.bearing_file.BearingFile`).
+
+        Raises:
+            ConfigError: the file has no ``thermal:`` section.
+        """
+        g, t = doc.geometry, doc.thermal
+        if t is None:
+            raise ConfigError(source, "thermal", "missing (required)")
         return cls(
-            bore=d,
-            outside_diameter=big_d,
-            width=g.number("width_m", gt=0.0, lt=0.5),
-            inner_shoulder=g.number("inner_shoulder_diameter_m", gt=d, lt=big_d),
-            outer_shoulder=g.number("outer_shoulder_diameter_m", gt=d, lt=big_d),
-            ambient=t.number("ambient_temperature_c", ge=10.0, le=40.0),
-            fit_conductance=t.number("fit_contact_conductance_w_m2_k", ge=5e3, le=1e5),
-            housing_mass=h.number("mass_kg", ge=0.5, le=20.0),
-            housing_area=h.number("outer_area_m2", ge=0.005, le=0.5),
-            housing_film=h.number("film_coefficient_w_m2_k", ge=3.0, le=30.0),
-            frame_conductance=h.number("frame_conductance_w_k", ge=0.0, le=5.0),
-            shaft_diameter=s.number("diameter_m", ge=0.005, le=0.2),
-            shaft_length=s.number("length_m", ge=0.02, le=1.0),
-            motor_conductance=s.number("motor_conductance_w_k", ge=0.0, le=5.0),
-            grease_fill=t.number("grease_fill_fraction", ge=0.05, le=0.5, default=0.2),
-            air_flow=t.number("cavity_air_flow_m3_s", ge=1e-5, le=2e-3, default=1.7e-4),
-            oil_flow=t.number("oil_flow_m3_s", ge=0.0, le=1e-3, default=0.0),
-            oil_inlet=t.number("oil_inlet_temperature_c", ge=0.0, le=200.0, default=t.number("ambient_temperature_c", ge=10.0, le=40.0)),
-            source=doc.source,
+            bore=g.bore_m,
+            outside_diameter=g.outside_diameter_m,
+            width=g.width_m,
+            inner_shoulder=g.inner_shoulder_diameter_m,
+            outer_shoulder=g.outer_shoulder_diameter_m,
+            ambient=t.ambient_temperature_c,
+            fit_conductance=t.fit_contact_conductance_w_m2_k,
+            housing_mass=t.housing.mass_kg,
+            housing_area=t.housing.outer_area_m2,
+            housing_film=t.housing.film_coefficient_w_m2_k,
+            frame_conductance=t.housing.frame_conductance_w_k,
+            shaft_diameter=t.shaft.diameter_m,
+            shaft_length=t.shaft.length_m,
+            motor_conductance=t.shaft.motor_conductance_w_k,
+            grease_fill=t.grease_fill_fraction,
+            air_flow=t.cavity_air_flow_m3_s,
+            oil_flow=t.oil_flow_m3_s,
+            oil_inlet=t.oil_inlet_temperature_c if t.oil_inlet_temperature_c is not None else t.ambient_temperature_c,
+            source=source,
         )
 
 

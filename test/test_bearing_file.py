@@ -155,7 +155,7 @@ def test_a_calibration_value_outside_its_range_is_refused(tmp_path: Path) -> Non
     assert str(info.value) == f"{path}: parameters.lubricant.yield_stress_pa.value: must be >= 50.0, got 10.0"
 
 
-SHIPPED = [
+SHIPPED: list[tuple[type[BaseModel], Path]] = [
     *((BearingFile, Path(p)) for p in sorted(glob.glob(str(config_path("bearings", "*.yaml"))))),
     *((LubricantFile, Path(p)) for p in sorted(glob.glob(str(config_path("lubricants", "*.yaml"))))),
 ]

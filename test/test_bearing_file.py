@@ -153,3 +153,76 @@ def test_a_calibration_value_outside_its_range_is_refused(tmp_path: Path) -> Non
     with pytest.raises(ConfigError) as info:
         BearingParameters.from_yaml(None, path)
     assert str(info.value) == f"{path}: parameters.lubricant.yield_stress_pa.value: must be >= 50.0, got 10.0"
+
+
+SHIPPED: list[tuple[type[BaseModel], Path]] = [
+    *((BearingFile, Path(p)) for p in sorted(glob.glob(str(config_path("bearings", "*.yaml"))))),
+    *((LubricantFile, Path(p)) for p in sorted(glob.glob(str(config_path("lubricants", "*.yaml"))))),
+]
+"""Every shipped bearing and lubricant file with its model."""
+
+
+def stated_entries(data: Any, key: str = "") -> list[tuple[str, dict[str, Any]]]:
+    """The values a file writes as ``{value, unit, range, source}``, by dotted key, read from the
+    YAML itself (not through the model)."""
+    if isinstance(data, dict) and set(data) == {"value", "unit", "range", "source"}:
+        return [(key, data)]
+    if isinstance(data, dict):
+        return [entry for k, v in data.items() for entry in stated_entries(v, f"{key}.{k}" if key else str(k))]
+    return []
+
+
+def test_the_shipped_files_state_the_ranges_of_their_values_and_lie_inside_them() -> None:
+    """The H7006C bearing file and every lubricant file write their values with the plausible
+    range their comments used to state (each range is checked here from the YAML itself)."""
+    counts = {}
+    for model, path in SHIPPED:
+        read_file(model, path)
+        entries = stated_entries(read_mapping(path))
+        for key, entry in entries:
+            low, high = (float(x) for x in entry["range"])
+            assert low <= float(entry["value"]) <= high, f"{path.name}: {key}"
+            assert entry["unit"] and entry["source"], f"{path.name}: {key}"
+        counts[path.name] = len(entries)
+    lubricants = [p.name for _, p in SHIPPED if p.parent.name == "lubricants"]
+    assert len(lubricants) >= 4
+    assert all(counts[name] >= 10 for name in ["h7006c.yaml", *lubricants]), counts
+
+
+@pytest.mark.parametrize(("model", "path"), [pytest.param(m, p, id=p.name) for m, p in SHIPPED if stated_entries(read_mapping(p))])
+def test_a_shipped_file_with_a_stated_value_moved_outside_its_range_is_refused(model: type[BaseModel], path: Path) -> None:
+    """Each stated value of each shipped file, moved just beyond either end of its range, is
+    refused naming the file, the dotted key and the bound of the range it crossed."""
+    for key, entry in stated_entries(read_mapping(path)):
+        low, high = (float(x) for x in entry["range"])
+        for bound, bad, problem in ((high, high + 0.5 * (high - low), "<="), (low, low - 0.5 * (high - low), ">=")):
+            data = read_mapping(path)
+            target = data
+            for part in key.split("."):
+                target = target[part]
+            target["value"] = bad
+            with pytest.raises(ConfigError) as info:
+                validate_mapping(model, data, str(path))
+            assert str(info.value) == f"{path}: {key}.value: must be {problem} {bound}, got {bad!r}"
+
+
+def test_the_calibration_lies_inside_the_range_the_lubricant_file_states(tmp_path: Path) -> None:
+    """The bench calibration overlays the grease's yield stress and consistency: their stated
+    ranges in the calibration file lie inside those of the grease file (0.05-2 kPa, 1-100 Pa s^n),
+    the calibrated values replace the grease file's (590.335 Pa and 50.0963 Pa s^n as written in
+    config/calibration/h7006c_table3.yaml), and a calibrated value beyond its range is refused
+    naming the calibration file, the key and the range."""
+    calibration = read_mapping(config_path("calibration", "h7006c_table3.yaml"))["parameters"]
+    grease = read_mapping(GREASE)["grease"]
+    for key in ("yield_stress_pa", "consistency_pa_sn"):
+        cal_low, cal_high = calibration[f"lubricant.{key}"]["range"]
+        low, high = grease[key]["range"]
+        assert low <= cal_low <= cal_high <= high
+    lubricant = BearingParameters.calibrated().lubricant
+    assert lubricant is not None
+    assert (lubricant.yield_stress, lubricant.consistency) == (590.335, 50.0963)
+    path = tmp_path / "cal.yaml"
+    path.write_text("parameters:\n  lubricant.yield_stress_pa: {value: 2500.0, unit: Pa, range: [50.0, 2000.0], source: fit}\n")
+    with pytest.raises(ConfigError) as info:
+        BearingParameters.from_yaml(None, path)
+    assert str(info.value) == f"{path}: parameters.lubricant.yield_stress_pa.value: must be <= 2000.0, got 2500.0"

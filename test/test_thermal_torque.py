@@ -89,7 +89,9 @@ def test_predict_transient_rises_toward_the_steady_state(capsys: pytest.CaptureF
 
 def test_predict_refuses_a_lubricant_file_with_a_value_out_of_range(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     bad = tmp_path / "bad.yaml"
-    bad.write_text((CONFIG / "lubricants" / "vg32_oil_air.yaml").read_text().replace("viscosity_100c_mm2_s: 5.4", "viscosity_100c_mm2_s: 50.4"))
+    bad.write_text(
+        (CONFIG / "lubricants" / "vg32_oil_air.yaml").read_text().replace("viscosity_100c_mm2_s: {value: 5.4,", "viscosity_100c_mm2_s: {value: 50.4,")
+    )
     assert main(["predict", "--rpm", "1000", "--load", "100", "--lubricant", str(bad)]) == 2
     err = capsys.readouterr().err
     assert "bad.yaml" in err and "viscosity_100c_mm2_s" in err

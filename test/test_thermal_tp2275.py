@@ -53,7 +53,7 @@ def test_tp2275_heat_generation_against_the_reports_measurements(capsys: pytest.
     [
         ("bearings/tp2275.yaml", "    mass_kg: 5.0 ", "    mass_kg: 50.0 ", "thermal.housing.mass_kg"),
         ("bearings/tp2275.yaml", "  oil_inlet_temperature_c: 120.85", "  oil_inlet_temperature_c: 420.85", "thermal.oil_inlet_temperature_c"),
-        ("lubricants/mil_l_23699.yaml", "  specific_heat_j_kg_k: 2000.0", "  specific_heat_j_kg_k: 200.0", "base_oil.specific_heat_j_kg_k"),
+        ("lubricants/mil_l_23699.yaml", "  specific_heat_j_kg_k: {value: 2000.0,", "  specific_heat_j_kg_k: {value: 200.0,", "base_oil.specific_heat_j_kg_k"),
     ],
 )
 def test_a_value_outside_its_range_is_refused_naming_file_key_and_range(

@@ -169,6 +169,15 @@ AXIAL_LOAD_SETPOINT = Topic(
     "program runner, user",
     stamped=False,
 )
+RADIAL_LOAD_SETPOINT = Topic(
+    "/rig/radial_load/setpoint",
+    "geometry_msgs/msg/WrenchStamped",
+    "reliable",
+    "one per segment of a program with radial loads or moments",
+    "N, N m",
+    "program runner, user (a bench with a radial loader)",
+    note="force.x/y radial (magnitude and azimuth), torque.x/y a moment; force.z, torque.z unused; up to the rig file's limits",
+)
 AXIAL_LOAD_STATE = Topic("/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", "100 Hz (sim)", "N, A", "load controller")
 AXIAL_LOAD_FORCE = Topic(
     "/rig/axial_load/force",
@@ -241,6 +250,7 @@ TOPICS: tuple[Topic, ...] = (
     SPEEDS,
     TRUTH,
     AXIAL_LOAD_SETPOINT,
+    RADIAL_LOAD_SETPOINT,
     AXIAL_LOAD_STATE,
     AXIAL_LOAD_FORCE,
     BEARING_AXIAL_FORCE,

@@ -1,7 +1,8 @@
 """The load controller's operation of the loading chain, without ROS: stepping by elapsed sim time
 (batched ticks give the same chain as single ticks; a clock that goes back or jumps), the state
 and diagnostics schedule, set-point refusals and the health they leave, the fault latch and its
-reset policy, and the stated settle-time bound.
+reset policy, the stated settle-time bound, and the radial loader's set-point against the rig
+file's limits.
 """
 
 from __future__ import annotations
@@ -12,8 +13,9 @@ import math
 import pytest
 
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, SetpointSource, settle_time_bound
-from bearing_rig_sim.rig.loading import LoadingChainConfig
+from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, RadialLoad, SetpointSource, settle_time_bound
+from bearing_rig_sim.rig.loading import LoadingChain, LoadingChainConfig
+from bearing_rig_sim.rig.program import RigLimits
 
 
 @pytest.fixture(scope="module")
@@ -261,3 +263,54 @@ def test_a_checked_set_point_is_not_applied_and_a_refused_one_warns(config: Load
     assert op.setpoint == 100.0 and op.health().level == HealthLevel.WARN
     assert op.request_setpoint(250.0, SetpointSource.PARAMETER).accepted  # the accepted one clears the WARN
     assert op.setpoint == 250.0 and op.health().level == HealthLevel.OK
+
+
+# -- the radial loader's set-point --------------------------------------------------------------
+def radial_limits(radial_n: float, moment_n_m: float) -> RigLimits:
+    """A rig whose ``combined_loading`` section states these limits (the rest as shipped)."""
+    return dataclasses.replace(RigLimits.from_rig_file(), source="radial.yaml", max_radial_load_n=radial_n, max_moment_n_m=moment_n_m)
+
+
+def test_shipped_rig_refuses_any_radial_setpoint_naming_the_limit(config: LoadingChainConfig) -> None:
+    """config/rig.yaml states 0 N and 0 N m: the paper's bench loads only axially."""
+    op = AxialLoadOperation.from_config(config)
+    reply = op.request_radial(RadialLoad(force_x=500.0), SetpointSource.TOPIC)
+    assert not reply.accepted
+    assert "radial force 500 N is above the rig's limit of 0 N (combined_loading.max_radial_setpoint_n in rig.yaml)" in reply.message
+    assert op.radial == RadialLoad()
+    assert op.health().level is HealthLevel.WARN and reply.message in op.health().message
+    assert op.request_radial(RadialLoad(), SetpointSource.TOPIC).accepted  # zero is what the shipped rig gives
+    assert op.health().level is HealthLevel.OK
+
+
+def test_radial_setpoint_within_the_limits_is_applied_as_given_and_refusals_keep_it(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation(
+        LoadingChain(config),
+        state_period_s=0.01,
+        diagnostics_period_s=1.0,
+        max_clock_gap_s=0.5,
+        sample_period_s=0.001,
+        engage=True,
+        radial_limits=radial_limits(800.0, 5.0),
+    )
+    # (300, 400) N is 500 N (3-4-5); (0.6, 0.8) N m is 1 N m
+    accepted = op.request_radial(RadialLoad(300.0, 400.0, 0.6, 0.8), SetpointSource.TOPIC)
+    assert accepted.accepted and "500 N, moment 1 N m" in accepted.message
+    in_force = RadialLoad(300.0, 400.0, 0.6, 0.8)
+    assert op.radial == in_force
+    # applied without the axial chain's dynamics, and the axial chain untouched by it
+    op.advance_to(0.0)
+    op.advance_to(0.001)
+    assert op.radial == in_force and op.setpoint == 0.0
+    # (600, 600) N is 848.5 N > 800 N; (3, 4) N m is 5 N m: at the limit, accepted
+    refused = op.request_radial(RadialLoad(600.0, 600.0), SetpointSource.TOPIC)
+    assert not refused.accepted
+    assert "radial force 848.528 N is above the rig's limit of 800 N (combined_loading.max_radial_setpoint_n in radial.yaml)" in refused.message
+    assert op.radial == in_force and op.health().level is HealthLevel.WARN
+    moment = op.request_radial(RadialLoad(0.0, 0.0, 3.0, -6.0), SetpointSource.TOPIC)  # 6.708 N m
+    assert not moment.accepted and "moment 6.7082 N m is above the rig's limit of 5 N m (combined_loading.max_moment_setpoint_n_m" in moment.message
+    nan = op.request_radial(RadialLoad(math.nan), SetpointSource.TOPIC)
+    assert not nan.accepted and "force.x must be a finite number" in nan.message
+    assert op.radial == in_force
+    assert op.request_radial(RadialLoad(0.0, 0.0, 3.0, 4.0), SetpointSource.TOPIC).accepted
+    assert op.health().level is HealthLevel.OK

@@ -41,7 +41,17 @@ Policies (the node's documentation repeats them):
   an ERROR naming the set-point and the bound, until the force is back in the band. A new
   set-point, an engagement or a reset starts the count again from the force at that moment.
 
-Units: N, s throughout.
+* **Radial load and moment** (:meth:`AxialLoadOperation.request_radial`): a separate loader,
+  not the axial chain (the paper's bench has none; a bench that loads radially states its limits
+  in the rig file's ``combined_loading`` section). Its set-point, a :class:`RadialLoad`, is
+  applied as given from the next force sample on (the section states no dynamics of the radial
+  loader) and travels in force.x/y and torque.x/y of the force on the bearing. One with a
+  component that is not a finite number, or a magnitude above
+  ``combined_loading.max_radial_setpoint_n`` (force) or ``max_moment_setpoint_n_m`` (moment)
+  is refused: the previous one stays and the health turns WARN until the next accepted one. The
+  axial chain's interlocks do not act on it.
+
+Units: N, N m, s throughout.
 """
 
 from __future__ import annotations
@@ -55,6 +65,7 @@ from typing import TYPE_CHECKING
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.loading import ClutchState, LoadChainState, LoadingChain, LoadingChainConfig, SetpointError
+from bearing_rig_sim.rig.program import RigLimits
 
 if TYPE_CHECKING:
     from bearing_rig_sim.load_control.settings import LoadControllerSettings
@@ -64,6 +75,7 @@ __all__ = [
     "AxialLoadOperation",
     "Health",
     "HealthLevel",
+    "RadialLoad",
     "Reply",
     "SetpointSource",
     "closed_loop_time_constant",
@@ -110,6 +122,35 @@ class AdvanceResult:
     """Why the clock was not stepped as read (went back, gap capped); empty normally."""
 
 
+@dataclass(frozen=True)
+class RadialLoad:
+    """A radial-load set-point in the bearing's frame (the fields of
+    ``/rig/radial_load/setpoint``'s wrench that may be non-zero).
+
+    The radial force is the magnitude of (``force_x``, ``force_y``) at the azimuth
+    atan2(force_y, force_x); the moment across the axis is (``torque_x``, ``torque_y``).
+    """
+
+    force_x: float = 0.0
+    """Radial force along the bearing frame's x axis, N."""
+    force_y: float = 0.0
+    """Radial force along the y axis, N."""
+    torque_x: float = 0.0
+    """Moment about the x axis, N m."""
+    torque_y: float = 0.0
+    """Moment about the y axis, N m."""
+
+    @property
+    def radial_n(self) -> float:
+        """The radial force's magnitude, N."""
+        return math.hypot(self.force_x, self.force_y)
+
+    @property
+    def moment_n_m(self) -> float:
+        """The moment's magnitude, N m."""
+        return math.hypot(self.torque_x, self.torque_y)
+
+
 class AxialLoadOperation:
     """Set-point requests, fault latch and reset, and clock-driven stepping of a loading chain.
 
@@ -120,6 +161,9 @@ class AxialLoadOperation:
         max_clock_gap_s: longest clock advance stepped at once, s (> 0).
         sample_period_s: sim time between two force samples of :meth:`follow`, s (> 0).
         engage: engage the clutch at start.
+        radial_limits: the rig file's limits of radial-load set-points (``combined_loading``;
+            default: the shipped ``config/rig.yaml``'s, 0 N and 0 N m: the paper's bench loads
+            only axially).
 
     The values come from :class:`~bearing_rig_sim.load_control.settings.LoadControllerSettings`
     (``config/load_controller.yaml``); there are no defaults here.
@@ -137,6 +181,7 @@ class AxialLoadOperation:
         max_clock_gap_s: float,
         sample_period_s: float,
         engage: bool,
+        radial_limits: RigLimits | None = None,
     ) -> None:
         for name, value in (
             ("state_period_s", state_period_s),
@@ -160,6 +205,10 @@ class AxialLoadOperation:
         self._off_since: float | None = None
         self._off_bound = 0.0
         self._unmet = ""
+        self.radial_limits = radial_limits
+        self.radial = RadialLoad()
+        """The radial-load set-point in force (:meth:`request_radial`)."""
+        self._radial_refusal = ""
         if engage:
             chain.engage()
         self._apply_zero_load_rule()
@@ -191,6 +240,7 @@ class AxialLoadOperation:
             max_clock_gap_s=settings.max_clock_gap_s,
             sample_period_s=1.0 / settings.force_rate_hz,
             engage=settings.engage_clutch_on_start,
+            radial_limits=RigLimits.from_rig_file(settings.rig_file),
         )
 
     # -- requests ---------------------------------------------------------------------------------
@@ -239,6 +289,40 @@ class AxialLoadOperation:
             self._refusal = f"set-point by {origin} refused: {exc}"
             return Reply(False, self._refusal)
         return Reply(True, "")
+
+    def request_radial(self, load: RadialLoad, source: SetpointSource | str) -> Reply:
+        """Ask for a radial force and a moment (see the module documentation); ``load`` may
+        hold anything in its fields (a message's), judged here.
+
+        Returns:
+            Accepted (the set-point in force), or refused with the reason naming the rig file's
+            limit (the previous one stays; the health turns WARN until the next accepted one).
+        """
+        origin = SetpointSource(source).value
+        reason = self._radial_reason(load)
+        if reason:
+            self._radial_refusal = f"radial set-point by {origin} refused: {reason}"
+            return Reply(False, self._radial_refusal)
+        self._radial_refusal = ""
+        self.radial = RadialLoad(*(float(v) for v in (load.force_x, load.force_y, load.torque_x, load.torque_y)))
+        return Reply(True, f"radial-load set-point {self.radial.radial_n:g} N, moment {self.radial.moment_n_m:g} N m (by {origin})")
+
+    def _radial_reason(self, load: RadialLoad) -> str:
+        """Why ``load`` cannot be applied; empty when it can."""
+        for name in ("force_x", "force_y", "torque_x", "torque_y"):
+            value = getattr(load, name)
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+                return f"{name.replace('_', '.')} must be a finite number, got {value!r}"
+        if self.radial_limits is None:
+            self.radial_limits = RigLimits.from_rig_file()
+        limits = self.radial_limits
+        for what, size, limit, unit, key in (
+            ("radial force", load.radial_n, limits.max_radial_load_n, "N", "max_radial_setpoint_n"),
+            ("moment", load.moment_n_m, limits.max_moment_n_m, "N m", "max_moment_setpoint_n_m"),
+        ):
+            if size > limit:
+                return f"{what} {size:g} {unit} is above the rig's limit of {limit:g} {unit} (combined_loading.{key} in {limits.source})"
+        return ""
 
     def _apply_zero_load_rule(self) -> None:
         """Brake de-energised (open loop, 0 V) at a 0 N set-point, closed loop otherwise."""
@@ -398,8 +482,9 @@ class AxialLoadOperation:
             return Health(HealthLevel.ERROR, (f"interlock: {chain.fault_reason}",))
         if self._unmet:
             return Health(HealthLevel.ERROR, (self._unmet,))
-        if self._refusal:
-            return Health(HealthLevel.WARN, (self._refusal,))
+        refusals = tuple(r for r in (self._refusal, self._radial_refusal) if r)
+        if refusals:
+            return Health(HealthLevel.WARN, refusals)
         if chain.clutch.state is ClutchState.RELEASED:
             return Health(HealthLevel.OK, (f"clutch released; set-point {chain.setpoint:g} N",))
         if chain.setpoint == 0.0:

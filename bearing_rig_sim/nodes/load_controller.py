@@ -16,6 +16,13 @@ Interfaces (README, interface table):
   simulator faster than real time (each wake-up takes whatever sim time passed);
 * subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable), taken by the step
   timer before it steps, so a set-point is in force for every sample published after it came;
+* subscribes ``/rig/radial_load/setpoint`` (geometry_msgs/WrenchStamped, reliable): a radial
+  loader's set-point, force.x/y the radial force (N, magnitude and azimuth), torque.x/y a moment
+  across the axis (N m); force.z and torque.z are unused (the axial load has its own set-point).
+  Taken by the step like the axial set-point and applied as given from the next sample on (the
+  rig file's ``combined_loading`` states no loader dynamics); refused above its
+  ``max_radial_setpoint_n`` / ``max_moment_setpoint_n_m`` (0 for the paper's axially loaded
+  bench) with a logged reason and a WARN naming the limit, the previous one kept;
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
@@ -25,12 +32,14 @@ Interfaces (README, interface table):
   force whichever way it was given;
 * publishes, stamped with the simulation time of the clock tick:
   ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z = the force that reaches the
-  bearing, N, reliable, ``force_rate_hz`` of sim time: the simulator's input),
+  bearing, N, force.x/y and torque.x/y the radial set-point in force (all 0.0 without one), reliable,
+  ``force_rate_hz`` of sim time: the simulator's input),
   ``/rig/axial_load/force`` (WrenchStamped, the load cell's reading, N, sensor data, the same),
   ``/rig/axial_load/state`` (bearing_rig_msgs/AxialLoadState, reliable, ``state_rate_hz`` of sim
   time) and ``/diagnostics`` (every ``diagnostics_period_s`` of sim time and at once on a change:
   OK; WARN after a refused set-point, until the next accepted one; ERROR with the interlock's
-  reason while a fault is latched).
+  reason while a fault is latched; on a rig file with a radial loader, the values
+  ``radial_setpoint_n`` and ``moment_setpoint_n_m`` too).
 
 A set-point that is NaN, negative or above the chain's ``max_setpoint_n`` is refused (the
 previous one stays) with a logged reason and a WARN on ``/diagnostics``; the node carries on. An
@@ -82,10 +91,11 @@ from bearing_rig_sim.interfaces import (
     BEARING_AXIAL_FORCE,
     CLOCK,
     DIAGNOSTICS,
+    RADIAL_LOAD_SETPOINT,
 )
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, Reply, SetpointSource
+from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, RadialLoad, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
 from bearing_rig_sim.nodes.common import (
     drain,
@@ -175,6 +185,13 @@ class LoadControllerNode(ManagedNode):
         self._setpoint_sub = self._clock_tap.create_subscription(
             Float64, AXIAL_LOAD_SETPOINT.name, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
         )
+        self._radial_sub = self._clock_tap.create_subscription(
+            WrenchStamped,
+            RADIAL_LOAD_SETPOINT.name,
+            _unused,
+            qos_profile(RADIAL_LOAD_SETPOINT),
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+        )
         self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
         self._bearing_msg = WrenchStamped()
         self._bearing_msg.header.frame_id = "bearing"
@@ -223,6 +240,8 @@ class LoadControllerNode(ManagedNode):
         and publish them."""
         for setpoint, _info in drain(self._setpoint_sub, Float64, serialized=False):
             self._on_setpoint(setpoint)
+        for radial, _info in drain(self._radial_sub, WrenchStamped, serialized=False):
+            self._on_radial_setpoint(radial)
         operation = self.operation
         stamp = self._latest_clock()
         if operation is None or stamp is None:
@@ -246,6 +265,10 @@ class LoadControllerNode(ManagedNode):
         bearing, cell = self._bearing_msg, self._load_cell_msg
         bearing.header.stamp = stamp
         bearing.wrench.force.z = state.bearing_force
+        if self.operation is not None:
+            radial = self.operation.radial
+            force, torque = bearing.wrench.force, bearing.wrench.torque
+            force.x, force.y, torque.x, torque.y = radial.force_x, radial.force_y, radial.torque_x, radial.torque_y
         self._force_pub.publish(bearing)
         cell.header.stamp = stamp
         cell.wrench.force.z = state.load_cell_force
@@ -281,6 +304,10 @@ class LoadControllerNode(ManagedNode):
             "fault_reason": state.fault_reason,
             "sim_time_s": f"{now:.3f}",
         }
+        limits = self.operation.radial_limits
+        if limits is not None and (limits.max_radial_load_n > 0.0 or limits.max_moment_n_m > 0.0):  # a rig with a radial loader
+            values["radial_setpoint_n"] = f"{self.operation.radial.radial_n:g}"
+            values["moment_setpoint_n_m"] = f"{self.operation.radial.moment_n_m:g}"
         status = diagnostic_status(DIAGNOSTIC_NAME, _LEVELS[health.level], health.message, values)
         self._diagnostics_pub.publish(diagnostic_array(to_stamp(now), [status]))
         self.operation.mark_reported(health)
@@ -313,6 +340,11 @@ class LoadControllerNode(ManagedNode):
         assert self.operation is not None  # taken by the step, which runs from activate to deactivate
         if self._apply(self.operation.request_setpoint(msg.data, SetpointSource.TOPIC)).accepted:
             self._mirror_setpoint()
+
+    def _on_radial_setpoint(self, msg: WrenchStamped) -> None:
+        assert self.operation is not None  # taken by the step, which runs from activate to deactivate
+        force, torque = msg.wrench.force, msg.wrench.torque
+        self._apply(self.operation.request_radial(RadialLoad(force.x, force.y, torque.x, torque.y), SetpointSource.TOPIC))
 
     def _on_set_service(self, request: SetAxialLoad.Request, response: SetAxialLoad.Response) -> SetAxialLoad.Response:
         assert self.operation is not None  # the service lives from configure to cleanup

@@ -26,6 +26,7 @@ from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
+from geometry_msgs.msg import WrenchStamped
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64
 
@@ -39,6 +40,7 @@ from bearing_rig_sim.interfaces import (
     CAGE_PULSES,
     CLOCK,
     DIAGNOSTICS,
+    RADIAL_LOAD_SETPOINT,
     SLIP_STATUS,
     SPEEDS,
     SPINDLE_COMMAND,
@@ -155,6 +157,7 @@ class SessionNode(Node):
         self.live = LiveValues()
         self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
         self._setpoint = self.create_publisher(Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
+        self._radial_setpoint = self.create_publisher(WrenchStamped, RADIAL_LOAD_SETPOINT.name, qos_profile(RADIAL_LOAD_SETPOINT))
         self.tap = Node(f"{name}_recorder", context=context)
         self._recorded = [
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
@@ -172,7 +175,7 @@ class SessionNode(Node):
         """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
-        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter()}
+        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter(), RADIAL_LOAD_SETPOINT.name: Counter()}
         """Serialized commands and set-points this session published, not yet seen by its recorder:
         any other on those topics came from outside and marks the running segment."""
 
@@ -196,10 +199,21 @@ class SessionNode(Node):
 
     def send_setpoint(self, plan: SegmentPlan) -> None:
         """The segment's axial-load set-point (no stamp: it is in force from its arrival, so it is
-        sent when the segment starts)."""
+        sent when the segment starts) and, for a program that loads radially
+        (:attr:`ProgramRunner.loads_radially`), its radial-load set-point: force.x the radial
+        load along the bearing frame's x axis (N), torque.y the moment (N m), stamped with the
+        segment's start."""
         setpoint = Float64(data=plan.segment.axial_load)
         self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._setpoint.publish(setpoint)
+        if self.runner.loads_radially:
+            radial = WrenchStamped()
+            radial.header.stamp = to_stamp(plan.start_time)
+            radial.header.frame_id = "bearing"
+            radial.wrench.force.x = plan.segment.radial_load
+            radial.wrench.torque.y = plan.segment.moment
+            self._own[RADIAL_LOAD_SETPOINT.name][repr(radial)] += 1
+            self._radial_setpoint.publish(radial)
 
     # -- readiness --------------------------------------------------------------------------------
     def unmatched_streams(self) -> list[str]:

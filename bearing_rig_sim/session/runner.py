@@ -293,6 +293,13 @@ class ProgramRunner:
     def segment_count(self) -> int:
         return len(self.program.segments)
 
+    @property
+    def loads_radially(self) -> bool:
+        """Some segment asks for a radial load or a moment: the session then sends every
+        segment's radial set-point (0 included); a program that loads only axially sends none,
+        as the paper's bench has no radial loader to send it to."""
+        return any(seg.radial_load != 0.0 or seg.moment != 0.0 for seg in self.program.segments)
+
     # -- driving ----------------------------------------------------------------------------------
     def start(self, now: float) -> SegmentPlan:
         """Start the first segment at ``now`` (s of sim time); returns its plan.

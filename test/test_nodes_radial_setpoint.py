@@ -15,7 +15,8 @@ the cage is pushed off the axis (whirl radius above 0, as under a pure axial loa
 ball load is well above the mean (Sjovall's integral); with
 a moment applied the inner ring's tilts are free, so at equilibrium the balls' moment on the ring
 balances the applied one (1 N m about y, torque.y). The shipped rig file (0 N, 0 N m) refuses the
-same program naming the segment and the limit.
+same program naming the segment and the limit; a set-point above the test rig's limit, sent on the
+topic, is refused on the load controller's status and the one in force stays.
 """
 
 from __future__ import annotations
@@ -29,10 +30,13 @@ import pytest
 pytestmark = pytest.mark.ros
 rclpy = pytest.importorskip("rclpy")
 
+from diagnostic_msgs.msg import DiagnosticStatus  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from rclpy.serialization import deserialize_message  # noqa: E402
 
 from bearing_rig_sim.config import ConfigError  # noqa: E402
 from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, BEARING_AXIAL_FORCE, DIAGNOSTICS, RADIAL_LOAD_SETPOINT, TRUTH  # noqa: E402
+from bearing_rig_sim.nodes.common import from_stamp, qos_profile  # noqa: E402
 from bearing_rig_sim.rig.program import RigLimits, load_program  # noqa: E402
 from bearing_rig_sim.session.node import MESSAGE_TYPES, SessionNode  # noqa: E402
 from bearing_rig_sim.session.recorder import SessionRecorder  # noqa: E402
@@ -154,4 +158,21 @@ def test_programs_radial_load_and_moment_reach_the_simulator_through_the_load_co
         ),
         "the ring balancing the moment",
     )
+    assert controller.poll() is None
+
+    # 900 N on the set-point topic is above the rig file's 800 N: refused on the load controller's
+    # status naming the limit, the node up, the force on the bearing keeping 500 N and 1 N m
+    bench = session.create_publisher(WrenchStamped, RADIAL_LOAD_SETPOINT.name, qos_profile(RADIAL_LOAD_SETPOINT))
+    too_much = WrenchStamped()
+    too_much.wrench.force.x = 900.0
+    bench.publish(too_much)
+    refusal = (
+        f"radial set-point by topic refused: radial force 900 N is above the rig's limit of 800 N (combined_loading.max_radial_setpoint_n in {rig_file.name})"
+    )
+    wait(lambda: any(s.level == DiagnosticStatus.WARN and refusal in s.message for a in sent(DIAGNOSTICS) for s in a.status), "WARN for 900 N")
+    refused_at = session.sim_time
+    wait(lambda: session.sim_time > refused_at + 0.05, "the rig going on after the refusal")
+    after = [m for m in sent(BEARING_AXIAL_FORCE) if from_stamp(m.header.stamp) > refused_at]
+    assert after and all((m.wrench.force.x, m.wrench.torque.y) == (RADIAL_N, MOMENT_N_M) for m in after)
+    assert memory.diagnostic("load_controller", "radial_setpoint_n") == f"{RADIAL_N:g}"
     assert controller.poll() is None

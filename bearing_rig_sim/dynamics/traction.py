@@ -205,49 +205,6 @@ def _table_position(t: np.ndarray, base: int, srr: float, speed: float, load: fl
 
 
 @njit(cache=True)
-def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float]:
-    """Interpolate a traction table stored in ``t`` from index ``base``: returns
-    (mu, d mu / d SRR, u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer). Trilinear in
-    (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last value is the
-    speed-load factor of Houpert's rolling force, from the same logarithms."""
-    ns = int(t[base])
-    nu = int(t[base + 1])
-    size = ns * nu * int(t[base + 2])
-    i_s, i_u, i_q, ws, wu, wq, lu, lq = _table_position(t, base, srr, speed, load)
-    mu0 = 0.0
-    mu1 = 0.0
-    for dq in range(2):
-        cq = wq if dq == 1 else 1.0 - wq
-        for du in range(2):
-            cu = wu if du == 1 else 1.0 - wu
-            k = base + HEADER + 2 * (contact * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s)
-            mu0 += cq * cu * t[k]
-            mu1 += cq * cu * t[k + 2]
-    mu = mu0 + ws * (mu1 - mu0)
-    dxi = 2.0 * t[base + 3] / (ns - 1)
-    slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
-    rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
-    return mu, slope, rolling
-
-
-@njit(cache=True)
-def table_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
-    """Interpolated dissipation P / (Q u_e) of ``contact`` (same grid as :func:`table_lookup`)."""
-    ns = int(t[base])
-    nu = int(t[base + 1])
-    size = ns * nu * int(t[base + 2])
-    i_s, i_u, i_q, ws, wu, wq, _, _ = _table_position(t, base, srr, speed, load)
-    pw = 0.0
-    for dq in range(2):
-        cq = wq if dq == 1 else 1.0 - wq
-        for du in range(2):
-            cu = wu if du == 1 else 1.0 - wu
-            k = base + HEADER + 2 * (contact * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s) + 1
-            pw += cq * cu * ((1.0 - ws) * t[k] + ws * t[k + 2])
-    return pw
-
-
-@njit(cache=True)
 def table_lookup_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float, float]:
     """:func:`table_lookup` and :func:`table_power` in one pass over the cell (one position
     computation): (mu, d mu / d SRR, u_e^0.66 Q^0.47, P / (Q u_e))."""
@@ -272,3 +229,20 @@ def table_lookup_power(t: np.ndarray, base: int, contact: int, srr: float, speed
     slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
     rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
     return mu, slope, rolling, pw
+
+
+@njit(cache=True)
+def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float]:
+    """Interpolate a traction table stored in ``t`` from index ``base``: returns
+    (mu, d mu / d SRR, u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer). Trilinear in
+    (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last value is the
+    speed-load factor of Houpert's rolling force, from the same logarithms
+    (:func:`table_lookup_power` without the dissipation)."""
+    mu, slope, rolling, _ = table_lookup_power(t, base, contact, srr, speed, load)
+    return mu, slope, rolling
+
+
+@njit(cache=True)
+def table_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
+    """Interpolated dissipation P / (Q u_e) of ``contact`` (same grid as :func:`table_lookup`)."""
+    return table_lookup_power(t, base, contact, srr, speed, load)[3]

@@ -35,7 +35,10 @@ from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 RPM = math.pi / 30.0
 SPEED = 900 * RPM
 """The low-speed case: centrifugal force 0.03 N against ball loads of 10-140 N."""
-GEOMETRY = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+GEOMETRY = {
+    key: entry["value"] if isinstance(entry, dict) else entry  # a value with its stated range, or plain
+    for key, entry in yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"].items()
+}
 Z = GEOMETRY["ball_count"]
 R_I = 0.5 * GEOMETRY["pitch_diameter_m"] + (GEOMETRY["inner_groove_curvature_ratio"] - 0.5) * GEOMETRY["ball_diameter_m"] * math.cos(
     math.radians(GEOMETRY["contact_angle_deg"])

@@ -373,3 +373,15 @@ def write_foreign_metadata(bag_dir: Path, topics: Sequence[tuple[str, str, int]]
         }
     }
     (bag_dir / "metadata.yaml").write_text(yaml.safe_dump(doc), encoding="utf-8")
+
+
+def bearing_section(section: str, bearing: str = "h7006c.yaml") -> dict[str, Any]:
+    """One section of a shipped bearing file as plain values, read as YAML independently of the
+    package's loader: a value written with its stated range (``{value, unit, range, source}``)
+    is given as its ``value``."""
+    import yaml
+
+    from bearing_rig_sim.config import config_path
+
+    raw = yaml.safe_load(config_path("bearings", bearing).read_text())[section]
+    return {key: entry["value"] if isinstance(entry, dict) and "value" in entry else entry for key, entry in raw.items()}

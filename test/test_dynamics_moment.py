@@ -25,20 +25,16 @@ import math
 
 import numpy as np
 import pytest
-import yaml
 
-from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters, DynamicsInputError
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
+from conftest import bearing_section
 
 RPM = math.pi / 30.0
 SPEED = 900 * RPM
 """The low-speed case: centrifugal force 0.03 N against ball loads of 10-140 N."""
-GEOMETRY = {
-    key: entry["value"] if isinstance(entry, dict) else entry  # a value with its stated range, or plain
-    for key, entry in yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"].items()
-}
+GEOMETRY = bearing_section("geometry")
 Z = GEOMETRY["ball_count"]
 R_I = 0.5 * GEOMETRY["pitch_diameter_m"] + (GEOMETRY["inner_groove_curvature_ratio"] - 0.5) * GEOMETRY["ball_diameter_m"] * math.cos(
     math.radians(GEOMETRY["contact_angle_deg"])

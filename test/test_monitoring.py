@@ -19,13 +19,14 @@ import yaml
 from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonitor
 from bearing_rig_sim.rig.fibre_optic import Pulse
+from conftest import bearing_section
 
 TWO_PI = 2.0 * math.pi
 
 
 def ratio() -> float:
     """n_s / n_i for the shipped bearing at its nominal angle, from the file's numbers."""
-    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    g = bearing_section("geometry")
     return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
 
 

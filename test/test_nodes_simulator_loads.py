@@ -38,6 +38,7 @@ from geometry_msgs.msg import WrenchStamped  # noqa: E402
 
 from bearing_rig_sim.config import config_path  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, RELIABLE_STREAM_QOS, from_stamp  # noqa: E402
+from conftest import bearing_section  # noqa: E402
 
 WAIT = 60.0
 """Longest wait for any one condition, wall s (node start-up takes a few seconds)."""
@@ -57,7 +58,7 @@ TRUTH_PERIOD_S = 0.01
 
 def stribeck_max_ball_load(radial: float) -> float:
     """Q_max = 4.37 F_r / (Z cos a), N, for the shipped bearing's ball count and contact angle."""
-    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    g = bearing_section("geometry")
     return 4.37 * radial / (g["ball_count"] * math.cos(math.radians(g["contact_angle_deg"])))
 
 
@@ -111,7 +112,7 @@ class Bench:
 
 def hand_reaction_moment(radial: float) -> float:
     """F_r R_i tan a0, N m, R_i = d_m/2 + (f_i - 1/2) D_w cos a0 for the shipped bearing."""
-    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    g = bearing_section("geometry")
     a0 = math.radians(g["contact_angle_deg"])
     r_i = 0.5 * g["pitch_diameter_m"] + (g["inner_groove_curvature_ratio"] - 0.5) * g["ball_diameter_m"] * math.cos(a0)
     return radial * r_i * math.tan(a0)

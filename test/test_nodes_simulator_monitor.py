@@ -28,6 +28,7 @@ from sensor_msgs.msg import JointState  # noqa: E402
 
 from bearing_rig_sim.config import config_path  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS, from_stamp, to_stamp  # noqa: E402
+from conftest import bearing_section  # noqa: E402
 
 RPM = math.pi / 30.0
 WAIT = 60.0
@@ -35,7 +36,7 @@ WAIT = 60.0
 
 
 def epicyclic_ratio() -> float:
-    g = yaml.safe_load(config_path("bearings", "h7006c.yaml").read_text())["geometry"]
+    g = bearing_section("geometry")
     return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
 
 

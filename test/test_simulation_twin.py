@@ -24,6 +24,7 @@ from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, Shaft
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RadialLoadError, RigTwin, TwinError
+from conftest import bearing_section
 
 RPM = math.pi / 30.0
 BEARING = config_path("bearings", "h7006c.yaml")
@@ -31,7 +32,7 @@ BEARING = config_path("bearings", "h7006c.yaml")
 
 def epicyclic_ratio() -> float:
     """n_s / n_i = (1 - Dw cos(alpha) / dm) / 2, from the bearing file's numbers (paper Eq. 12)."""
-    g = yaml.safe_load(BEARING.read_text())["geometry"]
+    g = bearing_section("geometry")
     return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
 
 

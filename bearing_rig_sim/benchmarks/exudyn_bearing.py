@@ -50,10 +50,10 @@ class ExudynRun:
         return self.sim_s / self.wall_s
 
 
-def run_exudyn(params: BearingParameters, speed: float, axial_load: float, sim_s: float) -> ExudynRun:
+def run_exudyn(params: BearingParameters, speed: float, axial_load: float, sim_s: float, cage_start: float | None = None) -> ExudynRun:
     """Simulate Exudyn's rigid ball bearing for ``sim_s`` seconds at inner-ring speed ``speed``
-    (rad/s) under ``axial_load`` (N), starting with the cage at its pure-rolling speed; time
-    the solve alone (model assembly excluded).
+    (rad/s) under ``axial_load`` (N), starting with the cage at ``cage_start`` (rad/s; default
+    its pure-rolling speed); time the solve alone (model assembly excluded).
 
     Raises:
         ImportError: Exudyn is not installed.
@@ -110,7 +110,7 @@ def run_exudyn(params: BearingParameters, speed: float, axial_load: float, sim_s
         outer,
         density,
         params.cage_density,
-        cageInitialAngularVelocity=[0.0, 0.0, params.epicyclic_ratio * speed],
+        cageInitialAngularVelocity=[0.0, 0.0, params.epicyclic_ratio * speed if cage_start is None else cage_start],
         springStiffnessCage=CAGE_SPRING[0],
         springDampingCage=CAGE_SPRING[1],
         contactParametersRingBalls=contact,

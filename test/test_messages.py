@@ -83,6 +83,16 @@ SAMPLES: dict[str, dict[str, Any]] = {
         "friction_torque": 0.0152,
         "power_loss": 42.75,
         "cage_whirl_radius_um": 37.5,
+        "ball_azimuth": [0.0, 2.0943951023931953, 4.1887902047863905],
+        "ball_orbit_speed": [398.0, 398.25, 397.875],
+        "ball_spin_speed": [-3125.5, -3126.0, -3124.75],
+        "ball_inner_contact_load": [139.0, 0.0, 20.125],
+        "ball_outer_contact_load": [140.5, 1.5e-3, 21.0],
+        "ball_inner_contact_angle": [0.28, 0.2617993877991494, 0.27],
+        "ball_outer_contact_angle": [0.26, 0.2617993877991494, 0.25],
+        "ball_pocket_load": [-0.5, 1.25, 0.0625],
+        "cage_centre_x": -1.25e-5,
+        "cage_centre_y": 3.5e-5,
     },
     "AxialLoadState": {
         "header": {"stamp": {"sec": 99, "nanosec": 1}, "frame_id": "load_cell"},
@@ -259,9 +269,17 @@ def _parse_definition(text: str) -> tuple[dict[str, str], dict[str, str]]:
 _RCLPY_TYPE = {"float64": "double", "float32": "float", "bool": "boolean", "byte": "octet", "char": "uint8"}
 
 
+def _rclpy_type(definition: str) -> str:
+    """rclpy's name of a .msg field type: ``float64`` -> ``double``, ``float64[]`` ->
+    ``sequence<double>`` (ROS 2 IDL mapping of an unbounded sequence)."""
+    if definition.endswith("[]"):
+        return f"sequence<{_rclpy_type(definition[:-2])}>"
+    return _RCLPY_TYPE.get(definition, definition)
+
+
 def _check_class_matches(cls: type, text: str) -> None:
     fields, constants = _parse_definition(text)
-    expected = {name: _RCLPY_TYPE.get(t, t) for name, t in fields.items()}
+    expected = {name: _rclpy_type(t) for name, t in fields.items()}
     assert cls.get_fields_and_field_types() == expected, f"{cls.__name__} differs from its definition"
     for name, literal in constants.items():
         assert getattr(cls, name) == int(literal), f"{cls.__name__}.{name}"

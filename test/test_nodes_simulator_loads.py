@@ -118,6 +118,33 @@ def hand_reaction_moment(radial: float) -> float:
     return radial * r_i * math.tan(a0)
 
 
+def check_per_ball_equilibrium(truth: SimulatorTruth, radial: tuple[float, float]) -> None:
+    """The per-ball truth balances the loads on the inner ring (its quasi-static equilibrium,
+    Harris and Kotzalas vol. 1, ch. 7: sum Q sin a = F_a, sum Q cos a (cos psi, sin psi) = F_r's
+    components, with centrifugal and ring-inertia terms negligible at 900 rpm), and the most
+    loaded ball sits under the radial load, within half a ball spacing of its azimuth."""
+    g = bearing_section("geometry")
+    z = g["ball_count"]
+    q = list(truth.ball_inner_contact_load)
+    a = list(truth.ball_inner_contact_angle)
+    psi = list(truth.ball_azimuth)
+    assert len(q) == len(a) == len(psi) == len(truth.ball_outer_contact_load) == len(truth.ball_pocket_load) == z
+    assert all(0.0 <= p < 2.0 * math.pi for p in psi)
+    assert min(q) >= 0.0
+    axial = sum(qj * math.sin(aj) for qj, aj in zip(q, a, strict=True))
+    fx = sum(qj * math.cos(aj) * math.cos(pj) for qj, aj, pj in zip(q, a, psi, strict=True))
+    fy = sum(qj * math.cos(aj) * math.sin(pj) for qj, aj, pj in zip(q, a, psi, strict=True))
+    assert axial == pytest.approx(truth.axial_load, rel=0.02)
+    magnitude = math.hypot(*radial)
+    assert fx == pytest.approx(radial[0], abs=0.03 * magnitude)
+    assert fy == pytest.approx(radial[1], abs=0.03 * magnitude)
+    heaviest = psi[q.index(max(q))]
+    off = abs(math.remainder(heaviest - math.atan2(radial[1], radial[0]), 2.0 * math.pi))
+    assert off <= math.pi / z + 1e-9
+    assert max(q) == pytest.approx(truth.inner_contact_load_max, rel=1e-12)
+    assert math.hypot(truth.cage_centre_x, truth.cage_centre_y) * 1e6 == pytest.approx(truth.cage_whirl_radius_um, rel=1e-9)
+
+
 def radial_rig_file(directory: Path) -> Path:
     """The shipped rig file with a radial loading chain of :data:`RADIAL_LIMIT_N` and
     :data:`MOMENT_LIMIT_N_M`."""
@@ -156,6 +183,7 @@ def test_radial_force_on_the_topic_loads_the_twin_within_the_rig_files_limit(ros
     assert last.axial_load == AXIAL_N
     assert last.inner_contact_load_max == pytest.approx(stribeck_max_ball_load(RADIAL_N), rel=0.03)
     assert last.inner_contact_load_max > 2.0 * last.inner_contact_load_mean  # balls outside the zone unloaded
+    check_per_ball_equilibrium(last, (RADIAL_X_N, RADIAL_Y_N))
     bench.wait(lambda: bench.value("radial_load_n") == "500", "the radial load in the report")
     assert float(bench.value("radial_load_azimuth_deg")) == pytest.approx(math.degrees(math.atan2(RADIAL_Y_N, RADIAL_X_N)), abs=1e-3)
 

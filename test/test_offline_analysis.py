@@ -22,7 +22,7 @@ from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_
 from bearing_rig_sim.offline.analysis import analyse_bag, decode_pulse
 from bearing_rig_sim.offline.segments import PROFILE_CONSTANT_ACCELERATION, SEGMENTS_CSV, SegmentTracker
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, RowDecimator, SlipWindowRow, StatusRow
-from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
+from bearing_rig_sim.synthetic.traffic import NO_BALLS, RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
 from bearing_rig_sim.bags.typestore import msg_folder
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation import RigTwin, SpindleCommand
@@ -159,6 +159,7 @@ def write_twin_bag(
                     step_count=truth.step_count,
                     overruns=0,
                     cage_whirl_radius_um=truth.cage_whirl_radius * 1e6,
+                    **NO_BALLS,
                 )
                 bag.write_message("/rig/truth", now, message)
             if record_status and round(out.time * 1000) % 100 == 0:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -95,6 +95,9 @@ class Observation:
         cage_angle: unwrapped angle of the cage segment carrying the reflective strip, rad.
         cage_speed: mean speed of the cage segments, rad/s.
         ball_orbit_speeds: per ball, rad/s.
+        ball_azimuths: per ball, the orbital angle of its centre from the bearing's x axis, in
+            [0, 2 pi), rad.
+        ball_spin_speeds: per ball, its rotation speed about its own axis, rad/s.
         inner_contact_loads / outer_contact_loads: per ball, N.
         inner_contact_angles / outer_contact_angles: per ball, rad.
         pocket_loads: per ball, signed (> 0: ball pushes the cage forward), N.
@@ -128,6 +131,8 @@ class Observation:
     cage_centre: tuple[float, float] = (0.0, 0.0)
     inner_ring_tilt: tuple[float, float] = (0.0, 0.0)
     ring_moment: tuple[float, float] = (0.0, 0.0)
+    ball_azimuths: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    ball_spin_speeds: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
 
 @dataclass(frozen=True)
@@ -595,4 +600,6 @@ class BearingDynamics:
             cage_centre=(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY])),
             inner_ring_tilt=(float(self.ring[kn.R_TX]), float(self.ring[kn.R_TY])),
             ring_moment=(float(self.ring[kn.R_MX]), float(self.ring[kn.R_MY])),
+            ball_azimuths=np.mod(self.ball[:, kn.B_THETA], 2.0 * math.pi),
+            ball_spin_speeds=self.ball[:, kn.B_SPIN].copy(),
         )

@@ -53,9 +53,12 @@ from __future__ import annotations
 import math
 import sys
 import time
+from array import array
+from dataclasses import fields
 from typing import Any
 from collections.abc import Sequence
 
+import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
@@ -124,6 +127,11 @@ ACK_GIVE_UP_S = 10.0
 """Wall time a reader may acknowledge nothing (a stopped process) before the loop goes on
 without it, with a WARN on /diagnostics, s; it is not waited for again until every reader has
 caught up."""
+
+
+def _doubles(values: Any) -> array[float]:
+    """A float64[] message field's value from an array of floats."""
+    return array("d", np.ascontiguousarray(values, dtype=np.float64).tobytes())
 
 
 class SimulatorNode(ManagedNode):
@@ -374,7 +382,12 @@ class SimulatorNode(ManagedNode):
             friction_torque=t.friction_torque,
             power_loss=t.power_loss,
             cage_whirl_radius_um=t.cage_whirl_radius * 1e6,
+            cage_centre_x=t.cage_centre[0],
+            cage_centre_y=t.cage_centre[1],
         )
+        if t.balls is not None:  # each BallTruth field is the message's ball_<field>
+            for item in fields(t.balls):
+                setattr(msg, f"ball_{item.name}", _doubles(getattr(t.balls, item.name)))
         msg.header.stamp = to_stamp(t.time)
         msg.header.frame_id = "bearing"
         return msg

@@ -94,6 +94,8 @@ class TruthSummary:
     Contact angles are means over the balls with a non-zero contact load (NaN if none).
     Friction torque N m and power loss W: the engine's dissipation at the chunk's last step.
     ``cage_whirl_radius``: distance of the cage centre from the bearing axis, m.
+    ``balls``: the per-ball state (:class:`BallTruth`); ``cage_centre``: the cage centre's (x, y)
+    displacement in the bearing frame, m.
     """
 
     time: float
@@ -115,6 +117,29 @@ class TruthSummary:
     friction_torque: float = 0.0
     power_loss: float = 0.0
     cage_whirl_radius: float = 0.0
+    balls: BallTruth | None = None
+    cage_centre: tuple[float, float] = (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class BallTruth:
+    """Per ball (index k = ball k, in cage pocket k), from the engine's observation.
+
+    Azimuths from the bearing frame's x axis (the radial load's azimuth is measured from it),
+    in [0, 2 pi), rad; orbit and spin speeds rad/s (spin: about the ball's own axis); contact
+    loads N (0: out of contact); contact angles rad, of the line from the ball centre to each
+    groove's curvature centre (the contact angle where the ball is loaded); pocket loads N,
+    > 0 where the ball pushes the cage forward.
+    """
+
+    azimuth: np.ndarray
+    orbit_speed: np.ndarray
+    spin_speed: np.ndarray
+    inner_contact_load: np.ndarray
+    outer_contact_load: np.ndarray
+    inner_contact_angle: np.ndarray
+    outer_contact_angle: np.ndarray
+    pocket_load: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -526,4 +551,15 @@ class RigTwin:
             friction_torque=self.engine.friction_torque(),
             power_loss=self.engine.power_loss(),
             cage_whirl_radius=obs.cage_whirl_radius,
+            balls=BallTruth(
+                azimuth=obs.ball_azimuths,
+                orbit_speed=obs.ball_orbit_speeds,
+                spin_speed=obs.ball_spin_speeds,
+                inner_contact_load=qi,
+                outer_contact_load=qo,
+                inner_contact_angle=obs.inner_contact_angles,
+                outer_contact_angle=obs.outer_contact_angles,
+                pocket_load=obs.pocket_loads,
+            ),
+            cage_centre=obs.cage_centre,
         )

@@ -60,6 +60,26 @@ SPEEDS_TOPIC = SPEEDS.name
 SPINDLE_PULSES_TOPIC = SPINDLE_PULSES.name
 CAGE_PULSES_TOPIC = CAGE_PULSES.name
 TRUTH_TOPIC = TRUTH.name
+
+NO_BALLS: dict[str, Any] = {
+    **{
+        f"ball_{name}": np.zeros(0)
+        for name in (
+            "azimuth",
+            "orbit_speed",
+            "spin_speed",
+            "inner_contact_load",
+            "outer_contact_load",
+            "inner_contact_angle",
+            "outer_contact_angle",
+            "pocket_load",
+        )
+    },
+    "cage_centre_x": 0.0,
+    "cage_centre_y": 0.0,
+}
+"""SimulatorTruth's per-ball fields for a truth without per-ball state (rosbags keyword arguments:
+empty arrays and a centred cage)."""
 RIG_TRAFFIC_TOPICS: dict[str, tuple[str, str]] = {t.name: (t.msgtype, t.qos) for t in (SPEEDS, SPINDLE_PULSES, CAGE_PULSES, TRUTH)}
 """Topics of :func:`rig_traffic`: name -> (type, QoS profile), from the interface contract."""
 
@@ -204,6 +224,7 @@ def rig_traffic(
                 friction_torque=0.01,
                 power_loss=3.0,
                 cage_whirl_radius_um=0.0,
+                **NO_BALLS,
             )
             yield TRUTH_TOPIC, time_ns, bytes(store.serialize_cdr(truth, "bearing_rig_msgs/msg/SimulatorTruth"))
         pulses = []

@@ -51,8 +51,8 @@ def test_tp2275_heat_generation_against_the_reports_measurements(capsys: pytest.
 @pytest.mark.parametrize(
     ("name", "old", "new", "key"),
     [
-        ("bearings/tp2275.yaml", "    mass_kg: 5.0 ", "    mass_kg: 50.0 ", "thermal.housing.mass_kg"),
-        ("bearings/tp2275.yaml", "  oil_inlet_temperature_c: 120.85", "  oil_inlet_temperature_c: 420.85", "thermal.oil_inlet_temperature_c"),
+        ("bearings/tp2275.yaml", "    mass_kg: {value: 5.0,", "    mass_kg: {value: 50.0,", "thermal.housing.mass_kg"),
+        ("bearings/tp2275.yaml", "  oil_inlet_temperature_c: {value: 120.85,", "  oil_inlet_temperature_c: {value: 160.85,", "thermal.oil_inlet_temperature_c"),
         ("lubricants/mil_l_23699.yaml", "  specific_heat_j_kg_k: {value: 2000.0,", "  specific_heat_j_kg_k: {value: 200.0,", "base_oil.specific_heat_j_kg_k"),
     ],
 )

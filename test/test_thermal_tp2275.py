@@ -33,7 +33,7 @@ HOUSING_DEFICIT_K = (20.0, 35.0)
 """How much cooler than the report's outer ring the twin's runs, K, at every speed: the assumed
 housing and shaft (config/bearings/tp2275.yaml, thermal:) lead heat to 22 degC air, while the
 report's rig is not described in anything read here (its jet oil at 394 K, its heat exchanger;
-the laboratory's 35 mm rig of TP-1732 also had outer-ring cooling). Measured: 27.1-30.1 K. The
+the laboratory's 35 mm rig of TP-1732 had provisions for outer-ring cooling). Measured: 27.1-30.1 K. The
 band is that deficit, stated, with +-7 K for reading temperatures off the report's figures
 (about 1 % of 420 K, twice) and the secant steady-state solver; it is not agreement."""
 TREND_K = 5.0

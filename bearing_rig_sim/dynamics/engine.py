@@ -141,8 +141,11 @@ class ChunkAverage:
     speed (rad/s) over ``duration`` (s), and the work the drive did on the inner ring over it,
     ``drive_work`` (J: the integral of :meth:`BearingDynamics.drive_torque` times the inner-ring
     speed, step by step), the heat the bearing dissipated over it, ``heat`` (J: the integral of
-    :meth:`BearingDynamics.power_loss`, step by step), and ``damping_heat`` (J: the pocket
-    and land contacts' Hunt-Crossley damping and the cage rim's damping, reduced model)."""
+    :meth:`BearingDynamics.power_loss`, step by step), ``damping_heat`` (J: the pocket
+    contacts' Hunt-Crossley damping, the cage rim's damping and, reduced model, the guiding
+    land's work on the moving cage centre: film squeeze and whirl, contact damping and
+    friction) and ``contact_damping_heat`` (J: the raceway contacts' Hunt-Crossley damping,
+    stiff model; the reduced model's normal contacts are quasi-static)."""
 
     duration: float
     cage_speed: float
@@ -150,6 +153,7 @@ class ChunkAverage:
     drive_work: float = 0.0
     heat: float = 0.0
     damping_heat: float = 0.0
+    contact_damping_heat: float = 0.0
 
 
 def _finite(name: str, value: float, lo: float | None = None) -> float:
@@ -205,8 +209,9 @@ class BearingDynamics:
         self.out = np.zeros((z, kn.NO))
         self.stats = np.zeros(kn.NS)
         self.dissipated = 0.0
-        """Heat dissipated since the engine was built, J (:attr:`ChunkAverage.heat` and
-        :attr:`ChunkAverage.damping_heat` summed over every :meth:`advance`)."""
+        """Heat dissipated since the engine was built, J (:attr:`ChunkAverage.heat`,
+        :attr:`ChunkAverage.damping_heat` and :attr:`ChunkAverage.contact_damping_heat` summed
+        over every :meth:`advance`)."""
         self.damping_dissipated = 0.0
         """The damping's share of :attr:`dissipated`, J."""
         self.work = np.zeros((z, kn.NW))
@@ -431,10 +436,10 @@ class BearingDynamics:
         t = self.stats[kn.S_TIME]
         if t <= 0.0:
             return ChunkAverage(0.0, self.cage_speed, self.inner_ring_speed)
-        heat, damping = float(self.stats[kn.S_HEAT]), float(self.stats[kn.S_DAMP])
-        self.dissipated += heat + damping
+        heat, damping, contact = float(self.stats[kn.S_HEAT]), float(self.stats[kn.S_DAMP]), float(self.stats[kn.S_CONTACT_DAMP])
+        self.dissipated += heat + damping + contact
         self.damping_dissipated += damping
-        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t, float(self.stats[kn.S_DRIVE]), heat, damping)
+        return ChunkAverage(t, self.stats[kn.S_CAGE] / t, self.stats[kn.S_INNER] / t, float(self.stats[kn.S_DRIVE]), heat, damping, contact)
 
     def check_state(self) -> None:
         """Raise if the state is one no bearing can be in (a numerical fault).

@@ -120,8 +120,9 @@ NO = 11
 S_CAGE, S_INNER, S_TIME = 0, 1, 2
 S_DRIVE = 3  # drive work, J
 S_HEAT = 4  # heat dissipated (the engine's power loss, step by step), J
-S_DAMP = 5  # heat of the pocket and land contacts' Hunt-Crossley damping and the cage rim's damping, J
-NS = 6
+S_DAMP = 5  # heat of the pocket contacts' Hunt-Crossley damping, the cage rim's damping and the land's work on the moving cage centre, J
+S_CONTACT_DAMP = 6  # heat of the raceway contacts' Hunt-Crossley damping (stiff model), J
+NS = 7
 G_QI, G_QO, G_NIR, G_NIZ, G_NOR, G_NOZ, G_DI, G_DO = 0, 1, 2, 3, 4, 5, 6, 7
 NG = 8
 
@@ -228,6 +229,16 @@ def impact_force(x: float, xdot: float, k: float, p: np.ndarray) -> tuple[float,
     if f <= 0.0:
         return 0.0, 0.0, 0.0
     return f, 1.5 * k * sq, c
+
+
+@njit(cache=True)
+def impact_damping_power(x: float, xdot: float, force: float, k: float) -> float:
+    """Power (W) the damping of an :func:`impact_force` contact dissipates: the force beyond
+    Hertz's K x^1.5 times the penetration rate (the force never adhesive, so once the damping
+    would pull, its share is -K x^1.5 and the power still >= 0); 0 out of contact."""
+    if x <= 0.0:
+        return 0.0
+    return (force - k * x * math.sqrt(x)) * xdot
 
 
 @njit(cache=True)
@@ -1092,6 +1103,47 @@ def cage_centre_forces(p: np.ndarray, ring: np.ndarray, omega_c: float) -> tuple
 
 
 @njit(cache=True)
+def land_centre_heat(
+    p: np.ndarray,
+    cx: float,
+    cy: float,
+    cvx: float,
+    cvy: float,
+    dvx: float,
+    dvy: float,
+    dt: float,
+    fcx: float,
+    fcy: float,
+    kxx: float,
+    kxy: float,
+    kyx: float,
+    kyy: float,
+    cxx: float,
+    cxy: float,
+    cyx: float,
+    cyy: float,
+) -> float:
+    """Heat (W, over one reduced step) of the guiding land's work on the moving cage centre:
+    the film's squeeze and whirl (Ocvirk) forces and the land contact's damping and friction,
+    as the implicit step applied them (F + K dx + C dv, :func:`cage_centre_forces`, gravity
+    aside), times the centre's mean velocity over the step, with the sign of a loss; the land
+    contact's elastic force k d stores its work (:func:`mechanical_energy`) and is left out.
+    The centre's kinetic energy changes by m_c dv . (v + dv/2), so with this heat its account
+    closes to the step's rounding. Negative when the film's wedge drives the whirl (a centre
+    whirling below half the cage speed): the model takes that work from no torque on the cage."""
+    v1x, v1y = cvx + dvx, cvy + dvy
+    fx = fcx + dt * (kxx * v1x + kxy * v1y) + cxx * dvx + cxy * dvy
+    fy = fcy - p[P_CAGE_GRAV_Y] + dt * (kyx * v1x + kyy * v1y) + cyx * dvx + cyy * dvy
+    mx, my = 0.5 * (cvx + v1x), 0.5 * (cvy + v1y)
+    e = math.sqrt(cx * cx + cy * cy)
+    if e > p[P_LAND_CLEAR]:
+        elastic = p[P_LAND_K] * (e - p[P_LAND_CLEAR]) / e
+        fx += elastic * cx
+        fy += elastic * cy
+    return -(fx * mx + fy * my)
+
+
+@njit(cache=True)
 def step_reduced(
     p: np.ndarray,
     ball: np.ndarray,
@@ -1173,11 +1225,6 @@ def step_reduced(
                 omega_c += cage[k, C_OMEGA]
             fcx, fcy, land_n, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy = cage_centre_forces(p, ring, omega_c / z)
             pocket_directions(cage, work[:, w0 + 20], work[:, w0 + 21], pitch_c, pitch_s)
-            ecc = math.sqrt(cx * cx + cy * cy)
-            if land_n > 0.0 and ecc > p[P_LAND_CLEAR]:
-                # the land contact's Hunt-Crossley damping k d 1.5 a_e v_r, times v_r
-                vr = (cvx * cx + cvy * cy) / ecc
-                damp += p[P_LAND_K] * (ecc - p[P_LAND_CLEAR]) * 1.5 * p[P_HC_A] * vr * vr
         else:
             ring[R_LAND_N], ring[R_LAND_F] = 0.0, 1.0
             work[:, w0 + 20] = 0.0
@@ -1306,6 +1353,7 @@ def step_reduced(
             ring[R_CVY] = cvy + dvy
             ring[R_CX] = cx + dt * ring[R_CVX]
             ring[R_CY] = cy + dt * ring[R_CVY]
+            damp += land_centre_heat(p, cx, cy, cvx, cvy, dvx, dvy, dt, fcx, fcy, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy)
             for j in range(z):
                 d_omega[j] += yx[j] * dvx + yy[j] * dvy
         cage_sum = 0.0
@@ -1381,17 +1429,25 @@ def step_stiff(
         ring_force = axial_load
         drive = 0.0
         heat = 0.0
+        damp = 0.0
+        contact_damp = 0.0
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
             rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
-            qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
-            qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
+            rate_i, rate_o = nir * vr + niz * (vz - vdelta), nor * vr + noz * vz
+            qi, _, _ = impact_force(di, rate_i, p[P_K_IN], p)
+            qo, _, _ = impact_force(do, rate_o, p[P_K_OUT], p)
+            # the raceway contacts' Hunt-Crossley damping: the force beyond Hertz's, times the rate
+            contact_damp += impact_damping_power(di, rate_i, qi, p[P_K_IN]) + impact_damping_power(do, rate_o, qo, p[P_K_OUT])
             fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
             drive += fi * r_ci
             wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
             fd, _ = ball_drag(p, rb * wm)
-            fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
+            gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
+            fs, _, _ = pocket_force(p, gap, rate)
+            x = abs(gap) - p[P_POCKET_CLEAR]
+            damp += impact_damping_power(x, rate if gap > 0.0 else -rate, abs(fs), p[P_K_POCKET])
             t_inner, m_outer, m_ring, t_orbit = contact_moments(
                 p,
                 inner_speed_scale(omega_i),
@@ -1441,7 +1497,11 @@ def step_stiff(
             torque[k] += tau
             tl, _ = cage_land_torque(p, cage[k, C_OMEGA], z)
             heat += abs(tl * cage[k, C_OMEGA])
+            dw = cage[0 if k == z - 1 else k + 1, C_OMEGA] - cage[k, C_OMEGA]
+            damp += p[P_LINK_C] * dw * dw  # the rim's damping between segments k and k+1
         stats[S_HEAT] += heat * dt
+        stats[S_DAMP] += damp * dt
+        stats[S_CONTACT_DAMP] += contact_damp * dt
         cage_sum = 0.0
         for k in range(z):
             cage[k, C_OMEGA] += dt * torque[k] / jseg
@@ -1459,10 +1519,17 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
     """Total mechanical energy (J) of the stiff model: kinetic energy of balls (orbit, radial,
     axial, spin), cage segments and the inner ring's axial motion, plus Hertz potentials
     (2/5 K x^2.5) of raceway and pocket contacts, rim strain energy and the potential
-    -F_a delta_a of the constant axial load."""
+    -F_a delta_a of the constant axial load. The reduced model's cage centre adds its kinetic
+    energy, the land contact's strain energy k d^2 / 2 and the potential of the cage's weight,
+    and moves the pockets' gaps by its offset (the stiff model's centre stays on the axis)."""
     z = ball.shape[0]
     m, ib, jseg, rm = p[P_MBALL], p[P_IBALL], p[P_JSEG], p[P_RM]
     e = 0.5 * p[P_M_INNER] * ring[R_VDELTA] ** 2 - axial_load * ring[R_DELTA]
+    cx, cy = ring[R_CX], ring[R_CY]
+    e += 0.5 * p[P_CAGE_MASS] * (ring[R_CVX] ** 2 + ring[R_CVY] ** 2) - p[P_CAGE_GRAV_Y] * cy
+    d = math.sqrt(cx * cx + cy * cy) - p[P_LAND_CLEAR]
+    if d > 0.0:
+        e += 0.5 * p[P_LAND_K] * d * d
     clear = p[P_POCKET_CLEAR]
     for j in range(z):
         rb = ball[j, B_R]
@@ -1473,7 +1540,8 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
             e += 0.4 * p[P_K_IN] * di**2.5
         if do > 0.0:
             e += 0.4 * p[P_K_OUT] * do**2.5
-        x = abs(rm * (ball[j, B_THETA] - cage[j, C_PHI])) - clear
+        phi = cage[j, C_PHI]
+        x = abs(rm * (ball[j, B_THETA] - phi) - (cy * math.cos(phi) - cx * math.sin(phi))) - clear
         if x > 0.0:
             e += 0.4 * p[P_K_POCKET] * x**2.5
         e += 0.5 * jseg * cage[j, C_OMEGA] ** 2

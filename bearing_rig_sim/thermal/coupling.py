@@ -94,11 +94,15 @@ TABLE_STEP_K = 5.0
 """Spacing of the temperature grid of the coupled engine's traction tables, K (grid points at
 whole multiples). The table's values move smoothly with the base oil's viscosity: between two
 grid points the engine's table is their linear blend."""
-TABLE_SLICE_S = 0.01
+TABLE_SLICE_S = 0.1
 """Simulated time between two slices of a table under construction, s: a slice
-(:data:`SRR_PER_SLICE` ellipse integrations) costs about a millisecond, so a table
-(2 x 12 x 12 x 4 slices) takes about 11.5 s of simulated time and its building adds about a
-tenth to a 1 ms chunk's cost while it lasts."""
+(:data:`SRR_PER_SLICE` ellipse integrations) costs one to two milliseconds, about five 1 ms
+chunks of the reduced engine, so a table (2 x 12 x 12 x 4 slices) takes about 115 s of
+simulated time and its building adds about 5 % to the engine's time while it lasts (a slice
+every 0.01 s added 40-58 %: ``bearing-rig bench thermal``, ``table_build_pct``). The lubricant
+moves 5 K (:data:`TABLE_STEP_K`) in a few minutes once the bearing's own bodies have warmed
+(the housing's time constant is about 20 minutes, docs/thermal.md), so the grid keeps up; in
+the first seconds of a warm-up the nearest built table stands in."""
 
 
 SRR_PER_SLICE = 25

@@ -402,8 +402,9 @@ class BearingDynamics:
             self.radial_angle = _finite("radial_angle", radial_angle)
         accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
         n = int(round(duration / self.time_step))
-        if accel < 0.0:
-            n = min(n, int(self.ring[kn.R_OMEGA] / (-accel * self.time_step)))
+        slowing = -accel * self.time_step  # 0 for a subnormal deceleration
+        if slowing * n > self.ring[kn.R_OMEGA]:
+            n = int(self.ring[kn.R_OMEGA] / slowing)
         self.stats[:] = 0.0
         if n > 0:
             self._step(

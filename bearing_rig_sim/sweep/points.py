@@ -38,7 +38,7 @@ from bearing_rig_sim.dynamics.steady import (
     solver_for,
 )
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, SPEED_AXIS
+from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, MOMENT_AXIS, RADIAL_AXIS, SPEED_AXIS
 
 KIND_ROLLING_START = ORIGIN_ROLLING_START
 KIND_CONTINUATION = ORIGIN_CONTINUATION
@@ -171,12 +171,28 @@ def _fill(row: dict[str, Any], result: SteadyPoint) -> dict[str, Any]:
     return row
 
 
+def combined_load(point: dict[str, float]) -> tuple[float, tuple[float, float] | None] | None:
+    """The point's radial load (N, along x) and moment ((M_x, 0) N m, tilts free; None: held),
+    or None for a purely axial point."""
+    if RADIAL_AXIS not in point and MOMENT_AXIS not in point:
+        return None
+    moment = (float(point[MOMENT_AXIS]), 0.0) if MOMENT_AXIS in point else None
+    return float(point.get(RADIAL_AXIS, 0.0)), moment
+
+
 def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str, Any]:
     row = _base_row(point, key, KIND_ROLLING_START)
     try:
         solver = solver_for(parameters_for(task.params, point))
         omega = rpm_to_rad_s(point[SPEED_AXIS])
-        result = solver.integrate(omega, point[LOAD_AXIS]) if task.method == INTEGRATE else solver.solve(omega, point[LOAD_AXIS])
+        combined = combined_load(point)
+        if combined is not None and (combined[0] > 0.0 or combined[1] is not None):
+            # periodic at the ball-pass frequency: integrated and averaged over whole periods (either method)
+            result = solver.periodic(omega, point[LOAD_AXIS], combined[0], moment=combined[1])
+        elif task.method == INTEGRATE:
+            result = solver.integrate(omega, point[LOAD_AXIS])
+        else:
+            result = solver.solve(omega, point[LOAD_AXIS])
     except (RigError, ValueError, ArithmeticError) as exc:
         row["error"] = str(exc) or type(exc).__name__
         return row

@@ -71,6 +71,11 @@ def test_heat_under_a_radial_load_exceeds_the_axial_only_heat_and_grows_with_it(
     assert [r["method"] for r in rows] == ["newton", "integration-periodic", "integration-periodic"]
     power = [r["power_w"] for r in rows]
     assert power[0] < power[1] < power[2]
+    # the load distribution: at 500 N Stribeck/Sjovall's half-loaded ring, Q_max = 4.37 F_r /
+    # (Z cos 15 deg) = 141.4 N within 3 %, 7 to 9 of the 16 balls loaded (the two at 90 deg
+    # from the load on the zone's edge); under the axial load alone every ball alike
+    assert rows[2]["ball_load_max_n"] == pytest.approx(4.37 * 500.0 / (16 * math.cos(math.radians(15.0))), rel=0.03)
+    assert 7 <= rows[2]["loaded_balls"] <= 9 and rows[0]["loaded_balls"] == 16
     assert all(r["torque_n_m"] * 900.0 * math.pi / 30.0 == pytest.approx(r["power_w"], rel=1e-9) for r in rows)
 
 

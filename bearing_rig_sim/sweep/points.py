@@ -37,6 +37,7 @@ from bearing_rig_sim.dynamics.steady import (
     SteadyPoint,
     solver_for,
 )
+from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, MOMENT_AXIS, RADIAL_AXIS, SPEED_AXIS
 
@@ -69,11 +70,16 @@ COLUMNS: dict[str, str] = {
     "stable": "bool_",
     "time_to_stable_s": "float64",
     "peak_slip_pct": "float64",
+    "ball_load_max_n": "float64",
+    "loaded_balls": "int64",
     "error": "string",
 }
 """Result columns (besides one float64 column per axis) and their Arrow types. ``branch`` is
 how the point was reached (``rolling_start``, ``continuation`` or ``transient``); ``state`` is
-``rolling`` or ``skid``; ``error`` is empty unless the point could not be computed."""
+``rolling`` or ``skid``; ``ball_load_max_n`` and ``loaded_balls`` are the quasi-static load
+distribution at the point's speed (dynamics/quasi_static.py, as ``predict --radial-load``
+gives it) on the steady points of a spec with a ``radial_load_n`` or ``moment_n_m`` axis (NaN
+and 0 elsewhere); ``error`` is empty unless the point could not be computed."""
 
 
 @dataclass(frozen=True)
@@ -149,6 +155,8 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
         "stable": False,
         "time_to_stable_s": math.nan,
         "peak_slip_pct": math.nan,
+        "ball_load_max_n": math.nan,
+        "loaded_balls": 0,
         "error": "",
     }
     row.update({k: float(v) for k, v in point.items()})
@@ -193,6 +201,10 @@ def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str,
             result = solver.integrate(omega, point[LOAD_AXIS])
         else:
             result = solver.solve(omega, point[LOAD_AXIS])
+        if combined is not None:
+            case = LoadCase(point[LOAD_AXIS], combined[0], combined[1], inner_ring_speed=omega)
+            distribution = QuasiStaticBearing(solver.params).solve(case)
+            row.update(ball_load_max_n=distribution.ball_load_max, loaded_balls=distribution.loaded_balls)
     except (RigError, ValueError, ArithmeticError) as exc:
         row["error"] = str(exc) or type(exc).__name__
         return row

@@ -44,12 +44,13 @@ def assert_physical(engine: BearingDynamics, peak: float) -> None:
     assert engine.cage_speed <= ROLLING_BOUND * peak + TOLERANCE, (engine.time, engine.cage_speed, peak)
 
 
-def run_up(engine: BearingDynamics, target: float, acceleration: float, load: float) -> float:
-    """Accelerate in 1 ms chunks to ``target`` (rad/s), checking the bounds; returns the peak."""
+def run_up(engine: BearingDynamics, target: float, acceleration: float, load: float, radial: float = 0.0) -> float:
+    """Accelerate in 1 ms chunks to ``target`` (rad/s) under ``load`` N axial and ``radial`` N
+    radial (the engine's moment and load azimuth as set), checking the bounds; returns the peak."""
     peak = engine.inner_ring_speed
     while engine.inner_ring_speed < target - 1e-9:
         step = min(CHUNK, (target - engine.inner_ring_speed) / acceleration)
-        engine.advance(step if step >= engine.time_step else engine.time_step, axial_load=load, inner_ring_acceleration=acceleration)
+        engine.advance(step if step >= engine.time_step else engine.time_step, axial_load=load, inner_ring_acceleration=acceleration, radial_load=radial)
         peak = max(peak, engine.inner_ring_speed)
         assert_physical(engine, peak)
     return peak
@@ -112,3 +113,45 @@ def test_stop_to_rest_and_restart(params: BearingParameters) -> None:
         assert_physical(engine, peak)
     assert abs(engine.cage_speed) < TOLERANCE
     run_up(engine, 100.0, 500.0, 1000.0)
+
+
+@pytest.mark.parametrize("moment", [None, (2.0, 0.5)])
+def test_run_up_from_rest_under_combined_load(params: BearingParameters, moment: tuple[float, float] | None) -> None:
+    """Started at rest under 163 N axial, 500 N radial at 0.4 rad and (tilts free) a moment of
+    (2.0, 0.5) N m, as the simulator starts the twin: 0.05 s at rest, a run-up at the rig's
+    largest acceleration (1000 rad/s^2) to 3000 rpm and 0.1 s of hold, within the bounds
+    throughout; at the end the cage turns between rest and pure rolling at the largest loaded
+    contact angle (under 25 deg: docs/model.md, Contacts)."""
+    engine = BearingDynamics(params)
+    engine.initialise(0.0, 163.0, radial_load=500.0, radial_angle=0.4, moment=moment)
+    for _ in range(50):
+        engine.advance(CHUNK)
+        assert_physical(engine, 0.0)
+    peak = run_up(engine, 3000 * RPM, 1000.0, 163.0, 500.0)
+    for _ in range(100):
+        engine.advance(CHUNK)
+        assert_physical(engine, peak)
+    assert 0.0 < engine.cage_speed < 0.5 * (1.0 - 0.0063 * math.cos(math.radians(25.0)) / 0.04245) * peak
+
+
+def test_load_change_at_rest_then_run_up_under_radial_load(params: BearingParameters) -> None:
+    """The issue's axial case with a radial load and a moment: started at rest under 100 N
+    axial and 200 N radial, both raised at rest over 0.2 s to 200 N and 600 N while the load
+    turns by 1 rad and a moment of (1.5, -1.0) N m is applied, held at rest to 0.5 s, then a
+    run-up at 20 rad/s^2 for 0.5 s in 1 ms chunks (the issue's slow start, where the axial
+    case diverged) and at 1000 rad/s^2 on to 3000 rpm: within the bounds throughout, and the
+    cage follows the ring (faster than a fifth of pure rolling after the slow part)."""
+    engine = BearingDynamics(params)
+    engine.initialise(0.0, 100.0, radial_load=200.0)
+    engine.set_moment((1.5, -1.0))
+    for i in range(200):
+        f = (i + 1) / 200
+        engine.advance(CHUNK, axial_load=100.0 + 100.0 * f, radial_load=200.0 + 400.0 * f, radial_angle=f)
+        assert_physical(engine, 0.0)
+    for _ in range(300):
+        engine.advance(CHUNK)
+        assert_physical(engine, 0.0)
+    peak = run_up(engine, 10.0, 20.0, 200.0, 600.0)
+    assert engine.cage_speed > 0.2 * ROLLING_RATIO * peak
+    peak = run_up(engine, 3000 * RPM, 1000.0, 200.0, 600.0)
+    assert engine.time == pytest.approx(1.0 + (3000 * RPM - 10.0) / 1000.0, abs=2e-3)

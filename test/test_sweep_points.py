@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -10,6 +11,7 @@ from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.sweep.points import (
     INTEGRATE,
+    KIND_CONTINUATION,
     KIND_ROLLING_START,
     KIND_TRANSIENT,
     SweepTask,
@@ -17,6 +19,8 @@ from bearing_rig_sim.sweep.points import (
     parameters_for,
     point_key,
 )
+from bearing_rig_sim.sweep.runner import base_parameters, plan_tasks
+from bearing_rig_sim.sweep.spec import load_spec
 
 
 @pytest.fixture(scope="module")
@@ -52,6 +56,40 @@ def test_more_ball_drag_means_more_slip_at_the_same_point(params: BearingParamet
     slips = [r["slip_pct"] for r in rows]
     assert all(r["error"] == "" for r in rows)
     assert slips[0] < slips[1] < slips[2]
+
+
+def test_heat_under_a_radial_load_exceeds_the_axial_only_heat_and_grows_with_it(params: BearingParameters) -> None:
+    """900 rpm, 163 N axial, radial loads 0, 250 and 500 N (163 N = 1.216 x 500 N x tan 15 deg:
+    at 500 N Stribeck's half-loaded ring, the loaded balls carrying up to 141 N against 35 N
+    each under the axial load alone): more contact load and a cage pushed into its land
+    dissipate more, so the power (the friction torque times the speed, at the same axial load)
+    rises with the radial load. The radial points are periodic steady states, averaged over
+    whole ball-pass periods; the axial one is the direct solve's."""
+    points = [{"inner_ring_speed_rpm": 900.0, "axial_load_n": 163.0, "radial_load_n": f} for f in (0.0, 250.0, 500.0)]
+    rows = evaluate(task(params, KIND_ROLLING_START, points))
+    assert all(r["error"] == "" for r in rows)
+    assert [r["method"] for r in rows] == ["newton", "integration-periodic", "integration-periodic"]
+    power = [r["power_w"] for r in rows]
+    assert power[0] < power[1] < power[2]
+    # the load distribution: at 500 N Stribeck/Sjovall's half-loaded ring, Q_max = 4.37 F_r /
+    # (Z cos 15 deg) = 141.4 N within 3 %, 7 to 9 of the 16 balls loaded (the two at 90 deg
+    # from the load on the zone's edge); under the axial load alone every ball alike
+    assert rows[2]["ball_load_max_n"] == pytest.approx(4.37 * 500.0 / (16 * math.cos(math.radians(15.0))), rel=0.03)
+    assert 7 <= rows[2]["loaded_balls"] <= 9 and rows[0]["loaded_balls"] == 16
+    assert all(r["torque_n_m"] * 900.0 * math.pi / 30.0 == pytest.approx(r["power_w"], rel=1e-9) for r in rows)
+
+
+def test_combined_load_rows_are_not_followed_by_continuation(tmp_path: Path) -> None:
+    """A continuation row starts each load from the previous steady state of the four-number
+    solve: only the axial points of a spec with a radial-load axis are followed."""
+    text = "sweep: {name: t, continuation: true}\ngrid: {inner_ring_speed_rpm: [900], axial_load_n: [100, 200], radial_load_n: [0, 300]}\n"
+    path = tmp_path / "spec.yaml"
+    path.write_text(text, encoding="utf-8")
+    spec = load_spec(path)
+    tasks = plan_tasks(spec, base_parameters(spec), set())
+    followed = [p for t in tasks if t.kind == KIND_CONTINUATION for p in t.points]
+    assert len(followed) == 2 and all(p["radial_load_n"] == 0.0 for p in followed)
+    assert sum(len(t.points) for t in tasks if t.kind == KIND_ROLLING_START) == 4
 
 
 def test_integrate_method_rows_say_how_they_were_computed(params: BearingParameters) -> None:

@@ -59,6 +59,25 @@ def test_speed_and_acceleration_together_are_refused(tmp_path: Path) -> None:
         load_spec(path)
 
 
+def test_a_combined_load_needs_steady_points(tmp_path: Path) -> None:
+    path = write(tmp_path, HEAD + "grid: {inner_ring_acceleration_rad_s2: [20], axial_load_n: [200], radial_load_n: [100]}\n")
+    with pytest.raises(ConfigError, match="radial_load_n needs steady points"):
+        load_spec(path)
+
+
+def test_radial_load_and_moment_axes_cross_the_grid(tmp_path: Path) -> None:
+    text = HEAD + "grid: {inner_ring_speed_rpm: [900, 2700], axial_load_n: [163], radial_load_n: [0, 250, 500]}\n"
+    text += "samples: {method: sobol, count: 2, ranges: {moment_n_m: [-2, 2]}}\n"
+    spec = load_spec(write(tmp_path, text))
+    assert len(spec.points()) == 2 * 3 * 2
+    assert spec.axis_names == ("inner_ring_speed_rpm", "axial_load_n", "radial_load_n", "moment_n_m")
+    assert not spec.transient
+    bad = HEAD + "grid: {inner_ring_speed_rpm: [900], axial_load_n: [163], radial_load_n: [-1]}\n"
+    with pytest.raises(ConfigError) as info:
+        load_spec(write(tmp_path, bad))
+    assert info.value.key == "grid.radial_load_n[0]"
+
+
 def test_a_bad_sample_range_is_refused_naming_the_key(tmp_path: Path) -> None:
     text = HEAD + "grid: {inner_ring_speed_rpm: [1000], axial_load_n: [100]}\n"
     text += "samples: {method: sobol, count: 4, ranges: {ball_diameter_m: [0.0063, 0.0063]}}\n"

@@ -20,8 +20,11 @@ distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max
 the engine's under the combined load, averaged over whole ball-pass periods (the steady state is
 periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`), with
 ``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end (and no
-uncertainty interval: the calibration's is an axial-load one). ``--thermal`` and
-``--transient`` take the axial load only.
+uncertainty interval: the calibration's is an axial-load one). With ``--thermal`` such a
+point is the coupled thermal steady state of that periodic state (its heat the mean over the
+window's whole ball-pass periods; the network's conductances those of the axial load), its
+``isothermal`` values the periodic state at the bearing file's temperature. ``--transient``
+takes the axial load only.
 """
 
 from __future__ import annotations
@@ -94,8 +97,10 @@ def run(args: argparse.Namespace) -> int:
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)
     radial = _radial_loads(args)
     params = load_parameters(args.bearing, args.calibration, args.lubricant)
+    if args.transient is not None and radial is not None:
+        raise RigError("--transient takes the axial load only: give --thermal for the steady state under --radial-load")
     if args.thermal or args.transient is not None:
-        return _run_thermal(args, params, loads)
+        return _run_thermal(args, params, loads, radial)
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
     unc = _uncertainty(args)
     for k, s in enumerate(states):
@@ -171,20 +176,23 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
     print(line)
 
 
-def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: list[float]) -> int:
+def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: list[float], radial: list[float] | None = None) -> int:
     from bearing_rig_sim.config import rad_s_to_rpm
     from bearing_rig_sim.studies.calibration import SteadyState
     from bearing_rig_sim.thermal.bearing import ThermalConfig
     from bearing_rig_sim.thermal.coupling import params_at_temperature, thermal_steady_state, warm_up
 
     cfg = ThermalConfig.from_yaml(args.bearing)
-    for n, f in zip(args.rpm, loads):
+    moment = None if args.moment is None else (float(args.moment[0]), float(args.moment[1]))
+    for k, (n, f) in enumerate(zip(args.rpm, loads)):
         omega = rpm_to_rad_s(n)
         if args.transient is not None:
             for r in warm_up(params, cfg, omega, f, args.transient, step=args.transient_step):
                 _print({"rpm": n, "axial_load_n": f, **r}, args.json)
             continue
-        ts = thermal_steady_state(params, cfg, omega, f)
+        f_r = radial[k] if radial is not None else 0.0
+        combined = radial is not None and (f_r > 0.0 or moment is not None)
+        ts = thermal_steady_state(params, cfg, omega, f, radial_load=f_r, moment=moment) if combined else thermal_steady_state(params, cfg, omega, f)
         pt = ts.point
         s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
         row: dict[str, Any] = dict(s.as_row())
@@ -202,19 +210,22 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
         }
         row["time_constants_s"] = [round(t, 1) for t in ts.time_constants[:3]]
         row["thermal_residual_k"] = round(ts.residual_k, 3)
-        unc = _uncertainty(args)
+        unc = None if combined else _uncertainty(args)  # the calibration's interval is an axial-load one
         if unc is not None:
             if _thermal_calibration(args):
                 # fitted through the thermal steady states: so are the interval's gradients
                 _add_interval(row, params, unc, omega, f, pt.slip_pct, cfg)
             else:
                 _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
-        iso = steady_states(params, [(omega, f)], workers=1)[0]
-        row["isothermal"] = {
-            "temperature_c": params.lubricant_temperature,
-            "slip_pct": round(iso.slip_pct, 4),
-            "friction_torque_nm": round(iso.friction_torque, 6),
-        }
+        if combined:
+            iso_pt = solver_for(params).periodic(omega, f, f_r, moment=moment)
+            iso_slip, iso_torque = iso_pt.slip_pct, iso_pt.torque
+        else:
+            iso = steady_states(params, [(omega, f)], workers=1)[0]
+            iso_slip, iso_torque = iso.slip_pct, iso.friction_torque
+        row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso_slip, 4), "friction_torque_nm": round(iso_torque, 6)}
+        if radial is not None:
+            row.update(load_distribution_row(params, omega, f, f_r, args.moment))
         _print(row, args.json)
     return 0
 

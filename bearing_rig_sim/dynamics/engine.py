@@ -303,9 +303,11 @@ class BearingDynamics:
         for _ in range(3):  # speeds and loaded angle depend on each other through centrifugal force
             # 1e-11 of the load; under a few newtons that is below the rounding of the contact
             # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there,
-            # with more iterations: at low speed the balls outside a load zone slide down the
-            # outer groove under their centrifugal force of milli-newtons, a few thousand Newton
-            # iterations from the start at 100 rpm, 40 000 at 50 rpm (one-off, 1 us each).
+            # with more iterations: between rest and 50 rpm the balls outside a load zone slide
+            # down the outer groove under centrifugal forces of micro-newtons until the inner
+            # groove wedges them (kernels.ball_jacobian), at most about 900 Newton iterations
+            # over 0-10 000 rpm, 1-1000 N axial, 0-1000 N radial, 0-5 N m (one-off, about 1 us
+            # each).
             if self._solve_normal(load, radial, angle, applied, 1e-11, 200) > 200 and self._solve_normal(load, radial, angle, applied, 1e-9, 50_000) > 50_000:
                 raise DynamicsInputError(f"no static equilibrium found for axial load {load} N, radial load {radial} N at {omega} rad/s")
             self._set_rolling_speeds(omega)
@@ -410,8 +412,9 @@ class BearingDynamics:
             self.radial_angle = _finite("radial_angle", radial_angle)
         accel = _finite("inner_ring_acceleration", inner_ring_acceleration)
         n = int(round(duration / self.time_step))
-        if accel < 0.0:
-            n = min(n, int(self.ring[kn.R_OMEGA] / (-accel * self.time_step)))
+        slowing = -accel * self.time_step  # 0 for a subnormal deceleration
+        if slowing * n > self.ring[kn.R_OMEGA]:
+            n = int(self.ring[kn.R_OMEGA] / slowing)
         self.stats[:] = 0.0
         if n > 0:
             self._step(

@@ -297,6 +297,87 @@ def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> 
 
 
 @njit(cache=True)
+def ball_jacobian(
+    p: np.ndarray,
+    qi: float,
+    qo: float,
+    di: float,
+    do: float,
+    nir: float,
+    niz: float,
+    nor: float,
+    noz: float,
+    disti: float,
+    disto: float,
+    spin2: float,
+    rb: float,
+) -> tuple:
+    """A ball's quasi-static Jacobian J = H_i + H_o + m omega^2 e_r e_r (``spin2`` = m omega^2)
+    at contact loads ``qi``, ``qo`` (N), penetrations ``di``, ``do`` (m), normals and centre
+    distances (:func:`shifted_raceway_geometry`), with the ball centre's radius ``rb`` (m).
+
+    Returns (h_rr, h_rz, h_zz, d_rr, d_rz, d_zz, j_rr, j_rz, j_zz, det): the inner contact's
+    block H_i coupling ball and ring, the ring's own stiffness D from it, and J with its
+    determinant.
+
+    A closed contact adds its normal stiffness 1.5 K sqrt(delta); so does an open one whose gap
+    is below the other contact's penetration (within a Newton step of closing), with delta at
+    least MIN_PENETRATION_FOR_JACOBIAN, as every open contact did before: a lightly loaded ball
+    at the edge of a load zone, whose contact opens by a fraction of a nanometre as the ring
+    moves, is stepped as before. A contact open by more adds nothing to the ball's J: that
+    fictitious stiffness (3e5 N/m) would dwarf the groove's tangential stiffness Q/distance
+    under a light load, and a ball outside a load zone at low speed, pressed on the outer
+    groove by a centrifugal force of micro-newtons, crept down the groove by nanometres per
+    Newton iteration (every step's 30 used up; no start found below 50 rpm under a radial load)
+    instead of reaching its equilibrium in a few tens (lower on the groove, where the inner
+    groove wedges it: at 163 N, 500 N the ball opposite the load at 6 deg on the outer
+    raceway and 30 deg on the inner, the same from 5 to 900 rpm). The ring keeps the fictitious
+    stiffness of such an inner contact in D (the ball held where it is), so its Schur system
+    stays regular when no ball touches it, and its step moves it towards the balls.
+
+    At speed, a ball on its outer contact alone has that contact's Jacobian at the load it will
+    carry, m omega^2 r_b (barely touching, its tangential stiffness would be ~0 and the step
+    along the groove unbounded), and a free ball (both contacts open) the isotropic secant
+    stiffness that carries its centrifugal force across the outer gap in one step,
+    m omega^2 r_b n_or/gap (plus m omega^2, J's own radial term). At rest a free ball keeps the
+    regularising stiffness of both contacts. A singular J (the ball on the line of the
+    curvature centres at rest, both contacts barely touching) gets a spring of 1e-6 of its
+    stiffness across that line."""
+    ki, ko = p[P_K_IN], p[P_K_OUT]
+    if di <= 0.0 and do <= 0.0 and spin2 == 0.0:
+        di = do = MIN_PENETRATION_FOR_JACOBIAN
+    regular = 1.5 * ki * math.sqrt(MIN_PENETRATION_FOR_JACOBIAN)
+    if di <= 0.0 and do <= 0.0:  # free, at speed
+        d_rr, d_rz, d_zz = contact_jacobian(0.0, regular, nir, niz, disti)
+        k = spin2 * rb * max(nor, 0.1) / max(-do, 1e-12) + spin2
+        return 0.0, 0.0, 0.0, d_rr, d_rz, d_zz, spin2 - k, 0.0, -k, k * (k - spin2)
+    if di > -max(do, MIN_PENETRATION_FOR_JACOBIAN):
+        h_rr, h_rz, h_zz = contact_jacobian(qi, 1.5 * ki * math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN)), nir, niz, disti)
+        d_rr, d_rz, d_zz = h_rr, h_rz, h_zz
+    else:
+        h_rr = h_rz = h_zz = 0.0
+        d_rr, d_rz, d_zz = contact_jacobian(0.0, regular, nir, niz, disti)
+        if spin2 > 0.0:
+            # the outer contact's Jacobian at the load it carries alone at equilibrium,
+            # m omega^2 r_b: barely touching, its tangential stiffness Q/distance is ~0
+            qo = max(qo, spin2 * rb)
+            do = max(do, (qo / ko) ** (2.0 / 3.0))
+    o_rr, o_rz, o_zz = (
+        contact_jacobian(qo, 1.5 * ko * math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN)), nor, noz, disto)
+        if do > -max(di, MIN_PENETRATION_FOR_JACOBIAN)
+        else (0.0, 0.0, 0.0)
+    )
+    j_rr, j_rz, j_zz = h_rr + o_rr + spin2, h_rz + o_rz, h_zz + o_zz
+    det = j_rr * j_zz - j_rz * j_rz
+    if abs(det) <= 1e-12 * (j_rr * j_rr + j_zz * j_zz):
+        soft = 1e-6 * (abs(j_rr) + abs(j_zz)) + 1e-12
+        j_rr -= soft
+        j_zz -= soft
+        det = j_rr * j_zz - j_rz * j_rz
+    return h_rr, h_rz, h_zz, d_rr, d_rz, d_zz, j_rr, j_rz, j_zz, det
+
+
+@njit(cache=True)
 def solve_quasi_static(
     p: np.ndarray,
     ball: np.ndarray,
@@ -340,10 +421,8 @@ def solve_quasi_static(
                 cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
                 shift = dx * cth + dy * sth
             di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
-            sdi = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN))
-            sdo = math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
-            qi = ki * di * sdi if di > 0.0 else 0.0
-            qo = ko * do * sdo if do > 0.0 else 0.0
+            qi = ki * di * math.sqrt(di) if di > 0.0 else 0.0
+            qo = ko * do * math.sqrt(do) if do > 0.0 else 0.0
             geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
             geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
             w2 = ball[j, B_OMEGA] * ball[j, B_OMEGA]
@@ -356,20 +435,7 @@ def solve_quasi_static(
                 gy += qi * nir * sth
             if it == max_iter:
                 continue
-            hirr, hirz, hizz = contact_jacobian(qi, 1.5 * ki * sdi, nir, niz, disti)
-            horr, horz, hozz = contact_jacobian(qo, 1.5 * ko * sdo, nor, noz, disto)
-            a11 = hirr + horr + m * w2
-            a12 = hirz + horz
-            a22 = hizz + hozz
-            det = a11 * a22 - a12 * a12
-            if abs(det) <= 1e-12 * (a11 * a11 + a22 * a22):
-                # both contacts barely touching along parallel normals at rest (the ball on the
-                # line of the curvature centres, no centrifugal force): free across that line;
-                # a spring of 1e-6 of the contacts' stiffness keeps the Newton step defined
-                eps = 1e-6 * (abs(a11) + abs(a22)) + 1e-12
-                a11 -= eps
-                a22 -= eps
-                det = a11 * a22 - a12 * a12
+            hirr, hirz, hizz, drr, drz, dzz, a11, a12, a22, det = ball_jacobian(p, qi, qo, di, do, nir, niz, nor, noz, disti, disto, m * w2, rb)
             # u = J^-1 f; w = J^-1 b for the ring's axial (b = -Hi e_z) and radial (-Hi e_r) moves
             ux = (a22 * fr - a12 * fz) / det
             uz = (-a12 * fr + a11 * fz) / det
@@ -382,13 +448,13 @@ def solve_quasi_static(
             ca_u = -(hirz * ux + hizz * uz)
             cr_u = -(hirr * ux + hirz * uz)
             r0 += ca_u
-            s00 += hizz + hirz * wx + hizz * wz
+            s00 += dzz + hirz * wx + hizz * wz
             if radial:
                 r1 += cr_u * cth
                 r2 += cr_u * sth
-                ca_v = hirz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
-                cr_w = hirz + hirr * wx + hirz * wz  # radial row, axial column
-                cr_v = hirr + hirr * vx + hirz * vz  # radial row, radial column
+                ca_v = drz + hirz * vx + hizz * vz  # (D - C W), axial row, radial column, per unit shift
+                cr_w = drz + hirr * wx + hirz * wz  # radial row, axial column
+                cr_v = drr + hirr * vx + hirz * vz  # radial row, radial column
                 s01 += ca_v * cth
                 s02 += ca_v * sth
                 s10 += cr_w * cth
@@ -498,9 +564,8 @@ def solve_quasi_static_tilted(
             cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
             lift = ri * (tx * cth + ty * sth)
             di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, ball[j, B_R], ball[j, B_Z], delta_a + lift, dx * cth + dy * sth)
-            root_i, root_o = math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN)), math.sqrt(max(do, MIN_PENETRATION_FOR_JACOBIAN))
-            qi = ki * di * root_i if di > 0.0 else 0.0
-            qo = ko * do * root_o if do > 0.0 else 0.0
+            qi = ki * di * math.sqrt(di) if di > 0.0 else 0.0
+            qo = ko * do * math.sqrt(do) if do > 0.0 else 0.0
             geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
             geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ] = nir, niz, nor, noz
             spin2 = m * ball[j, B_OMEGA] ** 2
@@ -515,15 +580,7 @@ def solve_quasi_static_tilted(
             if it == max_iter:
                 continue
             # the ball's 2x2 Jacobian J = H_i + H_o + m omega^2 e_r e_r and its inverse
-            h_rr, h_rz, h_zz = contact_jacobian(qi, 1.5 * ki * root_i, nir, niz, disti)
-            o_rr, o_rz, o_zz = contact_jacobian(qo, 1.5 * ko * root_o, nor, noz, disto)
-            j_rr, j_rz, j_zz = h_rr + o_rr + spin2, h_rz + o_rz, h_zz + o_zz
-            det = j_rr * j_zz - j_rz * j_rz
-            if abs(det) <= 1e-12 * (j_rr * j_rr + j_zz * j_zz):  # free across the contact line (see solve_quasi_static)
-                soft = 1e-6 * (abs(j_rr) + abs(j_zz)) + 1e-12
-                j_rr -= soft
-                j_zz -= soft
-                det = j_rr * j_zz - j_rz * j_rz
+            h_rr, h_rz, h_zz, d_rr, d_rz, d_zz, j_rr, j_rz, j_zz, det = ball_jacobian(p, qi, qo, di, do, nir, niz, nor, noz, disti, disto, spin2, ball[j, B_R])
             inv_rr, inv_rz, inv_zz = j_zz / det, -j_rz / det, j_rr / det
             # the ball's step u = J^-1 f and its response to a unit local move of the inner
             # curvature centre, axial (w = -J^-1 H_i e_z) and radial (v = -J^-1 H_i e_r)
@@ -533,8 +590,8 @@ def solve_quasi_static_tilted(
             work[j, 0], work[j, 1], work[j, 2], work[j, 3], work[j, 4], work[j, 5] = u_r, u_z, w_r, w_z, v_r, v_z
             # the ring's local balance (axial a, radial r): right side -H_i u, stiffness H_i (I + [w v])
             rho_a, rho_r = -(h_rz * u_r + h_zz * u_z), -(h_rr * u_r + h_rz * u_z)
-            k_aa, k_ar = h_zz + h_rz * w_r + h_zz * w_z, h_rz + h_rz * v_r + h_zz * v_z
-            k_ra, k_rr = h_rz + h_rr * w_r + h_rz * w_z, h_rr + h_rr * v_r + h_rz * v_z
+            k_aa, k_ar = d_zz + h_rz * w_r + h_zz * w_z, d_rz + h_rz * v_r + h_zz * v_z
+            k_ra, k_rr = d_rz + h_rr * w_r + h_rz * w_z, d_rr + h_rr * v_r + h_rz * v_z
             for k in range(5):
                 rhs[k] += ba[k] * rho_a + br[k] * rho_r
                 for c in range(5):

@@ -46,7 +46,7 @@ from numba import njit
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.engine import BearingDynamics, DynamicsInputError
+from bearing_rig_sim.dynamics.engine import BearingDynamics, ChunkAverage, DynamicsInputError
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 
 SKID_SLIP_PCT = 20.0
@@ -290,6 +290,8 @@ class SteadySolver:
         self._out = np.zeros((z, kn.NO))
         self._stats = np.zeros(kn.NS)
         self._work = np.zeros((z, kn.NW))
+        self.last_average: ChunkAverage | None = None
+        """The averaging window of the last :meth:`periodic` point (its heat among them)."""
 
     # -- public --------------------------------------------------------------------------------
     def solve(self, inner_ring_speed: float, axial_load: float, start: SteadyPoint | None = None) -> SteadyPoint:
@@ -366,6 +368,7 @@ class SteadySolver:
         e.advance(PERIODIC_SETTLE_S)
         period = 2.0 * math.pi / (self.params.ball_count * max(e.cage_speed, 1e-9))
         avg = e.advance(math.ceil(AVERAGE_S / period) * period)
+        self.last_average = avg
         x = self._vector_of_engine()
         x[2] = avg.cage_speed
         return self._engine_point(x, omega, axial_load, avg.drive_work / avg.duration, ORIGIN_ROLLING_START, METHOD_PERIODIC, 0, False)

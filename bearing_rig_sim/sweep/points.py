@@ -37,8 +37,9 @@ from bearing_rig_sim.dynamics.steady import (
     SteadyPoint,
     solver_for,
 )
+from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, SPEED_AXIS
+from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, MOMENT_AXIS, RADIAL_AXIS, SPEED_AXIS
 
 KIND_ROLLING_START = ORIGIN_ROLLING_START
 KIND_CONTINUATION = ORIGIN_CONTINUATION
@@ -69,11 +70,16 @@ COLUMNS: dict[str, str] = {
     "stable": "bool_",
     "time_to_stable_s": "float64",
     "peak_slip_pct": "float64",
+    "ball_load_max_n": "float64",
+    "loaded_balls": "int64",
     "error": "string",
 }
 """Result columns (besides one float64 column per axis) and their Arrow types. ``branch`` is
 how the point was reached (``rolling_start``, ``continuation`` or ``transient``); ``state`` is
-``rolling`` or ``skid``; ``error`` is empty unless the point could not be computed."""
+``rolling`` or ``skid``; ``ball_load_max_n`` and ``loaded_balls`` are the quasi-static load
+distribution at the point's speed (dynamics/quasi_static.py, as ``predict --radial-load``
+gives it) on the steady points of a spec with a ``radial_load_n`` or ``moment_n_m`` axis (NaN
+and 0 elsewhere); ``error`` is empty unless the point could not be computed."""
 
 
 @dataclass(frozen=True)
@@ -149,6 +155,8 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
         "stable": False,
         "time_to_stable_s": math.nan,
         "peak_slip_pct": math.nan,
+        "ball_load_max_n": math.nan,
+        "loaded_balls": 0,
         "error": "",
     }
     row.update({k: float(v) for k, v in point.items()})
@@ -171,12 +179,32 @@ def _fill(row: dict[str, Any], result: SteadyPoint) -> dict[str, Any]:
     return row
 
 
+def combined_load(point: dict[str, float]) -> tuple[float, tuple[float, float] | None] | None:
+    """The point's radial load (N, along x) and moment ((M_x, 0) N m, tilts free; None: held),
+    or None for a purely axial point."""
+    if RADIAL_AXIS not in point and MOMENT_AXIS not in point:
+        return None
+    moment = (float(point[MOMENT_AXIS]), 0.0) if MOMENT_AXIS in point else None
+    return float(point.get(RADIAL_AXIS, 0.0)), moment
+
+
 def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str, Any]:
     row = _base_row(point, key, KIND_ROLLING_START)
     try:
         solver = solver_for(parameters_for(task.params, point))
         omega = rpm_to_rad_s(point[SPEED_AXIS])
-        result = solver.integrate(omega, point[LOAD_AXIS]) if task.method == INTEGRATE else solver.solve(omega, point[LOAD_AXIS])
+        combined = combined_load(point)
+        if combined is not None and (combined[0] > 0.0 or combined[1] is not None):
+            # periodic at the ball-pass frequency: integrated and averaged over whole periods (either method)
+            result = solver.periodic(omega, point[LOAD_AXIS], combined[0], moment=combined[1])
+        elif task.method == INTEGRATE:
+            result = solver.integrate(omega, point[LOAD_AXIS])
+        else:
+            result = solver.solve(omega, point[LOAD_AXIS])
+        if combined is not None:
+            case = LoadCase(point[LOAD_AXIS], combined[0], combined[1], inner_ring_speed=omega)
+            distribution = QuasiStaticBearing(solver.params).solve(case)
+            row.update(ball_load_max_n=distribution.ball_load_max, loaded_balls=distribution.loaded_balls)
     except (RigError, ValueError, ArithmeticError) as exc:
         row["error"] = str(exc) or type(exc).__name__
         return row

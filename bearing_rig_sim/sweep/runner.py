@@ -32,6 +32,7 @@ from bearing_rig_sim.sweep.points import (
     KIND_TRANSIENT,
     SOLVE,
     SweepTask,
+    combined_load,
     evaluate,
     point_key,
     solver_for,
@@ -130,8 +131,13 @@ def plan_tasks(spec: SweepSpec, params: BearingParameters, done: set[str], metho
             )
         )
     if spec.continuation and method == SOLVE:
+        # a load row followed upwards from the previous steady state: the four-number solve's, so
+        # axial points only (a combined load's steady state is periodic, from the rolling start)
         rows: dict[str, list[dict[str, float]]] = defaultdict(list)
         for p in points:
+            combined = combined_load(p)
+            if combined is not None and (combined[0] > 0.0 or combined[1] is not None):
+                continue
             rows[json.dumps({k: v for k, v in sorted(p.items()) if k != LOAD_AXIS})].append(p)
         for j, row in enumerate(rows.values()):
             row.sort(key=lambda q: q[LOAD_AXIS])

@@ -463,10 +463,15 @@ MAX_LUBRICANT_C = 200.0
 
 class _HeatAtTemperature:
     """The engine's steady heat at a lubricant temperature, cached (each costs a traction table
-    and a steady solution: about a second or two)."""
+    and a steady solution: about a second or two). Under a radial load (or a moment) the steady
+    state is periodic (:meth:`SteadySolver.periodic`): its heat is the mean over the whole
+    ball-pass periods of its window, split in the proportions of the window's last step."""
 
-    def __init__(self, params: BearingParameters, inner_ring_speed: float, axial_load: float) -> None:
+    def __init__(
+        self, params: BearingParameters, inner_ring_speed: float, axial_load: float, radial_load: float = 0.0, moment: tuple[float, float] | None = None
+    ) -> None:
         self.params, self.speed, self.load = params, inner_ring_speed, axial_load
+        self.radial, self.moment = radial_load, moment
         self.cache: dict[float, tuple[SteadyPoint, HeatSources]] = {}
 
     def __call__(self, temperature_c: float) -> tuple[SteadyPoint, HeatSources]:
@@ -484,8 +489,15 @@ class _HeatAtTemperature:
                     warm = warm.replace(reduced_time_step=0.5 * warm.reduced_time_step)
             else:
                 raise StepLimitError(f"no stable step for {self.params.source} with the lubricant at {key:g} degC")
-            point = solver.solve(self.speed, self.load)
-            got = self.cache[key] = (point, heat_sources(solver.engine))
+            if self.radial > 0.0 or self.moment is not None:
+                point = solver.periodic(self.speed, self.load, self.radial, moment=self.moment)
+                window = solver.last_average
+                assert window is not None and window.duration > 0.0
+                sources = heat_sources(solver.engine).scaled(window.heat / window.duration, window.damping_heat / window.duration)
+            else:
+                point = solver.solve(self.speed, self.load)
+                sources = heat_sources(solver.engine)
+            got = self.cache[key] = (point, sources)
         return got
 
 
@@ -497,12 +509,22 @@ def _steady_temperatures(
 
 
 def thermal_steady_state(
-    params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, *, tolerance_k: float = 0.2, max_iter: int = 10
+    params: BearingParameters,
+    config: ThermalConfig,
+    inner_ring_speed: float,
+    axial_load: float,
+    *,
+    tolerance_k: float = 0.2,
+    max_iter: int = 10,
+    radial_load: float = 0.0,
+    moment: tuple[float, float] | None = None,
 ) -> ThermalSteadyState:
     """The steady state where the dissipation at the lubricant temperature T heats the network to
     T: the root of g(T) = T_lub,ss(heat(T)) - T by secant steps from the bearing file's
-    temperature (g falls with T: warmer lubricant, less heat)."""
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load)
+    temperature (g falls with T: warmer lubricant, less heat). With ``radial_load`` (N) or
+    ``moment`` (N m, tilts free) the engine's steady state is the periodic one under the
+    combined load; the network's conductances stay those of the axial load."""
+    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     lub_i = 4  # "lubricant" in NODES
 
     def g(t: float) -> float:

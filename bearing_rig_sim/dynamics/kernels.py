@@ -7,7 +7,9 @@ Conventions (every kernel):
 * ``ball``: shape (Z, NB), one row per ball, columns ``B_*``: orbital angle theta (rad), orbital
   speed omega_m (rad/s), spin omega_a (rad/s, absolute angular velocity component along the
   ball's rolling axis), ball-centre radius r_b and axial position z_b (m), radial and axial
-  velocity (m/s; stiff model only).
+  velocity (m/s; stiff model only), pivot omega_t (rad/s: absolute angular velocity component
+  along e_t, perpendicular to the rolling axis and the orbit radius, the direction of the
+  gyroscopic moment).
 * ``cage``: shape (Z, NC), one row per cage segment (pocket), columns ``C_*``: angle phi (rad),
   speed Omega (rad/s).
 * ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
@@ -29,7 +31,10 @@ direction of rotation. The outer ring is fixed; the axial load pushes the inner 
 Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer).
 Ball attitude: the rolling axis lies in the r-z plane at the pitch angle beta with
 tan(beta) = sin(alpha)/(cos(alpha) + gamma) (Harris and Kotzalas), alpha the mean loaded contact
-angle; gyroscopic pivoting is suppressed (the axis does not yaw).
+angle (fixed pitch: the ball's angular velocity relative to the orbiting frame has no component
+along the third direction of the r-z plane). The pivot omega_t is dynamic: the rotating frame's
+gyroscopic moment J omega_m omega_roll sin(beta) drives it and the transverse tractions of both
+raceway contacts resist it (:func:`sliding_traction`).
 
 Cage slip is not computed anywhere here: the cage speed results from integrating the
 ball-pocket, rim and land forces, and the ball speeds from the raceway tractions.
@@ -42,7 +47,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_power, table_power
+from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_full, table_power
 
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
@@ -105,8 +110,8 @@ P_LAND_MU = 56  # cage-land contact friction coefficient, 1
 P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
 P_SIZE = 58
 
-B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
-NB = 7
+B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT = 0, 1, 2, 3, 4, 5, 6, 7
+NB = 8
 C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
@@ -180,18 +185,6 @@ def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, 
         return mu, slope / ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
     return mu, dmu, 0.0
-
-
-@njit(cache=True, inline="always")
-def contact_traction_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
-    """:func:`contact_traction` and :func:`contact_power` together (one table lookup): traction
-    coefficient, d mu/ds (s/m), Houpert rolling force (N) and dissipated power (W)."""
-    if p[P_FRIC_MODEL] == 2.0:
-        ue = max(entrainment, 1e-3)
-        mu, slope, rolling, pw = table_lookup_power(p, int(p[P_TABLE]), contact, s / ue, ue, load)
-        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue
-    mu, dmu = traction_coefficient(p, s, entrainment)
-    return mu, dmu, 0.0, abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -857,15 +850,45 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
 
 
 @njit(cache=True, inline="always")
+def sliding_traction(p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float) -> tuple[float, float, float, float, float]:
+    """:func:`contact_traction` and :func:`contact_power` together (one table pass) of a raceway
+    contact sliding at ``s`` (m/s, rolling direction) and ``st`` (m/s, transverse: the ball's
+    pivot r omega_t), with the transverse traction coefficient per unit transverse sliding k_t
+    (s/m): (mu, d mu/ds, Houpert rolling force N, power W, k_t). The transverse traction is the law applied to the magnitude of the
+    sliding vector |s_v| = sqrt(s^2 + st^2) along the sliding, mu_t = mu(|s_v|) st/|s_v| = k_t st,
+    as a rheological film carries its shear stress along its shear; mu is the law's odd part
+    (:func:`.traction.table_lookup_full`: the rheology table's offset at SRR = 0, from spin and
+    Heathcote slip, acts in the rolling direction only, which keeps the law of s), and k_t is at
+    most the law's steepest slope. One table pass for both."""
+    smag = math.sqrt(s * s + st * st)
+    cap = slope_cap(p, entrainment)
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        mu, slope, rolling, pw, odd = table_lookup_full(p, int(p[P_TABLE]), contact, s / ue, smag / ue, ue, load)
+        kt = min(odd / smag, cap) if smag > 1e-12 else cap
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue, kt
+    mu, dmu = traction_coefficient(p, s, entrainment)
+    kt = cap
+    if smag > 1e-12:
+        mut, _ = traction_coefficient(p, smag, entrainment)
+        kt = min(abs(mut) / smag, cap)
+    return mu, dmu, 0.0, abs(mu * load * s), kt
+
+
+@njit(cache=True, inline="always")
 def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
     """Raceway tractions of ball j (shared by both models).
 
     Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
-    po, fri): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at
-    >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
+    po, fri, k_pivot): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m,
+    clipped at >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
     :func:`ball_kinematics`, the sum of the two contacts' Houpert rolling forces (N; model 2
-    only, else 0), the two contacts' dissipated power (W, :func:`contact_power`) and the inner
-    contact's rolling force (N).
+    only, else 0), the two contacts' dissipated power in the rolling direction (W,
+    :func:`contact_power`), the inner contact's rolling force (N) and the transverse
+    tractions' coefficient per unit pivot sliding, Q_i k_t,i + Q_o k_t,o (N s/m,
+    :func:`sliding_traction`): both
+    contacts' transverse tractions, k_pivot r omega_t together, make the moment
+    -r k_pivot r omega_t on the pivot.
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
@@ -873,11 +896,13 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
     uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
-    mui, dmui, fri, pi = contact_traction_power(p, 0, si, uei, qi)
-    muo, dmuo, fro, po = contact_traction_power(p, 1, so, ueo, qo)
+    st = p[P_RBALL] * ball[j, B_PIVOT]
+    mui, dmui, fri, pi, kni = sliding_traction(p, 0, si, st, uei, qi)
+    muo, dmuo, fro, po, kno = sliding_traction(p, 1, so, st, ueo, qo)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
-    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri
+    kpiv = qi * kni + qo * kno
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri, kpiv
 
 
 @njit(cache=True)
@@ -998,6 +1023,7 @@ def ball_power(
     m_ring: float,
     t_orbit: float,
     cb: float,
+    pivot: float = 0.0,
 ) -> float:
     """Power (W) dissipated at ball j, each term the work its force or moment takes from the
     drive or the bodies in the equations of motion (so that drive work = heat + kinetic and
@@ -1005,8 +1031,10 @@ def ball_power(
     contact's moments on the ring (t_inner omega_i), the moments resisting the ball's rotation
     (rolling resistance, pocket friction, the outer contact's Heathcote moment: ``mres``) at its
     spin omega_a plus the inner ring's share of the hysteresis through its rotation
-    (m_ring cos(beta) omega_i), the EHL forces on its orbit, and the drag."""
-    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm
+    (m_ring cos(beta) omega_i), the EHL forces on its orbit, the drag, and ``pivot``: the
+    transverse tractions x the pivot sliding, k_pivot (r omega_t)^2, taken from the ball's
+    pivot."""
+    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm + pivot
 
 
 @njit(cache=True)
@@ -1195,9 +1223,11 @@ def step_reduced(
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv = ball_tractions(
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
+            )
             drive += fi * r_ci
-            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
             cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
@@ -1227,10 +1257,31 @@ def step_reduced(
             b12 = -dt * jma
             b21 = -dt * jam
             b22 = ib - dt * jaa
+            # the pivot omega_t: the orbiting frame's gyroscopic terms, g = J omega_m sin(beta)
+            # times (cos(beta) omega_t, omega_t, -omega_roll) on (orbit, spin, pivot), skew and
+            # taken trapezoidally (they keep the energy exactly), and the transverse tractions'
+            # moment -r k_pivot r omega_t implicitly (secant through zero); the pivot's row is
+            # eliminated onto the 2x2 block (Schur complement). The terms presuppose the fixed
+            # pitch that raceway control holds; with no traction at either contact (k_pivot = 0:
+            # frictionless or unloaded) nothing holds it, and they are left out
+            g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0
+            hg = 0.5 * dt * g
+            gm += g * cb * wt
+            ga += g * wt
+            inv33 = 1.0 / (ib + dt * r * r * kpiv)
+            r3 = dt * (-g * omega_roll - r * r * kpiv * wt) * inv33
+            t1, t2 = hg * cb * inv33, hg * inv33
+            b11 += hg * cb * t1
+            b12 += hg * cb * t2
+            b21 += hg * t1
+            b22 += hg * t2
+            work[j, w0 + 29] = r3
+            work[j, w0 + 30] = t1
+            work[j, w0 + 31] = t2
             det = b11 * b22 - b12 * b21
             i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
-            r1 = dt * (gm - dt * rm * ku * rate)
-            r2 = dt * ga
+            r1 = dt * (gm - dt * rm * ku * rate) + hg * cb * r3
+            r2 = dt * ga + hg * r3
             x2 = i11 * r1 + i12 * r2
             work[j, w0 + 0] = i11
             work[j, w0 + 1] = i21
@@ -1259,7 +1310,7 @@ def step_reduced(
                 rcy += ny * fp
             work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
             work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2)
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
@@ -1316,6 +1367,7 @@ def step_reduced(
             d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
             ball[j, B_OMEGA] += d_wm
             ball[j, B_SPIN] += d_wa
+            ball[j, B_PIVOT] += work[j, w0 + 29] - work[j, w0 + 30] * d_wm - work[j, w0 + 31] * d_wa
             # the drive torque of the traction the step applied: Q mu at the start plus its
             # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
             d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
@@ -1333,8 +1385,9 @@ def step_reduced(
     return worst_iter
 
 
-NW = NG + 8 + 29
-"""Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling)."""
+NW = NG + 8 + 32
+"""Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling;
+w0 + 29 onwards: the pivot's elimination)."""
 
 
 @njit(cache=True)
@@ -1387,9 +1440,12 @@ def step_stiff(
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv = ball_tractions(
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
+            )
             drive += fi * r_ci
-            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
+            g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
             fd, _ = ball_drag(p, rb * wm)
             fs, _, _ = pocket_force(p, rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA]))
             t_inner, m_outer, m_ring, t_orbit = contact_moments(
@@ -1416,11 +1472,15 @@ def step_stiff(
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
             # momenta at the current positions (p_theta first: p_r's update needs it)
-            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit)
+            # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
+            # pivot (symplectic Euler on the skew terms: bounded energy error)
+            wt = wt - dt * (g * (wa + cb * wm) + r * r * kpiv * wt) / ib
+            ball[j, B_PIVOT] = wt
+            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt)
             wnew = ptheta / (m * rb * rb)
             vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
             vz_new = vz + dt * (-qi * niz - qo * noz) / m
-            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres) / ib
+            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres + g * wt) / ib
             ball[j, B_THETA] += dt * wnew
             rb_new = rb + dt * vr_new
             ball[j, B_R] = rb_new
@@ -1429,7 +1489,7 @@ def step_stiff(
             ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
             ring_force += qi * niz
             torque[j] = rm * fs
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2)
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
@@ -1457,7 +1517,7 @@ def step_stiff(
 @njit(cache=True)
 def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray, axial_load: float) -> float:
     """Total mechanical energy (J) of the stiff model: kinetic energy of balls (orbit, radial,
-    axial, spin), cage segments and the inner ring's axial motion, plus Hertz potentials
+    axial, spin, pivot), cage segments and the inner ring's axial motion, plus Hertz potentials
     (2/5 K x^2.5) of raceway and pocket contacts, rim strain energy and the potential
     -F_a delta_a of the constant axial load."""
     z = ball.shape[0]
@@ -1467,7 +1527,7 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
     for j in range(z):
         rb = ball[j, B_R]
         e += 0.5 * m * (ball[j, B_VR] ** 2 + ball[j, B_VZ] ** 2 + (rb * ball[j, B_OMEGA]) ** 2)
-        e += 0.5 * ib * ball[j, B_SPIN] ** 2
+        e += 0.5 * ib * (ball[j, B_SPIN] ** 2 + ball[j, B_PIVOT] ** 2)
         di, _, _, _, do, _, _, _ = raceway_geometry(p, rb, ball[j, B_Z], ring[R_DELTA])
         if di > 0.0:
             e += 0.4 * p[P_K_IN] * di**2.5

@@ -33,7 +33,13 @@ centrifugal force), so the limit follows the bearing, its lubricant and the rig.
   (:func:`traction_bound`) and omega_m the fastest ball orbit of the envelope. The dependence
   of the traction on the entrainment speed is frozen too; it is the slide-to-roll ratio times
   the implicit sliding slope (mu(SRR) with SRR = s/u_e), so below SRR = 1 it cannot
-  destabilise the step (|1 - h b| <= 1 + h a for b <= a). docs/model.md, Integration.
+  destabilise the step (|1 - h b| <= 1 + h a for b <= a). The ball's pivot (gyroscopic) adds
+  nothing to the limit: its transverse tractions enter with their secant slope (implicit), the
+  gyroscopic terms are skew and taken trapezoidally with a coefficient frozen over the step
+  (J omega_m sin(beta): h omega_m sin(beta) < 5e-3 at the envelope's top), and the one explicit
+  dependence, of the transverse slope on the rolling sliding, runs one way (the rolling
+  traction does not depend on the pivot), a triangular coupling that cannot grow.
+  docs/model.md, Integration.
 
 A step above the limit is refused at engine construction (:class:`StepLimitError`, one line
 naming the file key, the value, the limit and the mechanism).

@@ -1,0 +1,188 @@
+"""Gyroscopic pivoting (issue 23): the ball's pivot omega_t is a dynamic DOF driven by the
+orbiting frame's gyroscopic moment and resisted by the transverse tractions of both raceway
+contacts.
+
+Expected values come from the literature, not from the engine: the gyroscopic moment
+M_g = J omega_R omega_m sin(beta) with tan(beta) = sin(alpha)/(cos(alpha) + Dw/dm) (Harris and
+Kotzalas, high-speed operation), and the pivoting limit of a ball held between two contacts
+by friction mu: both contacts' transverse tractions act with the lever Dw/2, so the largest
+moment they can give is mu (Q_i + Q_o) Dw/2 (Harris's mu Q Dw with Q the mean contact load).
+The traction is a test-only law with a known limit, the exponential EHL curve
+mu = mu_max (1 - exp(-SRR/SRR0)) applied to the magnitude of the sliding vector, and every
+other resistance off, so that the rolling direction barely slides and the pivot alone is seen.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.dynamics.engine import BearingDynamics
+
+CONFIG = Path(__file__).resolve().parents[1] / "config"
+BEARING = CONFIG / "bearings" / "h7006c.yaml"
+RPM = 9000.0
+"""The envelope's gyroscopic corner: M_g grows as the square of the speed (1.25 mN m at 100 N)."""
+LOAD_N = 100.0
+SRR0 = 0.01
+"""Reference slide-to-roll ratio of the test law: its creep (linear) region is SRR < SRR0."""
+
+
+def pivot_params(mu_max: float) -> BearingParameters:
+    """H7006C without resistances, with the exponential traction law of limit ``mu_max``."""
+    base = BearingParameters.from_yaml(BEARING).without_resistances()
+    return base.replace(friction_model="ehl_traction", ehl_max_coefficient=mu_max, ehl_reference_srr=SRR0)
+
+
+def harris_gyroscopic_moment(engine: BearingDynamics) -> tuple[float, float, float, float]:
+    """(M_g in N m, Q_i + Q_o in N, u_e inner and outer in m/s) from the state: Harris's
+    M_g = J omega_R omega_m sin(beta), J = m Dw^2/10 of a steel sphere, beta from the mean
+    loaded contact angle, omega_R the ball's rolling speed relative to the orbiting frame."""
+    p = engine.params
+    obs = engine.observe()
+    dw, dm = p.ball_diameter, p.pitch_diameter
+    mass = p.ball_density * math.pi * dw**3 / 6.0
+    inertia = mass * dw**2 / 10.0
+    alpha_i, alpha_o = float(np.mean(obs.inner_contact_angles)), float(np.mean(obs.outer_contact_angles))
+    alpha = 0.5 * (alpha_i + alpha_o)
+    beta = math.atan(math.sin(alpha) / (math.cos(alpha) + dw / dm))
+    omega_m = float(np.mean(obs.ball_orbit_speeds))
+    omega_roll = float(np.mean(engine.ball[:, kn.B_SPIN])) + math.cos(beta) * omega_m
+    moment = inertia * omega_roll * omega_m * math.sin(beta)
+    loads = float(np.mean(obs.inner_contact_loads) + np.mean(obs.outer_contact_loads))
+    ue_i = (obs.inner_ring_speed - omega_m) * (0.5 * dm - 0.5 * dw * math.cos(alpha_i))
+    ue_o = omega_m * (0.5 * dm + 0.5 * dw * math.cos(alpha_o))
+    return moment, loads, ue_i, ue_o
+
+
+def mean_pivot(engine: BearingDynamics) -> float:
+    return float(np.mean(engine.ball[:, kn.B_PIVOT]))
+
+
+@pytest.fixture(scope="module")
+def operating_point() -> tuple[float, float, float, float]:
+    """M_g, Q_i + Q_o and the entrainment speeds at 9000 rpm, 100 N (they do not depend on
+    the traction's limit: kinematics and the thrust equilibrium with centrifugal force)."""
+    engine = BearingDynamics(pivot_params(0.05))
+    engine.initialise(rpm_to_rad_s(RPM), LOAD_N)
+    engine.advance(0.005)
+    return harris_gyroscopic_moment(engine)
+
+
+def test_gyroscopic_moment_is_harris_value(operating_point: tuple[float, float, float, float]) -> None:
+    """The moment the pivot feels at 9000 rpm, 100 N is the review's 1252 uN m (5 %)."""
+    assert operating_point[0] == pytest.approx(1252e-6, rel=0.05)
+
+
+@pytest.mark.parametrize("ratio", [4.0, 2.0])
+def test_no_pivoting_below_the_limit(operating_point: tuple[float, float, float, float], ratio: float) -> None:
+    """Limit mu (Q_i + Q_o) Dw/2 = 4 and 2 times M_g: the pivot settles at micro-slip, the
+    transverse slide-to-roll ratio below the law's creep scale SRR0, at the rate where the two
+    contacts' transverse tractions of the exponential law carry M_g (solved here)."""
+    moment, loads, ue_i, ue_o = operating_point
+    p = pivot_params(0.05)
+    r = 0.5 * p.ball_diameter
+    mu = ratio * moment / (loads * r)
+    engine = BearingDynamics(pivot_params(mu))
+    engine.initialise(rpm_to_rad_s(RPM), LOAD_N)
+    engine.advance(0.02)
+    first = mean_pivot(engine)
+    engine.advance(0.005)
+    pivot = mean_pivot(engine)
+    assert pivot == pytest.approx(first, rel=1e-4)  # steady
+    moment, loads, ue_i, ue_o = harris_gyroscopic_moment(engine)
+    qi = float(np.mean(engine.observe().inner_contact_loads))
+    qo = loads - qi
+    slide = abs(pivot) * r
+    assert slide < SRR0 * min(ue_i, ue_o)
+
+    def transverse_moment(s: float) -> float:
+        return r * mu * (qi * (1.0 - math.exp(-s / (SRR0 * ue_i))) + qo * (1.0 - math.exp(-s / (SRR0 * ue_o)))) - moment
+
+    expected = brentq(transverse_moment, 0.0, SRR0 * max(ue_i, ue_o) * 20.0)
+    assert slide == pytest.approx(expected, rel=0.05)
+
+
+def pivot_acceleration(mu: float) -> tuple[float, float, float]:
+    """Mean pivot acceleration (rad/s^2) over 0.6-1.2 ms from the rolling start, Harris's
+    (M_g - mu (Q_i + Q_o) Dw/2)/J at the same instants (the transverse traction saturated) and
+    the pivot's sliding speed r |omega_t| at 1.2 ms (m/s)."""
+    engine = BearingDynamics(pivot_params(mu))
+    engine.initialise(rpm_to_rad_s(RPM), LOAD_N)
+    r = 0.5 * engine.params.ball_diameter
+    dw = engine.params.ball_diameter
+    inertia = engine.params.ball_density * math.pi * dw**3 / 6.0 * dw**2 / 10.0
+    engine.advance(0.0006)
+    w1 = mean_pivot(engine)
+    m1, q1, _, _ = harris_gyroscopic_moment(engine)
+    engine.advance(0.0006)
+    w2 = mean_pivot(engine)
+    m2, q2, _, _ = harris_gyroscopic_moment(engine)
+    excess = 0.5 * (m1 + m2) - mu * r * 0.5 * (q1 + q2)
+    return abs(w2 - w1) / 0.0006, excess / inertia, abs(w2) * r
+
+
+def test_pivoting_above_the_limit(operating_point: tuple[float, float, float, float]) -> None:
+    """Limit 0.5 and 0.25 times M_g: the ball pivots, its pivot accelerating at
+    (M_g - limit)/J (5 %), faster the more M_g exceeds the limit, its transverse sliding beyond
+    the creep region after a millisecond (SRR above 3 SRR0, where the law gives 95 % of its
+    limit)."""
+    moment, loads, ue_i, ue_o = operating_point
+    r = 0.5 * pivot_params(0.05).ball_diameter
+    rates = []
+    for ratio in (0.5, 0.25):
+        measured, expected, slide = pivot_acceleration(ratio * moment / (loads * r))
+        assert expected > 0.0
+        assert measured == pytest.approx(expected, rel=0.05)
+        rates.append(measured)
+        assert slide > 3.0 * SRR0 * max(ue_i, ue_o)
+    assert rates[1] > 1.3 * rates[0]
+
+
+def test_shipped_twin_pivots_only_by_micro_slip() -> None:
+    """The shipped grease twin at 900 and 2700 rpm, 100 N: the rheology law's limit
+    Lambda (Q_i + Q_o) Dw/2 (about 10 mN m) is 800 and 90 times M_g, so the pivot is micro-slip:
+    its sliding a small fraction of the rolling contacts' own slide-to-roll ratio."""
+    params = BearingParameters.from_yaml(BEARING, CONFIG / "calibration" / "h7006c_table3.yaml")
+    engine = BearingDynamics(params)
+    r = 0.5 * params.ball_diameter
+    for rpm in (900.0, 2700.0):
+        engine.initialise(rpm_to_rad_s(rpm), LOAD_N)
+        engine.advance(0.05)
+        moment, loads, ue_i, ue_o = harris_gyroscopic_moment(engine)
+        assert params.lubricant is not None
+        assert moment < 0.02 * params.lubricant.limiting_shear_coefficient * loads * r
+        assert abs(mean_pivot(engine)) * r < 2e-3 * min(ue_i, ue_o)
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_transverse_law_is_the_tables_odd_part(contact: int) -> None:
+    """The transverse traction reads the rheology table's odd part (mu(+SRR) - mu(-SRR))/2: equal
+    to it from two lookups at nodes and between them, zero at SRR = 0 though the table is not
+    (spin and Heathcote offset), rising with SRR and bounded by the film's limiting shear
+    coefficient Lambda."""
+    from bearing_rig_sim.dynamics.parameters import traction_table
+    from bearing_rig_sim.dynamics.traction import SRR_REF, table_lookup, table_odd
+
+    params = BearingParameters.from_yaml(BEARING, CONFIG / "calibration" / "h7006c_table3.yaml")
+    assert params.lubricant is not None
+    t = traction_table(params)
+    ns, xi_max = int(t[0]), t[3]
+    u, q = 3.0, 100.0
+    assert abs(table_lookup(t, 0, 1, 0.0, u, q)[0]) > 1e-3  # the table's own offset
+    assert table_odd(t, 0, contact, 0.0, u, q) == pytest.approx(0.0, abs=1e-12)
+    prev = 0.0
+    for i in (52.0, 60.0, 60.5, 70.0, 80.25, 96.0):
+        srr = SRR_REF * math.sinh(-xi_max + i * 2.0 * xi_max / (ns - 1))
+        odd = table_odd(t, 0, contact, srr, u, q)
+        both = 0.5 * (table_lookup(t, 0, contact, srr, u, q)[0] - table_lookup(t, 0, contact, -srr, u, q)[0])
+        assert odd == pytest.approx(both, rel=1e-6, abs=1e-15)  # (the last node: the edge clamp)
+        assert prev < odd < params.lubricant.limiting_shear_coefficient
+        prev = odd

@@ -108,10 +108,12 @@ P_LAND_CONS = 54  # land film: grease consistency x fill x scale, Pa s^n (flow i
 P_LAND_K = 55  # cage-land contact stiffness (conformal line contact, linearised), N/m
 P_LAND_MU = 56  # cage-land contact friction coefficient, 1
 P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
-P_SIZE = 58
+P_SPIN_IN = 58  # spin lever of the inner contact at 1 N, (3/8) a E(e^2), m (x Q^(1/3))
+P_SPIN_OUT = 59  # same, outer contact
+P_SIZE = 60
 
-B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT = 0, 1, 2, 3, 4, 5, 6, 7
-NB = 8
+B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT, B_PITCH = 0, 1, 2, 3, 4, 5, 6, 7, 8
+NB = 9
 C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
@@ -850,29 +852,47 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def sliding_traction(p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float) -> tuple[float, float, float, float, float]:
+def sliding_traction(
+    p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float, spin: float, dspin: float
+) -> tuple[float, float, float, float, float, float, float]:
     """:func:`contact_traction` and :func:`contact_power` together (one table pass) of a raceway
     contact sliding at ``s`` (m/s, rolling direction) and ``st`` (m/s, transverse: the ball's
     pivot r omega_t), with the transverse traction coefficient per unit transverse sliding k_t
-    (s/m): (mu, d mu/ds, Houpert rolling force N, power W, k_t). The transverse traction is the law applied to the magnitude of the
-    sliding vector |s_v| = sqrt(s^2 + st^2) along the sliding, mu_t = mu(|s_v|) st/|s_v| = k_t st,
-    as a rheological film carries its shear stress along its shear; mu is the law's odd part
-    (:func:`.traction.table_lookup_full`: the rheology table's offset at SRR = 0, from spin and
-    Heathcote slip, acts in the rolling direction only, which keeps the law of s), and k_t is at
-    most the law's steepest slope. One table pass for both."""
+    (s/m) and the change of the contact's spin moment when its spin goes from ``spin`` to
+    ``spin + dspin`` (rad/s, the ball's pitch rate's share): (mu, d mu/ds, Houpert rolling force
+    N, power W, k_t, dC N m, k_C N m s). The transverse traction is the law applied to the
+    magnitude of the sliding vector |s_v| = sqrt(s^2 + st^2) along the sliding,
+    mu_t = mu(|s_v|) st/|s_v| = k_t st, as a rheological film carries its shear stress along
+    its shear; mu is the law's odd part (:func:`.traction.table_lookup_full`: the rheology
+    table's offset at SRR = 0, from spin and Heathcote slip, acts in the rolling direction only,
+    which keeps the law of s), and k_t is at most the law's steepest slope. The spin moment is
+    C(spin) = Q rho mu_odd(|spin| rho / u_e) sgn(spin), rho = (3/8) a E(e^2) the Hertz
+    pressure's mean lever over the contact ellipse (exact for a saturated law: (3 pi/16) mu Q a
+    on a circle); dC = C(spin + dspin) - C(spin) with its secant k_C = dC/dspin (at most the
+    law's steepest slope Q rho^2 d mu/ds). One table pass for all."""
     smag = math.sqrt(s * s + st * st)
     cap = slope_cap(p, entrainment)
+    rho = p[P_SPIN_IN + contact] * load ** (1.0 / 3.0) if load > 0.0 else 0.0
+    s0 = spin * rho
+    s1 = (spin + dspin) * rho
+    kc_cap = load * rho * rho * cap
     if p[P_FRIC_MODEL] == 2.0:
         ue = max(entrainment, 1e-3)
-        mu, slope, rolling, pw, odd = table_lookup_full(p, int(p[P_TABLE]), contact, s / ue, smag / ue, ue, load)
+        mu, slope, rolling, pw, odd, m0, m1 = table_lookup_full(p, int(p[P_TABLE]), contact, s / ue, smag / ue, ue, load, abs(s0) / ue, abs(s1) / ue)
         kt = min(odd / smag, cap) if smag > 1e-12 else cap
-        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue, kt
+        dc = load * rho * (math.copysign(m1, s1) - math.copysign(m0, s0))
+        kc = min(max(dc / dspin, 0.0), kc_cap) if abs(dspin * rho) > 1e-12 else kc_cap
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue, kt, dc, kc
     mu, dmu = traction_coefficient(p, s, entrainment)
     kt = cap
     if smag > 1e-12:
         mut, _ = traction_coefficient(p, smag, entrainment)
         kt = min(abs(mut) / smag, cap)
-    return mu, dmu, 0.0, abs(mu * load * s), kt
+    m0, _ = traction_coefficient(p, abs(s0), entrainment)
+    m1, _ = traction_coefficient(p, abs(s1), entrainment)
+    dc = load * rho * (math.copysign(abs(m1), s1) - math.copysign(abs(m0), s0))
+    kc = min(max(dc / dspin, 0.0), kc_cap) if abs(dspin * rho) > 1e-12 else kc_cap
+    return mu, dmu, 0.0, abs(mu * load * s), kt, dc, kc
 
 
 @njit(cache=True, inline="always")
@@ -880,7 +900,7 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     """Raceway tractions of ball j (shared by both models).
 
     Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
-    po, fri, k_pivot): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m,
+    po, fri, k_pivot, m_pitch, k_pitch): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m,
     clipped at >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
     :func:`ball_kinematics`, the sum of the two contacts' Houpert rolling forces (N; model 2
     only, else 0), the two contacts' dissipated power in the rolling direction (W,
@@ -888,7 +908,16 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     tractions' coefficient per unit pivot sliding, Q_i k_t,i + Q_o k_t,o (N s/m,
     :func:`sliding_traction`): both
     contacts' transverse tractions, k_pivot r omega_t together, make the moment
-    -r k_pivot r omega_t on the pivot.
+    -r k_pivot r omega_t on the pivot; the moment -m_pitch (N m) of both contacts' spin
+    moments on the ball's pitch rate omega_p (about w = (cos beta, sin beta) in (e_r, e_z), the
+    ball's angular velocity relative to the raceway-control state, ``B_PITCH``) and its
+    secant slope k_pitch (N m s) per omega_p. The spin of each contact (ball relative to race,
+    about the normal from the ball centre, n = (n_r, n_z)) at raceway control is
+    (omega_a a + omega_m sin(beta) w - Omega_race e_z) . n with a = (sin beta, -cos beta) the
+    rolling axis; omega_p adds (w . n) omega_p: cos(alpha_o - beta) omega_p at the outer
+    contact, -cos(alpha_i - beta) omega_p at the inner. Only the change of the spin moments
+    from the raceway-control state acts on omega_p (that state's spin losses are in the
+    rolling-direction law, the table's offset), projected on w.
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
@@ -897,12 +926,19 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     so = -aom * wm + aoa * wa
     uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
     st = p[P_RBALL] * ball[j, B_PIVOT]
-    mui, dmui, fri, pi, kni = sliding_traction(p, 0, si, st, uei, qi)
-    muo, dmuo, fro, po, kno = sliding_traction(p, 1, so, st, ueo, qo)
+    wp = ball[j, B_PITCH]
+    sb = math.sqrt(max(1.0 - cb * cb, 0.0))
+    # spins at raceway control: a . n = sin(alpha_i - beta) (inner), -sin(alpha_o - beta) (outer)
+    spin_i = wa * (nir * sb - niz * cb) - wm * sb * ci - omega_i * niz
+    spin_o = wa * (nor * sb - noz * cb) + wm * sb * co
+    mui, dmui, fri, pi, kni, dci, kci = sliding_traction(p, 0, si, st, uei, qi, spin_i, -ci * wp)
+    muo, dmuo, fro, po, kno, dco, kco = sliding_traction(p, 1, so, st, ueo, qo, spin_o, co * wp)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
     kpiv = qi * kni + qo * kno
-    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri, kpiv
+    mpitch = co * dco - ci * dci
+    kpitch = ci * ci * kci + co * co * kco
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri, kpiv, mpitch, kpitch
 
 
 @njit(cache=True)
@@ -1223,11 +1259,11 @@ def step_reduced(
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv = ball_tractions(
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, mpitch, kpitch = ball_tractions(
                 p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
             )
             drive += fi * r_ci
-            wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
+            wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
             cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
@@ -1257,20 +1293,28 @@ def step_reduced(
             b12 = -dt * jma
             b21 = -dt * jam
             b22 = ib - dt * jaa
-            # the pivot omega_t: the orbiting frame's gyroscopic terms, g = J omega_m sin(beta)
-            # times (cos(beta) omega_t, omega_t, -omega_roll) on (orbit, spin, pivot), skew and
-            # taken trapezoidally (they keep the energy exactly), and the transverse tractions'
-            # moment -r k_pivot r omega_t implicitly (secant through zero); the pivot's row is
-            # eliminated onto the 2x2 block (Schur complement). The terms presuppose the fixed
-            # pitch that raceway control holds; with no traction at either contact (k_pivot = 0:
-            # frictionless or unloaded) nothing holds it, and they are left out
-            g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0
+            # the pivot omega_t and the pitch rate omega_p: the orbiting frame's gyroscopic
+            # terms, g = J omega_m sin(beta) times (cos(beta) omega_t, omega_t, -omega_roll) on
+            # (orbit, spin, pivot) and gc = J omega_m cos(beta) times (-omega_p, omega_t) on
+            # (pivot, pitch), skew and taken trapezoidally (they keep the energy exactly); the
+            # transverse tractions' moment -r k_pivot r omega_t and the spin moments' change
+            # -m_pitch implicitly (secants through zero); the (pivot, pitch) rows are eliminated
+            # onto the 2x2 block (Schur complement). With no traction at either contact
+            # (k_pivot = 0: frictionless or unloaded) the gyroscopic terms are left out
+            sbg = math.sqrt(max(1.0 - cb * cb, 0.0))
+            g = ib * wm * sbg if kpiv > 0.0 else 0.0
+            gc = ib * wm * cb if kpiv > 0.0 else 0.0
             hg = 0.5 * dt * g
+            hgc = 0.5 * dt * gc
             gm += g * cb * wt
             ga += g * wt
-            inv33 = 1.0 / (ib + dt * r * r * kpiv)
-            r3 = dt * (-g * omega_roll - r * r * kpiv * wt) * inv33
-            t1, t2 = hg * cb * inv33, hg * inv33
+            s11 = ib + dt * r * r * kpiv
+            s22 = ib + dt * kpitch
+            dinv = 1.0 / (s11 * s22 + hgc * hgc)
+            rt = dt * (-g * omega_roll - gc * wp - r * r * kpiv * wt)
+            rp = dt * (gc * wt - mpitch)
+            r3 = (s22 * rt - hgc * rp) * dinv
+            t1, t2 = s22 * hg * cb * dinv, s22 * hg * dinv
             b11 += hg * cb * t1
             b12 += hg * cb * t2
             b21 += hg * t1
@@ -1278,6 +1322,9 @@ def step_reduced(
             work[j, w0 + 29] = r3
             work[j, w0 + 30] = t1
             work[j, w0 + 31] = t2
+            work[j, w0 + 32] = (hgc * rt + s11 * rp) * dinv
+            work[j, w0 + 33] = hgc * hg * cb * dinv
+            work[j, w0 + 34] = hgc * hg * dinv
             det = b11 * b22 - b12 * b21
             i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
             r1 = dt * (gm - dt * rm * ku * rate) + hg * cb * r3
@@ -1310,7 +1357,7 @@ def step_reduced(
                 rcy += ny * fp
             work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
             work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2 + mpitch * wp)
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
@@ -1368,6 +1415,7 @@ def step_reduced(
             ball[j, B_OMEGA] += d_wm
             ball[j, B_SPIN] += d_wa
             ball[j, B_PIVOT] += work[j, w0 + 29] - work[j, w0 + 30] * d_wm - work[j, w0 + 31] * d_wa
+            ball[j, B_PITCH] += work[j, w0 + 32] - work[j, w0 + 33] * d_wm - work[j, w0 + 34] * d_wa
             # the drive torque of the traction the step applied: Q mu at the start plus its
             # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
             d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
@@ -1385,9 +1433,9 @@ def step_reduced(
     return worst_iter
 
 
-NW = NG + 8 + 32
+NW = NG + 8 + 35
 """Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling;
-w0 + 29 onwards: the pivot's elimination)."""
+w0 + 29 onwards: the pivot's and the pitch's elimination)."""
 
 
 @njit(cache=True)
@@ -1440,7 +1488,7 @@ def step_stiff(
             di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv = ball_tractions(
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
                 p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
             )
             drive += fi * r_ci
@@ -1527,7 +1575,7 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
     for j in range(z):
         rb = ball[j, B_R]
         e += 0.5 * m * (ball[j, B_VR] ** 2 + ball[j, B_VZ] ** 2 + (rb * ball[j, B_OMEGA]) ** 2)
-        e += 0.5 * ib * (ball[j, B_SPIN] ** 2 + ball[j, B_PIVOT] ** 2)
+        e += 0.5 * ib * (ball[j, B_SPIN] ** 2 + ball[j, B_PIVOT] ** 2 + ball[j, B_PITCH] ** 2)
         di, _, _, _, do, _, _, _ = raceway_geometry(p, rb, ball[j, B_Z], ring[R_DELTA])
         if di > 0.0:
             e += 0.4 * p[P_K_IN] * di**2.5

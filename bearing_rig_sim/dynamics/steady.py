@@ -414,7 +414,16 @@ class SteadySolver:
         e = self.engine
         rm = float(e.vector[kn.P_RM])
         u = rm * float(np.mean(e.ball[:, kn.B_THETA] - e.cage[:, kn.C_PHI]))
-        return np.array([float(np.mean(e.ball[:, kn.B_OMEGA])), float(np.mean(e.ball[:, kn.B_SPIN])), e.cage_speed, u, float(np.mean(e.ball[:, kn.B_PIVOT])), float(np.mean(e.ball[:, kn.B_PITCH]))])
+        return np.array(
+            [
+                float(np.mean(e.ball[:, kn.B_OMEGA])),
+                float(np.mean(e.ball[:, kn.B_SPIN])),
+                e.cage_speed,
+                u,
+                float(np.mean(e.ball[:, kn.B_PIVOT])),
+                float(np.mean(e.ball[:, kn.B_PITCH])),
+            ]
+        )
 
     def _load_engine(self, x: np.ndarray, omega: float) -> None:
         e = self.engine

@@ -108,7 +108,7 @@ P_LAND_CONS = 54  # land film: grease consistency x fill x scale, Pa s^n (flow i
 P_LAND_K = 55  # cage-land contact stiffness (conformal line contact, linearised), N/m
 P_LAND_MU = 56  # cage-land contact friction coefficient, 1
 P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
-P_SPIN_IN = 58  # spin lever of the inner contact at 1 N, (3/8) a E(e^2), m (x Q^(1/3))
+P_SPIN_IN = 58  # spin lever of the inner contact per sqrt(penetration), (3/8) a E(e^2), m^0.5 (x delta^0.5)
 P_SPIN_OUT = 59  # same, outer contact
 P_SIZE = 60
 
@@ -853,7 +853,7 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
 
 @njit(cache=True, inline="always")
 def sliding_traction(
-    p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float, spin: float, dspin: float
+    p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float, spin: float, dspin: float, rho: float
 ) -> tuple[float, float, float, float, float, float, float]:
     """:func:`contact_traction` and :func:`contact_power` together (one table pass) of a raceway
     contact sliding at ``s`` (m/s, rolling direction) and ``st`` (m/s, transverse: the ball's
@@ -867,12 +867,11 @@ def sliding_traction(
     table's offset at SRR = 0, from spin and Heathcote slip, acts in the rolling direction only,
     which keeps the law of s), and k_t is at most the law's steepest slope. The spin moment is
     C(spin) = Q rho mu_odd(|spin| rho / u_e) sgn(spin), rho = (3/8) a E(e^2) the Hertz
-    pressure's mean lever over the contact ellipse (exact for a saturated law: (3 pi/16) mu Q a
-    on a circle); dC = C(spin + dspin) - C(spin) with its secant k_C = dC/dspin (at most the
+    pressure's mean lever over the contact ellipse (``rho``, m; exact for a saturated law:
+    (3 pi/16) mu Q a on a circle); dC = C(spin + dspin) - C(spin) with its secant k_C = dC/dspin (at most the
     law's steepest slope Q rho^2 d mu/ds). One table pass for all."""
     smag = math.sqrt(s * s + st * st)
     cap = slope_cap(p, entrainment)
-    rho = p[P_SPIN_IN + contact] * load ** (1.0 / 3.0) if load > 0.0 else 0.0
     s0 = spin * rho
     s1 = (spin + dspin) * rho
     kc_cap = load * rho * rho * cap
@@ -896,8 +895,11 @@ def sliding_traction(
 
 
 @njit(cache=True, inline="always")
-def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
-    """Raceway tractions of ball j (shared by both models).
+def ball_tractions(
+    p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float, di: float, do: float
+) -> tuple:
+    """Raceway tractions of ball j (shared by both models), with the contacts' loads (N),
+    normals and penetrations (m).
 
     Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
     po, fri, k_pivot, m_pitch, k_pitch): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m,
@@ -931,8 +933,11 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     # spins at raceway control: a . n = sin(alpha_i - beta) (inner), -sin(alpha_o - beta) (outer)
     spin_i = wa * (nir * sb - niz * cb) - wm * sb * ci - omega_i * niz
     spin_o = wa * (nor * sb - noz * cb) + wm * sb * co
-    mui, dmui, fri, pi, kni, dci, kci = sliding_traction(p, 0, si, st, uei, qi, spin_i, -ci * wp)
-    muo, dmuo, fro, po, kno, dco, kco = sliding_traction(p, 1, so, st, ueo, qo, spin_o, co * wp)
+    # the spin levers (3/8) a E(e^2): a grows as Q^(1/3) = K^(1/3) delta^(1/2)
+    rho_i = p[P_SPIN_IN] * math.sqrt(max(di, 0.0))
+    rho_o = p[P_SPIN_OUT] * math.sqrt(max(do, 0.0))
+    mui, dmui, fri, pi, kni, dci, kci = sliding_traction(p, 0, si, st, uei, qi, spin_i, -ci * wp, rho_i)
+    muo, dmuo, fro, po, kno, dco, kco = sliding_traction(p, 1, so, st, ueo, qo, spin_o, co * wp, rho_o)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
     kpiv = qi * kni + qo * kno
@@ -1260,7 +1265,7 @@ def step_reduced(
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
             fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, mpitch, kpitch = ball_tractions(
-                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, geo[j, G_DI], geo[j, G_DO]
             )
             drive += fi * r_ci
             wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
@@ -1489,7 +1494,7 @@ def step_stiff(
             qi, _, _ = impact_force(di, nir * vr + niz * (vz - vdelta), p[P_K_IN], p)
             qo, _, _ = impact_force(do, nor * vr + noz * vz, p[P_K_OUT], p)
             fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
-                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, di, do
             )
             drive += fi * r_ci
             wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]

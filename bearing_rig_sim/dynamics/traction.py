@@ -249,8 +249,15 @@ def table_lookup_full(
             fp = (math.asinh(odd_srr / SRR_REF) + xi_max) / dxi
         i_p, i_m, wp, wm = _mirrored(ns, fp)
     if spin:
-        ia_p, ia_m, wa_p, wa_m = _mirrored(ns, (math.asinh(spin_a / SRR_REF) + xi_max) / dxi)
-        ib_p, ib_m, wb_p, wb_m = _mirrored(ns, (math.asinh(spin_b / SRR_REF) + xi_max) / dxi)
+        fa = (math.asinh(spin_a / SRR_REF) + xi_max) / dxi
+        d = spin_b - spin_a
+        if abs(d) <= ODD_TAYLOR * spin_a:
+            # close to spin_a (a small pitch rate): asinh to first order, as for odd_srr
+            fb = fa + d / math.sqrt(SRR_REF * SRR_REF + spin_a * spin_a) / dxi
+        else:
+            fb = (math.asinh(spin_b / SRR_REF) + xi_max) / dxi
+        ia_p, ia_m, wa_p, wa_m = _mirrored(ns, fa)
+        ib_p, ib_m, wb_p, wb_m = _mirrored(ns, fb)
     mu0 = 0.0
     mu1 = 0.0
     pw = 0.0

@@ -9,7 +9,9 @@ Conventions (every kernel):
   ball's rolling axis), ball-centre radius r_b and axial position z_b (m), radial and axial
   velocity (m/s; stiff model only), pivot omega_t (rad/s: absolute angular velocity component
   along e_t, perpendicular to the rolling axis and the orbit radius, the direction of the
-  gyroscopic moment).
+  gyroscopic moment), pitch rate omega_p (rad/s: angular velocity about
+  w = (cos beta, 0, sin beta) relative to raceway control, omega . w = omega_m sin(beta) +
+  omega_p; 0 in the stiff model).
 * ``cage``: shape (Z, NC), one row per cage segment (pocket), columns ``C_*``: angle phi (rad),
   speed Omega (rad/s).
 * ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
@@ -29,12 +31,15 @@ Conventions (every kernel):
 Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
 direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
 Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer).
-Ball attitude: the rolling axis lies in the r-z plane at the pitch angle beta with
+Ball attitude: the reference rolling axis lies in the r-z plane at the pitch angle beta with
 tan(beta) = sin(alpha)/(cos(alpha) + gamma) (Harris and Kotzalas), alpha the mean loaded contact
-angle (fixed pitch: the ball's angular velocity relative to the orbiting frame has no component
-along the third direction of the r-z plane). The pivot omega_t is dynamic: the rotating frame's
-gyroscopic moment J omega_m omega_roll sin(beta) drives it and the transverse tractions of both
-raceway contacts resist it (:func:`sliding_traction`).
+angle (raceway control: the ball's angular velocity relative to the orbiting frame has no
+component along the third direction w of the r-z plane). The pivot omega_t and the pitch rate
+omega_p are dynamic (reduced model): the rotating frame's gyroscopic moment
+J omega_m (sin(beta) omega_roll + cos(beta) omega_p) drives the pivot, the transverse tractions
+of both raceway contacts resist it, the gyroscopic coupling J omega_m cos(beta) omega_t turns it
+into pitch and the change of both contacts' spin moments resists the pitch
+(:func:`sliding_traction`, docs/model.md, "Ball attitude"). The stiff model holds the pitch.
 
 Cage slip is not computed anywhere here: the cage speed results from integrating the
 ball-pocket, rim and land forces, and the ball speeds from the raceway tractions.

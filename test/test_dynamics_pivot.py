@@ -246,3 +246,38 @@ def test_transverse_law_is_the_tables_odd_part(contact: int) -> None:
         assert odd == pytest.approx(both, rel=1e-6, abs=1e-15)  # (the last node: the edge clamp)
         assert prev < odd < params.lubricant.limiting_shear_coefficient
         prev = odd
+
+
+@pytest.mark.parametrize("contact", [0, 1])
+def test_spin_lever_is_the_hertz_pressures_mean_distance(contact: int) -> None:
+    """The spin moment's lever rho (docs/model.md, Ball attitude) is the mean distance from the
+    contact centre under the Hertz pressure p0 sqrt(1 - x^2/a^2 - y^2/b^2) (Johnson, Contact
+    Mechanics, 3.4): integrated numerically over the ellipse here at 100 N, the kernel's lever at
+    the same contact's penetration agrees (1e-6); on a circle the integral is Johnson's
+    (3 pi/16) a, the Coulomb spin moment's lever."""
+    from scipy.integrate import dblquad
+
+    from bearing_rig_sim.dynamics.parameters import derive
+
+    params = BearingParameters.from_yaml(BEARING)
+    vector, _ = derive(params)
+    hertz = params.raceway_contacts()[contact]
+    load = 100.0
+    a, b = hertz.semi_axes(load)
+
+    def mean_distance(a: float, b: float) -> float:
+        # polar coordinates on the unit disc, x = a s cos(phi), y = b s sin(phi), dA = a b s ds dphi
+        def weight(s: float, phi: float) -> float:
+            return math.sqrt(1.0 - s * s) * s
+
+        def moment(s: float, phi: float) -> float:
+            return weight(s, phi) * s * math.hypot(a * math.cos(phi), b * math.sin(phi))
+
+        num = dblquad(moment, 0.0, 2.0 * math.pi, 0.0, 1.0, epsabs=1e-14, epsrel=1e-10)[0]
+        den = dblquad(weight, 0.0, 2.0 * math.pi, 0.0, 1.0, epsabs=1e-14, epsrel=1e-10)[0]
+        return num / den
+
+    assert mean_distance(1.0, 1.0) == pytest.approx(3.0 * math.pi / 16.0, rel=1e-8)
+    penetration = (load / hertz.stiffness) ** (2.0 / 3.0)
+    lever = vector[kn.P_SPIN_IN + contact] * math.sqrt(penetration)
+    assert lever == pytest.approx(mean_distance(a, b), rel=1e-6)

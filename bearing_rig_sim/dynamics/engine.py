@@ -3,7 +3,7 @@
 Two formulations of the same model (see :mod:`.kernels`):
 
 * ``"reduced"`` (default): quasi-static ball-raceway normal contact solved every step, ball
-  orbit/spin and the flexible cage integrated with a linearly implicit Euler step
+  orbit, spin, pivot and pitch (gyroscopic) and the flexible cage integrated with a linearly implicit Euler step
   (steps of tens of microseconds, real time with margin);
 * ``"stiff"`` (reference): every body dynamic, the paper's IMPACT contacts with Hunt-Crossley
   damping integrated explicitly (steps of a fraction of a microsecond).
@@ -98,6 +98,10 @@ class Observation:
         ball_azimuths: per ball, the orbital angle of its centre from the bearing's x axis, in
             [0, 2 pi), rad.
         ball_spin_speeds: per ball, its rotation speed about its own axis, rad/s.
+        ball_pivot_speeds: per ball, the pivot omega_t (rad/s, about the axis perpendicular to
+            the rolling axis and the orbit radius: the gyroscopic moment's), sign of e_t.
+        ball_pitch_speeds: per ball, the pitch rate omega_p (rad/s, about the third axis of the
+            radial-axial plane, relative to raceway control: the rolling axis's tilt).
         inner_contact_loads / outer_contact_loads: per ball, N.
         inner_contact_angles / outer_contact_angles: per ball, rad.
         pocket_loads: per ball, signed (> 0: ball pushes the cage forward), N.
@@ -129,6 +133,8 @@ class Observation:
     axial_load: float
     cage_whirl_radius: float = 0.0
     cage_centre: tuple[float, float] = (0.0, 0.0)
+    ball_pivot_speeds: np.ndarray | None = None
+    ball_pitch_speeds: np.ndarray | None = None
     inner_ring_tilt: tuple[float, float] = (0.0, 0.0)
     ring_moment: tuple[float, float] = (0.0, 0.0)
     ball_azimuths: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -606,6 +612,8 @@ class BearingDynamics:
             axial_load=self.axial_load,
             cage_whirl_radius=self.cage_whirl_radius,
             cage_centre=(float(self.ring[kn.R_CX]), float(self.ring[kn.R_CY])),
+            ball_pivot_speeds=self.ball[:, kn.B_PIVOT].copy(),
+            ball_pitch_speeds=self.ball[:, kn.B_PITCH].copy(),
             inner_ring_tilt=(float(self.ring[kn.R_TX]), float(self.ring[kn.R_TY])),
             ring_moment=(float(self.ring[kn.R_MX]), float(self.ring[kn.R_MY])),
             ball_azimuths=np.mod(self.ball[:, kn.B_THETA], 2.0 * math.pi),

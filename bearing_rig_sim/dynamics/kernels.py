@@ -7,7 +7,11 @@ Conventions (every kernel):
 * ``ball``: shape (Z, NB), one row per ball, columns ``B_*``: orbital angle theta (rad), orbital
   speed omega_m (rad/s), spin omega_a (rad/s, absolute angular velocity component along the
   ball's rolling axis), ball-centre radius r_b and axial position z_b (m), radial and axial
-  velocity (m/s; stiff model only).
+  velocity (m/s; stiff model only), pivot omega_t (rad/s: absolute angular velocity component
+  along e_t, perpendicular to the rolling axis and the orbit radius, the direction of the
+  gyroscopic moment), pitch rate omega_p (rad/s: angular velocity about
+  w = (cos beta, 0, sin beta) relative to raceway control, omega . w = omega_m sin(beta) +
+  omega_p; 0 in the stiff model).
 * ``cage``: shape (Z, NC), one row per cage segment (pocket), columns ``C_*``: angle phi (rad),
   speed Omega (rad/s).
 * ``ring``: shape (NR,), ``R_*``: inner-ring angle (rad) and speed (rad/s), axial displacement
@@ -27,9 +31,15 @@ Conventions (every kernel):
 Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
 direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
 Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer).
-Ball attitude: the rolling axis lies in the r-z plane at the pitch angle beta with
+Ball attitude: the reference rolling axis lies in the r-z plane at the pitch angle beta with
 tan(beta) = sin(alpha)/(cos(alpha) + gamma) (Harris and Kotzalas), alpha the mean loaded contact
-angle; gyroscopic pivoting is suppressed (the axis does not yaw).
+angle (raceway control: the ball's angular velocity relative to the orbiting frame has no
+component along the third direction w of the r-z plane). The pivot omega_t and the pitch rate
+omega_p are dynamic (reduced model): the rotating frame's gyroscopic moment
+J omega_m (sin(beta) omega_roll + cos(beta) omega_p) drives the pivot, the transverse tractions
+of both raceway contacts resist it, the gyroscopic coupling J omega_m cos(beta) omega_t turns it
+into pitch and the change of both contacts' spin moments resists the pitch
+(:func:`sliding_traction`, docs/model.md, "Ball attitude"). The stiff model holds the pitch.
 
 Cage slip is not computed anywhere here: the cage speed results from integrating the
 ball-pocket, rim and land forces, and the ball speeds from the raceway tractions.
@@ -42,7 +52,7 @@ import math
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_power, table_power
+from bearing_rig_sim.dynamics.traction import table_lookup, table_lookup_full, table_power
 
 # -- parameter vector layout ------------------------------------------------------------------
 P_Z = 0  # number of balls
@@ -103,10 +113,12 @@ P_LAND_CONS = 54  # land film: grease consistency x fill x scale, Pa s^n (flow i
 P_LAND_K = 55  # cage-land contact stiffness (conformal line contact, linearised), N/m
 P_LAND_MU = 56  # cage-land contact friction coefficient, 1
 P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
-P_SIZE = 58
+P_SPIN_IN = 58  # spin lever of the inner contact per sqrt(penetration), (3/8) a E(e^2), m^0.5 (x delta^0.5)
+P_SPIN_OUT = 59  # same, outer contact
+P_SIZE = 60
 
-B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ = 0, 1, 2, 3, 4, 5, 6
-NB = 7
+B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT, B_PITCH = 0, 1, 2, 3, 4, 5, 6, 7, 8
+NB = 9
 C_PHI, C_OMEGA = 0, 1
 NC = 2
 R_ANGLE, R_OMEGA, R_DELTA, R_VDELTA, R_TIME, R_DX, R_DY = 0, 1, 2, 3, 4, 5, 6
@@ -181,18 +193,6 @@ def contact_traction(p: np.ndarray, contact: int, s: float, entrainment: float, 
         return mu, slope / ue, p[P_FR_IN + contact] * rolling
     mu, dmu = traction_coefficient(p, s, entrainment)
     return mu, dmu, 0.0
-
-
-@njit(cache=True, inline="always")
-def contact_traction_power(p: np.ndarray, contact: int, s: float, entrainment: float, load: float) -> tuple[float, float, float, float]:
-    """:func:`contact_traction` and :func:`contact_power` together (one table lookup): traction
-    coefficient, d mu/ds (s/m), Houpert rolling force (N) and dissipated power (W)."""
-    if p[P_FRIC_MODEL] == 2.0:
-        ue = max(entrainment, 1e-3)
-        mu, slope, rolling, pw = table_lookup_power(p, int(p[P_TABLE]), contact, s / ue, ue, load)
-        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue
-    mu, dmu = traction_coefficient(p, s, entrainment)
-    return mu, dmu, 0.0, abs(mu * load * s)
 
 
 @njit(cache=True)
@@ -925,15 +925,74 @@ def slope_cap(p: np.ndarray, entrainment: float) -> float:
 
 
 @njit(cache=True, inline="always")
-def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float) -> tuple:
-    """Raceway tractions of ball j (shared by both models).
+def sliding_traction(
+    p: np.ndarray, contact: int, s: float, st: float, entrainment: float, load: float, spin: float, dspin: float, rho: float
+) -> tuple[float, float, float, float, float, float, float]:
+    """:func:`contact_traction` and :func:`contact_power` together (one table pass) of a raceway
+    contact sliding at ``s`` (m/s, rolling direction) and ``st`` (m/s, transverse: the ball's
+    pivot r omega_t), with the transverse traction coefficient per unit transverse sliding k_t
+    (s/m) and the change of the contact's spin moment when its spin goes from ``spin`` to
+    ``spin + dspin`` (rad/s, the ball's pitch rate's share): (mu, d mu/ds, Houpert rolling force
+    N, power W, k_t, dC N m, k_C N m s). The transverse traction is the law applied to the
+    magnitude of the sliding vector |s_v| = sqrt(s^2 + st^2) along the sliding,
+    mu_t = mu(|s_v|) st/|s_v| = k_t st, as a rheological film carries its shear stress along
+    its shear; mu is the law's odd part (:func:`.traction.table_lookup_full`: the rheology
+    table's offset at SRR = 0, from spin and Heathcote slip, acts in the rolling direction only,
+    which keeps the law of s), and k_t is at most the law's steepest slope. The spin moment is
+    C(spin) = Q rho mu_odd(|spin| rho / u_e) sgn(spin), rho = (3/8) a E(e^2) the Hertz
+    pressure's mean lever over the contact ellipse (``rho``, m; exact for a saturated law:
+    (3 pi/16) mu Q a on a circle); dC = C(spin + dspin) - C(spin) with its secant k_C = dC/dspin (at most the
+    law's steepest slope Q rho^2 d mu/ds). One table pass for all."""
+    smag = math.sqrt(s * s + st * st)
+    cap = slope_cap(p, entrainment)
+    s0 = spin * rho
+    s1 = (spin + dspin) * rho
+    kc_cap = load * rho * rho * cap
+    if p[P_FRIC_MODEL] == 2.0:
+        ue = max(entrainment, 1e-3)
+        mu, slope, rolling, pw, odd, m0, m1 = table_lookup_full(p, int(p[P_TABLE]), contact, s / ue, smag / ue, ue, load, abs(s0) / ue, abs(s1) / ue)
+        kt = min(odd / smag, cap) if smag > 1e-12 else cap
+        dc = load * rho * (math.copysign(m1, s1) - math.copysign(m0, s0))
+        kc = min(max(dc / dspin, 0.0), kc_cap) if abs(dspin * rho) > 1e-12 else kc_cap
+        return mu, slope / ue, p[P_FR_IN + contact] * rolling, pw * load * ue, kt, dc, kc
+    mu, dmu = traction_coefficient(p, s, entrainment)
+    kt = cap
+    if smag > 1e-12:
+        mut, _ = traction_coefficient(p, smag, entrainment)
+        kt = min(abs(mut) / smag, cap)
+    m0, _ = traction_coefficient(p, abs(s0), entrainment)
+    m1, _ = traction_coefficient(p, abs(s1), entrainment)
+    dc = load * rho * (math.copysign(abs(m1), s1) - math.copysign(abs(m0), s0))
+    kc = min(max(dc / dspin, 0.0), kc_cap) if abs(dspin * rho) > 1e-12 else kc_cap
+    return mu, dmu, 0.0, abs(mu * load * s), kt, dc, kc
+
+
+@njit(cache=True, inline="always")
+def ball_tractions(
+    p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: float, qo: float, nir: float, niz: float, nor: float, noz: float, di: float, do: float
+) -> tuple:
+    """Raceway tractions of ball j (shared by both models), with the contacts' loads (N),
+    normals and penetrations (m).
 
     Returns (fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cos_beta, f_roll, pi,
-    po, fri): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m, clipped at
-    >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
+    po, fri, k_pivot, m_pitch, k_pitch): traction forces on the ball along e_t (N), their slopes dF/ds (N s/m,
+    clipped at >= 0 for the implicit step), sliding velocities (m/s), the lever arms of
     :func:`ball_kinematics`, the sum of the two contacts' Houpert rolling forces (N; model 2
-    only, else 0), the two contacts' dissipated power (W, :func:`contact_power`) and the inner
-    contact's rolling force (N).
+    only, else 0), the two contacts' dissipated power in the rolling direction (W,
+    :func:`contact_power`), the inner contact's rolling force (N) and the transverse
+    tractions' coefficient per unit pivot sliding, Q_i k_t,i + Q_o k_t,o (N s/m,
+    :func:`sliding_traction`): both
+    contacts' transverse tractions, k_pivot r omega_t together, make the moment
+    -r k_pivot r omega_t on the pivot; the moment -m_pitch (N m) of both contacts' spin
+    moments on the ball's pitch rate omega_p (about w = (cos beta, sin beta) in (e_r, e_z), the
+    ball's angular velocity relative to the raceway-control state, ``B_PITCH``) and its
+    secant slope k_pitch (N m s) per omega_p. The spin of each contact (ball relative to race,
+    about the normal from the ball centre, n = (n_r, n_z)) at raceway control is
+    (omega_a a + omega_m sin(beta) w - Omega_race e_z) . n with a = (sin beta, -cos beta) the
+    rolling axis; omega_p adds (w . n) omega_p: cos(alpha_o - beta) omega_p at the outer
+    contact, -cos(alpha_i - beta) omega_p at the inner. Only the change of the spin moments
+    from the raceway-control state acts on omega_p (that state's spin losses are in the
+    rolling-direction law, the table's offset), projected on w.
     """
     rb = ball[j, B_R]
     r_ci, r_co, ci, co, aim, aia, aom, aoa, cb = ball_kinematics(p, nir, niz, nor, noz, rb)
@@ -941,11 +1000,23 @@ def ball_tractions(p: np.ndarray, ball: np.ndarray, j: int, omega_i: float, qi: 
     si = omega_i * r_ci - aim * wm - aia * wa
     so = -aom * wm + aoa * wa
     uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
-    mui, dmui, fri, pi = contact_traction_power(p, 0, si, uei, qi)
-    muo, dmuo, fro, po = contact_traction_power(p, 1, so, ueo, qo)
+    st = p[P_RBALL] * ball[j, B_PIVOT]
+    wp = ball[j, B_PITCH]
+    sb = math.sqrt(max(1.0 - cb * cb, 0.0))
+    # spins at raceway control: a . n = sin(alpha_i - beta) (inner), -sin(alpha_o - beta) (outer)
+    spin_i = wa * (nir * sb - niz * cb) - wm * sb * ci - omega_i * niz
+    spin_o = wa * (nor * sb - noz * cb) + wm * sb * co
+    # the spin levers (3/8) a E(e^2): a grows as Q^(1/3) = K^(1/3) delta^(1/2)
+    rho_i = p[P_SPIN_IN] * math.sqrt(max(di, 0.0))
+    rho_o = p[P_SPIN_OUT] * math.sqrt(max(do, 0.0))
+    mui, dmui, fri, pi, kni, dci, kci = sliding_traction(p, 0, si, st, uei, qi, spin_i, -ci * wp, rho_i)
+    muo, dmuo, fro, po, kno, dco, kco = sliding_traction(p, 1, so, st, ueo, qo, spin_o, co * wp, rho_o)
     kti = qi * implicit_slope(mui, dmui, si, slope_cap(p, uei))
     kto = qo * implicit_slope(muo, dmuo, so, slope_cap(p, ueo))
-    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri
+    kpiv = qi * kni + qo * kno
+    mpitch = co * dco - ci * dci
+    kpitch = ci * ci * kci + co * co * kco
+    return qi * mui, qo * muo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, fri + fro, pi, po, fri, kpiv, mpitch, kpitch
 
 
 @njit(cache=True)
@@ -1066,6 +1137,7 @@ def ball_power(
     m_ring: float,
     t_orbit: float,
     cb: float,
+    pivot: float = 0.0,
 ) -> float:
     """Power (W) dissipated at ball j, each term the work its force or moment takes from the
     drive or the bodies in the equations of motion (so that drive work = heat + kinetic and
@@ -1073,8 +1145,10 @@ def ball_power(
     contact's moments on the ring (t_inner omega_i), the moments resisting the ball's rotation
     (rolling resistance, pocket friction, the outer contact's Heathcote moment: ``mres``) at its
     spin omega_a plus the inner ring's share of the hysteresis through its rotation
-    (m_ring cos(beta) omega_i), the EHL forces on its orbit, and the drag."""
-    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm
+    (m_ring cos(beta) omega_i), the EHL forces on its orbit, the drag, and ``pivot``: the
+    transverse tractions x the pivot sliding, k_pivot (r omega_t)^2, taken from the ball's
+    pivot."""
+    return fi * si + fo * so + t_inner * omega_i + mres * wa + m_ring * cb * omega_i - t_orbit * wm + fd * rb * wm + pivot
 
 
 @njit(cache=True)
@@ -1299,9 +1373,11 @@ def step_reduced(
         for j in range(z):
             rb = ball[j, B_R]
             qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, mpitch, kpitch = ball_tractions(
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, geo[j, G_DI], geo[j, G_DO]
+            )
             drive += fi * r_ci
-            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
             fd, dfd = ball_drag(p, rb * wm)
             dfd = implicit_slope(fd, dfd, rb * wm)
             cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
@@ -1331,10 +1407,42 @@ def step_reduced(
             b12 = -dt * jma
             b21 = -dt * jam
             b22 = ib - dt * jaa
+            # the pivot omega_t and the pitch rate omega_p: the orbiting frame's gyroscopic
+            # terms, g = J omega_m sin(beta) times (cos(beta) omega_t, omega_t, -omega_roll) on
+            # (orbit, spin, pivot) and gc = J omega_m cos(beta) times (-omega_p, omega_t) on
+            # (pivot, pitch), skew and taken trapezoidally (they keep the energy exactly); the
+            # transverse tractions' moment -r k_pivot r omega_t and the spin moments' change
+            # -m_pitch implicitly (secants through zero); the (pivot, pitch) rows are eliminated
+            # onto the 2x2 block (Schur complement). With no traction at either contact
+            # (k_pivot = 0: frictionless or unloaded) the gyroscopic terms are left out
+            sbg = math.sqrt(max(1.0 - cb * cb, 0.0))
+            g = ib * wm * sbg if kpiv > 0.0 else 0.0
+            gc = ib * wm * cb if kpiv > 0.0 else 0.0
+            hg = 0.5 * dt * g
+            hgc = 0.5 * dt * gc
+            gm += g * cb * wt
+            ga += g * wt
+            s11 = ib + dt * r * r * kpiv
+            s22 = ib + dt * kpitch
+            dinv = 1.0 / (s11 * s22 + hgc * hgc)
+            rt = dt * (-g * omega_roll - gc * wp - r * r * kpiv * wt)
+            rp = dt * (gc * wt - mpitch)
+            r3 = (s22 * rt - hgc * rp) * dinv
+            t1, t2 = s22 * hg * cb * dinv, s22 * hg * dinv
+            b11 += hg * cb * t1
+            b12 += hg * cb * t2
+            b21 += hg * t1
+            b22 += hg * t2
+            work[j, w0 + 29] = r3
+            work[j, w0 + 30] = t1
+            work[j, w0 + 31] = t2
+            work[j, w0 + 32] = (hgc * rt + s11 * rp) * dinv
+            work[j, w0 + 33] = hgc * hg * cb * dinv
+            work[j, w0 + 34] = hgc * hg * dinv
             det = b11 * b22 - b12 * b21
             i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
-            r1 = dt * (gm - dt * rm * ku * rate)
-            r2 = dt * ga
+            r1 = dt * (gm - dt * rm * ku * rate) + hg * cb * r3
+            r2 = dt * ga + hg * r3
             x2 = i11 * r1 + i12 * r2
             work[j, w0 + 0] = i11
             work[j, w0 + 1] = i21
@@ -1363,7 +1471,7 @@ def step_reduced(
                 rcy += ny * fp
             work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
             work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2 + mpitch * wp)
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
@@ -1421,6 +1529,8 @@ def step_reduced(
             d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
             ball[j, B_OMEGA] += d_wm
             ball[j, B_SPIN] += d_wa
+            ball[j, B_PIVOT] += work[j, w0 + 29] - work[j, w0 + 30] * d_wm - work[j, w0 + 31] * d_wa
+            ball[j, B_PITCH] += work[j, w0 + 32] - work[j, w0 + 33] * d_wm - work[j, w0 + 34] * d_wa
             # the drive torque of the traction the step applied: Q mu at the start plus its
             # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
             d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
@@ -1438,8 +1548,9 @@ def step_reduced(
     return worst_iter
 
 
-NW = NG + 8 + 29
-"""Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling)."""
+NW = NG + 8 + 35
+"""Columns of the reduced model's scratch array (w0 + 20 onwards: the cage centre's coupling;
+w0 + 29 onwards: the pivot's and the pitch's elimination)."""
 
 
 @njit(cache=True)
@@ -1497,9 +1608,12 @@ def step_stiff(
             qo, _, _ = impact_force(do, rate_o, p[P_K_OUT], p)
             # the raceway contacts' Hunt-Crossley damping: the force beyond Hertz's, times the rate
             contact_damp += impact_damping_power(di, rate_i, qi, p[P_K_IN]) + impact_damping_power(do, rate_o, qo, p[P_K_OUT])
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri = ball_tractions(p, ball, j, omega_i, qi, qo, nir, niz, nor, noz)
+            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
+                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, di, do
+            )
             drive += fi * r_ci
-            wm, wa = ball[j, B_OMEGA], ball[j, B_SPIN]
+            wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
+            g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
             fd, _ = ball_drag(p, rb * wm)
             gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
             fs, _, _ = pocket_force(p, gap, rate)
@@ -1529,11 +1643,15 @@ def step_stiff(
             drive += t_inner + m_ring * cb
             mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
             # momenta at the current positions (p_theta first: p_r's update needs it)
-            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit)
+            # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
+            # pivot (symplectic Euler on the skew terms: bounded energy error)
+            wt = wt - dt * (g * (wa + cb * wm) + r * r * kpiv * wt) / ib
+            ball[j, B_PIVOT] = wt
+            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt)
             wnew = ptheta / (m * rb * rb)
             vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
             vz_new = vz + dt * (-qi * niz - qo * noz) / m
-            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres) / ib
+            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres + g * wt) / ib
             ball[j, B_THETA] += dt * wnew
             rb_new = rb + dt * vr_new
             ball[j, B_R] = rb_new
@@ -1542,7 +1660,7 @@ def step_stiff(
             ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
             ring_force += qi * niz
             torque[j] = rm * fs
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb)
+            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2)
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
@@ -1574,7 +1692,7 @@ def step_stiff(
 @njit(cache=True)
 def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray, axial_load: float) -> float:
     """Total mechanical energy (J) of the stiff model: kinetic energy of balls (orbit, radial,
-    axial, spin), cage segments and the inner ring's axial motion, plus Hertz potentials
+    axial, spin, pivot), cage segments and the inner ring's axial motion, plus Hertz potentials
     (2/5 K x^2.5) of raceway and pocket contacts, rim strain energy and the potential
     -F_a delta_a of the constant axial load. The reduced model's cage centre adds its kinetic
     energy, the land contact's strain energy k d^2 / 2 and the potential of the cage's weight,
@@ -1591,7 +1709,7 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
     for j in range(z):
         rb = ball[j, B_R]
         e += 0.5 * m * (ball[j, B_VR] ** 2 + ball[j, B_VZ] ** 2 + (rb * ball[j, B_OMEGA]) ** 2)
-        e += 0.5 * ib * ball[j, B_SPIN] ** 2
+        e += 0.5 * ib * (ball[j, B_SPIN] ** 2 + ball[j, B_PIVOT] ** 2 + ball[j, B_PITCH] ** 2)
         di, _, _, _, do, _, _, _ = raceway_geometry(p, rb, ball[j, B_Z], ring[R_DELTA])
         if di > 0.0:
             e += 0.4 * p[P_K_IN] * di**2.5

@@ -492,6 +492,12 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_LAND_K] = 0.25 * math.pi * e_star * p.land_width
     v[kn.P_LAND_MU] = p.cage_land_friction
     v[kn.P_CAGE_GRAV_Y] = -cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
+    # spin lever of each contact: the Hertz pressure's mean distance from the centre,
+    # (3/8) a E(e^2) (a the semi-major axis, E the complete elliptic integral of the second kind
+    # at e^2 = 1 - b^2/a^2; (3 pi/16) a on a circle, 3a/8 on a long ellipse); a grows as
+    # Q^(1/3) = K^(1/3) delta^(1/2), so the value at 1 N times K^(1/3), x delta^(1/2)
+    v[kn.P_SPIN_IN] = 0.375 * inner.semi_axes(1.0)[0] * inner.second_kind * inner.stiffness ** (1.0 / 3.0)
+    v[kn.P_SPIN_OUT] = 0.375 * outer.semi_axes(1.0)[0] * outer.second_kind * outer.stiffness ** (1.0 / 3.0)
     gamma = dw * math.cos(a0) / dm
     rx_in, rx_out = rball * (1.0 - gamma), rball * (1.0 + gamma)
     if lub is not None:

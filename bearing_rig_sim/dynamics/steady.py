@@ -1,9 +1,10 @@
 """Direct steady-state solver of the default (reduced) engine at constant speed and axial load.
 
-Under a pure axial load every ball runs the same way, so a steady state is four numbers:
-ball orbit speed omega_m and spin omega_a (rad/s), cage speed Omega (rad/s) and the pocket
-offset u = r_m (theta - phi) (m), the same for every ball and pocket. Instead of integrating
-the equations of motion until they settle, :class:`SteadySolver` solves for these four numbers
+Under a pure axial load every ball runs the same way, so a steady state is six numbers:
+ball orbit speed omega_m and spin omega_a (rad/s), cage speed Omega (rad/s), the pocket
+offset u = r_m (theta - phi) (m), the ball's pivot omega_t and its pitch rate omega_p (rad/s),
+the same for every ball and pocket. Instead of integrating
+the equations of motion until they settle, :class:`SteadySolver` solves for these six numbers
 by Newton's method on a residual built from the engine's own step:
 
     g(x) = (step_h(x) - x) / h
@@ -12,12 +13,12 @@ where ``step_h`` is one linearly implicit step (:func:`.kernels.step_reduced`) o
 the symmetric state x. That step is x + (I - h J~)^-1 h f(x) with f the model's right-hand
 side, so g(x) = 0 exactly where f(x) = 0: the solution is the engine's equilibrium under the
 engine's own force laws, whatever they are, and no law is restated here. The Jacobian of g is
-formed by finite differences (four more steps). At the solution that Jacobian is
+formed by finite differences (six more steps). At the solution that Jacobian is
 (I - h J~)^-1 J, and its eigenvalues tell whether integration with step h would settle there
 (all real parts negative) or leave: stability as the reference integrator sees it (an unstable
 mode growing faster than 1/h looks stable to both).
 
-The four unknowns are the reduced model's dynamic states (ball centres and the inner ring's
+The six unknowns are the reduced model's dynamic states (ball centres and the inner ring's
 axial position are quasi-static: the step solves them itself). A dynamic state added to the
 reduced model later must be added to x here; ``test/test_dynamics_steady.py`` compares the
 solver with the integration over the paper's grid and would show the omission.
@@ -100,7 +101,7 @@ largest magnitude) count as unstable."""
 def _load_state(
     x: np.ndarray, omega_i: float, rm: float, base_ball: np.ndarray, base_ring: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: np.ndarray
 ) -> None:
-    """Write the symmetric state x = (omega_m, omega_a, Omega, u) into the engine arrays."""
+    """Write the symmetric state x = (omega_m, omega_a, Omega, u, omega_t, omega_p) into the engine arrays."""
     z = ball.shape[0]
     ball[:, :] = base_ball
     ring[:] = base_ring
@@ -110,6 +111,8 @@ def _load_state(
         ball[j, kn.B_THETA] = theta
         ball[j, kn.B_OMEGA] = x[0]
         ball[j, kn.B_SPIN] = x[1]
+        ball[j, kn.B_PIVOT] = x[4]
+        ball[j, kn.B_PITCH] = x[5]
         cage[j, kn.C_PHI] = theta - x[3] / rm
         cage[j, kn.C_OMEGA] = x[2]
 
@@ -131,16 +134,22 @@ def _residual(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: floa
     wa = 0.0
     wc = 0.0
     u = 0.0
+    wt = 0.0
+    wp = 0.0
     for j in range(z):
         theta = 2.0 * math.pi * j / z
         wm += ball[j, kn.B_OMEGA]
         wa += ball[j, kn.B_SPIN]
+        wt += ball[j, kn.B_PIVOT]
+        wp += ball[j, kn.B_PITCH]
         wc += cage[j, kn.C_OMEGA]
         u += rm * ((ball[j, kn.B_THETA] - theta) - (cage[j, kn.C_PHI] - theta))
     g[0] = (wm / z - x[0]) / h
     g[1] = (wa / z - x[1]) / h
     g[2] = (wc / z - x[2]) / h
     g[3] = (u / z - x[3]) / h
+    g[4] = (wt / z - x[4]) / h
+    g[5] = (wp / z - x[5]) / h
 
 
 @njit(cache=True)
@@ -161,14 +170,14 @@ def _newton(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float,
     """
     speed_scale = max(abs(omega_i), 1.0)
     clear = max(p[kn.P_POCKET_CLEAR], 1e-9)
-    scale = np.array([speed_scale, speed_scale, speed_scale, clear])
+    scale = np.array([speed_scale, speed_scale, speed_scale, clear, speed_scale, speed_scale])
     # residual norm: the increments of one step, relative to the unknowns' scales
     rscale = h / scale
-    trust = np.array([0.2, 0.2, 0.2, 1.0]) * scale
-    g = np.zeros(4)
-    gt = np.zeros(4)
-    jac = np.zeros((4, 4))
-    xt = np.zeros(4)
+    trust = np.array([0.2, 0.2, 0.2, 1.0, 0.2, 0.2]) * scale
+    g = np.zeros(6)
+    gt = np.zeros(6)
+    jac = np.zeros((6, 6))
+    xt = np.zeros(6)
     _residual(p, x, omega_i, load, h, arrays, g)
     _keep_warm_start(arrays)
     norm = np.max(np.abs(g * rscale))
@@ -176,7 +185,7 @@ def _newton(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float,
     it = 0
     while it < max_iter and not converged:
         it += 1
-        for k in range(4):
+        for k in range(6):
             e = 1e-7 * scale[k]
             xt[:] = x
             xt[k] += e
@@ -243,6 +252,11 @@ class SteadyPoint:
         iterations: Newton iterations of the last Newton run (0 if none converged).
         stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
             False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
+        ball_pivot_speed: rad/s, the ball's pivot omega_t (about e_t, driven by the gyroscopic
+            moment, resisted by the transverse tractions).
+        ball_pitch_speed: rad/s, the ball's pitch rate omega_p (its angular velocity about the
+            third axis of the radial-axial plane, relative to raceway control: the rolling
+            axis's tilt; resisted by the contacts' spin moments).
     """
 
     inner_ring_speed: float
@@ -261,11 +275,13 @@ class SteadyPoint:
     method: str
     iterations: int
     stable: bool
+    ball_pivot_speed: float = 0.0
+    ball_pitch_speed: float = 0.0
 
     @property
     def vector(self) -> np.ndarray:
-        """(omega_m, omega_a, Omega, u): the solver's unknowns, to continue from."""
-        return np.array([self.ball_orbit_speed, self.ball_spin_speed, self.cage_speed, self.pocket_offset])
+        """(omega_m, omega_a, Omega, u, omega_t, omega_p): the solver's unknowns, to continue from."""
+        return np.array([self.ball_orbit_speed, self.ball_spin_speed, self.cage_speed, self.pocket_offset, self.ball_pivot_speed, self.ball_pitch_speed])
 
 
 class SteadySolver:
@@ -316,7 +332,9 @@ class SteadySolver:
             origin = ORIGIN_CONTINUATION
             # the neighbour's speeds scaled to this inner-ring speed; the engine's current ball
             # positions are only the warm start of the normal-contact solution
-            x0 = start.vector * np.array([omega / start.inner_ring_speed] * 3 + [1.0])
+            # (the pivot grows as the gyroscopic moment, the square of the speed)
+            ratio = omega / start.inner_ring_speed
+            x0 = start.vector * np.array([ratio] * 3 + [1.0, ratio * ratio, ratio * ratio])
         x = x0.copy()
         status, iterations = self._newton(x, omega, axial_load)
         if status == _CONVERGED:
@@ -399,7 +417,16 @@ class SteadySolver:
         e = self.engine
         rm = float(e.vector[kn.P_RM])
         u = rm * float(np.mean(e.ball[:, kn.B_THETA] - e.cage[:, kn.C_PHI]))
-        return np.array([float(np.mean(e.ball[:, kn.B_OMEGA])), float(np.mean(e.ball[:, kn.B_SPIN])), e.cage_speed, u])
+        return np.array(
+            [
+                float(np.mean(e.ball[:, kn.B_OMEGA])),
+                float(np.mean(e.ball[:, kn.B_SPIN])),
+                e.cage_speed,
+                u,
+                float(np.mean(e.ball[:, kn.B_PIVOT])),
+                float(np.mean(e.ball[:, kn.B_PITCH])),
+            ]
+        )
 
     def _load_engine(self, x: np.ndarray, omega: float) -> None:
         e = self.engine
@@ -444,6 +471,8 @@ class SteadySolver:
             method=method,
             iterations=iterations,
             stable=stable,
+            ball_pivot_speed=float(x[4]),
+            ball_pitch_speed=float(x[5]),
         )
 
 

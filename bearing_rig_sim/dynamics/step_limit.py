@@ -33,7 +33,15 @@ centrifugal force), so the limit follows the bearing, its lubricant and the rig.
   (:func:`traction_bound`) and omega_m the fastest ball orbit of the envelope. The dependence
   of the traction on the entrainment speed is frozen too; it is the slide-to-roll ratio times
   the implicit sliding slope (mu(SRR) with SRR = s/u_e), so below SRR = 1 it cannot
-  destabilise the step (|1 - h b| <= 1 + h a for b <= a). docs/model.md, Integration.
+  destabilise the step (|1 - h b| <= 1 + h a for b <= a). The ball's pivot and pitch
+  (gyroscopic) add nothing to the limit: the transverse tractions and the spin moments' change
+  enter with their secant slopes (implicit), the gyroscopic terms are skew and taken
+  trapezoidally with coefficients frozen over the step (J omega_m sin(beta) and
+  J omega_m cos(beta): h omega_m < 5e-3 at the envelope's top), and the explicit dependences,
+  of the transverse slope on the rolling sliding and of the spin moments on the raceway-control
+  spins, run one way (the rolling traction depends on neither the pivot nor the pitch), a
+  triangular coupling that cannot grow.
+  docs/model.md, Integration.
 
 A step above the limit is refused at engine construction (:class:`StepLimitError`, one line
 naming the file key, the value, the limit and the mechanism).

@@ -46,6 +46,9 @@ SPEED_RANGE = (0.05, 40.0)
 """Entrainment speeds of the table, m/s (log-spaced)."""
 LOAD_RANGE = (0.5, 2000.0)
 """Contact loads of the table, N (log-spaced)."""
+ODD_TAYLOR = 0.002
+"""Relative distance from |SRR| within which :func:`table_lookup_full` places the odd part's
+SRR by a first-order step from the rolling SRR's position instead of its own asinh."""
 HEADER = 8
 """Header of a table in the parameter vector: n_srr, n_speed, n_load, xi_max, ln u0, d ln u,
 ln q0, d ln q; then the pairs (mu, power)[contact, load, speed, srr] interleaved, so that one
@@ -204,30 +207,95 @@ def _table_position(t: np.ndarray, base: int, srr: float, speed: float, load: fl
     return i_s, i_u, i_q, fs - i_s, fu - i_u, fq - i_q, lu, lq
 
 
+@njit(cache=True, inline="always")
+def _mirrored(ns: int, fp: float) -> tuple[int, int, float, float]:
+    """Cell indices and weights of an SRR's node position ``fp`` >= the table's centre and of its
+    mirror image (-SRR), clamped at the table's edge."""
+    fp = min(fp, ns - 1.000001)
+    fm = max(ns - 1.0 - fp, 0.0)
+    i_p, i_m = int(fp), int(fm)
+    return i_p, i_m, fp - i_p, fm - i_m
+
+
 @njit(cache=True)
-def table_lookup_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float, float]:
-    """:func:`table_lookup` and :func:`table_power` in one pass over the cell (one position
-    computation): (mu, d mu / d SRR, u_e^0.66 Q^0.47, P / (Q u_e))."""
+def table_lookup_full(
+    t: np.ndarray, base: int, contact: int, srr: float, odd_srr: float, speed: float, load: float, spin_a: float = -1.0, spin_b: float = -1.0
+) -> tuple[float, float, float, float, float, float, float]:
+    """One pass over the cells of a table for ``contact``: (mu, d mu / d SRR,
+    u_e^0.66 Q^0.47, P / (Q u_e)) at ``srr`` and, when ``odd_srr`` >= 0, the odd part
+    (mu(+odd_srr) - mu(-odd_srr))/2 at ``odd_srr`` (else 0): the law with the offset of spin and
+    Heathcote slip at SRR = 0 taken out, rising from 0 and saturating like it; then the odd part
+    at ``spin_a`` and at ``spin_b`` when they are >= 0 (else 0; the spin moment's two SRRs,
+    :func:`.kernels.spin_moment_change`). The speed and load position is computed once for
+    all."""
     ns = int(t[base])
     nu = int(t[base + 1])
     size = ns * nu * int(t[base + 2])
     i_s, i_u, i_q, ws, wu, wq, lu, lq = _table_position(t, base, srr, speed, load)
+    odd = odd_srr >= 0.0
+    spin = spin_a >= 0.0 and spin_b >= 0.0
+    i_p = i_m = ia_p = ia_m = ib_p = ib_m = 0
+    wp = wm = wa_p = wa_m = wb_p = wb_m = 0.0
+    xi_max = t[base + 3]
+    dxi = 2.0 * xi_max / (ns - 1)
+    root = math.sqrt(SRR_REF * SRR_REF + srr * srr)
+    if odd:
+        d = odd_srr - abs(srr)
+        if 0.0 <= d <= ODD_TAYLOR * abs(srr):
+            # close to |srr|: asinh to first order from srr's own position (d asinh(x/R)/dx =
+            # 1/sqrt(R^2 + x^2)); the second-order term is below 2e-6 of a cell
+            fp = abs(i_s + ws - 0.5 * (ns - 1)) + 0.5 * (ns - 1) + d / root / dxi
+        else:
+            fp = (math.asinh(odd_srr / SRR_REF) + xi_max) / dxi
+        i_p, i_m, wp, wm = _mirrored(ns, fp)
+    if spin:
+        fa = (math.asinh(spin_a / SRR_REF) + xi_max) / dxi
+        d = spin_b - spin_a
+        if abs(d) <= ODD_TAYLOR * spin_a:
+            # close to spin_a (a small pitch rate): asinh to first order, as for odd_srr
+            fb = fa + d / math.sqrt(SRR_REF * SRR_REF + spin_a * spin_a) / dxi
+        else:
+            fb = (math.asinh(spin_b / SRR_REF) + xi_max) / dxi
+        ia_p, ia_m, wa_p, wa_m = _mirrored(ns, fa)
+        ib_p, ib_m, wb_p, wb_m = _mirrored(ns, fb)
     mu0 = 0.0
     mu1 = 0.0
     pw = 0.0
+    mu_odd = 0.0
+    mu_a = 0.0
+    mu_b = 0.0
     for dq in range(2):
         cq = wq if dq == 1 else 1.0 - wq
         for du in range(2):
             cu = wu if du == 1 else 1.0 - wu
-            k = base + HEADER + 2 * (contact * size + ((i_q + dq) * nu + (i_u + du)) * ns + i_s)
+            cell = base + HEADER + 2 * (contact * size + ((i_q + dq) * nu + (i_u + du)) * ns)
+            k = cell + 2 * i_s
             w = cq * cu
             mu0 += w * t[k]
             mu1 += w * t[k + 2]
             pw += w * ((1.0 - ws) * t[k + 1] + ws * t[k + 3])
+            if odd:
+                plus = (1.0 - wp) * t[cell + 2 * i_p] + wp * t[cell + 2 * i_p + 2]
+                minus = (1.0 - wm) * t[cell + 2 * i_m] + wm * t[cell + 2 * i_m + 2]
+                mu_odd += w * (plus - minus)
+            if spin:
+                plus = (1.0 - wa_p) * t[cell + 2 * ia_p] + wa_p * t[cell + 2 * ia_p + 2]
+                minus = (1.0 - wa_m) * t[cell + 2 * ia_m] + wa_m * t[cell + 2 * ia_m + 2]
+                mu_a += w * (plus - minus)
+                plus = (1.0 - wb_p) * t[cell + 2 * ib_p] + wb_p * t[cell + 2 * ib_p + 2]
+                minus = (1.0 - wb_m) * t[cell + 2 * ib_m] + wb_m * t[cell + 2 * ib_m + 2]
+                mu_b += w * (plus - minus)
     mu = mu0 + ws * (mu1 - mu0)
-    dxi = 2.0 * t[base + 3] / (ns - 1)
-    slope = (mu1 - mu0) / dxi / math.sqrt(SRR_REF * SRR_REF + srr * srr)
+    slope = (mu1 - mu0) / dxi / root
     rolling = math.exp(0.66 * lu + 0.47 * lq) if load > 0.0 else 0.0
+    return mu, slope, rolling, pw, 0.5 * mu_odd, 0.5 * mu_a, 0.5 * mu_b
+
+
+@njit(cache=True)
+def table_lookup_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> tuple[float, float, float, float]:
+    """:func:`table_lookup` and :func:`table_power` in one pass over the cell (one position
+    computation): (mu, d mu / d SRR, u_e^0.66 Q^0.47, P / (Q u_e))."""
+    mu, slope, rolling, pw, _, _, _ = table_lookup_full(t, base, contact, srr, -1.0, speed, load)
     return mu, slope, rolling, pw
 
 
@@ -237,12 +305,19 @@ def table_lookup(t: np.ndarray, base: int, contact: int, srr: float, speed: floa
     (mu, d mu / d SRR, u_e^0.66 Q^0.47) for ``contact`` (0 inner, 1 outer). Trilinear in
     (asinh(SRR/SRR_REF), ln u_e, ln Q), clamped at the table's edges; the last value is the
     speed-load factor of Houpert's rolling force, from the same logarithms
-    (:func:`table_lookup_power` without the dissipation)."""
-    mu, slope, rolling, _ = table_lookup_power(t, base, contact, srr, speed, load)
+    (:func:`table_lookup_full` without the dissipation)."""
+    mu, slope, rolling, _, _, _, _ = table_lookup_full(t, base, contact, srr, -1.0, speed, load)
     return mu, slope, rolling
 
 
 @njit(cache=True)
 def table_power(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
     """Interpolated dissipation P / (Q u_e) of ``contact`` (same grid as :func:`table_lookup`)."""
-    return table_lookup_power(t, base, contact, srr, speed, load)[3]
+    return table_lookup_full(t, base, contact, srr, -1.0, speed, load)[3]
+
+
+@njit(cache=True)
+def table_odd(t: np.ndarray, base: int, contact: int, srr: float, speed: float, load: float) -> float:
+    """The odd part (mu(+SRR) - mu(-SRR))/2 of ``contact``'s traction at ``srr`` >= 0
+    (:func:`table_lookup_full`)."""
+    return table_lookup_full(t, base, contact, srr, srr, speed, load)[4]

@@ -340,17 +340,20 @@ def ball_jacobian(
     along the groove unbounded), and a free ball (both contacts open) the isotropic secant
     stiffness that carries its centrifugal force across the outer gap in one step,
     m omega^2 r_b n_or/gap (plus m omega^2, J's own radial term). At rest a free ball keeps the
-    regularising stiffness of both contacts. A singular J (the ball on the line of the
+    regularising stiffness of both contacts, and so does one so slow that its centrifugal stiffness
+    is below 1e-9 of the contacts'. A singular J (the ball on the line of the
     curvature centres at rest, both contacts barely touching) gets a spring of 1e-6 of its
     stiffness across that line."""
     ki, ko = p[P_K_IN], p[P_K_OUT]
-    if di <= 0.0 and do <= 0.0 and spin2 == 0.0:
-        di = do = MIN_PENETRATION_FOR_JACOBIAN
     regular = 1.5 * ki * math.sqrt(MIN_PENETRATION_FOR_JACOBIAN)
-    if di <= 0.0 and do <= 0.0:  # free, at speed
-        d_rr, d_rz, d_zz = contact_jacobian(0.0, regular, nir, niz, disti)
+    if di <= 0.0 and do <= 0.0:
         k = spin2 * rb * max(nor, 0.1) / max(-do, 1e-12) + spin2
-        return 0.0, 0.0, 0.0, d_rr, d_rz, d_zz, spin2 - k, 0.0, -k, k * (k - spin2)
+        if k > 1e-9 * regular:  # free, at speed
+            d_rr, d_rz, d_zz = contact_jacobian(0.0, regular, nir, niz, disti)
+            return 0.0, 0.0, 0.0, d_rr, d_rz, d_zz, spin2 - k, 0.0, -k, k * (k - spin2)
+        # at rest, or so slow that the centrifugal stiffness is below 1e-9 of the contacts' (a
+        # subnormal speed made k (k - m omega^2) underflow to a zero determinant)
+        di = do = MIN_PENETRATION_FOR_JACOBIAN
     if di > -max(do, MIN_PENETRATION_FOR_JACOBIAN):
         h_rr, h_rz, h_zz = contact_jacobian(qi, 1.5 * ki * math.sqrt(max(di, MIN_PENETRATION_FOR_JACOBIAN)), nir, niz, disti)
         d_rr, d_rz, d_zz = h_rr, h_rz, h_zz

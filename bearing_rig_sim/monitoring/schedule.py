@@ -95,9 +95,10 @@ class StatusSchedule:
         return ScheduledStatus(self.clock, "end", self.monitor.status())
 
 
-STABLE_CONFIDENCE = 0.95
+STABLE_CONFIDENCE = 0.6
 """A stable status counts for the time to stable when P(slope >= k) is at least this (1): the
-one-sided 95 % bound the verdict itself uses."""
+confidence of the STABLE test itself, the shipped ``stable_confidence`` of config/monitor.yaml
+(a test keeps the two equal; a caller with other settings passes its own)."""
 
 
 def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int, min_window_s: float = 0.0) -> float:
@@ -139,9 +140,14 @@ class TimeToStable:
         ramp_end: end of the segment's ramp, rig s.
         target_speed: the commanded inner-ring speed, rad/s; None: not checked.
         run_up_start: start of a run-up, rig s; None for any other segment.
+        min_confidence: least P(slope >= k) of the status that makes it stable (1): the monitor's
+            ``stable_confidence``.
     """
 
-    def __init__(self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None) -> None:
+    def __init__(
+        self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None, min_confidence: float = STABLE_CONFIDENCE
+    ) -> None:
+        self.min_confidence = min_confidence
         self.run_up_start = run_up_start
         self.ramp_end = ramp_end if run_up_start is None else run_up_start
         """The origin of the time to stable: the ramp's end, or the run-up's start, rig s."""
@@ -153,7 +159,7 @@ class TimeToStable:
         """A status stamped ``stamp`` whose verdict rests on data from ``evidence_from`` on (s,
         :func:`evidence_start`), measured at ``inner_ring_speed`` (rad/s); returns whether this
         status made the segment stable."""
-        if self.stable_at is not None or state != SlipState.STABLE or not confidence >= STABLE_CONFIDENCE:
+        if self.stable_at is not None or state != SlipState.STABLE or not confidence >= self.min_confidence:
             return False
         target = self.target_speed
         if target is not None and not abs(inner_ring_speed - target) <= speed_tolerance(target):

@@ -322,7 +322,6 @@ def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
     start(ros_graph, "monitor", "loss_min_timeout_s:=30.0", "silent_shaft_revolutions:=1000.0")
     probe = Probe(ros_graph)
     publishers = {shaft: probe.node.create_publisher(FibreOpticPulse, f"/rig/{shaft}/pulses", SENSOR_QOS) for shaft in ("spindle", "cage")}
-    probe.wait(lambda: all(p.get_subscription_count() > 0 for p in publishers.values()), "the monitor's pulse subscriptions")
     received: dict[tuple[str, int], float] = {}  # (shaft, pulse_index) -> wall time received here
     arrivals: list[tuple[float, float, float]] = []  # (status stamp, wall time it arrived here, slip)
     for shaft in ("spindle", "cage"):
@@ -332,6 +331,9 @@ def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
     probe.node.create_subscription(
         SlipStatus, "/rig/slip_status", lambda m: arrivals.append((from_stamp(m.header.stamp), time.time(), m.slip_rate)), STATUS_QOS
     )
+    # the monitor up: its statuses come (on its timer before any pulse), and each pulse topic has a
+    # reader besides this node's two (a start-up slower than the 8 s of pulses made no window)
+    probe.wait(lambda: bool(arrivals) and all(p.get_subscription_count() > 2 for p in publishers.values()), "the monitor's status and pulse subscriptions")
     w = 900 * RPM
     ratio = epicyclic_ratio()
     scenario = BenchScenario(8.0, lambda t: t * 0.0 + w, lambda t: t * 0.0 + 2.0, epicyclic_ratio=ratio, jitter_s=0.0)

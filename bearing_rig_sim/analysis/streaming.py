@@ -1,8 +1,8 @@
 """The slope criterion on points arriving one by one: :class:`TrailingSlope`, the monitor's verdict.
 
 x is the time (s) or the axial load (N). The verdict is the slope of a least-squares line through
-the slip of a trailing window, decided only when its one-sided 95 % bound (Student's t,
-:func:`t_quantile_95`) is on one side of k (with hysteresis), with change detection on the slip
+the slip of a trailing window, decided only when its one-sided bound (Student's t: at
+``stable_confidence`` for STABLE, 95 % for SLIPPING) is on one side of k (with hysteresis), with change detection on the slip
 itself; microseconds per point (see its docstring; ``bearing-rig bench analysis`` measures it).
 
 The paper's own form, a Gaussian sum fitted to the whole series with the onset of the stable
@@ -114,8 +114,9 @@ class TrailingSlope:
     straddle a change), and never below ``resolution`` (percent): until enough points are in,
     the larger of that and the line's own residual scatter.
 
-    **Decision with hysteresis.** With ``q`` the one-sided 95 % Student's t quantile: the state
-    becomes STABLE when ``slope - q se >= k``, SLIPPING when ``slope + q se < k``, and otherwise
+    **Decision with hysteresis.** With ``q_c`` and ``q`` the one-sided Student's t quantiles at
+    ``stable_confidence`` and 95 %: the state becomes STABLE when ``slope - q_c se >= k``,
+    SLIPPING when ``slope + q se < k`` and the slope clearly falls (:meth:`falling`), and otherwise
     stays what it was (UNKNOWN at the start of a series). Since the test is repeated at every
     point, a held verdict is overturned only once the opposite one has been reached over
     :data:`OVERTURN_CONFIRM` of the span, or at once when beyond doubt
@@ -149,6 +150,8 @@ class TrailingSlope:
         change_threshold: prediction standard errors beyond which a point is a candidate change.
         max_span: longest stretch of the series the slope may rest on when the trailing window
             cannot decide, unit of x (None: the trailing window only; >= span).
+        stable_confidence: one-sided confidence of the STABLE test (0.5-1): a false STABLE at a
+            true slope of k with P = 1 - this per test (docs/method.md).
     """
 
     def __init__(
@@ -373,8 +376,9 @@ class TrailingSlope:
         return slope + 2.0 * t_quantile_95(self._dof) * standard_error < 0.0
 
     def _clear(self, line: tuple[float, float, float, float, float, int], strict: bool = False) -> SlipState:
-        """The state a line decides by the one-sided 95 % bound (UNKNOWN: neither side); with
-        ``strict``, by the bound at 1 - :data:`OVERTURN_AT_ONCE_P`. SLIPPING only on a slope
+        """The state a line decides by its one-sided bounds, at ``stable_confidence`` for STABLE and
+        95 % for SLIPPING (UNKNOWN: neither side); with ``strict``, both at 1 -
+        :data:`OVERTURN_AT_ONCE_P`. SLIPPING only on a slope
         also clearly falling (:meth:`falling`)."""
         slope, se, *_rest = line
         q = t_quantile_overturn(self._dof) if strict else t_quantile_95(self._dof)

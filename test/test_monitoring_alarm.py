@@ -63,3 +63,30 @@ def test_a_first_verdict_may_come_between_slip_points_and_is_then_held() -> None
     assert trailing.state is SlipState.STABLE
     trailing.refresh((-1.0, 0.01, DOF))
     assert trailing.state is SlipState.STABLE
+
+
+def held_then_falling_windows(trailing: tuple[float, float, int]) -> list[SlipState]:
+    """States of a series held STABLE on 3 s of flat slip points (scattering +-0.01 %, 0.159 s
+    apart, the phase's trailing slope 0 +- 0.005), whose points then fall at -0.1 %/s for 2 s
+    while the phase's trailing slope is ``trailing``."""
+    series = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0)
+    states = []
+    for i in range(32):
+        x = 0.159 * i
+        noise = 0.01 if i % 2 else -0.01
+        falling = x >= 3.0
+        series.add(x, 2.0 - 0.1 * max(x - 3.0, 0.0) + noise, trailing if falling else (0.0, 0.005, DOF))
+        states.append(series.state)
+    return states
+
+
+def test_the_windows_longer_line_raises_the_alarm_only_with_the_trailing_slope_falling() -> None:
+    """The windows' line from the held verdict's data on (up to 2.2 s of points falling at -0.1
+    %/s for their last second and more) comes out clearly below k2; the held STABLE is overturned
+    to SLIPPING only while the finer trailing slope itself falls clearly (-0.1 +- 0.02: -0.1 + 2 *
+    1.72 * 0.02 < 0), not while it is undecided (-0.032 +- 0.033, a 900 rpm hold's phase at one
+    second: 2 t95 se = 0.11 above it), which a 50 us-jitter hold once turned into a false alarm."""
+    undecided = held_then_falling_windows((-0.032, 0.033, DOF))
+    assert undecided[18] is SlipState.STABLE and set(undecided[18:]) == {SlipState.STABLE}
+    falling = held_then_falling_windows((-0.1, 0.02, DOF))
+    assert falling[18] is SlipState.STABLE and falling[-1] is SlipState.SLIPPING

@@ -392,7 +392,8 @@ def _backlogged(pulses: list, start: float, end: float) -> list:
 def test_a_backlog_of_the_two_topics_is_put_back_in_time_order() -> None:
     """After a 2 s hold-up at 2100 rpm the cage backlog runs ahead of the spindle's in time; fed
     as received, the checks find the spindle silent (FAULT); through PulseMerger, the pulses go
-    on in time order (within two pulse intervals) and no FAULT comes."""
+    on in stamp order exactly (but for the last ones, still held for the other shaft's next pulse)
+    and no FAULT comes."""
     w = 2100.0 * math.pi / 30.0
     scenario = BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=RATIO)
     arrivals = _backlogged(bench_pulses(scenario), 4.0, 6.0)
@@ -412,10 +413,8 @@ def test_a_backlog_of_the_two_topics_is_put_back_in_time_order() -> None:
     assert SlipState.FAULT in unmerged  # the problem is real
     merged, order = states(True)
     assert SlipState.FAULT not in merged
-    # in time order up to the merger's tolerance: two pulse intervals of the other shaft
-    latest = np.maximum.accumulate(np.array(order))
-    spindle_interval = 2.0 * math.pi / (4 * w)
-    assert np.max(latest - np.array(order)) <= 2.0 * spindle_interval * 1.01
+    assert order == sorted(p.time for _, p in arrivals)[: len(order)]
+    assert len(order) >= len(arrivals) - 2
 
 
 def test_kinematic_slip_removes_the_contact_angle_and_either_slip_can_be_judged() -> None:
@@ -486,15 +485,21 @@ def test_run_ups_of_the_paper_are_judged_stable_and_stay_so(acceleration: float,
 
 @pytest.mark.parametrize(
     ("acceleration", "changes"),
-    [(20.0, {"lost_fraction": 0.005, "seed": 1}), (60.0, {"bursts": (Burst("cage", 1.8, 8),)}), (40.0, {"jitter_s": 10e-6, "seed": 2})],
+    [
+        (20.0, {"lost_fraction": 0.005, "seed": 1}),
+        (60.0, {"bursts": (Burst("cage", 1.8, 8),)}),
+        (20.0, {"bursts": (Burst("cage", 1.77, 8),)}),  # 0.1 s after the onset (1.67 s)
+        (40.0, {"jitter_s": 10e-6, "seed": 2}),
+    ],
 )
 def test_run_ups_with_sensor_imperfections_are_judged_stable_after_the_onset(acceleration: float, changes: dict) -> None:
     """The same run-ups with 0.5 % of the pulses lost, a burst of 8 lost cage pulses (2 revolutions)
     just after the onset, or 10 us of jitter: no FAULT, never stable before the onset, stable
     within ONSET_DELAY_S after it and kept. (Seeds 100-119 of each case at 20-80 rad/s^2:
-    0.53-1.43 s; but a burst of 2 cage revolutions 0.1 s after the onset at 20 rad/s^2, where the
-    cage gives some 8 pulses a second, leaves too few pulses for 1.5 s: 1.83 s. Before the
-    phase's stretch reached back to PHASE_MIN_PULSES pulses, 10 us of jitter took up to 1.8 s.)"""
+    0.53-1.43 s at a stable_confidence of 0.95; a burst of 2 cage revolutions 0.1 s after the
+    onset at 20 rad/s^2, where the cage gives some 9 pulses a second, took 1.83 s then and 1.43 s
+    at the shipped 0.6, tested below. Before the phase's stretch reached back to
+    PHASE_MIN_PULSES pulses, 10 us of jitter took up to 1.8 s.)"""
     scenario = table7_run_up(acceleration, epicyclic_ratio=RATIO, **changes)
     onset = table7_onset(acceleration, K2)
     out = run(scenario)
@@ -504,17 +509,17 @@ def test_run_ups_with_sensor_imperfections_are_judged_stable_after_the_onset(acc
     assert np.all(out.states[out.times >= stable[0]] == SlipState.STABLE)
 
 
-@pytest.mark.parametrize(("rpm", "first_stable_s"), [(900.0, 2.0), (1500.0, 1.5), (3000.0, 1.5), (9000.0, 1.5)])
+@pytest.mark.parametrize(("rpm", "first_stable_s"), [(900.0, 1.5), (1500.0, 1.5), (3000.0, 1.5), (9000.0, 1.5)])
 def test_a_hold_with_50_us_of_jitter_is_stable_and_its_median_slip_true(rpm: float, first_stable_s: float) -> None:
     """A 10 s hold at constant 2 % slip with 50 us of timing jitter on every pulse: no FAULT, a
     stable verdict that is kept, and the median slip of the statuses within 0.02 pp of the truth
     (windows of at least min_window_s = 0.1 s: at 9000 rpm a one-revolution window's slip
     scatters by about 0.45 % under this jitter, a 0.1 s one by 0.07 %). The verdict comes within
-    1.5 s (issue 25) from 1500 rpm up. At 900 rpm the data hardly allow it: the cage's phase over
-    T seconds (26 pulses a second, each 50 us = 2e-3 rad off, the spindle's angle as much again)
-    leaves the slope a standard error of about 0.034 T^-2.5 %/s, and its 95 % bound clears
-    k2 = -0.03 %/s from a true slope of 0 only from T = 1.25 s (12 seeds: 1.0-2.4 s, median 1.3 s);
-    the bound there is 2 s. (Before the phase fit: 3-4 s.)"""
+    1.5 s (issue 25). At 900 rpm the data hardly allow it: the cage's phase over T seconds (26
+    pulses a second, each 50 us = 2e-3 rad off, the spindle's angle as much again) leaves the
+    slope a standard error of about 0.034 T^-2.5 %/s, and a 95 % bound cleared k2 = -0.03 %/s
+    from a true slope of 0 within 1.5 s for 75 % of seeds; the shipped stable_confidence of 0.6
+    does for all 40 held-out seeds (docs/method.md). (Before the phase fit: 3-4 s.)"""
     w = rpm * math.pi / 30.0
     scenario = BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=RATIO, jitter_s=50e-6, seed=3)
     out = run(scenario)

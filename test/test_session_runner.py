@@ -83,7 +83,7 @@ def test_until_stable_needs_a_stable_verdict_on_windows_after_the_ramp(program: 
     runner.observe_status(status(3.3, StatusState.STABLE))  # its windows reach back to 2.14 s: ignored
     assert runner.update(3.3) == []
     first = plan.ramp_end + 1.0 + W40
-    runner.observe_status(status(first + 0.01, StatusState.STABLE, confidence=0.9))  # held, not shown now
+    runner.observe_status(status(first + 0.01, StatusState.STABLE, confidence=0.55))  # held, not shown now (below STABLE_CONFIDENCE, 0.6)
     runner.observe_status(status(first + 0.05, StatusState.STABLE, slip=3.2))
     (nxt,) = runner.update(first + 0.06)
     outcome = runner.outcomes[-1]
@@ -109,14 +109,15 @@ def test_stable_verdict_of_the_previous_speed_does_not_end_the_next_segment(prog
 
 def test_a_stable_verdict_resting_on_the_ramp_does_not_count(program: TestProgram) -> None:
     """A verdict whose slope still includes windows of the ramp speaks for the ramp, and a stable
-    state held by hysteresis (P(slope >= k) below 0.95) for older points: neither counts."""
+    state held by hysteresis (P(slope >= k) below the STABLE test's confidence, 0.6) for older
+    points: neither counts."""
     runner = ProgramRunner(program)
     runner.start(0.0)
     (plan,) = runner.update(1.0)  # n0900: ramp 1.0 .. 2.5
     cage = 2.0 * math.pi / 0.1  # 0.1 s windows: a verdict reaches back 1.1 s
     runner.observe_status(status(2.55, StatusState.STABLE, cage=cage))
     runner.observe_status(status(3.5, StatusState.STABLE, cage=cage))  # back to 2.4 s: in the ramp
-    runner.observe_status(status(3.62, StatusState.STABLE, cage=cage, confidence=0.6))
+    runner.observe_status(status(3.62, StatusState.STABLE, cage=cage, confidence=0.55))
     assert runner.update(3.62) == []
     runner.observe_status(status(3.65, StatusState.STABLE, slip=3.3, cage=cage))
     assert runner.update(3.65) and runner.outcomes[-1].time_to_stable == pytest.approx(3.65 - plan.ramp_end)

@@ -1,8 +1,8 @@
 """The slope criterion on points arriving one by one: :class:`TrailingSlope`, the monitor's verdict.
 
 x is the time (s) or the axial load (N). The verdict is the slope of a least-squares line through
-the slip of a trailing window, decided only when its one-sided 95 % bound (Student's t,
-:func:`t_quantile_95`) is on one side of k (with hysteresis), with change detection on the slip
+the slip of a trailing window, decided only when its one-sided bound (Student's t: at
+``stable_confidence`` for STABLE, 95 % for SLIPPING) is on one side of k (with hysteresis), with change detection on the slip
 itself; microseconds per point (see its docstring; ``bearing-rig bench analysis`` measures it).
 
 The paper's own form, a Gaussian sum fitted to the whole series with the onset of the stable
@@ -34,6 +34,13 @@ def t_quantile_overturn(dof: int) -> float:
     """One-sided Student's t quantile at 1 - :data:`OVERTURN_AT_ONCE_P` with ``dof`` (>= 1)
     degrees of freedom (``scipy.stats.t.ppf``; cached)."""
     return float(student_t.ppf(1.0 - OVERTURN_AT_ONCE_P, dof))
+
+
+@functools.lru_cache(maxsize=1024)
+def t_quantile(probability: float, dof: int) -> float:
+    """Student's t quantile at ``probability`` (0-1) with ``dof`` (>= 1) degrees of freedom
+    (``scipy.stats.t.ppf``; cached, as the monitor asks for the same few at every point)."""
+    return float(student_t.ppf(probability, dof))
 
 
 @functools.lru_cache(maxsize=256)
@@ -107,8 +114,9 @@ class TrailingSlope:
     straddle a change), and never below ``resolution`` (percent): until enough points are in,
     the larger of that and the line's own residual scatter.
 
-    **Decision with hysteresis.** With ``q`` the one-sided 95 % Student's t quantile: the state
-    becomes STABLE when ``slope - q se >= k``, SLIPPING when ``slope + q se < k``, and otherwise
+    **Decision with hysteresis.** With ``q_c`` and ``q`` the one-sided Student's t quantiles at
+    ``stable_confidence`` and 95 %: the state becomes STABLE when ``slope - q_c se >= k``,
+    SLIPPING when ``slope + q se < k`` and the slope clearly falls (:meth:`falling`), and otherwise
     stays what it was (UNKNOWN at the start of a series). Since the test is repeated at every
     point, a held verdict is overturned only once the opposite one has been reached over
     :data:`OVERTURN_CONFIRM` of the span, or at once when beyond doubt
@@ -142,6 +150,8 @@ class TrailingSlope:
         change_threshold: prediction standard errors beyond which a point is a candidate change.
         max_span: longest stretch of the series the slope may rest on when the trailing window
             cannot decide, unit of x (None: the trailing window only; >= span).
+        stable_confidence: one-sided confidence of the STABLE test (0.5-1): a false STABLE at a
+            true slope of k with P = 1 - this per test (docs/method.md).
     """
 
     def __init__(
@@ -152,7 +162,11 @@ class TrailingSlope:
         resolution: float = 0.01,
         change_threshold: float = 4.0,
         max_span: float | None = None,
+        stable_confidence: float = 0.95,
     ) -> None:
+        self.stable_confidence = finite_number("stable_confidence", stable_confidence)
+        if not 0.5 <= self.stable_confidence < 1.0:
+            raise AnalysisError(f"stable_confidence: must be in [0.5, 1), got {stable_confidence!r}")
         self.critical_slope = finite_number("critical_slope", critical_slope)
         self.span = finite_number("span", span)
         if not self.span > 0.0:
@@ -362,13 +376,15 @@ class TrailingSlope:
         return slope + 2.0 * t_quantile_95(self._dof) * standard_error < 0.0
 
     def _clear(self, line: tuple[float, float, float, float, float, int], strict: bool = False) -> SlipState:
-        """The state a line decides by the one-sided 95 % bound (UNKNOWN: neither side); with
-        ``strict``, by the bound at 1 - :data:`OVERTURN_AT_ONCE_P`. SLIPPING only on a slope
+        """The state a line decides by its one-sided bounds, at ``stable_confidence`` for STABLE and
+        95 % for SLIPPING (UNKNOWN: neither side); with ``strict``, both at 1 -
+        :data:`OVERTURN_AT_ONCE_P`. SLIPPING only on a slope
         also clearly falling (:meth:`falling`)."""
         slope, se, *_rest = line
         q = t_quantile_overturn(self._dof) if strict else t_quantile_95(self._dof)
+        q_stable = q if strict else t_quantile(self.stable_confidence, self._dof)
         k = self.critical_slope
-        if slope - q * se >= k:
+        if slope - q_stable * se >= k:
             return SlipState.STABLE
         if slope + q * se < k and self.falling(slope, se):
             return SlipState.SLIPPING
@@ -419,6 +435,11 @@ class TrailingSlope:
             # a new verdict only where the trailing slope itself points (the older points may be
             # from before a steep stretch ended, which the trailing window has left behind)
             if (self._line[0] >= self.critical_slope) != (by_longer is SlipState.STABLE):
+                return
+            # and a held STABLE is overturned to the alarm only while the trailing slope itself
+            # falls clearly (:meth:`falling`): the windows' longer line of a 900 rpm hold with
+            # 50 us of jitter once said -0.107 +- 0.023 %/s where the phase said -0.032 +- 0.033
+            if by_longer is SlipState.SLIPPING and held is SlipState.STABLE and not self.falling(self._line[0], self._line[1]):
                 return
         if by_longer is not held or self._anchor is None:
             self._anchor = self._hx[-line[5]]  # the first of its points

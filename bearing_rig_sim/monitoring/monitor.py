@@ -10,7 +10,8 @@ kinematics, so it runs unchanged on the real bench's topics.
 * **Slip** of each window: Eq. 11 of the paper (docs/paper.md), percent.
 * **Verdict**: the paper's slope criterion on the slip series, against time (k2) or against the
   measured axial load (k1), by :class:`~bearing_rig_sim.analysis.streaming.TrailingSlope`: the
-  slope of a trailing least-squares line, decided only when its 95 % bound is on one side of k,
+  slope of a trailing least-squares line, decided only when its one-sided bound is on one side of k
+  (``stable_confidence`` for STABLE, 95 % and a clear fall for SLIPPING),
   and a change in the slip itself (whatever caused it) restarts the slope's window. Against time
   (nominal slip), the slope and its standard error come from the cage's phase over every pulse
   (:class:`~bearing_rig_sim.analysis.phase.PhaseSlope`, :data:`PHASE_WHITE_SHARE`), far less
@@ -34,10 +35,10 @@ from collections import deque
 from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
-from bearing_rig_sim.analysis.phase import PhaseEstimate, PhaseSlope
+from bearing_rig_sim.analysis.phase import PhaseSlope
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.analysis.stability import SlipState
-from bearing_rig_sim.analysis.streaming import TrailingSlope, t_quantile_95
+from bearing_rig_sim.analysis.streaming import TrailingSlope
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
 from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
@@ -176,14 +177,6 @@ class MonitorWindow:
         return self.window.cage_speed
 
 
-def _clear(estimate: PhaseEstimate | None, critical_slope: float) -> bool:
-    """Whether a phase slope is clear of k by its one-sided 95 % bound, on the side its value is."""
-    if estimate is None:
-        return False
-    bound = t_quantile_95(estimate.dof) * estimate.standard_error
-    return estimate.slope - bound >= critical_slope or estimate.slope + bound < critical_slope
-
-
 class SlipMonitor:
     """Online cage slip and its stability from the two pulse streams (module docstring).
 
@@ -207,6 +200,7 @@ class SlipMonitor:
             resolution=settings.slip_resolution_pct,
             change_threshold=settings.change_threshold,
             max_span=max(settings.slope_max_span_s, settings.slope_span_s),
+            stable_confidence=settings.stable_confidence,
         )
         self.phase: PhaseSlope | None = None
         """The slope against time from the cage's phase (time criterion, nominal slip); built at

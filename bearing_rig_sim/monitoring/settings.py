@@ -51,6 +51,9 @@ class MonitorSettings(NodeSettings):
     )
     critical_slope_pct_per_s: Number = param("critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0)
     critical_slope_pct_per_n: Number = param("critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0)
+    stable_confidence: Number = param(
+        "one-sided confidence of the STABLE test: STABLE when the slope's lower bound at this confidence is at or above k", unit="1", ge=0.5, le=0.999
+    )
     slope_span_s: Number = param("trailing window of the slope against time", unit="s", gt=0.0, le=600.0)
     slope_max_span_s: Number = param(
         "longest steady stretch the slope against time may rest on when the trailing window cannot decide", unit="s", gt=0.0, le=3600.0

@@ -132,6 +132,26 @@ def test_band_by_hand() -> None:
     assert band_pct(0.01, calibration_rms_pct=0.0, jitter_std_s=1e-5, coverage=3.0) == pytest.approx(0.6)
 
 
+@pytest.mark.parametrize(
+    ("text", "problem"),
+    [
+        ("parameters:\n  lubricant.no_such_key: 3.0\n", "parameters.lubricant.no_such_key: not a calibratable parameter"),
+        ("parameters:\n  lubricant.yield_stress_pa: -5.0\n", "parameters.lubricant.yield_stress_pa: must be >= 0.0, got -5.0"),
+        ("parameters: [unclosed\n", "not valid YAML"),
+    ],
+)
+def test_scaling_a_malformed_calibration_is_a_one_line_error_naming_file_and_key(tmp_path: Path, text: str, problem: str) -> None:
+    from bearing_rig_sim.config import ConfigError
+
+    source = tmp_path / "bad.yaml"
+    source.write_text(text)
+    with pytest.raises(ConfigError) as info:
+        scaled_calibration(source, "lubricant.yield_stress_pa", 1.3, tmp_path / "out.yaml")
+    message = str(info.value)
+    assert message.startswith(f"{source}: ") and problem in message and "\n" not in message
+    assert not (tmp_path / "out.yaml").exists()
+
+
 def test_shipped_settings_read_the_calibration_rms() -> None:
     import yaml
 

@@ -13,20 +13,6 @@ from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore
 from bearing_rig_sim.bags.writer import PROJECT_VERSION_KEY, BagWriter
 
 __all__ = [
-    "QOS_PROFILES",
-    "PROJECT_VERSION_KEY",
-    "RUN_METADATA_RECORD",
-    "BagError",
-    "BagMessage",
-    "BagReader",
-    "BagWarning",
-    "BagWriter",
-    "FileRepair",
-    "QosSpec",
-    "RepairReport",
-    "TopicInfo",
-    "msg_definition_text",
-    "open_bag",
-    "repair_bag",
-    "rig_typestore",
-]
+    "QOS_PROFILES", "PROJECT_VERSION_KEY", "RUN_METADATA_RECORD", "BagError", "BagMessage", "BagReader", "BagWarning", "BagWriter",
+    "FileRepair", "QosSpec", "RepairReport", "TopicInfo", "msg_definition_text", "open_bag", "repair_bag", "rig_typestore",
+]  # fmt: skip

@@ -1,20 +1,18 @@
 """CDR bytes as stored in bags: the project's one CDR module.
 
-Fast-CDR (behind ``rclpy.serialization.serialize_message`` and raw subscriptions) sizes its buffer
-with the worst-case alignment of every empty sequence of 8-byte elements, so such a message
-carries 4 to 12 bytes of padding after its last field, and rosbags' ``deserialize_cdr`` refuses
-more than 3 ("CDR message size mismatch"). :func:`length_function` finds the length a message
-really occupies by walking its bytes along the type's fields (lengths and alignment only, a few
-microseconds): the recorder stores messages cut to it (:func:`make_normaliser`) and the reader
-decodes the cut bytes (:func:`make_decoder`), so padded bags from ``ros2 bag record`` decode too.
-:func:`decode_pulse` and :func:`header_stamp_ns` read fields by hand, building no message object.
+Fast-CDR (behind ``rclpy.serialization.serialize_message``) pads a message with an empty sequence
+of 8-byte elements by 4 to 12 bytes, and rosbags' ``deserialize_cdr`` refuses more than 3.
+:func:`length_function` walks a message's lengths and alignment along its type's fields (a few
+microseconds) to its real length: the recorder stores messages cut to it (:func:`make_normaliser`),
+the reader decodes the cut bytes (:func:`make_decoder`), so padded bags from ``ros2 bag record``
+decode too. :func:`decode_pulse` and :func:`header_stamp_ns` read fields by hand, building no object.
 """
 
 from __future__ import annotations
 
 import struct
-from typing import Any, cast
 from collections.abc import Callable
+from typing import Any, cast
 
 from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
@@ -52,22 +50,16 @@ def _string(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]
     return position + 4 + u32(body, position)[0]
 
 
-def _primitives(size: int, count: int) -> Walk:
-    def walk(_body: memoryview, position: int, _u32: Callable[..., tuple[int, ...]]) -> int:
-        return ((position + size - 1) & -size) + size * count
-
-    return walk
-
-
-def _repeat(item: Walk, count: int | None) -> Walk:
-    """``count`` items, or a sequence (uint32 count first) when ``count`` is None."""
+def _repeat(item: Walk | int, count: int | None) -> Walk:
+    """``count`` items, or a sequence (uint32 count first) when None; an int item is a primitive of that size."""
 
     def walk(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
         n = count
         if n is None:
-            position = (position + 3) & ~3
-            n = u32(body, position)[0]
-            position += 4
+            position = ((position + 3) & ~3) + 4
+            n = u32(body, position - 4)[0]
+        if isinstance(item, int):
+            return ((position + item - 1) & -item) + item * n if n else position
         for _ in range(n):
             position = item(body, position, u32)
         return position
@@ -78,7 +70,7 @@ def _repeat(item: Walk, count: int | None) -> Walk:
 def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
     """The walk over one field (raises KeyError for a type it cannot walk: ``wstring``)."""
     if kind == Nodetype.BASE:
-        return _string if arg[0] == "string" else _primitives(_SIZES[arg[0]], 1)
+        return _string if arg[0] == "string" else _repeat(_SIZES[arg[0]], 1)
     if kind == Nodetype.NAME:
         steps = [_walker(typestore, *cast("tuple[Nodetype, Any]", desc)) for _name, desc in typestore.fielddefs[arg][1]]
 
@@ -90,18 +82,8 @@ def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
         return walk
     (subkind, subarg), length = arg
     count = length if kind == Nodetype.ARRAY else None
-    if subkind == Nodetype.BASE and subarg[0] != "string":
-        size = _SIZES[subarg[0]]
-        if count is not None:
-            return _primitives(size, count)
-
-        def sequence(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
-            position = (position + 3) & ~3
-            n = u32(body, position)[0]
-            return ((position + 4 + size - 1) & -size) + size * n if n else position + 4
-
-        return sequence
-    return _repeat(_walker(typestore, subkind, subarg), count)
+    item = _SIZES[subarg[0]] if subkind == Nodetype.BASE and subarg[0] != "string" else _walker(typestore, subkind, subarg)
+    return _repeat(item, count)
 
 
 def little_endian(msgtype: str, data: CdrBytes | bytearray) -> bool:

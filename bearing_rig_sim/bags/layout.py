@@ -5,11 +5,10 @@ where the project puts its run context too) and the storage files ``<name>_0.mca
 from __future__ import annotations
 
 import os
-import re
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePath
 from typing import Any
-from collections.abc import Callable, Sequence
 
 import yaml
 from rosbags.interfaces import Qos
@@ -70,29 +69,18 @@ class BagLayout:
 
     @property
     def start_ns(self) -> int:
-        """Earliest message time (ns); 0 for an empty bag."""
+        """Earliest message time (ns); 0 for an empty bag, as :attr:`end_ns`."""
         return min((f.start_ns for f in self.files if f.message_count), default=0)
 
     @property
     def end_ns(self) -> int:
-        """Latest message time (ns); 0 for an empty bag."""
+        """Latest message time (ns)."""
         return max((f.start_ns + f.duration_ns for f in self.files if f.message_count), default=0)
 
     @property
     def duration_ns(self) -> int:
         """``end_ns - start_ns``."""
         return self.end_ns - self.start_ns
-
-
-def storage_file_name(bag_dir: Path, index: int) -> str:
-    """Name of the ``index``-th storage file of a bag: ``<dir name>_<index>.mcap``."""
-    return f"{bag_dir.name}_{index}.mcap"
-
-
-def storage_file_index(name: str) -> int:
-    """Split index from a storage file name (``run_3.mcap`` -> 3), -1 when it has none."""
-    match = re.search(r"_(\d+)\.mcap$", name)
-    return int(match.group(1)) if match else -1
 
 
 def _qos_dicts(profiles: list[Qos]) -> list[dict[str, Any]]:
@@ -105,11 +93,7 @@ def qos_yaml(profiles: list[Qos]) -> str:
 
 
 def parse_qos_profiles(value: Any, source: str) -> list[Qos]:
-    """QoS profiles from ``metadata.yaml`` (v9 list, v8 YAML) or MCAP channel metadata.
-
-    Raises:
-        BagError: the text is not a list of QoS profiles.
-    """
+    """QoS profiles from ``metadata.yaml`` (v9 list, v8 YAML) or MCAP channel metadata; BagError for another value."""
     if value in (None, "", []):
         return []
     try:
@@ -120,6 +104,18 @@ def parse_qos_profiles(value: Any, source: str) -> list[Qos]:
 
 def layout_to_dict(layout: BagLayout) -> dict[str, Any]:
     """The ``metadata.yaml`` document of a layout."""
+    topics = [
+        {
+            "topic_metadata": {"name": t.name, "type": t.msgtype, "serialization_format": t.serialization_format,
+                               "offered_qos_profiles": _qos_dicts(t.qos), "type_description_hash": t.type_hash},
+            "message_count": t.message_count,
+        }
+        for t in layout.topics
+    ]  # fmt: skip
+    files = [
+        {"path": f.path, "starting_time": {"nanoseconds_since_epoch": f.start_ns}, "duration": {"nanoseconds": f.duration_ns}, "message_count": f.message_count}
+        for f in layout.files
+    ]
     return {
         "rosbag2_bagfile_information": {
             "version": layout.version,
@@ -127,31 +123,11 @@ def layout_to_dict(layout: BagLayout) -> dict[str, Any]:
             "duration": {"nanoseconds": layout.duration_ns},
             "starting_time": {"nanoseconds_since_epoch": layout.start_ns},
             "message_count": layout.message_count,
-            "topics_with_message_count": [
-                {
-                    "topic_metadata": {
-                        "name": t.name,
-                        "type": t.msgtype,
-                        "serialization_format": t.serialization_format,
-                        "offered_qos_profiles": _qos_dicts(t.qos),
-                        "type_description_hash": t.type_hash,
-                    },
-                    "message_count": t.message_count,
-                }
-                for t in layout.topics
-            ],
+            "topics_with_message_count": topics,
             "compression_format": "",
             "compression_mode": "",
             "relative_file_paths": [f.path for f in layout.files],
-            "files": [
-                {
-                    "path": f.path,
-                    "starting_time": {"nanoseconds_since_epoch": f.start_ns},
-                    "duration": {"nanoseconds": f.duration_ns},
-                    "message_count": f.message_count,
-                }
-                for f in layout.files
-            ],
+            "files": files,
             "custom_data": dict(layout.custom_data) or None,
             "ros_distro": layout.ros_distro,
         }
@@ -176,11 +152,8 @@ def _get(mapping: Any, key: str, source: str, kind: type | tuple[type, ...], whe
 
 
 def read_layout(bag_dir: Path) -> BagLayout:
-    """Parse ``<bag_dir>/metadata.yaml``.
-
-    Raises:
-        BagError: missing, not YAML, keys a reader needs missing, or rosbag2 file/message compression.
-    """
+    """Parse ``<bag_dir>/metadata.yaml``; BagError when missing, not YAML, without keys a reader needs,
+    or for rosbag2 file or message compression."""
     path = bag_dir / METADATA_FILE
     source = str(path)
     try:
@@ -238,21 +211,13 @@ def read_layout(bag_dir: Path) -> BagLayout:
 def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | None = None) -> str:
     """Message type of a channel: from its storage, else from ``metadata.yaml``, else empty."""
     channel = index.channels[channel_id]
-    if channel.msgtype:
-        return channel.msgtype
-    if previous is not None:
-        for topic in previous.topics:
-            if topic.name == channel.topic:
-                return topic.msgtype
-    return ""
+    stated = (t.msgtype for t in (previous.topics if previous is not None else []) if t.name == channel.topic)
+    return channel.msgtype or next(stated, "")
 
 
 def layout_from_indexes(
-    indexes: Sequence[FileIndex],
-    previous: BagLayout | None,
-    report: Callable[[str], None],
-    type_hash_of: Callable[[str], str] = lambda _msgtype: "",
-    accepted: list[dict[int, str]] | None = None,
+    indexes: Sequence[FileIndex], previous: BagLayout | None, report: Callable[[str], None],
+    type_hash_of: Callable[[str], str] = lambda _msgtype: "", accepted: list[dict[int, str]] | None = None,
 ) -> BagLayout:
     """The ``metadata.yaml`` content matching what the storage files hold: topics from their
     channels, completed by ``previous`` (the existing ``metadata.yaml``) for topics without
@@ -296,12 +261,7 @@ def layout_from_indexes(
         if not entry.type_hash and entry.msgtype:
             entry.type_hash = type_hash_of(entry.msgtype)
     files = [FileEntry(i.path.name, i.start_ns, i.end_ns - i.start_ns, i.message_count) if i.message_count else FileEntry(i.path.name) for i in indexes]
-    custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), None)
-    if custom is None:
-        custom = dict(previous.custom_data) if previous is not None else {}
-    return BagLayout(
-        topics=list(topics.values()),
-        files=files,
-        custom_data=custom,
-        ros_distro=previous.ros_distro if previous is not None and previous.ros_distro else ROS_DISTRO,
-    )
+    stated = dict(previous.custom_data) if previous is not None else {}
+    custom = next((dict(i.metadata[RUN_METADATA_RECORD]) for i in indexes if RUN_METADATA_RECORD in i.metadata), stated)
+    distro = previous.ros_distro if previous is not None and previous.ros_distro else ROS_DISTRO
+    return BagLayout(topics=list(topics.values()), files=files, custom_data=custom, ros_distro=distro)

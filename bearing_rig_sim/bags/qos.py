@@ -37,17 +37,8 @@ class QosSpec:
     def to_rosbags(self) -> Qos:
         """The same profile as a rosbags :class:`~rosbags.interfaces.Qos` (as stored in bags)."""
         zero = QosTime(0, 0)
-        return Qos(
-            QosHistory[self.history.upper()],
-            self.depth,
-            QosReliability[self.reliability.upper()],
-            QosDurability[self.durability.upper()],
-            zero,
-            zero,
-            QosLiveliness.SYSTEM_DEFAULT,
-            zero,
-            False,
-        )
+        history, reliability, durability = QosHistory[self.history.upper()], QosReliability[self.reliability.upper()], QosDurability[self.durability.upper()]
+        return Qos(history, self.depth, reliability, durability, zero, zero, QosLiveliness.SYSTEM_DEFAULT, zero, False)
 
     @classmethod
     def from_rosbags(cls, qos: Qos) -> QosSpec | None:

@@ -1,27 +1,22 @@
-"""Reading rig bags: rosbag2 directories with MCAP or SQLite 3 storage, or a single ``.mcap`` file.
-
-::
+"""Reading rig bags (rosbag2 directories with MCAP or SQLite 3 storage, or one ``.mcap`` file)::
 
     with open_bag("bags/run-0001") as bag:
-        print(bag.topics["/rig/speeds"].message_count, bag.run_metadata["project_version"])
-        for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]):
-            ...
+        for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]): ...
 
-Messages come in log-time order, decoded into rosbags message objects, streamed chunk by chunk,
-with the definitions the bag carries (an old bag keeps decoding after a message changes), else
-ROS 2 Jazzy's and ``bearing_rig_msgs``'. Damage is reported, not fatal (``docs/bags.md``): each
-problem is a :class:`~bearing_rig_sim.bags.errors.BagWarning` and a line in
-:attr:`BagReader.problems`; ``strict=True`` turns them into :class:`BagError`.
+Messages come in log-time order, streamed, decoded into rosbags objects with the definitions the
+bag carries (an old bag keeps decoding after a message changes), else ROS 2 Jazzy's and
+``bearing_rig_msgs``'. Damage is not fatal (``docs/bags.md``): each problem is a :class:`BagWarning`
+and a line in :attr:`BagReader.problems`; ``strict=True`` makes it a :class:`BagError`.
 """
 
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
 from typing import Literal, NamedTuple
-from collections.abc import Iterable, Iterator
 
 from rosbags.interfaces.typing import Constdefs, Fielddefs, Typesdict
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -35,7 +30,7 @@ from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
 from bearing_rig_sim.bags.typestore import SCHEMA_SEPARATOR, dependencies, rig_typestore
-from bearing_rig_sim.bags.verify import BagCheck, verify_indexes
+from bearing_rig_sim.clock_guard import DEFAULT_MAX_STEP_NS
 
 StorageFormat = McapFormat | Sqlite3Format
 STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sqlite3Format()}
@@ -43,11 +38,7 @@ STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sq
 
 
 def storage_format(identifier: str) -> StorageFormat:
-    """The format of a ``storage_identifier``.
-
-    Raises:
-        BagError: a format this project does not read (the message lists those it does).
-    """
+    """The format of a ``storage_identifier``; BagError naming those read for another."""
     try:
         return STORAGE_FORMATS[identifier]
     except KeyError:
@@ -60,8 +51,7 @@ class BagMessage(NamedTuple):
     topic: str
     log_time_ns: int
     msgtype: str
-    message: object
-    """The decoded rosbags message object (the serialized CDR bytes with ``raw=True``)."""
+    message: object  # the rosbags message object, or the CDR bytes with raw=True
 
 
 @dataclass(frozen=True)
@@ -94,19 +84,10 @@ def _parse_definition(msgtype: str, encoding: str, text: str) -> Typesdict:
 
 
 class BagReader:
-    """An open bag (see the module documentation and :func:`open_bag`).
-
-    Attributes:
-        files: the storage files read.
-        topics: by name.
-        message_count / start_ns / end_ns / duration_ns: readable messages (all topics), their
-            log-time range (ns; 0 for an empty bag).
-        run_metadata: the run context: the MCAP metadata record ``bearing_rig_sim``, else
-            ``metadata.yaml``'s ``custom_data``.
-        typestore: the types the messages are decoded with.
-        layout: the parsed ``metadata.yaml`` (None for a bare ``.mcap`` file).
-        problems: every problem met so far, one line each (also issued as :class:`BagWarning`).
-    """
+    """An open bag (see the module documentation): ``files`` read, ``topics`` by name,
+    ``message_count`` readable and their log-time range ``start_ns``, ``end_ns``, ``duration_ns``
+    (ns; 0 when empty), ``run_metadata`` (the run context, docs/bags.md), the ``typestore`` decoding
+    them, ``layout`` (``metadata.yaml``; None for a bare ``.mcap`` file), ``problems`` met so far."""
 
     def __init__(self, path: str | Path, *, strict: bool = False) -> None:
         self.path = Path(path)
@@ -154,8 +135,7 @@ class BagReader:
             )
 
     def verify(self) -> BagCheck:
-        """Read every chunk: checksums, unreadable messages, log-time outliers (see
-        :mod:`.verify`); slower than opening, which reads the index only."""
+        """Read every chunk (:func:`verify_indexes`); slower than opening, which reads the index only."""
         return verify_indexes(self._indexes, self._format.messages)
 
     @property
@@ -166,17 +146,9 @@ class BagReader:
     def messages(
         self, topics: Iterable[str] | None = None, *, start_ns: int | None = None, stop_ns: int | None = None, raw: bool = False
     ) -> Iterator[BagMessage]:
-        """Messages in log-time order, streamed.
-
-        Args:
-            topics: topic names to read; None for every decodable topic.
-            start_ns / stop_ns: keep messages with ``start_ns <= log_time < stop_ns``.
-            raw: yield the serialized CDR bytes instead of decoded objects (undecodable
-                topics included).
-
-        Raises:
-            BagError: a requested topic is not in the bag; (strict) a damaged chunk or message.
-        """
+        """Messages of ``topics`` (None: every decodable one) with ``start_ns <= log_time < stop_ns``
+        in log-time order, streamed; ``raw`` yields the CDR bytes instead (undecodable topics too).
+        BagError for a topic not in the bag, and (strict) for a damaged chunk or message."""
         if self._closed:
             raise BagError(f"{self.path}: the bag is closed")
         if topics is None:
@@ -247,11 +219,8 @@ class BagReader:
             cdr = entry.serialization_format == "cdr"
             decodable = cdr and bool(entry.msgtype) and entry.msgtype in self.typestore.fielddefs
             if not decodable:
-                why = (
-                    f"message encoding {entry.serialization_format!r} is not cdr"
-                    if not cdr
-                    else f"type {entry.msgtype or '(none)'} is unknown: no definition in the bag and not a ROS 2 Jazzy or bearing_rig_msgs type"
-                )
+                why = f"type {entry.msgtype or '(none)'} is unknown: no definition in the bag and not a ROS 2 Jazzy or bearing_rig_msgs type"
+                why = why if cdr else f"message encoding {entry.serialization_format!r} is not cdr"
                 self._report(f"{self.path.name}: topic {entry.name}: {why}; its {entry.message_count} messages are skipped")
             qos = QosSpec.from_rosbags(entry.qos[0]) if entry.qos else None
             topics[entry.name] = TopicInfo(entry.name, entry.msgtype, entry.message_count, qos, entry.type_hash, decodable)
@@ -287,11 +256,82 @@ class BagReader:
                 self._report(f"{self.path.name}: topic {name}: {count} messages could not be decoded in all")
 
 
-def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:
-    """Open a bag directory (with ``metadata.yaml``) or a single ``.mcap`` file for reading.
+TIMELINE_GAP_NS = DEFAULT_MAX_STEP_NS
+"""A gap over this (10 s, the largest step the clock guard accepts) splits the timeline."""
 
-    Raises:
-        BagError: not a bag, ``metadata.yaml`` missing or corrupt, a storage format this project
-            does not read, a storage file not of its format, or (``strict``) any damage.
-    """
+
+@dataclass
+class Stretch:
+    """Log times with no gap over :data:`TIMELINE_GAP_NS` between neighbours (ns)."""
+
+    start_ns: int
+    end_ns: int
+    count: int
+
+
+@dataclass
+class BagCheck:
+    """What :func:`verify_indexes` found: a line per damaged chunk, messages read and counted by
+    the indexes, the timeline's stretches in time order."""
+
+    damaged: list[str] = field(default_factory=list)
+    messages_read: int = 0
+    messages_indexed: int = 0
+    stretches: list[Stretch] = field(default_factory=list)
+
+    @property
+    def messages_unreadable(self) -> int:
+        """Messages counted by the index that no chunk delivered."""
+        return max(0, self.messages_indexed - self.messages_read)
+
+    @property
+    def main(self) -> Stretch | None:
+        """The stretch with the most messages."""
+        return max(self.stretches, key=lambda s: s.count, default=None)
+
+    @property
+    def outliers(self) -> list[Stretch]:
+        """Every stretch but the main one."""
+        return [s for s in self.stretches if s is not self.main]
+
+    def problems(self) -> list[str]:
+        """One line per finding (empty for a sound bag)."""
+        lines = list(self.damaged)
+        if self.messages_unreadable:
+            share = 100.0 * self.messages_unreadable / self.messages_indexed
+            lines.append(f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that cannot be read")
+        main = self.main
+        for s in self.outliers:
+            assert main is not None  # there are outliers only beside a main stretch
+            after = s.start_ns > main.end_ns
+            distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
+            lines.append(
+                f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
+                f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
+                f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
+            )
+        return lines
+
+
+def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
+    """The full check of a bag (docs/bags.md): every message of the files read once, in time order,
+    with their format's ``messages``; a chunk that fails is named, messages the index counts but no
+    chunk delivers are unreadable, log times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`."""
+    check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
+    streams = [(i.start_ns, i.end_ns, messages(i, report=check.damaged.append)) for i in indexes]
+    for log_time, _channel, _publish, _data in merge_in_time(streams):
+        check.messages_read += 1
+        last = check.stretches[-1] if check.stretches else None
+        if last is not None and log_time - last.end_ns <= TIMELINE_GAP_NS:
+            last.end_ns = max(last.end_ns, log_time)
+            last.count += 1
+        else:
+            check.stretches.append(Stretch(log_time, log_time, 1))
+    return check
+
+
+def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:
+    """Open a bag directory (with ``metadata.yaml``) or a single ``.mcap`` file for reading; BagError
+    for no bag, a missing or corrupt ``metadata.yaml``, a storage format not read or a file not of
+    its format, and (``strict``) any damage."""
     return BagReader(path, strict=strict)

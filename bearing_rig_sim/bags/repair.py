@@ -1,22 +1,20 @@
-"""Repairing a bag whose recording was killed (``bearing-rig bag repair BAG...``).
-
-A killed recorder leaves MCAP files without summary, possibly cut inside a chunk, and a stale
-``metadata.yaml``; the reader reads them up to the last complete chunk, other tools need the
-index back. Each storage file is indexed and its chunks checked; a damaged one is rewritten from
-its readable chunks as a finished file, the original kept as ``<name>.mcap.orig`` (a file that is
-not MCAP is moved aside so); ``metadata.yaml`` is rebuilt from the files (the old one kept as
+"""Repairing a bag whose recording was killed (``bearing-rig bag repair BAG...``, docs/bags.md):
+each storage file is indexed and its chunks checked; a damaged one is rewritten from its readable
+chunks as a finished file, the original kept as ``<name>.mcap.orig`` (a file that is not MCAP is
+moved aside so); ``metadata.yaml`` is rebuilt from the files (the old one kept as
 ``metadata.yaml.orig``). A bag that needs nothing is left unchanged.
 """
 
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Literal
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.layout import METADATA_FILE, BagLayout, layout_from_indexes, layout_to_dict, read_layout, storage_file_index, write_layout
+from bearing_rig_sim.bags.layout import METADATA_FILE, BagLayout, layout_from_indexes, layout_to_dict, read_layout, write_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat, McapIndex, check_chunks, index_file
 from bearing_rig_sim.bags.typestore import rig_typestore, type_hash
 from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink, register_topic, start_mcap
@@ -26,10 +24,9 @@ BACKUP_SUFFIX = ".orig"
 
 @dataclass
 class FileRepair:
-    """What the repair did to one storage file: ``intact`` (untouched), ``rebuilt`` (rewritten from
-    its readable part) or ``removed`` (not MCAP: moved aside). ``messages_lost`` counts what the
-    original's index counted and the repair did not recover (0 without an index); ``bytes_lost``
-    the damaged chunks and the end of the file that belonged to no complete record."""
+    """What the repair did to one storage file: ``intact``, ``rebuilt`` (from its readable part) or
+    ``removed`` (not MCAP: moved aside); ``messages_lost``: counted by the original's index and not
+    recovered (0 without an index); ``bytes_lost``: damaged chunks and the end in no complete record."""
 
     name: str
     action: Literal["intact", "rebuilt", "removed"]
@@ -51,17 +48,15 @@ class RepairReport:
 
     @property
     def messages_recovered(self) -> int:
-        """Messages in the bag after the repair."""
+        """Messages in the bag after the repair (``messages_lost``, ``bytes_lost``: as :class:`FileRepair`'s, summed)."""
         return sum(f.messages_recovered for f in self.files)
 
     @property
     def bytes_lost(self) -> int:
-        """Bytes of the originals that could not be used."""
         return sum(f.bytes_lost for f in self.files)
 
     @property
     def messages_lost(self) -> int:
-        """Messages the originals' indexes counted and the repair did not recover."""
         return sum(f.messages_lost for f in self.files)
 
     @property
@@ -95,7 +90,8 @@ def _backup_path(path: Path) -> Path:
 
 def _storage_files(bag_dir: Path, previous: BagLayout | None) -> list[Path]:
     listed = [bag_dir / f.path for f in previous.files] if previous is not None else []
-    found = sorted(bag_dir.glob("*.mcap"), key=lambda p: (storage_file_index(p.name), p.name))
+    split = re.compile(r"_(\d+)\.mcap$")  # the writer's <dir>_<n>.mcap; files without come first
+    found = sorted(bag_dir.glob("*.mcap"), key=lambda p: (int(m.group(1)) if (m := split.search(p.name)) else -1, p.name))
     files = [p for p in listed if p.is_file()]
     files += [p for p in found if p not in files]
     return files
@@ -134,11 +130,7 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
 
 def repair_bag(path: str | Path) -> RepairReport:
     """Make a bag whose recording was interrupted readable by every tool again (see the module
-    documentation); originals are kept as ``*.orig``.
-
-    Raises:
-        BagError: the path is not a directory, or holds no ``.mcap`` file.
-    """
+    documentation); BagError for a path that is not a directory or holds no ``.mcap`` file."""
     bag_dir = Path(path)
     if not bag_dir.is_dir():
         raise BagError(f"{bag_dir}: not a bag directory (repair works on the directory holding metadata.yaml and the .mcap files)")
@@ -161,14 +153,14 @@ def repair_bag(path: str | Path) -> RepairReport:
             continue
         chunk_bytes_lost = 0
         if index.indexed and not index.problems:
-            index.problems.extend(check_chunks(index))
-            chunk_bytes_lost = index.damaged_bytes
+            damaged, chunk_bytes_lost = check_chunks(index)
+            index.problems.extend(damaged)
         if index.indexed and not index.problems:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)
             continue
         counted = index.message_count if index.indexed else 0
-        entry = FileRepair(file.name, "rebuilt", bytes_lost=index.bytes_lost + chunk_bytes_lost, problems=list(index.problems))
+        entry = FileRepair(file.name, "rebuilt", bytes_lost=max(0, index.file_size - index.readable_bytes) + chunk_bytes_lost, problems=list(index.problems))
         rebuilt = _rewrite(index, previous, entry.problems)
         entry.backup = _backup_path(file)
         os.replace(file, entry.backup)

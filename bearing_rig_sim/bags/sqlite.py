@@ -23,11 +23,7 @@ class Sqlite3Format:
     identifier = "sqlite3"
 
     def indexes(self, bag: Path, files: list[Path]) -> list[FileIndex]:
-        """The bag's topics, definitions and statistics.
-
-        Raises:
-            BagError: rosbags cannot open the bag (a database missing or not SQLite).
-        """
+        """The bag's topics, definitions and statistics; BagError when rosbags cannot open the bag."""
         index = FileIndex(path=bag, indexed=True, has_header=True)
         try:
             with Reader(bag) as reader:

@@ -1,6 +1,5 @@
-"""What reading a bag needs from its storage, whatever the format: MCAP (:mod:`.mcapfile`, what
-the project records) or SQLite 3 (:mod:`.sqlite`, what older benches record). A format gives
-:class:`FileIndex` objects and streams messages in log-time order; nothing else is seen above."""
+"""What reading a bag needs from its storage, MCAP (:mod:`.mcapfile`) or SQLite 3 (:mod:`.sqlite`):
+a format gives :class:`FileIndex` objects and streams messages in log-time order, nothing else."""
 
 from __future__ import annotations
 
@@ -35,15 +34,10 @@ class ChannelInfo:
 
 @dataclass
 class FileIndex:
-    """What a storage file (for SQLite 3, a whole bag) holds.
-
-    Attributes:
-        indexed: the file was finished properly (its own index is complete).
-        has_header: False when nothing at all is readable.
-        definitions: message definitions by type, as (``ros2msg`` or ``ros2idl``, text).
-        metadata: named string maps (the run context under ``bearing_rig_sim``).
-        problems: what was wrong, one line each.
-    """
+    """What a storage file (for SQLite 3, a whole bag) holds: ``indexed`` when it was finished
+    properly, ``has_header`` False when nothing is readable, message ``definitions`` by type as
+    (``ros2msg`` or ``ros2idl``, text), named string maps in ``metadata`` (the run context under
+    ``bearing_rig_sim``), one line per problem in ``problems``."""
 
     path: Path
     indexed: bool = False

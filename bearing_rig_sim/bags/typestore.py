@@ -4,12 +4,11 @@ installed ``share/bearing_rig_msgs/msg``), never from the generated Python packa
 
 from __future__ import annotations
 
+import contextlib
 import functools
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, cast
 
-from rosbags.interfaces import Nodetype
 from rosbags.interfaces.typing import Typesdict
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
@@ -27,14 +26,11 @@ def msg_folder() -> Path:
     local = Path(__file__).resolve().parents[2] / "msg_defs" / "msg"
     if local.is_dir():
         return local
-    try:
+    with contextlib.suppress(Exception):  # ament index absent or package not installed
         from ament_index_python.packages import get_package_share_directory
 
-        installed = Path(get_package_share_directory(RIG_MSG_PACKAGE)) / "msg"
-        if installed.is_dir():
+        if (installed := Path(get_package_share_directory(RIG_MSG_PACKAGE)) / "msg").is_dir():
             return installed
-    except Exception:  # ament index absent or package not installed
-        pass
     raise BagError(f"cannot find the {RIG_MSG_PACKAGE} message definitions: neither {local} nor an installed share/{RIG_MSG_PACKAGE}/msg exists")
 
 
@@ -82,17 +78,10 @@ def type_hash(msgtype: str, typestore: Typestore | None = None) -> str:
 
 
 def dependencies(store: Typestore, names: Iterable[str]) -> set[str]:
-    """The types and every type they use, recursively."""
-    todo, found = list(names), set()
-    while todo:
-        name = todo.pop()
-        if name in found or name not in store.fielddefs:
-            continue
-        found.add(name)
-        for _field, desc in store.fielddefs[name][1]:
-            kind, arg = cast("tuple[Nodetype, Any]", desc)
-            if kind == Nodetype.NAME:
-                todo.append(arg)
-            elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE) and arg[0][0] == Nodetype.NAME:
-                todo.append(arg[0][1])
-    return found
+    """The known types among ``names`` and every type they use, recursively (as rosbags' ``gendefhash`` finds them)."""
+    found: dict[str, tuple[str, str]] = {}
+    for name in names:
+        if name in store.fielddefs and name not in found:
+            found[name] = ("", "")
+            store.gendefhash(name, found, ros_version=2)
+    return set(found)

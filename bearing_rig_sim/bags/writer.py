@@ -1,27 +1,23 @@
-"""The recorder: a rosbag2 (format version 9) bag directory with MCAP storage (``docs/bags.md``).
-
-::
+"""The recorder: a rosbag2 (format version 9) bag directory with MCAP storage (``docs/bags.md``)::
 
     with BagWriter("bags/run-0001", metadata={"configuration": config_text}) as bag:
         bag.add_topic("/rig/speeds", "sensor_msgs/msg/JointState", "sensor_data")
         bag.write("/rig/speeds", sim_time_ns, raw_cdr_bytes)
 
-``log_time`` is the simulation time in ns, strictly increasing over the bag: a time not after
-the previous one is nudged to previous + 1 ns (:attr:`BagWriter.nudged_count`); ``publish_time``
-keeps the time given. Chunks reach the operating system when complete and ``metadata.yaml`` is
-rewritten whenever topics or files change, so a killed recording keeps every complete chunk
-(:func:`~bearing_rig_sim.bags.repair.repair_bag` restores the index). Leaving the ``with``
-block for any reason, Ctrl-C included, finalises the bag.
+``log_time`` is the simulation time (ns), strictly increasing: a time not after the previous one
+is nudged to previous + 1 ns (:attr:`BagWriter.nudged_count`); ``publish_time`` keeps the time
+given. A killed recording keeps every complete chunk (docs/bags.md); leaving the ``with`` block
+for any reason, Ctrl-C included, finalises the bag.
 """
 
 from __future__ import annotations
 
 import operator
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
 from typing import IO, Any, Literal, cast
-from collections.abc import Callable
 
 from mcap.well_known import SchemaEncoding
 from mcap.writer import LIBRARY_IDENTIFIER, CompressionType, Writer
@@ -30,7 +26,7 @@ from rosbags.typesys.store import Typestore
 import bearing_rig_sim
 from bearing_rig_sim.bags.cdr import CdrBytes, make_normaliser
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, FileEntry, TopicEntry, qos_yaml, storage_file_name, write_layout
+from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD, BagLayout, FileEntry, TopicEntry, qos_yaml, write_layout
 from bearing_rig_sim.bags.qos import QosSpec, qos_spec
 from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore, type_hash
 
@@ -106,31 +102,16 @@ class _Topic:
 
 
 class BagWriter:
-    """Writes a rosbag2 v9 bag directory with MCAP storage (see the module documentation); the
-    directory is created at once, :meth:`close` (or leaving the ``with`` block) finalises it.
-
-    Args:
-        path: bag directory to create (must not exist, or be empty).
-        compression: chunk compression, ``"zstd"`` or ``"none"``.
-        chunk_size: uncompressed bytes per chunk (>= 1024).
-        max_file_bytes: start a new ``.mcap`` file once the current one reaches this size (at the
-            next message, so a file may exceed it by a chunk and its summary); None for one file.
-        metadata: run context as string pairs; ``project_version`` is added.
-        typestore: types to accept; default :func:`~bearing_rig_sim.bags.typestore.rig_typestore`.
-
-    Raises:
-        BagError: bad option, or the path exists and is not an empty directory.
-    """
+    """Writes a bag directory (see the module documentation), created at once (``path`` must not
+    exist or be empty) and finalised by :meth:`close`. ``chunk_size`` is in uncompressed bytes
+    (>= 1024); past ``max_file_bytes`` a new ``.mcap`` file starts at the next message (a file may
+    exceed it by a chunk and its summary; None: one file); ``metadata`` is the run context, to which
+    ``project_version`` is added; ``typestore`` defaults to :func:`.typestore.rig_typestore`.
+    BagError for a bad option or an existing path."""
 
     def __init__(
-        self,
-        path: str | Path,
-        *,
-        compression: Compression = "zstd",
-        chunk_size: int = DEFAULT_CHUNK_SIZE,
-        max_file_bytes: int | None = None,
-        metadata: dict[str, str] | None = None,
-        typestore: Typestore | None = None,
+        self, path: str | Path, *, compression: Compression = "zstd", chunk_size: int = DEFAULT_CHUNK_SIZE,
+        max_file_bytes: int | None = None, metadata: dict[str, str] | None = None, typestore: Typestore | None = None,
     ) -> None:
         if compression not in ("zstd", "none"):
             raise BagError(f"compression must be 'zstd' or 'none', got {compression!r}")
@@ -145,7 +126,6 @@ class BagWriter:
         run_context.setdefault(PROJECT_VERSION_KEY, bearing_rig_sim.__version__)
 
         self.path = Path(path)
-        """The bag directory."""
         if self.path.exists() and (not self.path.is_dir() or any(self.path.iterdir())):
             raise BagError(f"{self.path}: exists already and is not an empty directory, not overwriting")
         try:
@@ -153,16 +133,12 @@ class BagWriter:
         except OSError as exc:
             raise BagError(f"{self.path}: cannot create the bag directory ({exc.strerror or exc})") from None
 
-        self._compression = compression
-        self._chunk_size = chunk_size
-        self._max_file_bytes = max_file_bytes
-        self._run_context = run_context
+        self._compression, self._chunk_size, self._max_file_bytes, self._run_context = compression, chunk_size, max_file_bytes, run_context
         self._typestore = typestore if typestore is not None else rig_typestore()
         self._topics: dict[str, _Topic] = {}
         self._files: list[FileEntry] = []
         self._last_time = -1
-        self.nudged_count = 0
-        """Messages whose log time was moved forward to keep log times strictly increasing."""
+        self.nudged_count = 0  # messages whose log time was moved forward (see the module documentation)
         self._sink: CountingSink | None = None
         self._mcap: Writer | None = None
         self._schema_ids: dict[str, int] = {}
@@ -174,22 +150,14 @@ class BagWriter:
         return sum(f.message_count for f in self._files)
 
     @property
-    def files(self) -> list[Path]:
-        """Storage files written so far (the last one is open until :meth:`close`)."""
-        return [self.path / f.path for f in self._files]
-
-    @property
     def closed(self) -> bool:
         """True once :meth:`close` has finalised the bag."""
         return self._mcap is None
 
     def add_topic(self, name: str, msgtype: str, qos: str | QosSpec = "reliable") -> None:
         """Declare a topic (``/name``, ``pkg/msg/Name`` or ``pkg/Name``, offered QoS: a name of
-        :data:`~bearing_rig_sim.bags.qos.QOS_PROFILES` or a ``QosSpec``) before writing to it.
-
-        Raises:
-            BagError: bag closed, bad name, unknown type, or the topic exists with another type or QoS.
-        """
+        :data:`.qos.QOS_PROFILES` or a ``QosSpec``) before writing to it; BagError when the bag is
+        closed, for a bad name or unknown type, or when the topic exists with another type or QoS."""
         self._check_open()
         if not isinstance(name, str) or not name.startswith("/") or len(name) < 2:
             raise BagError(f"topic name must be fully qualified (start with '/'), got {name!r}")
@@ -210,13 +178,8 @@ class BagWriter:
 
     def write(self, topic: str, log_time_ns: int, data: CdrBytes) -> None:
         """Record one serialized message (CDR with its 4-byte encapsulation header, as from
-        ``rclpy.serialization.serialize_message`` or a raw subscription); trailing Fast-CDR
-        padding is trimmed (:mod:`bearing_rig_sim.bags.cdr`).
-
-        Raises:
-            BagError: bag closed, unknown topic, a time outside 0 .. 2**63-1 ns, or bytes that
-                are not a message of the topic's type.
-        """
+        ``rclpy.serialization.serialize_message``), Fast-CDR padding trimmed (:mod:`.cdr`); BagError
+        when closed, for an unknown topic, a time outside 0 .. 2**63-1 ns, or bytes of another type."""
         entry = self._topic(topic)
         if not isinstance(data, (bytes, bytearray, memoryview)):
             raise BagError(f"topic {topic}: data must be serialized bytes, got {type(data).__name__}")
@@ -242,9 +205,7 @@ class BagWriter:
     def flush(self) -> None:
         """Finish the chunk in progress and refresh ``metadata.yaml``: everything written so far
         survives a kill. Each call costs a smaller chunk (less compression)."""
-        self._check_open()
-        assert self._mcap is not None
-        self._mcap.flush()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
+        self._check_open().flush()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
         self._write_layout()
 
     def close(self) -> None:
@@ -270,9 +231,10 @@ class BagWriter:
                 raise
         return False
 
-    def _check_open(self) -> None:
+    def _check_open(self) -> Writer:
         if self._mcap is None:
             raise BagError(f"{self.path}: the bag is closed")
+        return self._mcap
 
     def _topic(self, name: str) -> _Topic:
         entry = self._topics.get(name)
@@ -300,8 +262,7 @@ class BagWriter:
         if log_time <= self._last_time:
             log_time = self._last_time + 1
             self.nudged_count += 1
-        assert self._mcap is not None
-        self._mcap.add_message(topic.channel_id, log_time, cast(bytes, data), log_time_ns)  # mcap takes any buffer
+        self._check_open().add_message(topic.channel_id, log_time, cast(bytes, data), log_time_ns)  # mcap takes any buffer
         self._last_time = log_time
         topic.entry.message_count += 1
         if current.message_count == 0:
@@ -310,7 +271,7 @@ class BagWriter:
         current.message_count += 1
 
     def _start_file(self) -> None:
-        name = storage_file_name(self.path, len(self._files))
+        name = f"{self.path.name}_{len(self._files)}.mcap"
         self._sink = CountingSink(self.path / name)
         self._mcap = start_mcap(self._sink, self._chunk_size, self._compression)
         self._mcap.add_metadata(RUN_METADATA_RECORD, dict(self._run_context))
@@ -321,8 +282,7 @@ class BagWriter:
         self._write_layout()
 
     def _register(self, topic: _Topic) -> None:
-        assert self._mcap is not None
-        topic.channel_id = register_topic(self._mcap, self._schema_ids, topic.entry, self._typestore)
+        topic.channel_id = register_topic(self._check_open(), self._schema_ids, topic.entry, self._typestore)
 
     def _finish_file(self) -> None:
         assert self._mcap is not None and self._sink is not None

@@ -107,12 +107,16 @@ def _save_calibration(dest: Path, source: Path | None, estimate: Any) -> None:
     """Write ``source`` with the estimate's value to ``dest`` (a new file, never ``source``).
 
     Raises:
-        RigError: no estimate, the destination is the calibration itself or exists, or the
-            estimate lies outside the parameter's stated range.
+        RigError: no estimate, the destination is the calibration itself or exists, the estimate
+            lies outside the parameter's stated range, or the source is not a valid calibration
+            file (:class:`~bearing_rig_sim.config.ConfigError`, naming the file and the key).
     """
     import yaml
 
+    from bearing_rig_sim.config import read_mapping
+    from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
     from bearing_rig_sim.errors import RigError
+    from bearing_rig_sim.settings_model import validate_mapping
 
     if estimate is None or source is None:
         raise RigError("--save-calibration needs --recalibrate and a calibration file")
@@ -120,7 +124,8 @@ def _save_calibration(dest: Path, source: Path | None, estimate: Any) -> None:
         raise RigError(f"--save-calibration: {dest} exists already, not overwriting")
     if not estimate.in_range:
         raise RigError(f"--save-calibration: {estimate.name} = {estimate.value:.6g} lies outside its stated range {estimate.range}; not written")
-    doc = yaml.safe_load(source.read_text(encoding="utf-8"))
+    doc = read_mapping(source)
+    validate_mapping(CalibrationFile, doc, str(source))  # the raw document is rewritten, checked first
     entry = doc["parameters"][estimate.name]
     if isinstance(entry, dict):
         entry["value"] = float(f"{estimate.value:.6g}")

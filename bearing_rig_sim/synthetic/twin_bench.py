@@ -20,10 +20,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.config import read_mapping, rpm_to_rad_s
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
+from bearing_rig_sim.settings_model import validate_mapping
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import RigTwin
 from bearing_rig_sim.thermal import sensors as bench_sensors
@@ -191,10 +193,12 @@ def scaled_calibration(source: str | Path, key: str, factor: float, dest: str | 
 
     Raises:
         KeyError: no such parameter in the file and no ``base``.
+        ConfigError: ``source`` is not a valid calibration file (one line naming the file and the key).
     """
     import yaml
 
-    doc = yaml.safe_load(Path(source).read_text(encoding="utf-8"))
+    doc = read_mapping(source)
+    validate_mapping(CalibrationFile, doc, str(source))  # the raw document is rewritten, checked first
     params = doc["parameters"]
     if key not in params:
         if base is None:

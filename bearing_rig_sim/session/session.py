@@ -479,15 +479,15 @@ class _Session:
             node.drain()
 
     def _send_commands(self, now: float) -> None:
-        """Send the spindle commands due (the running segment's and those of the next segments
-        whose start is fixed, ahead of time: :meth:`ProgramRunner.commands_due`)."""
+        """Send the spindle commands and load set-points due (the running segment's and those of
+        the next segments whose start is fixed, ahead of time, each stamped with its segment's
+        start: :meth:`ProgramRunner.commands_due`)."""
         assert self.node is not None
         for plan in self.runner.commands_due(now):
             self.node.send_command(plan)
+            self.node.send_setpoint(plan)
 
     def _start_segment(self, plan: SegmentPlan) -> None:
-        assert self.node is not None
-        self.node.send_setpoint(plan)
         seg = plan.segment
         hold = f"until stable (at most {seg.timeout:g} s)" if seg.until_stable else f"dwell {seg.dwell:g} s"
         self._event(

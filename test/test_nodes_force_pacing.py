@@ -127,7 +127,9 @@ class Probe:
 
 def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactivated_one(ros_graph: Any) -> None:
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
-    controller = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", "-p", f"axial_load_setpoint_n:={BEFORE_N!r}")
+    controller = ros_graph.spawn_python(
+        "-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", "-p", f"axial_load_setpoint_n:={BEFORE_N!r}"
+    )
     probe = Probe(ros_graph)
     probe.wait(lambda: probe.setpoint.get_subscription_count() > 0, "the load controller's set-point reader")
     probe.wait(lambda: probe.pacing == "on" and probe.clock > 1.0, "the simulator pacing on the force stream")
@@ -153,7 +155,9 @@ def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactiv
     probe.wait(lambda: probe.last_force > clock_while_stopped, "the forces after the stop")
     assert not [t for t, sent in probe.published.items() if stopped_at < sent < resumed_at], "a stopped load controller sent a force"
     held = probe.last_force_sent_before(stopped_at)
-    assert clock_while_stopped <= held + FORCE_LEAD_S + 1e-6, f"the simulation ran to {clock_while_stopped:.4f} s past the last force {held:.4f} s + {FORCE_LEAD_S} s"
+    assert clock_while_stopped <= held + FORCE_LEAD_S + 1e-6, (
+        f"the simulation ran to {clock_while_stopped:.4f} s past the last force {held:.4f} s + {FORCE_LEAD_S} s"
+    )
     assert stamp > held  # the set-point was ahead of the load controller's chain
 
     stamp_ns = round(stamp * 1e9)

@@ -354,7 +354,9 @@ class LoadControllerNode(ManagedNode):
         assert self.operation is not None  # taken by the step, which runs from activate to deactivate
         force, torque = msg.wrench.force, msg.wrench.torque
         stamp = from_stamp(msg.header.stamp)
-        reply = self._apply(self.operation.request_load(force.z, RadialLoad(force.x, force.y, torque.x, torque.y), stamp if stamp > 0.0 else None, SetpointSource.TOPIC))
+        reply = self._apply(
+            self.operation.request_load(force.z, RadialLoad(force.x, force.y, torque.x, torque.y), stamp if stamp > 0.0 else None, SetpointSource.TOPIC)
+        )
         if reply.accepted:
             self._mirror_setpoint()
 

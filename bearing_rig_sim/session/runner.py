@@ -489,7 +489,14 @@ class ProgramRunner:
         if data is None or time < data.plan.start_time or self._ahead_of_segment(time, self.observe_radial, time, force_x, force_y):
             return
         want_x, want_y = data.plan.segment.radial_components
-        self._judge(data, "radial force on the bearing", time, math.hypot(force_x - want_x, force_y - want_y), math.hypot(force_x, force_y), data.plan.segment.radial_load)
+        self._judge(
+            data,
+            "radial force on the bearing",
+            time,
+            math.hypot(force_x - want_x, force_y - want_y),
+            math.hypot(force_x, force_y),
+            data.plan.segment.radial_load,
+        )
 
     def _judge_load(self, what: str, time: float, value: float, observe: Callable[..., None], *args: Any) -> None:
         """Judge an axial load sample (see the module documentation)."""

@@ -9,7 +9,7 @@ the simulator's truth and diagnostics. Every wait is for a message, bounded.
 Expected values, from the contract rather than the code: while the load controller is stopped
 (SIGSTOP) no force sample is published, so the simulation may run no further than the latest
 force stamp plus ``FORCE_LEAD_S`` (0.1 s) however long it stays stopped; a set-point sent while
-it is stopped, stamped T on the 10 ms grid of the state messages, shows first in the state
+it is stopped (sent ahead, as a session sends it), stamped T on the 10 ms grid of the state messages, shows first in the state
 stamped T (the one 10 ms before shows the previous set-point); from T + 0.5 s (``LOAD_SETTLE_S``;
 the chain's stated settle bound for 100 -> 300 N is under 0.1 s) the force on the bearing and the
 axial load the simulator applied lie within the settle band of 300 N (2 %: 6 N). Deactivated,
@@ -50,6 +50,11 @@ CHUNK_S = 0.001
 """The simulator's chunk (config/simulator.yaml), s."""
 
 BEFORE_N, AFTER_N = 100.0, 300.0
+
+AHEAD_S = 3.0
+"""How far ahead of the clock the set-point is stamped, s of sim time: the simulation, held by
+the stopped load controller, stays far short of it, and the set-point (published just before the
+stop, delivered at the latest by a repair after it) is queued before the chain reaches it."""
 
 
 class Probe:
@@ -125,6 +130,12 @@ class Probe:
         assert future.result().success
 
 
+def stopped(pid: int) -> bool:
+    """The process is stopped (state T in /proc/PID/stat): a SIGSTOP has taken effect."""
+    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+        return stat.read().rsplit(")", 1)[1].split()[0] == "T"
+
+
 def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactivated_one(ros_graph: Any) -> None:
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
     controller = ros_graph.spawn_python(
@@ -132,33 +143,35 @@ def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactiv
     )
     probe = Probe(ros_graph)
     probe.wait(lambda: probe.setpoint.get_subscription_count() > 0, "the load controller's set-point reader")
-    probe.wait(lambda: probe.pacing == "on" and probe.clock > 1.0, "the simulator pacing on the force stream")
+    probe.wait(lambda: probe.pacing == "on" and probe.last_force > 1.0, "the simulator pacing on the force stream, and its forces here")
 
-    stopped_at = time.time_ns()
+    # a set-point stamped ahead, as a session sends it; then the load controller stopped
+    stamp = math.ceil((probe.clock + AHEAD_S) / 0.01) * 0.01  # on the state messages' 10 ms grid
+    message = WrenchStamped()
+    message.header.stamp = to_stamp(stamp)
+    message.wrench.force.z = AFTER_N
+    probe.setpoint.publish(message)
     os.kill(controller.pid, signal.SIGSTOP)
     try:
+        probe.wait(lambda: stopped(controller.pid), "the load controller to stop")
+        stopped_at = time.time_ns()  # every force sent before this was sent before the stop
         # the simulation runs up to the last force sent plus the lead, and no further: what this
         # reader has of the forces sent before the stop is a lower bound of that (samples still
         # to be repaired come after the SIGCONT), so it reaches this at least
         probe.wait(lambda: probe.clock >= probe.last_force_sent_before(stopped_at) + FORCE_LEAD_S - 2 * CHUNK_S, "the simulation reaching the lead")
-        stamp = math.ceil((probe.clock + 0.05) / 0.01) * 0.01  # on the state messages' 10 ms grid, ahead of the chain
-        message = WrenchStamped()
-        message.header.stamp = to_stamp(stamp)
-        message.wrench.force.z = AFTER_N
-        probe.setpoint.publish(message)
         held_clock = probe.clock
         probe.wait(lambda: probe.clock > held_clock + FORCE_LEAD_S, "", timeout=1.0)  # a second of wall time, stopped: nothing expected
         clock_while_stopped = probe.clock
     finally:
+        resumed_at = time.time_ns()  # before the signal: a resumed process publishes at once
         os.kill(controller.pid, signal.SIGCONT)
-    resumed_at = time.time_ns()
     probe.wait(lambda: probe.last_force > clock_while_stopped, "the forces after the stop")
     assert not [t for t, sent in probe.published.items() if stopped_at < sent < resumed_at], "a stopped load controller sent a force"
     held = probe.last_force_sent_before(stopped_at)
     assert clock_while_stopped <= held + FORCE_LEAD_S + 1e-6, (
         f"the simulation ran to {clock_while_stopped:.4f} s past the last force {held:.4f} s + {FORCE_LEAD_S} s"
     )
-    assert stamp > held  # the set-point was ahead of the load controller's chain
+    assert stamp > held  # the set-point's stamp still ahead of the load controller's chain when stopped
 
     stamp_ns = round(stamp * 1e9)
     settled = stamp + LOAD_SETTLE_S + 0.1

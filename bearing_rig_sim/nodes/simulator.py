@@ -148,6 +148,9 @@ resort for a publisher gone without a word (as :data:`ACK_GIVE_UP_S` for a relia
 busy loops on two cores starved the load controller for over 2 s). A stopped process (SIGSTOP)
 holds the simulation until then."""
 
+UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"
+"""The node name the ROS graph gives an endpoint whose node it has not discovered yet (rmw)."""
+
 GRAPH_RECHECK_S = 0.2
 """Wall time between two look-ups of the force stream's publishers while they change, s."""
 
@@ -356,9 +359,10 @@ class SimulatorNode(ManagedNode):
             if count == 0:
                 self._force_pace, self._force_stamp, self._force_paused = None, -math.inf, False
                 self._pacing_off = f"no publisher of {BEARING_AXIAL_FORCE.name}"
-            # the graph may name a matched publisher's node later than the match: counted as
-            # known only once it does, so the lookup is repeated until then
-            infos = tap.get_publishers_info_by_topic(BEARING_AXIAL_FORCE.name)
+            # the graph may name a matched publisher's node later than the match (meanwhile
+            # "_NODE_NAME_UNKNOWN_"): counted as known only once it does, so the lookup is
+            # repeated until then
+            infos = [i for i in tap.get_publishers_info_by_topic(BEARING_AXIAL_FORCE.name) if i.node_name != UNKNOWN_NODE_NAME]
             self._force_publishers = count if len(infos) >= count else len(infos)
             for info in infos:
                 topic = f"{info.node_namespace.rstrip('/')}/{info.node_name}/transition_event"

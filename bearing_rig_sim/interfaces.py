@@ -172,7 +172,7 @@ AXIAL_LOAD_SETPOINT = Topic(
 LOAD_SETPOINT = Topic(
     "/rig/load/setpoint",
     "geometry_msgs/msg/WrenchStamped",
-    "reliable",
+    "reliable_stream",
     "one per segment (stamp: its start, sent ahead)",
     "N, N m",
     "program runner, user",

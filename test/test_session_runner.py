@@ -531,3 +531,21 @@ def test_the_radial_force_on_the_bearing_is_judged_against_the_segments(tmp_path
         runner.observe_radial(t, 0.0, 500.0) if k < 100 else runner.observe_radial(t, 500.0, 0.0)
     runner.update(3.0)
     assert runner.outcomes[-1].conditions == ("load off: radial force on the bearing 500.0 N at t = 2.000 s, 500 N commanded (+- 10 N)",)
+
+
+def test_set_points_of_every_fixed_start_go_at_once_and_stop_at_an_until_stable_end(program: TestProgram) -> None:
+    """load_up (dwell 1 s) fixes n0900's start at 1.0 s; n0900 is until_stable, so n1200's start
+    is not known: by default set-points of fixed starts go at once, without a lead; a lead of
+    0.5 s holds n0900's back until 0.5 s before its start."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    assert [(p.segment.name, p.start_time) for p in runner.setpoints_due(0.0)] == [("load_up", 0.0), ("n0900", 1.0)]
+    assert runner.setpoints_due(0.1) == []
+    assert [p.segment.name for p in runner.commands_due(0.1)] == ["load_up", "n0900"]  # the commands' own count
+    runner.update(1.0)
+    runner.update(7.0)  # n0900 times out at 1 + 1.5 + 4 = 6.5 s: n1200 starts when noticed
+    assert [(p.segment.name, p.start_time) for p in runner.setpoints_due(7.0)] == [("n1200", 7.0)]
+    led = ProgramRunner(program, setpoint_lead_s=0.5)
+    led.start(0.0)
+    assert [p.segment.name for p in led.setpoints_due(0.4)] == ["load_up"]
+    assert [p.segment.name for p in led.setpoints_due(0.5)] == ["n0900"]

@@ -358,6 +358,12 @@ class AxialLoadOperation:
         """Set-points stamped ahead and not in force yet."""
         return len(self._pending)
 
+    def drop_pending(self) -> int:
+        """Forget the set-points stamped ahead (they belong to the run that sent them); returns
+        how many there were."""
+        count, self._pending = len(self._pending), []
+        return count
+
     def _apply_load(self, axial_n: float, radial: RadialLoad, origin: str) -> Reply:
         """Put a judged load set-point in force: one reply for both parts."""
         axial = self.request_setpoint(axial_n, origin)

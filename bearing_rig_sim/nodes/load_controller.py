@@ -26,7 +26,8 @@ Interfaces (README, interface table):
   the chain's time reaches its stamp and is in force from that instant
   (:meth:`~bearing_rig_sim.load_control.AxialLoadOperation.request_load`): the session stamps each
   segment's set-point with its start and sends it ahead, so it reaches the bearing at the start
-  however far the simulator runs ahead of the session. The radial part is applied as given (the
+  however far the simulator runs ahead of the session. Those still waiting are dropped at
+  deactivation. The radial part is applied as given (the
   rig file's ``combined_loading`` states no loader dynamics);
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
@@ -213,6 +214,12 @@ class LoadControllerNode(ManagedNode):
         """Report the health at once on activation."""
         if self.operation is not None:
             self.operation.mark_reported(None)
+
+    def deactivate(self) -> None:
+        """Forget the set-points stamped ahead: a run that stops its nodes leaves none to take
+        effect at a later activation."""
+        if self.operation is not None and self.operation.pending:
+            self.get_logger().info(f"deactivated: {self.operation.drop_pending()} set-point(s) stamped ahead dropped")
 
     def cleanup(self) -> None:
         """Drop the chain, the services and the clock reader."""

@@ -45,9 +45,14 @@ Rules (simulation time throughout, s):
 * Observations stamped at or after the end of a dwell segment belong to the next segment (the
   simulator may be there already, its command having been sent ahead): they are kept until the
   runner starts it.
-* **Set-points with the commands**: each segment's load set-point goes with its spindle command
-  (:meth:`ProgramRunner.commands_due`), stamped with the segment's start: ahead of a fixed start,
-  at the start otherwise; the load controller puts it in force at its stamp.
+* **Set-points ahead of time** (:meth:`ProgramRunner.setpoints_due`): each segment's load
+  set-point, stamped with the segment's start, is sent as soon as that start is fixed (without
+  real time every set-point of a run of dwell segments at once; in real time
+  :data:`REALTIME_COMMAND_LEAD_S` ahead, as a command) and at the start otherwise; the load
+  controller keeps it until its stamp. A lead like the commands' 9 s was not enough: under four
+  busy loops on two cores the simulator ran more than 9 s ahead of the session (its recorder's
+  readers acknowledge from the middleware's thread, so the session's Python may lag far behind),
+  and four of 40 load-sweep segments began on the previous set-point.
 * **The load is judged sample by sample**: every bearing force of the load controller's state
   from :data:`LOAD_SETTLE_S` after the segment's start (after a fixed start, whose set-point was
   sent ahead and is in force from the start), or after the load controller's state first showed
@@ -278,10 +283,18 @@ class ProgramRunner:
         if runner.finished: ...                 # runner.outcomes holds one row per segment
     """
 
-    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None, command_lead_s: float = COMMAND_LEAD_S) -> None:
+    def __init__(
+        self,
+        program: TestProgram,
+        monitor_settings: MonitorSettings | None = None,
+        command_lead_s: float = COMMAND_LEAD_S,
+        setpoint_lead_s: float = math.inf,
+    ) -> None:
         self.program = program
         self.command_lead_s = command_lead_s
         """How long before a segment's fixed start its command is sent, s (:meth:`commands_due`)."""
+        self.setpoint_lead_s = setpoint_lead_s
+        """How long before a segment's fixed start its load set-point is sent, s (:meth:`setpoints_due`)."""
         self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
         """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
         self.outcomes: list[SegmentOutcome] = []
@@ -293,6 +306,8 @@ class ProgramRunner:
         """Plans of segments not started yet whose start is fixed (see :meth:`commands_due`)."""
         self._commanded = -1
         """Highest segment index whose command :meth:`commands_due` gave."""
+        self._setpoints_sent = -1
+        """Highest segment index whose set-point :meth:`setpoints_due` gave."""
         self._early: list[tuple[Callable[..., None], tuple[Any, ...]]] = []
         """Observations stamped after the running segment's end, for the next one (in order)."""
         self.latest_status: SlipObservation | None = None
@@ -385,22 +400,36 @@ class ProgramRunner:
         ahead of ``now``. Each command is stamped with its plan's start
         (:attr:`SegmentPlan.start_time`). An ``until_stable`` segment's end is not known ahead, so
         the segment after it is commanded when it starts."""
+        due, self._commanded = self._due(now, self.command_lead_s, self._commanded)
+        return due
+
+    def setpoints_due(self, now: float) -> list[SegmentPlan]:
+        """The plans whose load set-point is to be sent at ``now`` (s of sim time): as
+        :meth:`commands_due`, up to :attr:`setpoint_lead_s` ahead (by default every fixed start
+        at once: the load controller keeps them until their stamps, and, unlike a command, a
+        set-point has no lead limit at its receiver)."""
+        due, self._setpoints_sent = self._due(now, self.setpoint_lead_s, self._setpoints_sent)
+        return due
+
+    def _due(self, now: float, lead: float, sent: int) -> tuple[list[SegmentPlan], int]:
+        """The plans due within ``lead`` of ``now`` after the one of index ``sent``, and the new
+        highest index given (see :meth:`commands_due`)."""
         plan = self.current
         if plan is None:
-            return []
+            return [], sent
         due = []
-        if self._commanded < plan.index:
+        if sent < plan.index:
             due.append(plan)
-            self._commanded = plan.index
-        while plan.segment.dwell is not None and plan.index + 1 < self.segment_count and plan.deadline - now <= self.command_lead_s:
+            sent = plan.index
+        while plan.segment.dwell is not None and plan.index + 1 < self.segment_count and plan.deadline - now <= lead:
             following = self._ahead.get(plan.index + 1)
             if following is None:
                 following = self._ahead[plan.index + 1] = self._plan(plan.index + 1, plan.deadline)
-            if self._commanded < following.index:
+            if sent < following.index:
                 due.append(following)
-                self._commanded = following.index
+                sent = following.index
             plan = following
-        return due
+        return due, sent
 
     def interrupt(self, now: float) -> SegmentOutcome | None:
         """Stop: the running segment ends as "interrupted" (returned), the program as finished."""

@@ -164,19 +164,20 @@ AXIAL_LOAD_SETPOINT = Topic(
     "/rig/axial_load/setpoint",
     "std_msgs/msg/Float64",
     "reliable",
-    "one per segment",
+    "on request",
     "N",
-    "program runner, user",
+    "user (the manual input: in force on arrival)",
     stamped=False,
 )
-RADIAL_LOAD_SETPOINT = Topic(
-    "/rig/radial_load/setpoint",
+LOAD_SETPOINT = Topic(
+    "/rig/load/setpoint",
     "geometry_msgs/msg/WrenchStamped",
-    "reliable",
-    "one per segment of a program with radial loads or moments",
+    "reliable_stream",
+    "one per segment (stamp: its start, sent ahead)",
     "N, N m",
-    "program runner, user (a bench with a radial loader)",
-    note="force.x/y radial (magnitude and azimuth), torque.x/y a moment; force.z, torque.z unused; up to the rig file's limits",
+    "program runner, user",
+    note="the whole load set-point, in force from header.stamp (0: on arrival): force.z axial, force.x/y radial "
+    "(magnitude and azimuth), torque.x/y a moment; torque.z unused; up to the rig file's limits",
 )
 AXIAL_LOAD_STATE = Topic("/rig/axial_load/state", "bearing_rig_msgs/msg/AxialLoadState", "reliable", "100 Hz (sim)", "N, A", "load controller")
 AXIAL_LOAD_FORCE = Topic(
@@ -250,7 +251,7 @@ TOPICS: tuple[Topic, ...] = (
     SPEEDS,
     TRUTH,
     AXIAL_LOAD_SETPOINT,
-    RADIAL_LOAD_SETPOINT,
+    LOAD_SETPOINT,
     AXIAL_LOAD_STATE,
     AXIAL_LOAD_FORCE,
     BEARING_AXIAL_FORCE,

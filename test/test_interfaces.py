@@ -68,7 +68,8 @@ def test_every_qos_name_means_the_same_to_the_nodes_and_to_the_bags() -> None:
         assert f"depth {stored.depth}" in interfaces.QOS_DESCRIPTIONS[name], name
     # The twin's high-rate streams are the ones a recorder must get whole (issue: no pulse lost in a bag).
     streams = {t.name for t in interfaces.TOPICS if t.qos == "reliable_stream"}
-    assert streams == {"/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force"}
+    # ... and the load set-points, sent ahead all at once (a load sweep's 40): a depth of 10 would drop 30
+    assert streams == {"/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force", "/rig/load/setpoint"}
 
 
 def test_write_tables_replaces_a_stale_table(tmp_path: Path) -> None:

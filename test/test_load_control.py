@@ -1,8 +1,8 @@
 """The load controller's operation of the loading chain, without ROS: stepping by elapsed sim time
 (batched ticks give the same chain as single ticks; a clock that goes back or jumps), the state
 and diagnostics schedule, set-point refusals and the health they leave, the fault latch and its
-reset policy, the stated settle-time bound, and the radial loader's set-point against the rig
-file's limits.
+reset policy, the stated settle-time bound, the radial loader's set-point against the rig
+file's limits, and load set-points stamped ahead (in force from their stamp, not a sample before).
 """
 
 from __future__ import annotations
@@ -314,3 +314,67 @@ def test_radial_setpoint_within_the_limits_is_applied_as_given_and_refusals_keep
     assert op.radial == in_force
     assert op.request_radial(RadialLoad(0.0, 0.0, 3.0, 4.0), SetpointSource.TOPIC).accepted
     assert op.health().level is HealthLevel.OK
+
+
+def test_a_stamped_set_point_takes_effect_at_its_stamp_not_a_sample_before(config: LoadingChainConfig) -> None:
+    """``request_load`` with a stamp ahead: queued; the samples before the stamp keep the old
+    set-point, the one at the stamp shows the new one (force samples of 1 ms)."""
+    op = AxialLoadOperation.from_config(config)
+    op.follow(1.0)
+    assert op.request_setpoint(100.0, SetpointSource.TOPIC).accepted
+    queued = op.request_load(300.0, RadialLoad(), 1.005, SetpointSource.TOPIC)
+    assert queued.accepted and "from t = 1.005 s" in queued.message
+    assert op.setpoint == 100.0 and op.pending == 1
+    results = op.follow(1.010)
+    assert [round(r.time, 6) for r in results] == [1.001, 1.002, 1.003, 1.004, 1.005, 1.006, 1.007, 1.008, 1.009, 1.010]
+    assert [r.state.setpoint for r in results] == [100.0] * 4 + [300.0] * 6
+    assert [bool(r.applied) for r in results] == [False] * 4 + [True] + [False] * 5
+    assert results[4].applied[0].accepted and "300 N" in results[4].applied[0].message
+    assert op.pending == 0
+
+
+def test_a_stamp_between_samples_splits_the_step_there(config: LoadingChainConfig) -> None:
+    """A set-point stamped 0.4 ms into a 1 ms sample is in force for its last 0.6 ms: the chain
+    ends where one stepped 0.4 ms, given the set-point, then stepped 0.6 ms ends."""
+    op = AxialLoadOperation.from_config(config)
+    op.follow(0.0)
+    assert op.request_load(400.0, RadialLoad(), 0.0024, SetpointSource.TOPIC).accepted
+    op.follow(0.003)
+    by_hand = LoadingChain(config)
+    by_hand.engage()
+    by_hand.set_manual_voltage(0.0)  # the 0 N set-point: brake de-energised
+    by_hand.step(0.002)
+    by_hand.step(0.0004)
+    by_hand.set_setpoint(400.0)
+    by_hand.set_manual_voltage(None)
+    by_hand.step(0.0006)
+    state, hand = op.chain.state(), by_hand.state()
+    for name in ("ramped_setpoint", "bearing_force", "load_cell_force", "rope_tension", "brake_current"):
+        assert getattr(state, name) == pytest.approx(getattr(hand, name), rel=1e-9, abs=1e-9), name
+    # the set-point ramps at its rate from the stamp on: 0.6 ms of it (the ramp's own closed form)
+    assert state.ramped_setpoint == pytest.approx(config.controller.setpoint_rate_n_per_s * 0.0006, rel=0.02)
+
+
+def test_a_stamp_reached_already_or_none_applies_at_once_and_refusals_are_whole(config: LoadingChainConfig) -> None:
+    op = AxialLoadOperation(
+        LoadingChain(config),
+        state_period_s=0.01,
+        diagnostics_period_s=1.0,
+        max_clock_gap_s=0.5,
+        sample_period_s=0.001,
+        engage=True,
+        radial_limits=radial_limits(800.0, 5.0),
+    )
+    op.follow(2.0)
+    assert op.request_load(200.0, RadialLoad(0.0, 500.0), None, SetpointSource.TOPIC).accepted
+    assert op.setpoint == 200.0 and op.radial == RadialLoad(0.0, 500.0) and op.pending == 0
+    assert op.request_load(250.0, RadialLoad(), 1.5, SetpointSource.TOPIC).accepted  # a stamp in the past
+    assert op.setpoint == 250.0 and op.radial == RadialLoad() and op.pending == 0
+    # 900 N radial is above the rig's 800 N: the axial part refused with it, nothing queued
+    refused = op.request_load(300.0, RadialLoad(900.0), 3.0, SetpointSource.TOPIC)
+    assert not refused.accepted and "radial force 900 N is above the rig's limit of 800 N" in refused.message
+    assert op.pending == 0 and op.health().level is HealthLevel.WARN
+    negative = op.request_load(-1.0, RadialLoad(), 3.0, SetpointSource.TOPIC)
+    assert not negative.accepted and negative.message.startswith("set-point by topic refused")
+    op.follow(3.5)
+    assert op.setpoint == 250.0

@@ -1,11 +1,11 @@
 """A program's radial load and moment reach the twin: session -> load controller -> simulator.
 
-The session node sends a segment's set-points as a session does (``SessionNode.send_setpoint``):
-the axial one on ``/rig/axial_load/setpoint`` and, the program loading radially, the radial one
-on ``/rig/radial_load/setpoint`` (force.x the radial load, torque.y the moment). The load
-controller, on a rig file whose ``combined_loading`` section states a radial loader (800 N,
-5 N m), applies it in force.x and torque.y of the force on the bearing, which the simulator
-applies. The load controller and the simulator run as processes with the test's rig file on the
+The session node sends a segment's set-point as a session does (``SessionNode.send_setpoint``)
+on ``/rig/load/setpoint``: force.z the axial load, force.x/y the radial load at the segment's
+``radial_azimuth_deg`` (90 deg here: along the bearing frame's y axis, so force.y = 500 N and
+force.x = 500 cos 90 deg = 0 N to rounding), torque.y the moment. The load controller, on a rig
+file whose ``combined_loading`` section states a radial loader (800 N, 5 N m), applies it in
+force.x/y and torque.y of the force on the bearing, which the simulator applies. The load controller and the simulator run as processes with the test's rig file on the
 test's isolated domain (the simulator without real time); the session node records every topic
 into memory; every wait is for a message, bounded.
 
@@ -35,7 +35,7 @@ from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from rclpy.serialization import deserialize_message  # noqa: E402
 
 from bearing_rig_sim.config import ConfigError  # noqa: E402
-from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, BEARING_AXIAL_FORCE, DIAGNOSTICS, RADIAL_LOAD_SETPOINT, TRUTH  # noqa: E402
+from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, DIAGNOSTICS, LOAD_SETPOINT, TRUTH  # noqa: E402
 from bearing_rig_sim.nodes.common import from_stamp, qos_profile  # noqa: E402
 from bearing_rig_sim.rig.program import RigLimits, load_program  # noqa: E402
 from bearing_rig_sim.session.node import MESSAGE_TYPES, SessionNode  # noqa: E402
@@ -46,7 +46,7 @@ from test_nodes_simulator_loads import radial_rig_file  # noqa: E402
 WAIT = 90.0
 """Longest wait for any one condition, wall s (two nodes start, the chain settles)."""
 
-AXIAL_N, RADIAL_N, MOMENT_N_M = 163.0, 500.0, 1.0
+AXIAL_N, RADIAL_N, MOMENT_N_M, AZIMUTH_DEG = 163.0, 500.0, 1.0, 90.0
 
 PROGRAM = f"""
 name: radial_side_load
@@ -54,7 +54,7 @@ description: a side load and a moment at 900 rpm
 bearing: bearings/h7006c.yaml
 stability_criterion: time
 segments:
-  - {{name: side, speed_rpm: 900, ramp_s: 1.0, axial_load_n: {AXIAL_N:g}, radial_load_n: {RADIAL_N:g}, moment_n_m: {MOMENT_N_M:g}, dwell_s: 600.0}}
+  - {{name: side, speed_rpm: 900, ramp_s: 1.0, axial_load_n: {AXIAL_N:g}, radial_load_n: {RADIAL_N:g}, moment_n_m: {MOMENT_N_M:g}, radial_azimuth_deg: {AZIMUTH_DEG:g}, dwell_s: 600.0}}
 """
 """Held far longer than the test needs. Its spindle command is not sent: the simulator starts at
 900 rpm (initial_speed_rad_s)."""
@@ -124,22 +124,25 @@ def test_programs_radial_load_and_moment_reach_the_simulator_through_the_load_co
         assert ros_graph.spin_until(drained, WAIT, executor=executor), f"timed out waiting for {what}"
 
     wait(
-        lambda: session.count_subscribers(RADIAL_LOAD_SETPOINT.name) > 0 and session.count_subscribers(AXIAL_LOAD_SETPOINT.name) > 0,
-        "the load controller's set-point readers",
+        lambda: session.count_subscribers(LOAD_SETPOINT.name) > 0,
+        "the load controller's set-point reader",
     )
     wait(lambda: session.sim_time > 0.05 and memory.raw[BEARING_AXIAL_FORCE.name], "the simulator's clock and the controller's forces")
-    assert all(m.wrench.force.x == 0.0 and m.wrench.torque.y == 0.0 for m in memory.messages(BEARING_AXIAL_FORCE))  # none asked for yet
+    assert all(m.wrench.force.y == 0.0 and m.wrench.torque.y == 0.0 for m in memory.messages(BEARING_AXIAL_FORCE))  # none asked for yet
 
     session.send_setpoint(runner.start(session.sim_time))
     sent = memory.messages
-    wait(lambda: any(m.wrench.force.x == RADIAL_N for m in sent(BEARING_AXIAL_FORCE)), "the radial load in the force on the bearing")
-    loaded = [m for m in sent(BEARING_AXIAL_FORCE) if m.wrench.force.x != 0.0]
-    assert all((m.wrench.force.x, m.wrench.force.y, m.wrench.torque.x, m.wrench.torque.y) == (RADIAL_N, 0.0, 0.0, MOMENT_N_M) for m in loaded)
-    [setpoint] = sent(RADIAL_LOAD_SETPOINT)  # one segment, one set-point, recorded
-    assert (setpoint.wrench.force.x, setpoint.wrench.torque.y) == (RADIAL_N, MOMENT_N_M)
+    wait(lambda: any(m.wrench.force.y == RADIAL_N for m in sent(BEARING_AXIAL_FORCE)), "the radial load in the force on the bearing")
+    loaded = [m for m in sent(BEARING_AXIAL_FORCE) if m.wrench.force.y != 0.0]
+    assert all(
+        (m.wrench.force.x, m.wrench.force.y, m.wrench.torque.x, m.wrench.torque.y) == pytest.approx((0.0, RADIAL_N, 0.0, MOMENT_N_M), abs=1e-9) for m in loaded
+    )
+    [setpoint] = sent(LOAD_SETPOINT)  # one segment, one set-point, recorded
+    assert (setpoint.wrench.force.z, setpoint.wrench.force.y, setpoint.wrench.torque.y) == (AXIAL_N, RADIAL_N, MOMENT_N_M)
+    assert setpoint.wrench.force.x == pytest.approx(0.0, abs=1e-9)
 
     wait(lambda: memory.diagnostic("simulator", "radial_load_n") == f"{RADIAL_N:g}", "the simulator reporting the radial load")
-    assert float(memory.diagnostic("simulator", "radial_load_azimuth_deg")) == pytest.approx(0.0, abs=1e-9)  # force.x: along x
+    assert float(memory.diagnostic("simulator", "radial_load_azimuth_deg")) == pytest.approx(AZIMUTH_DEG, abs=1e-9)  # force.y: along y
     assert memory.diagnostic("simulator", "moment_n_m") == f"0 {MOMENT_N_M:g}"
     wait(lambda: memory.diagnostic("load_controller", "radial_setpoint_n") == f"{RADIAL_N:g}", "the load controller reporting the radial set-point")
     assert memory.diagnostic("load_controller", "moment_setpoint_n_m") == f"{MOMENT_N_M:g}"
@@ -162,8 +165,9 @@ def test_programs_radial_load_and_moment_reach_the_simulator_through_the_load_co
 
     # 900 N on the set-point topic is above the rig file's 800 N: refused on the load controller's
     # status naming the limit, the node up, the force on the bearing keeping 500 N and 1 N m
-    bench = session.create_publisher(WrenchStamped, RADIAL_LOAD_SETPOINT.name, qos_profile(RADIAL_LOAD_SETPOINT))
+    bench = session.create_publisher(WrenchStamped, LOAD_SETPOINT.name, qos_profile(LOAD_SETPOINT))
     too_much = WrenchStamped()
+    too_much.wrench.force.z = AXIAL_N
     too_much.wrench.force.x = 900.0
     bench.publish(too_much)
     refusal = (
@@ -173,6 +177,6 @@ def test_programs_radial_load_and_moment_reach_the_simulator_through_the_load_co
     refused_at = session.sim_time
     wait(lambda: session.sim_time > refused_at + 0.05, "the rig going on after the refusal")
     after = [m for m in sent(BEARING_AXIAL_FORCE) if from_stamp(m.header.stamp) > refused_at]
-    assert after and all((m.wrench.force.x, m.wrench.torque.y) == (RADIAL_N, MOMENT_N_M) for m in after)
+    assert after and all((m.wrench.force.y, m.wrench.torque.y) == (RADIAL_N, MOMENT_N_M) for m in after)
     assert memory.diagnostic("load_controller", "radial_setpoint_n") == f"{RADIAL_N:g}"
     assert controller.poll() is None

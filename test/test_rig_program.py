@@ -259,7 +259,7 @@ def test_program_file_errors_are_the_parameter_models_wording(tmp_path: Path) ->
         "speed_rpm: 900, ramp_s": (
             "speed_rpm: 900, sped: 1, ramp_s",
             "segments[0].sped: unknown key; allowed keys: acceleration_rad_s2, "
-            "axial_load_n, dwell_s, moment_n_m, name, radial_load_n, ramp_s, speed_rpm, timeout_s, until_stable",
+            "axial_load_n, dwell_s, moment_n_m, name, radial_azimuth_deg, radial_load_n, ramp_s, speed_rpm, timeout_s, until_stable",
         ),
         "axial_load_n: 100, dwell_s": ("axial_load_n: -5, dwell_s", "segments[0].axial_load_n: must be >= 0.0, got -5.0"),
         "until_stable: true": ("until_stable: 1", "segments[1].until_stable: must be true or false, got 1"),

@@ -3,10 +3,10 @@ thing it lacks, and all are ready only when each publishes and listens."""
 
 from __future__ import annotations
 
-from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, SLIP_STATUS, SPINDLE_COMMAND
+from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, LOAD_SETPOINT, SLIP_STATUS, SPINDLE_COMMAND
 from bearing_rig_sim.session.readiness import not_ready
 
-ALL_SUBSCRIBED = frozenset({SPINDLE_COMMAND.name, AXIAL_LOAD_SETPOINT.name, CAGE_PULSES.name})
+ALL_SUBSCRIBED = frozenset({SPINDLE_COMMAND.name, LOAD_SETPOINT.name, CAGE_PULSES.name})
 
 
 def missing(seen: bool, subscribed: frozenset[str], published: frozenset[str]) -> dict[str, str]:
@@ -31,5 +31,5 @@ def test_nothing_up_names_what_each_node_has_not_sent() -> None:
 
 
 def test_a_node_that_publishes_but_does_not_listen_is_not_ready() -> None:
-    for topic, node in ((SPINDLE_COMMAND.name, "simulator"), (AXIAL_LOAD_SETPOINT.name, "load_controller"), (CAGE_PULSES.name, "monitor")):
+    for topic, node in ((SPINDLE_COMMAND.name, "simulator"), (LOAD_SETPOINT.name, "load_controller"), (CAGE_PULSES.name, "monitor")):
         assert missing(True, ALL_SUBSCRIBED - {topic}, frozenset({SLIP_STATUS.name})) == {node: f"nobody subscribes {topic}"}

@@ -148,13 +148,14 @@ def test_hostile_clock_stamps_stay_off_the_timeline(fake: tuple[FakeWriter, Sess
     assert rec.counts["/clock"] == 8  # every message kept
 
 
-def test_a_command_stamped_ahead_is_logged_when_received(fake: tuple[FakeWriter, SessionRecorder]) -> None:
-    """The session sends a dwell segment's successor ahead, stamped with its start: logged at that
-    stamp, it would drag every message received before it up to it (strictly increasing); it is
-    logged at the last /clock, its header keeps the stamp."""
+@pytest.mark.parametrize("topic", ["/rig/spindle/command", "/rig/load/setpoint"])
+def test_a_command_or_set_point_stamped_ahead_is_logged_when_received(fake: tuple[FakeWriter, SessionRecorder], topic: str) -> None:
+    """The session sends a dwell segment's successor's command and load set-point ahead, stamped
+    with its start: logged at that stamp, it would drag every message received before it up to it
+    (strictly increasing); it is logged at the last /clock, its header keeps the stamp."""
     writer, rec = fake
     rec.record("/clock", stamped(10 * S))
     ahead = stamped(13 * S, b"command")
-    assert rec.record("/rig/spindle/command", ahead) == 10 * S + 1  # the /clock's time, 1 ns on
+    assert rec.record(topic, ahead) == 10 * S + 1  # the /clock's time, 1 ns on
     assert writer.written[-1][2] == ahead and header_stamp_ns(ahead) == 13 * S
     assert rec.record("/rig/speeds", stamped(10 * S + 1_000_000, b"speeds")) == 10 * S + 1_000_000  # not moved

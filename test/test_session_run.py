@@ -117,11 +117,17 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
     counts = check_bag_decodes(bag)
     for topic in (*SENSOR_TOPICS, "/clock", "/rig/axial_load/state", "/rig/bearing/axial_force", "/rig/truth", "/diagnostics"):
         assert counts.get(topic, 0) > 0, f"no {topic} in {counts}"
-    assert counts["/rig/spindle/command"] == 3 and counts["/rig/axial_load/setpoint"] == 3
-    # an axially loaded program sends no radial set-point, and the force on the bearing stays axial
-    assert counts.get("/rig/radial_load/setpoint", 0) == 0
+    # one stamped load set-point per segment, with its command; the manual axial input unused
+    assert counts["/rig/spindle/command"] == 3 and counts["/rig/load/setpoint"] == 3
+    assert counts.get("/rig/axial_load/setpoint", 0) == 0
+    # an axially loaded program's set-points carry no radial load: the force on the bearing stays axial
     with open_bag(bag) as reader:
         forces = [m.message.wrench for m in reader.messages(["/rig/bearing/axial_force"])]  # type: ignore[attr-defined]
+        commands = [m.message.header.stamp for m in reader.messages(["/rig/spindle/command"])]  # type: ignore[attr-defined]
+        setpoints = [m.message for m in reader.messages(["/rig/load/setpoint"])]  # type: ignore[attr-defined]
+    # each segment's set-point stamped with its start, as its command: 100 N axial, nothing radial
+    assert [(s.header.stamp.sec, s.header.stamp.nanosec) for s in setpoints] == [(c.sec, c.nanosec) for c in commands]
+    assert all((s.wrench.force.z, s.wrench.force.x, s.wrench.force.y) == (100.0, 0.0, 0.0) for s in setpoints)
     assert forces and all((w.force.x, w.force.y, w.torque.x, w.torque.y) == (0.0, 0.0, 0.0, 0.0) for w in forces)
     with open_bag(bag) as reader:
         context = reader.run_metadata

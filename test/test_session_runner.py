@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.rig.program import TestProgram, load_program
+from bearing_rig_sim.rig.program import RigLimits, TestProgram, load_program
 from bearing_rig_sim.session.runner import COMMAND_LEAD_S, ProgramRunner, SlipObservation, StatusState, Verdict
 
 PROGRAM = """
@@ -237,7 +237,8 @@ def test_a_load_off_its_set_point_is_marked_once_settled(program: TestProgram) -
     runner.update(1.0)
     outcome = runner.outcomes[-1]
     assert outcome.bearing_force == pytest.approx(30.0)
-    assert outcome.conditions == ("load 30.0 N on the bearing, 100 N commanded",)
+    # settle_band(100 N) = max(2 % of 100 N, 5 N) = 5 N; the first sample furthest out is named
+    assert outcome.conditions == ("load off: bearing force 30.0 N at t = 0.600 s, 100 N commanded (+- 5 N)",)
 
 
 def test_set_points_from_outside_mark_the_segment(program: TestProgram) -> None:
@@ -429,3 +430,123 @@ def test_a_run_up_stable_during_its_acceleration_is_judged_on_the_speed_it_holds
         runner.update(accel.deadline)
         outcome = runner.outcomes[-1]
         assert outcome.name == "accel_20" and outcome.time_to_stable == pytest.approx(2.0) and outcome.conditions_met is met
+
+
+LATE = """
+name: late
+bearing: bearings/h7006c.yaml
+stability_criterion: time
+initial_speed_rpm: 900
+segments:
+  - {name: a, speed_rpm: 900, axial_load_n: 100, dwell_s: 1.0}
+  - {name: b, speed_rpm: 900, axial_load_n: 300, dwell_s: 2.0}
+  - {name: c, speed_rpm: 900, axial_load_n: 50, dwell_s: 2.0}
+"""
+
+
+@pytest.fixture
+def late(tmp_path: Path) -> TestProgram:
+    path = tmp_path / "late.yaml"
+    path.write_text(LATE, encoding="utf-8")
+    return load_program(path)
+
+
+def feed_state(runner: ProgramRunner, t0: float, t1: float, setpoint: float, force: float) -> None:
+    """The load controller's state every 10 ms from ``t0`` to ``t1`` (exclusive)."""
+    for k in range(round((t1 - t0) / 0.01)):
+        t = t0 + 0.01 * k
+        runner.observe_axial_setpoint(t, setpoint)
+        runner.observe_load(t, force)
+
+
+def test_a_fixed_start_whose_set_point_came_late_is_flagged_though_its_mean_settles(late: TestProgram) -> None:
+    """Segment b follows a dwell: its set-point goes ahead, stamped with its start (1.0 s), so its
+    300 N is due from 1.0 + LOAD_SETTLE_S on. Here it reached the load controller only at 2.0 s:
+    100 N on the bearing from 1.5 s to 2.0 s is 200 N off, beyond settle_band(300 N) = 6 N. The
+    settled mean (from the set-point's arrival) alone would have said 300 N and "ok"."""
+    runner = ProgramRunner(late)
+    runner.start(0.0)
+    feed_state(runner, 0.0, 1.0, 100.0, 100.0)
+    runner.update(1.0)
+    feed_state(runner, 1.0, 2.0, 100.0, 100.0)
+    feed_state(runner, 2.0, 3.0, 300.0, 300.0)
+    runner.update(3.0)
+    a, b = runner.outcomes
+    assert a.conditions_met
+    assert b.bearing_force == pytest.approx(300.0)
+    assert b.conditions == ("load off: bearing force 100.0 N at t = 1.500 s, 300 N commanded (+- 6 N)",)
+
+
+def test_a_fixed_start_whose_set_point_came_in_time_is_ok(late: TestProgram) -> None:
+    runner = ProgramRunner(late)
+    runner.start(0.0)
+    feed_state(runner, 0.0, 1.0, 100.0, 100.0)
+    runner.update(1.0)
+    feed_state(runner, 1.0, 1.3, 300.0, 200.0)  # rising: within LOAD_SETTLE_S, not judged
+    feed_state(runner, 1.3, 3.0, 300.0, 301.0)
+    runner.update(3.0)
+    assert runner.outcomes[-1].conditions_met
+
+
+def test_the_load_the_simulator_applied_is_judged_too(late: TestProgram) -> None:
+    """The measured case: the load controller's state right, but the simulator applying a force
+    seconds old (618 N in a 50 N segment): the segment is flagged from the truth's axial load."""
+    runner = ProgramRunner(late)
+    runner.start(0.0)
+    feed_state(runner, 0.0, 1.0, 100.0, 100.0)
+    runner.update(1.0)
+    feed_state(runner, 1.0, 3.0, 300.0, 300.0)
+    runner.update(3.0)  # c, 50 N, from 3.0 s
+    feed_state(runner, 3.0, 5.0, 50.0, 50.0)
+    for k in range(200):
+        runner.observe_truth(3.0 + 0.01 * k, 3.0, 618.0 if k < 120 else 50.0)
+    runner.update(5.0)
+    c = runner.outcomes[-1]
+    assert c.bearing_force == pytest.approx(50.0)
+    assert c.conditions == ("load off: axial load on the simulated bearing 618.0 N at t = 3.500 s, 50 N commanded (+- 5 N)",)
+
+
+def test_a_set_point_never_shown_is_flagged(late: TestProgram) -> None:
+    runner = ProgramRunner(late)
+    runner.start(0.0)
+    feed_state(runner, 0.0, 1.0, 0.0, 0.0)  # the load controller still at its initial 0 N
+    runner.update(1.0)
+    assert runner.outcomes[-1].conditions == ("load off: the load controller never showed the set-point 100 N during the segment",)
+
+
+def test_the_radial_force_on_the_bearing_is_judged_against_the_segments(tmp_path: Path) -> None:
+    """A 500 N radial load at 90 deg: (0, 500) N expected in force.x/y; (500, 0) N is the right
+    magnitude in the wrong direction, 707 N off, beyond settle_band(500 N) = 10 N."""
+    path = tmp_path / "radial.yaml"
+    path.write_text(LATE.replace("axial_load_n: 300,", "axial_load_n: 300, radial_load_n: 500, radial_azimuth_deg: 90,"), encoding="utf-8")
+    program = load_program(path, RigLimits(1000.0, 1000.0, 1000.0, max_radial_load_n=800.0))
+    assert program.segments[1].radial_components == pytest.approx((0.0, 500.0), abs=1e-9)
+    runner = ProgramRunner(program)
+    assert runner.loads_radially
+    runner.start(0.0)
+    feed_state(runner, 0.0, 1.0, 100.0, 100.0)
+    runner.update(1.0)
+    feed_state(runner, 1.0, 3.0, 300.0, 300.0)
+    for k in range(200):
+        t = 1.0 + 0.01 * k
+        runner.observe_radial(t, 0.0, 500.0) if k < 100 else runner.observe_radial(t, 500.0, 0.0)
+    runner.update(3.0)
+    assert runner.outcomes[-1].conditions == ("load off: radial force on the bearing 500.0 N at t = 2.000 s, 500 N commanded (+- 10 N)",)
+
+
+def test_set_points_of_every_fixed_start_go_at_once_and_stop_at_an_until_stable_end(program: TestProgram) -> None:
+    """load_up (dwell 1 s) fixes n0900's start at 1.0 s; n0900 is until_stable, so n1200's start
+    is not known: by default set-points of fixed starts go at once, without a lead; a lead of
+    0.5 s holds n0900's back until 0.5 s before its start."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    assert [(p.segment.name, p.start_time) for p in runner.setpoints_due(0.0)] == [("load_up", 0.0), ("n0900", 1.0)]
+    assert runner.setpoints_due(0.1) == []
+    assert [p.segment.name for p in runner.commands_due(0.1)] == ["load_up", "n0900"]  # the commands' own count
+    runner.update(1.0)
+    runner.update(7.0)  # n0900 times out at 1 + 1.5 + 4 = 6.5 s: n1200 starts when noticed
+    assert [(p.segment.name, p.start_time) for p in runner.setpoints_due(7.0)] == [("n1200", 7.0)]
+    led = ProgramRunner(program, setpoint_lead_s=0.5)
+    led.start(0.0)
+    assert [p.segment.name for p in led.setpoints_due(0.4)] == ["load_up"]
+    assert [p.segment.name for p in led.setpoints_due(0.5)] == ["n0900"]

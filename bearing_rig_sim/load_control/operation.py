@@ -41,6 +41,14 @@ Policies (the node's documentation repeats them):
   an ERROR naming the set-point and the bound, until the force is back in the band. A new
   set-point, an engagement or a reset starts the count again from the force at that moment.
 
+* **Set-points stamped ahead** (:meth:`AxialLoadOperation.request_load`): a whole load set-point
+  (axial, radial, moment) with the simulation time it takes effect. It is judged on arrival
+  (refused as a whole, reported as any refusal, when one part would be) and, accepted, kept until
+  the chain's time reaches its stamp: the chain is stepped to the stamp, the set-point applied,
+  and the step goes on from there, so it is in force from its stamp exactly, not a sample before
+  (a stamp at or before the chain's time, or none, applies it at once). Without real time the
+  simulator runs ahead of whoever sends the set-points; stamped with a segment's start and sent
+  ahead, a set-point reaches the bearing when the segment starts however late its sender runs.
 * **Radial load and moment** (:meth:`AxialLoadOperation.request_radial`): a separate loader,
   not the axial chain (the paper's bench has none; a bench that loads radially states its limits
   in the rig file's ``combined_loading`` section). Its set-point, a :class:`RadialLoad`, is
@@ -120,12 +128,15 @@ class AdvanceResult:
     """The interlock reason if a fault latched during this step, else empty."""
     clock_note: str
     """Why the clock was not stepped as read (went back, gap capped); empty normally."""
+    applied: tuple[Reply, ...] = ()
+    """Set-points stamped ahead (:meth:`AxialLoadOperation.request_load`) that took effect during
+    this step, in order."""
 
 
 @dataclass(frozen=True)
 class RadialLoad:
     """A radial-load set-point in the bearing's frame (the fields of
-    ``/rig/radial_load/setpoint``'s wrench that may be non-zero).
+    ``/rig/load/setpoint``'s wrench besides the axial force.z).
 
     The radial force is the magnitude of (``force_x``, ``force_y``) at the azimuth
     atan2(force_y, force_x); the moment across the axis is (``torque_x``, ``torque_y``).
@@ -209,6 +220,10 @@ class AxialLoadOperation:
         self.radial = RadialLoad()
         """The radial-load set-point in force (:meth:`request_radial`)."""
         self._radial_refusal = ""
+        self._pending: list[tuple[int, int, float, RadialLoad, str]] = []
+        """Set-points stamped ahead, not in force yet: (stamp in ns, arrival order, axial N,
+        radial load, source), sorted."""
+        self._arrivals = 0
         if engage:
             chain.engage()
         self._apply_zero_load_rule()
@@ -307,6 +322,80 @@ class AxialLoadOperation:
         self.radial = RadialLoad(*(float(v) for v in (load.force_x, load.force_y, load.torque_x, load.torque_y)))
         return Reply(True, f"radial-load set-point {self.radial.radial_n:g} N, moment {self.radial.moment_n_m:g} N m (by {origin})")
 
+    def request_load(self, axial_n: object, radial: RadialLoad, at: float | None, source: SetpointSource | str) -> Reply:
+        """Ask for a whole load set-point (``axial_n`` N and ``radial``) in force from the
+        simulation time ``at`` (s; None: at once); see the module documentation.
+
+        Returns:
+            Refused (as a whole, with the reasons; the health turns WARN as for
+            :meth:`request_setpoint` and :meth:`request_radial`), accepted and in force (no stamp,
+            or one the chain's time has reached), or accepted and waiting for its stamp.
+        """
+        origin = SetpointSource(source).value
+        reasons = []
+        try:
+            self.chain.check_setpoint(axial_n)  # any object: the chain validates it
+        except SetpointError as exc:
+            self._refusal = f"set-point by {origin} refused: {exc}"
+            reasons.append(self._refusal)
+        radial_reason = self._radial_reason(radial)
+        if radial_reason:
+            self._radial_refusal = f"radial set-point by {origin} refused: {radial_reason}"
+            reasons.append(self._radial_refusal)
+        if reasons:
+            return Reply(False, "; ".join(reasons))
+        axial = float(axial_n)  # type: ignore[arg-type]  # a number: checked above
+        stamp_ns = None if at is None else round(at * 1e9)
+        if stamp_ns is None or (self._time is not None and stamp_ns <= round(self._time * 1e9)):
+            return self._apply_load(axial, radial, origin)
+        self._arrivals += 1
+        self._pending.append((stamp_ns, self._arrivals, axial, radial, origin))
+        self._pending.sort(key=lambda p: (p[0], p[1]))
+        return Reply(True, f"load set-point {axial:g} N axial, {radial.radial_n:g} N radial: in force from t = {stamp_ns * 1e-9:.9g} s (by {origin})")
+
+    @property
+    def pending(self) -> int:
+        """Set-points stamped ahead and not in force yet."""
+        return len(self._pending)
+
+    def drop_pending(self) -> int:
+        """Forget the set-points stamped ahead (they belong to the run that sent them); returns
+        how many there were."""
+        count, self._pending = len(self._pending), []
+        return count
+
+    def _apply_load(self, axial_n: float, radial: RadialLoad, origin: str) -> Reply:
+        """Put a judged load set-point in force: one reply for both parts."""
+        axial = self.request_setpoint(axial_n, origin)
+        side = self.request_radial(radial, origin)
+        if not (axial.accepted and side.accepted):  # pragma: no cover - judged on arrival
+            return Reply(False, "; ".join(r.message for r in (axial, side) if not r.accepted))
+        return Reply(True, f"{axial.message}; {side.message}" if radial.radial_n or radial.moment_n_m else axial.message)
+
+    def _step_applying(self, start: float, end: float) -> tuple[LoadChainState, tuple[Reply, ...]]:
+        """Step the chain from ``start`` to ``end`` (s of sim time), putting each set-point stamped
+        within (start, end] in force at its stamp."""
+        applied = []
+        at = start
+        end_ns = round(end * 1e9)
+        while self._pending and self._pending[0][0] <= end_ns:
+            stamp_ns, _order, axial, radial, origin = self._pending.pop(0)
+            when = stamp_ns * 1e-9
+            if when > at:
+                self.chain.step(when - at)
+                at = when
+            applied.append(self._apply_load(axial, radial, origin))
+        return (self.chain.step(end - at) if end > at else self.chain.state()), tuple(applied)
+
+    def _apply_due(self, now: float) -> tuple[Reply, ...]:
+        """Put in force at once every set-point stamped at or before ``now`` (s)."""
+        now_ns = round(now * 1e9)
+        applied = []
+        while self._pending and self._pending[0][0] <= now_ns:
+            _stamp, _order, axial, radial, origin = self._pending.pop(0)
+            applied.append(self._apply_load(axial, radial, origin))
+        return tuple(applied)
+
     def _radial_reason(self, load: RadialLoad) -> str:
         """Why ``load`` cannot be applied; empty when it can."""
         for name in ("force_x", "force_y", "torque_x", "torque_y"):
@@ -381,17 +470,23 @@ class AxialLoadOperation:
         note = ""
         stepped = 0.0
         state: LoadChainState | None = None
+        applied: tuple[Reply, ...] = ()
         if previous is None:
             self._schedule_from(sim_time)
+            applied = self._apply_due(sim_time)
         elif sim_time < previous:
             note = f"clock went back from {previous:.6f} s to {sim_time:.6f} s: restarting the step count"
             self._schedule_from(sim_time)
+            applied = self._apply_due(sim_time)
         elif sim_time > previous:
             stepped = sim_time - previous
             if stepped > self.max_clock_gap:
                 note = f"clock advanced {stepped:.3f} s at once: stepping {self.max_clock_gap:g} s (max_clock_gap_s)"
                 stepped = self.max_clock_gap
-            state = self.chain.step(stepped)  # the state after the step
+                applied = self._apply_due(sim_time)
+                state = self.chain.step(stepped)
+            else:
+                state, applied = self._step_applying(previous, float(sim_time))  # the state after the step
         self._time = float(sim_time)
         if state is None:
             state = self.chain.state()
@@ -405,7 +500,7 @@ class AxialLoadOperation:
             self._next_diagnostics = sim_time + self.diagnostics_period
             self._reported = health
         tripped = state.fault_reason if state.fault and not was_faulted else ""
-        return AdvanceResult(float(sim_time), stepped, state, state_due, diagnostics_due, tripped, note)
+        return AdvanceResult(float(sim_time), stepped, state, state_due, diagnostics_due, tripped, note, applied)
 
     def follow(self, sim_time: float) -> list[AdvanceResult]:
         """Step the chain to ``sim_time`` (s) in samples (see the module documentation).

@@ -16,13 +16,19 @@ Interfaces (README, interface table):
   simulator faster than real time (each wake-up takes whatever sim time passed);
 * subscribes ``/rig/axial_load/setpoint`` (std_msgs/Float64, N, reliable), taken by the step
   timer before it steps, so a set-point is in force for every sample published after it came;
-* subscribes ``/rig/radial_load/setpoint`` (geometry_msgs/WrenchStamped, reliable): a radial
-  loader's set-point, force.x/y the radial force (N, magnitude and azimuth), torque.x/y a moment
-  across the axis (N m); force.z and torque.z are unused (the axial load has its own set-point).
-  Taken by the step like the axial set-point and applied as given from the next sample on (the
-  rig file's ``combined_loading`` states no loader dynamics); refused above its
-  ``max_radial_setpoint_n`` / ``max_moment_setpoint_n_m`` (0 for the paper's axially loaded
-  bench) with a logged reason and a WARN naming the limit, the previous one kept;
+* subscribes ``/rig/load/setpoint`` (geometry_msgs/WrenchStamped, reliable): the whole load
+  set-point, in force from ``header.stamp`` (sim time; a zero stamp: on arrival). force.z the
+  axial load (N), force.x/y the radial force (N, magnitude and azimuth), torque.x/y a moment across
+  the axis (N m); torque.z unused. Taken by the step like the axial set-point and judged on
+  arrival: refused as a whole (a logged reason and a WARN, the previous one kept) when the axial
+  part would be or the radial part is above the rig file's ``max_radial_setpoint_n`` /
+  ``max_moment_setpoint_n_m`` (0 for the paper's axially loaded bench). Accepted, it waits until
+  the chain's time reaches its stamp and is in force from that instant
+  (:meth:`~bearing_rig_sim.load_control.AxialLoadOperation.request_load`): the session stamps each
+  segment's set-point with its start and sends it ahead, so it reaches the bearing at the start
+  however far the simulator runs ahead of the session. Those still waiting are dropped at
+  deactivation. The radial part is applied as given (the
+  rig file's ``combined_loading`` states no loader dynamics);
 * service ``/rig/axial_load/set`` (bearing_rig_msgs/srv/SetAxialLoad): accepted + message;
 * service ``/rig/axial_load/reset_fault`` (std_srvs/srv/Trigger): clears a latched interlock
   fault once its cause is gone (success false, with what persists, otherwise);
@@ -91,7 +97,7 @@ from bearing_rig_sim.interfaces import (
     BEARING_AXIAL_FORCE,
     CLOCK,
     DIAGNOSTICS,
-    RADIAL_LOAD_SETPOINT,
+    LOAD_SETPOINT,
 )
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
@@ -107,6 +113,7 @@ from bearing_rig_sim.nodes.common import (
     WARN,
     diagnostic_array,
     diagnostic_status,
+    from_stamp,
     run_node,
     to_stamp,
 )
@@ -185,11 +192,11 @@ class LoadControllerNode(ManagedNode):
         self._setpoint_sub = self._clock_tap.create_subscription(
             Float64, AXIAL_LOAD_SETPOINT.name, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
         )
-        self._radial_sub = self._clock_tap.create_subscription(
+        self._load_sub = self._clock_tap.create_subscription(
             WrenchStamped,
-            RADIAL_LOAD_SETPOINT.name,
+            LOAD_SETPOINT.name,
             _unused,
-            qos_profile(RADIAL_LOAD_SETPOINT),
+            qos_profile(LOAD_SETPOINT),
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
         )
         self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
@@ -207,6 +214,12 @@ class LoadControllerNode(ManagedNode):
         """Report the health at once on activation."""
         if self.operation is not None:
             self.operation.mark_reported(None)
+
+    def deactivate(self) -> None:
+        """Forget the set-points stamped ahead: a run that stops its nodes leaves none to take
+        effect at a later activation."""
+        if self.operation is not None and self.operation.pending:
+            self.get_logger().info(f"deactivated: {self.operation.drop_pending()} set-point(s) stamped ahead dropped")
 
     def cleanup(self) -> None:
         """Drop the chain, the services and the clock reader."""
@@ -240,8 +253,8 @@ class LoadControllerNode(ManagedNode):
         and publish them."""
         for setpoint, _info in drain(self._setpoint_sub, Float64, serialized=False):
             self._on_setpoint(setpoint)
-        for radial, _info in drain(self._radial_sub, WrenchStamped, serialized=False):
-            self._on_radial_setpoint(radial)
+        for load, _info in drain(self._load_sub, WrenchStamped, serialized=False):
+            self._on_load_setpoint(load)
         operation = self.operation
         stamp = self._latest_clock()
         if operation is None or stamp is None:
@@ -253,6 +266,9 @@ class LoadControllerNode(ManagedNode):
             sample = to_stamp(result.time)
             if result.clock_note:
                 self.get_logger().warning(result.clock_note)
+            for reply in result.applied:  # stamped set-points that took effect in this sample
+                self.get_logger().info(f"at t = {result.time:.6g} s: {reply.message}")
+                self._mirror_setpoint()
             if result.tripped:
                 self.get_logger().error(f"interlock tripped: {result.tripped}; brake de-energised, call reset_fault once clear")
             self._publish_forces(sample, result.state)
@@ -341,10 +357,15 @@ class LoadControllerNode(ManagedNode):
         if self._apply(self.operation.request_setpoint(msg.data, SetpointSource.TOPIC)).accepted:
             self._mirror_setpoint()
 
-    def _on_radial_setpoint(self, msg: WrenchStamped) -> None:
+    def _on_load_setpoint(self, msg: WrenchStamped) -> None:
         assert self.operation is not None  # taken by the step, which runs from activate to deactivate
         force, torque = msg.wrench.force, msg.wrench.torque
-        self._apply(self.operation.request_radial(RadialLoad(force.x, force.y, torque.x, torque.y), SetpointSource.TOPIC))
+        stamp = from_stamp(msg.header.stamp)
+        reply = self._apply(
+            self.operation.request_load(force.z, RadialLoad(force.x, force.y, torque.x, torque.y), stamp if stamp > 0.0 else None, SetpointSource.TOPIC)
+        )
+        if reply.accepted:
+            self._mirror_setpoint()
 
     def _on_set_service(self, request: SetAxialLoad.Request, response: SetAxialLoad.Response) -> SetAxialLoad.Response:
         assert self.operation is not None  # the service lives from configure to cleanup

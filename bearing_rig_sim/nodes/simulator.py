@@ -37,8 +37,10 @@ when due: in real time it runs the chunks the wall clock asks for (:class:`~bear
 batch of ``max_batch_chunks`` per call, as fast as its reliable readers take the streams: every
 :data:`ACK_WINDOW_CHUNKS` chunks the loop waits until each reliable reader (the session's
 recorder) has acknowledged all it was sent, so no sample leaves the writers' history unread and a
-recording holds every message. ``simulator --no-realtime`` sets the parameter ``realtime`` to
-false.
+recording holds every message, and no further than :data:`FORCE_LEAD_S` past the latest force on
+the bearing while the load controller's force stream follows the clock (so a starved load
+controller's force is never applied late; a deactivated or exited one holds nothing up).
+``simulator --no-realtime`` sets the parameter ``realtime`` to false.
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
 drive, sensors), publishers, subscriptions and timers are made at configure; the simulated time
@@ -61,11 +63,14 @@ from collections.abc import Sequence
 import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
+from lifecycle_msgs.msg import State as LifecycleState
+from lifecycle_msgs.msg import TransitionEvent
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
+from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState, Temperature
 
@@ -118,6 +123,39 @@ acknowledge when a writer's heartbeat asks: every 50 ms with the rig's Fast DDS 
 (:mod:`bearing_rig_sim.dds_profile`), so a wait costs a few tens of milliseconds per window;
 under Fast DDS's default of 3 s, a window would wait up to 3 s. (In real time the pace is the
 wall clock's: a reader that falls 5 s behind loses samples, as on a bench.)"""
+
+FORCE_LEAD_S = 0.1
+"""Without real time, how far the simulation may run ahead of the force on the bearing, s of
+simulated time. The load controller steps its chain to the latest /clock and stamps each force
+sample with it; a simulator that ran on regardless would apply a starved load controller's force
+seconds late (two busy loops on two cores: a load sweep's 50 N segment at 618 N). So while the
+force stream follows the clock, the loop runs no further than the latest force stamp plus this
+lead: a set-point reaches the bearing within it whatever the host's load (the session judges a
+segment's load from 0.5 s after its start, the chain settling within 0.37 s).
+
+Only a stream whose stamps advance and lie within :data:`FORCE_FOLLOW_S` of the simulated time
+sets the pace (a probe's unstamped messages do not). Pacing stops at once when its publisher
+leaves the active lifecycle state (its ``transition_event``: a deactivated load controller
+publishes nothing, and holds nothing up) or when no publisher is left (one that exited), and
+resumes when the stream advances again (after an activation); a stream silent for
+:data:`FORCE_SILENT_S` of wall time otherwise (a process killed before the middleware noticed)
+stops it too."""
+
+FORCE_FOLLOW_S = 1.0
+"""A force stamp this close (s of simulated time) to the simulation when it arrives is taken as
+a stream that follows the clock."""
+
+FORCE_SILENT_S = 10.0
+"""Wall time without a new force sample after which the loop stops waiting for one, s: the last
+resort for a publisher gone without a word (as :data:`ACK_GIVE_UP_S` for a reliable reader; two
+busy loops on two cores starved the load controller for over 2 s). A stopped process (SIGSTOP)
+holds the simulation until then."""
+
+UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"
+"""The node name the ROS graph gives an endpoint whose node it has not discovered yet (rmw)."""
+
+GRAPH_RECHECK_S = 0.2
+"""Wall time between two look-ups of the force stream's publishers while they change, s."""
 
 ACK_POLL_S = 0.005
 """Longest block on one acknowledgement check, s of wall time; the loop then yields to the
@@ -184,6 +222,22 @@ class SimulatorNode(ManagedNode):
         self._gave_up = False
         """A reader stayed unacknowledging past :data:`ACK_GIVE_UP_S`; not waited for again until
         every reader has acknowledged all."""
+        self._force_pace: float | None = None
+        """Without real time: the latest stamp (s) of a force stream that follows the clock."""
+        self._force_seen = 0.0
+        """Wall time (monotonic) the latest force sample was taken."""
+        self._force_stamp = -math.inf
+        """Stamp (s) of the latest force sample taken."""
+        self._force_publishers = -1
+        """Publishers of the force stream whose node is known (-1: not looked up yet)."""
+        self._graph_checked = -math.inf
+        """Wall time (monotonic) of the last look-up of the force stream's publishers."""
+        self._lifecycle_events: dict[str, Subscription] = {}
+        """The ``transition_event`` reader of each node that published the force stream, by topic."""
+        self._force_paused = False
+        """A publisher of the force stream left the active state (until it is active again)."""
+        self._pacing_off = "no force stream following the clock yet"
+        """Why the loop does not pace on the force stream (empty while it does); on /diagnostics."""
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
         self._anchor = True
@@ -246,11 +300,12 @@ class SimulatorNode(ManagedNode):
         self._take_forces()
 
     def cleanup(self) -> None:
-        """Destroy the force reader's node."""
+        """Destroy the force reader's node (and the lifecycle readers on it)."""
         tap = getattr(self, "_force_tap", None)
         if tap is not None:
             tap.destroy_node()
             self._force_tap = None
+        self._lifecycle_events = {}
 
     # -- the loop ------------------------------------------------------------------------------
     @survives_shutdown
@@ -268,7 +323,7 @@ class SimulatorNode(ManagedNode):
             self.pacer.start(self.twin.time)
             self._anchor = False
         self._take_forces()
-        for _ in range(self.pacer.due_chunks(self.twin.time)):
+        for _ in range(self._force_paced(self.pacer.due_chunks(self.twin.time), now)):
             try:
                 out = self.twin.tick(with_truth=(self._chunks + 1) % self._truth_every == 0)
             except RigError as exc:
@@ -278,6 +333,57 @@ class SimulatorNode(ManagedNode):
             self._publish_chunk(out)
         self.pacer.record(self.twin.time)
         self._publish_diagnostics_on_change()
+
+    def _force_paced(self, chunks: int, now: float) -> int:
+        """Without real time, at most the chunks that keep the simulation within
+        :data:`FORCE_LEAD_S` of the force stream that follows the clock (see there)."""
+        if self.pacer.realtime:
+            return chunks
+        self._follow_force_publishers()
+        pace = self._force_pace
+        if pace is None or self._force_paused:
+            self._pacing_off = self._pacing_off or "no force stream following the clock"
+            return chunks
+        if now - self._force_seen > FORCE_SILENT_S:
+            self._force_pace = None
+            self._pacing_off = f"no force on the bearing for {FORCE_SILENT_S:g} s of wall time"
+            return chunks
+        self._pacing_off = ""
+        room = int((pace + FORCE_LEAD_S - self.twin.time) / self.settings.chunk_s + 1e-9)
+        if room <= 0:
+            time.sleep(ACK_POLL_S)  # yield the core to the load controller rather than spin
+        return max(0, min(chunks, room))
+
+    def _follow_force_publishers(self) -> None:
+        """Count the force stream's publishers (none: pacing stops), read each one's lifecycle
+        transitions (one leaving the active state pauses pacing until it is active again)."""
+        tap = self._force_tap
+        if tap is None:
+            return
+        count = self._force_sub.get_publisher_count()
+        now = time.monotonic()
+        if count != self._force_publishers and now >= self._graph_checked + GRAPH_RECHECK_S:
+            self._graph_checked = now
+            if count == 0:
+                self._force_pace, self._force_stamp, self._force_paused = None, -math.inf, False
+                self._pacing_off = f"no publisher of {BEARING_AXIAL_FORCE.name}"
+            # the graph may name a matched publisher's node later than the match (meanwhile
+            # "_NODE_NAME_UNKNOWN_"): counted as known only once it does, so the lookup is
+            # repeated until then
+            infos = [i for i in tap.get_publishers_info_by_topic(BEARING_AXIAL_FORCE.name) if i.node_name != UNKNOWN_NODE_NAME]
+            self._force_publishers = count if len(infos) >= count else len(infos)
+            for info in infos:
+                topic = f"{info.node_namespace.rstrip('/')}/{info.node_name}/transition_event"
+                if topic not in self._lifecycle_events:
+                    self._lifecycle_events[topic] = tap.create_subscription(
+                        TransitionEvent, topic, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
+                    )
+        for reader in self._lifecycle_events.values():
+            for event, _info in drain(reader, TransitionEvent, serialized=False):
+                self._force_paused = event.goal_state.id != LifecycleState.PRIMARY_STATE_ACTIVE
+                if self._force_paused:
+                    self._force_pace, self._force_stamp = None, -math.inf
+                    self._pacing_off = f"{reader.topic_name.rsplit('/', 1)[0]} left the active state ({event.goal_state.label})"
 
     def _readers_caught_up(self, now: float) -> bool:
         """Without real time: has every reliable reader acknowledged all the streams sent it?
@@ -427,7 +533,13 @@ class SimulatorNode(ManagedNode):
         queued = drain(self._force_sub, WrenchStamped)
         if not queued:
             return
-        wrench = deserialize_message(queued[-1][0], WrenchStamped).wrench
+        message = deserialize_message(queued[-1][0], WrenchStamped)
+        stamp = from_stamp(message.header.stamp)
+        self._force_seen = time.monotonic()
+        advancing = stamp > self._force_stamp and abs(stamp - self.twin.time) <= FORCE_FOLLOW_S
+        self._force_pace = stamp if advancing and self._force_stamp > -math.inf else None
+        self._force_stamp = stamp
+        wrench = message.wrench
         force = wrench.force
         try:
             self.twin.set_loads(force.z, force.x, force.y, wrench.torque.x, wrench.torque.y)
@@ -482,6 +594,7 @@ class SimulatorNode(ManagedNode):
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,
             "reader_stalls": self.health.reader_stalls,
+            "force_pacing": "off" if pacer.realtime else (f"off: {self._pacing_off}" if self._pacing_off else "on"),
             STOPPED_KEY: self.health.halted,
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)

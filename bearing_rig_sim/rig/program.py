@@ -31,6 +31,7 @@ constant acceleration) is :mod:`bearing_rig_sim.rig.speed_profile`'s.
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,6 +79,15 @@ class Segment:
     """Radial-load set-point during the segment, N (``radial_load_n``, within the rig's limit)."""
     moment: float = 0.0
     """Moment on the inner ring across the radial load, N m (``moment_n_m``, within the rig's limit)."""
+    radial_azimuth: float = 0.0
+    """Direction of the radial load in the bearing's frame, rad from its x axis towards y
+    (``radial_azimuth_deg``; 0: along x)."""
+
+    @property
+    def radial_components(self) -> tuple[float, float]:
+        """The radial load along the bearing frame's x and y axes, N (force.x, force.y of the
+        load set-point)."""
+        return self.radial_load * math.cos(self.radial_azimuth), self.radial_load * math.sin(self.radial_azimuth)
 
     def speed_profile(self, start_time: float, start_speed: float) -> SegmentSpeed:
         """The segment's speed against time, for a start at ``start_time`` (s) from
@@ -240,6 +250,7 @@ class SegmentFile(BaseModel):
     timeout_s: Number = Field(0.0, gt=0.0, le=MAX_TIMEOUT_S, description="longest wait for a stable verdict, s")
     radial_load_n: Number = Field(0.0, ge=0.0, description="radial-load set-point, N")
     moment_n_m: Number = Field(0.0, description="moment set-point across the radial load, N m")
+    radial_azimuth_deg: Number = Field(0.0, ge=-360.0, le=360.0, description="direction of the radial load from the bearing frame's x axis towards y, deg")
 
 
 class ProgramFile(BaseModel):
@@ -372,4 +383,4 @@ def _segment(stated: SegmentFile, source: str, where: str, rig: RigLimits, start
         if "dwell_s" not in given:
             raise beyond("dwell_s", "missing (required): give dwell_s, or until_stable: true with timeout_s")
         dwell, timeout = stated.dwell_s, None
-    return Segment(stated.name, speed, profile, ramp, accel, load, dwell, until_stable, timeout, radial, moment)
+    return Segment(stated.name, speed, profile, ramp, accel, load, dwell, until_stable, timeout, radial, moment, math.radians(stated.radial_azimuth_deg))

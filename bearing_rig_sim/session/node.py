@@ -28,7 +28,6 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from geometry_msgs.msg import WrenchStamped
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64
 
 from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.interfaces import (
@@ -40,7 +39,7 @@ from bearing_rig_sim.interfaces import (
     CAGE_PULSES,
     CLOCK,
     DIAGNOSTICS,
-    RADIAL_LOAD_SETPOINT,
+    LOAD_SETPOINT,
     SLIP_STATUS,
     SPEEDS,
     SPINDLE_COMMAND,
@@ -48,7 +47,7 @@ from bearing_rig_sim.interfaces import (
     TOPICS,
     TRUTH,
 )
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.nodes.common import STATUS_QOS, drain, from_stamp, qos_profile, to_stamp
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -156,8 +155,7 @@ class SessionNode(Node):
         self.on_event = on_event
         self.live = LiveValues()
         self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
-        self._setpoint = self.create_publisher(Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
-        self._radial_setpoint = self.create_publisher(WrenchStamped, RADIAL_LOAD_SETPOINT.name, qos_profile(RADIAL_LOAD_SETPOINT))
+        self._setpoint = self.create_publisher(WrenchStamped, LOAD_SETPOINT.name, qos_profile(LOAD_SETPOINT))
         self.tap = Node(f"{name}_recorder", context=context)
         self._recorded = [
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
@@ -175,7 +173,7 @@ class SessionNode(Node):
         """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
-        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter(), RADIAL_LOAD_SETPOINT.name: Counter()}
+        self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter(), LOAD_SETPOINT.name: Counter()}
         """Serialized commands and set-points this session published, not yet seen by its recorder:
         any other on those topics came from outside and marks the running segment."""
 
@@ -198,22 +196,20 @@ class SessionNode(Node):
         self._spindle.publish(command)
 
     def send_setpoint(self, plan: SegmentPlan) -> None:
-        """The segment's axial-load set-point (no stamp: it is in force from its arrival, so it is
-        sent when the segment starts) and, for a program that loads radially
-        (:attr:`ProgramRunner.loads_radially`), its radial-load set-point: force.x the radial
-        load along the bearing frame's x axis (N), torque.y the moment (N m), stamped with the
-        segment's start."""
-        setpoint = Float64(data=plan.segment.axial_load)
-        self._own[AXIAL_LOAD_SETPOINT.name][repr(setpoint)] += 1
+        """The segment's load set-point on ``/rig/load/setpoint``, stamped with the segment's start
+        and sent with its spindle command (:meth:`ProgramRunner.commands_due`: ahead of a fixed
+        start), so the load controller puts it in force at the start however late the session
+        runs: force.z the axial load (N), force.x/y the radial load at the segment's azimuth (N;
+        both 0 for an axially loaded program), torque.y the moment (N m)."""
+        segment = plan.segment
+        setpoint = WrenchStamped()
+        setpoint.header.stamp = to_stamp(plan.start_time)
+        setpoint.header.frame_id = "bearing"
+        setpoint.wrench.force.z = segment.axial_load
+        setpoint.wrench.force.x, setpoint.wrench.force.y = segment.radial_components
+        setpoint.wrench.torque.y = segment.moment
+        self._own[LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._setpoint.publish(setpoint)
-        if self.runner.loads_radially:
-            radial = WrenchStamped()
-            radial.header.stamp = to_stamp(plan.start_time)
-            radial.header.frame_id = "bearing"
-            radial.wrench.force.x = plan.segment.radial_load
-            radial.wrench.torque.y = plan.segment.moment
-            self._own[RADIAL_LOAD_SETPOINT.name][repr(radial)] += 1
-            self._radial_setpoint.publish(radial)
 
     # -- readiness --------------------------------------------------------------------------------
     def unmatched_streams(self) -> list[str]:
@@ -354,7 +350,10 @@ class SessionNode(Node):
             )
         elif name == TRUTH.name:
             msg = deserialize_message(raw, msgtype)
-            self.runner.observe_truth(from_stamp(msg.header.stamp), msg.slip_rate)
+            self.runner.observe_truth(from_stamp(msg.header.stamp), msg.slip_rate, msg.axial_load)
+        elif name == BEARING_AXIAL_FORCE.name and self.runner.loads_radially:  # 1 kHz: decoded only when judged
+            msg = deserialize_message(raw, msgtype)
+            self.runner.observe_radial(from_stamp(msg.header.stamp), msg.wrench.force.x, msg.wrench.force.y)
         elif name == AXIAL_LOAD_STATE.name:
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1

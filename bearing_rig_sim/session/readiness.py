@@ -4,14 +4,15 @@
 
 A node is ready when it publishes and listens: the simulator has sent a ``/clock`` and
 subscribes the spindle commands, the load controller has sent a state and subscribes the
-set-point, the monitor publishes its status and subscribes the cage pulses.
+set-point the session sends (``/rig/load/setpoint``), the monitor publishes its status and
+subscribes the cage pulses.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from bearing_rig_sim.interfaces import AXIAL_LOAD_SETPOINT, AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, SLIP_STATUS, SPINDLE_COMMAND
+from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CAGE_PULSES, CLOCK, LOAD_SETPOINT, SLIP_STATUS, SPINDLE_COMMAND
 
 __all__ = ["not_ready"]
 
@@ -38,8 +39,8 @@ def not_ready(
         missing["simulator"] = f"nobody subscribes {SPINDLE_COMMAND.name}"
     if not load_state_seen:
         missing["load_controller"] = f"no {AXIAL_LOAD_STATE.name} received"
-    elif subscribers(AXIAL_LOAD_SETPOINT.name) == 0:
-        missing["load_controller"] = f"nobody subscribes {AXIAL_LOAD_SETPOINT.name}"
+    elif subscribers(LOAD_SETPOINT.name) == 0:
+        missing["load_controller"] = f"nobody subscribes {LOAD_SETPOINT.name}"
     if publishers(SLIP_STATUS.name) == 0:
         missing["monitor"] = f"nobody publishes {SLIP_STATUS.name}"
     elif subscribers(CAGE_PULSES.name) == 0:

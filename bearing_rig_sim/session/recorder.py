@@ -14,11 +14,11 @@ Every topic of the interface table (README) is recorded as the serialized CDR th
    bag's timeline in 2038;
 2. else (``std_msgs/Float64`` set-points), or when the stamp is zero (not set) or more than
    :data:`PLAUSIBLE_SPAN_NS` away from the last ``/clock`` (a wall-clock stamp from some other
-   publisher), the time of the last ``/clock`` received before it; so too a spindle command
-   stamped ahead of that ``/clock``: its stamp is when it is to take effect (the session sends
-   the next segment's command ahead), and logged there it would drag the timeline of every
-   message received meanwhile up to it (rule 3); it is logged when received, its header keeps
-   the stamp (``analyze`` starts the segment there);
+   publisher), the time of the last ``/clock`` received before it; so too a spindle command or a
+   load set-point stamped ahead of that ``/clock`` (:data:`STAMPED_AHEAD`): its stamp is when it
+   is to take effect (the session sends the next segment's ahead), and logged there it would drag
+   the timeline of every message received meanwhile up to it (rule 3); it is logged when
+   received, its header keeps the stamp (``analyze`` starts the segment there);
 3. strictly increasing over the bag: messages taken together (one drain of the subscriptions) are
    ordered by that time (ties keep their arrival order), and a time not after the previous one
    becomes previous + 1 ns. A stamp earlier than the last message written (a pulse interpolated
@@ -33,7 +33,7 @@ from collections.abc import Iterable, Sequence
 
 from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.clock_guard import DEFAULT_MAX_STEP_NS, ClockGuard
-from bearing_rig_sim.interfaces import CLOCK, SPINDLE_COMMAND, TOPICS, Topic
+from bearing_rig_sim.interfaces import CLOCK, LOAD_SETPOINT, SPINDLE_COMMAND, TOPICS, Topic
 
 __all__ = [
     "PLAUSIBLE_SPAN_NS",
@@ -57,6 +57,9 @@ RECORDED_TOPICS: tuple[Topic, ...] = TOPICS
 """Every topic of the interface contract (services are not recorded)."""
 
 CLOCK_TOPIC = CLOCK.name
+
+STAMPED_AHEAD = frozenset({SPINDLE_COMMAND.name, LOAD_SETPOINT.name})
+"""Topics whose stamp is when the message takes effect, which the session sends ahead of it."""
 
 MAX_CLOCK_NOTES = 20
 """Most notes about refused ``/clock`` stamps kept (the count is kept whole)."""
@@ -98,7 +101,7 @@ class LogTimeRule:
             return self.last_clock_ns
         if stamp is None or stamp <= 0 or abs(stamp - self.last_clock_ns) > self.plausible_span_ns:
             return self.last_clock_ns
-        if topic.name == SPINDLE_COMMAND.name and stamp > self.last_clock_ns:
+        if topic.name in STAMPED_AHEAD and stamp > self.last_clock_ns:
             return self.last_clock_ns
         return stamp
 

@@ -45,9 +45,28 @@ Rules (simulation time throughout, s):
 * Observations stamped at or after the end of a dwell segment belong to the next segment (the
   simulator may be there already, its command having been sent ahead): they are kept until the
   runner starts it.
-* Conditions: a segment whose measured speed or bearing force is off the commanded one by more
-  than the tolerance (:func:`speed_tolerance`, :func:`~bearing_rig_sim.load_control.settle_band`),
-  or during which a command, a set-point or the load controller's set-point came from outside
+* **Set-points ahead of time** (:meth:`ProgramRunner.setpoints_due`): each segment's load
+  set-point, stamped with the segment's start, is sent as soon as that start is fixed (without
+  real time every set-point of a run of dwell segments at once; in real time
+  :data:`REALTIME_COMMAND_LEAD_S` ahead, as a command) and at the start otherwise; the load
+  controller keeps it until its stamp. A lead like the commands' 9 s was not enough: under four
+  busy loops on two cores the simulator ran more than 9 s ahead of the session (its recorder's
+  readers acknowledge from the middleware's thread, so the session's Python may lag far behind),
+  and four of 40 load-sweep segments began on the previous set-point.
+* **The load is judged sample by sample**: every bearing force of the load controller's state
+  from :data:`LOAD_SETTLE_S` after the segment's start (after a fixed start, whose set-point was
+  sent ahead and is in force from the start), or after the load controller's state first showed
+  the set-point (the first segment, and one after an ``until_stable`` segment, whose set-point
+  leaves when the session notices the start and may reach a load controller running ahead of it
+  later in sim time), to the segment's end must lie within
+  :func:`~bearing_rig_sim.load_control.settle_band` of the set-point; so must the axial load the
+  simulator applied (its ground truth, where there is one: what the bearing carried) and, in a
+  program that loads radially, the radial force on the bearing (force.x/y of the load
+  controller's force on the bearing, against the segment's, within the band of its magnitude).
+  The worst sample outside names the segment's condition; a set-point the load controller never
+  showed during a segment longer than :data:`LOAD_SETTLE_S` does too.
+* Conditions: a segment whose measured speed is off the commanded one by more than the tolerance
+  (:func:`speed_tolerance`), whose load is off (above), or during which a command, a set-point or the load controller's set-point came from outside
   the session (:meth:`ProgramRunner.observe_disturbance`,
   :meth:`ProgramRunner.observe_axial_setpoint`), is marked: its ``conditions`` say what, and the
   session's exit status says so. Its verdict is what the monitor said, under other conditions.
@@ -96,8 +115,13 @@ drive outlives an interrupted session by at most this."""
 
 LOAD_SETTLE_S = 0.5
 """Sim time after a segment's start before its load is judged, s: the loading chain's stated
-settle bound is under 0.37 s for any step within 0-1000 N (``settle_time_bound``), and a set-point
-sent at the start reaches the load controller within this too."""
+settle bound is under 0.37 s for any step within 0-1000 N (``settle_time_bound``), and the
+simulator applies the force on the bearing within its ``FORCE_LEAD_S`` (0.1 s) of it."""
+
+STAMP_RESOLUTION_S = 1e-6
+"""Observations stamped this close before a dwell segment's end belong to the next segment, s:
+stamps are whole nanoseconds and a segment's end a sum of floats, so a sample stamped at the end
+(the next set-point in force from it) may read a hair before it."""
 
 
 StatusState = SlipState
@@ -236,6 +260,14 @@ class _SegmentData:
     disturbances: list[str] = field(default_factory=list)
     setpoint_seen: float | None = None
     """When the load controller's state first showed the segment's set-point, s of sim time."""
+    setpoint_states: int = 0
+    """States of the load controller seen during the segment."""
+    fixed_start: bool = False
+    """The segment's start was known ahead (it follows a dwell segment): its set-point was sent
+    ahead, stamped with it, and is judged from the start."""
+    worst: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    """Per judged load (see the module documentation): the sample furthest outside its band as
+    (excess over the band N, value N, time s)."""
 
 
 class ProgramRunner:
@@ -251,10 +283,18 @@ class ProgramRunner:
         if runner.finished: ...                 # runner.outcomes holds one row per segment
     """
 
-    def __init__(self, program: TestProgram, monitor_settings: MonitorSettings | None = None, command_lead_s: float = COMMAND_LEAD_S) -> None:
+    def __init__(
+        self,
+        program: TestProgram,
+        monitor_settings: MonitorSettings | None = None,
+        command_lead_s: float = COMMAND_LEAD_S,
+        setpoint_lead_s: float = math.inf,
+    ) -> None:
         self.program = program
         self.command_lead_s = command_lead_s
         """How long before a segment's fixed start its command is sent, s (:meth:`commands_due`)."""
+        self.setpoint_lead_s = setpoint_lead_s
+        """How long before a segment's fixed start its load set-point is sent, s (:meth:`setpoints_due`)."""
         self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
         """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
         self.outcomes: list[SegmentOutcome] = []
@@ -266,6 +306,8 @@ class ProgramRunner:
         """Plans of segments not started yet whose start is fixed (see :meth:`commands_due`)."""
         self._commanded = -1
         """Highest segment index whose command :meth:`commands_due` gave."""
+        self._setpoints_sent = -1
+        """Highest segment index whose set-point :meth:`setpoints_due` gave."""
         self._early: list[tuple[Callable[..., None], tuple[Any, ...]]] = []
         """Observations stamped after the running segment's end, for the next one (in order)."""
         self.latest_status: SlipObservation | None = None
@@ -319,7 +361,8 @@ class ProgramRunner:
         """Start segment ``index`` at ``start`` (s of sim time), or as planned ahead."""
         plan = self._ahead.pop(index, None) or self._plan(index, start)
         run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up))
+        fixed = index > 0 and self.program.segments[index - 1].dwell is not None
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up), fixed_start=fixed)
         early, self._early = self._early, []
         for observe, args in early:  # stamped within this segment, or beyond it (kept again)
             observe(*args)
@@ -357,22 +400,36 @@ class ProgramRunner:
         ahead of ``now``. Each command is stamped with its plan's start
         (:attr:`SegmentPlan.start_time`). An ``until_stable`` segment's end is not known ahead, so
         the segment after it is commanded when it starts."""
+        due, self._commanded = self._due(now, self.command_lead_s, self._commanded)
+        return due
+
+    def setpoints_due(self, now: float) -> list[SegmentPlan]:
+        """The plans whose load set-point is to be sent at ``now`` (s of sim time): as
+        :meth:`commands_due`, up to :attr:`setpoint_lead_s` ahead (by default every fixed start
+        at once: the load controller keeps them until their stamps, and, unlike a command, a
+        set-point has no lead limit at its receiver)."""
+        due, self._setpoints_sent = self._due(now, self.setpoint_lead_s, self._setpoints_sent)
+        return due
+
+    def _due(self, now: float, lead: float, sent: int) -> tuple[list[SegmentPlan], int]:
+        """The plans due within ``lead`` of ``now`` after the one of index ``sent``, and the new
+        highest index given (see :meth:`commands_due`)."""
         plan = self.current
         if plan is None:
-            return []
+            return [], sent
         due = []
-        if self._commanded < plan.index:
+        if sent < plan.index:
             due.append(plan)
-            self._commanded = plan.index
-        while plan.segment.dwell is not None and plan.index + 1 < self.segment_count and plan.deadline - now <= self.command_lead_s:
+            sent = plan.index
+        while plan.segment.dwell is not None and plan.index + 1 < self.segment_count and plan.deadline - now <= lead:
             following = self._ahead.get(plan.index + 1)
             if following is None:
                 following = self._ahead[plan.index + 1] = self._plan(plan.index + 1, plan.deadline)
-            if self._commanded < following.index:
+            if sent < following.index:
                 due.append(following)
-                self._commanded = following.index
+                sent = following.index
             plan = following
-        return due
+        return due, sent
 
     def interrupt(self, now: float) -> SegmentOutcome | None:
         """Stop: the running segment ends as "interrupted" (returned), the program as finished."""
@@ -390,7 +447,6 @@ class ProgramRunner:
             time_to_stable: float | None = data.stable.time - data.rule.ramp_end
         else:
             time_to_stable = None
-        settled = data.force_count > 0
         if data.force_count:
             force: float | None = data.force_sum / data.force_count
         elif data.force_count_all:
@@ -413,7 +469,7 @@ class ProgramRunner:
             truth_slip=self.truth_slip_over(decisive) if decisive is not None else None,
             bearing_force=force,
             measured_speed=measured_speed,
-            conditions=_conditions(plan.segment, measured_speed, force if settled else None, data.disturbances, verdict),
+            conditions=_conditions(plan.segment, measured_speed, _load_conditions(data, now), data.disturbances, verdict),
         )
         self.outcomes.append(outcome)
         self._data = None
@@ -442,15 +498,52 @@ class ProgramRunner:
         (:meth:`commands_due`), so the simulator, running ahead of the session, may already be in
         it. It is kept and given to the next segment when that starts (True); False otherwise."""
         data = self._data
-        if data is None or data.plan.segment.dwell is None or time < data.plan.deadline:
+        if data is None or data.plan.segment.dwell is None or time < data.plan.deadline - STAMP_RESOLUTION_S:
             return False
         self._early.append((observe, args))
         return True
 
-    def observe_truth(self, time: float, slip_rate: float) -> None:
-        """The simulator's true slip rate (%) at ``time`` (s of sim time)."""
+    def observe_truth(self, time: float, slip_rate: float, axial_load: float = math.nan) -> None:
+        """The simulator's true slip rate (%) and the axial load it applied (N; NaN: not given) at
+        ``time`` (s of sim time)."""
         if math.isfinite(slip_rate):
             self._truth.append((time, slip_rate))
+        if math.isfinite(axial_load):
+            self._judge_load("axial load on the simulated bearing", time, axial_load, self.observe_truth, slip_rate, axial_load)
+
+    def observe_radial(self, time: float, force_x: float, force_y: float) -> None:
+        """The radial force on the bearing (N, bearing frame) at ``time`` (s of sim time), from
+        the load controller's force on the bearing."""
+        data = self._data
+        if data is None or time < data.plan.start_time or self._ahead_of_segment(time, self.observe_radial, time, force_x, force_y):
+            return
+        want_x, want_y = data.plan.segment.radial_components
+        self._judge(
+            data,
+            "radial force on the bearing",
+            time,
+            math.hypot(force_x - want_x, force_y - want_y),
+            math.hypot(force_x, force_y),
+            data.plan.segment.radial_load,
+        )
+
+    def _judge_load(self, what: str, time: float, value: float, observe: Callable[..., None], *args: Any) -> None:
+        """Judge an axial load sample (see the module documentation)."""
+        data = self._data
+        if data is None or time < data.plan.start_time or self._ahead_of_segment(time, observe, time, *args):
+            return
+        target = data.plan.segment.axial_load
+        self._judge(data, what, time, abs(value - target), value, target)
+
+    @staticmethod
+    def _judge(data: _SegmentData, what: str, time: float, deviation: float, value: float, target: float) -> None:
+        """Keep the sample furthest outside :func:`settle_band` of ``target`` once the load is judged."""
+        judged_from = data.plan.start_time if data.fixed_start else data.setpoint_seen
+        if judged_from is None or time < judged_from + LOAD_SETTLE_S or not math.isfinite(deviation):
+            return
+        excess = deviation - settle_band(target)
+        if excess > 0.0 and excess > data.worst.get(what, (0.0, 0.0, 0.0))[0]:
+            data.worst[what] = (excess, value, time)
 
     def observe_load(self, time: float, bearing_force: float) -> None:
         """The axial force on the bearing (N) at ``time`` (s of sim time)."""
@@ -461,6 +554,7 @@ class ProgramRunner:
             return
         data.force_sum_all += bearing_force
         data.force_count_all += 1
+        self._judge(data, "bearing force", time, abs(bearing_force - data.plan.segment.axial_load), bearing_force, data.plan.segment.axial_load)
         seen = data.setpoint_seen
         if seen is not None and time >= max(data.plan.ramp_end, seen + LOAD_SETTLE_S):
             data.force_sum += bearing_force
@@ -475,6 +569,7 @@ class ProgramRunner:
         data = self._data
         if data is None or time < data.plan.start_time or self._ahead_of_segment(time, self.observe_axial_setpoint, time, setpoint):
             return
+        data.setpoint_states += 1
         own = data.plan.segment.axial_load
         if setpoint == own:
             if data.setpoint_seen is None:
@@ -501,17 +596,26 @@ class ProgramRunner:
         return before[-1] if before else None
 
 
-def _conditions(segment: Segment, measured_speed: float | None, bearing_force: float | None, disturbances: list[str], verdict: Verdict) -> tuple[str, ...]:
+def _load_conditions(data: _SegmentData, now: float) -> list[str]:
+    """What was off in a segment's load (see the module documentation)."""
+    segment = data.plan.segment
+    off = []
+    for what, (_excess, value, time) in data.worst.items():
+        target = segment.radial_load if what.startswith("radial") else segment.axial_load
+        off.append(f"{what} {value:.1f} N at t = {time:.3f} s, {target:g} N commanded (+- {settle_band(target):.3g} N)")
+    if data.setpoint_seen is None and data.setpoint_states > 0 and now - data.plan.start_time > LOAD_SETTLE_S:
+        off.append(f"the load controller never showed the set-point {segment.axial_load:g} N during the segment")
+    return off
+
+
+def _conditions(segment: Segment, measured_speed: float | None, load: list[str], disturbances: list[str], verdict: Verdict) -> tuple[str, ...]:
     """What was off in a segment (see the module documentation). An interrupted segment's speed
-    and load are not judged, nor a measurement that is missing (a segment shorter than
-    :data:`LOAD_SETTLE_S` has no settled load)."""
+    and load are not judged, nor a measurement that is missing."""
     off: list[str] = []
     if verdict is not Verdict.INTERRUPTED:
         target = segment.target_speed
         if measured_speed is not None and abs(measured_speed - target) > speed_tolerance(target):
             off.append(f"speed {rad_s_to_rpm(measured_speed):.0f} rpm measured, {rad_s_to_rpm(target):.0f} rpm commanded")
-        load = segment.axial_load
-        if bearing_force is not None and abs(bearing_force - load) > settle_band(load):
-            off.append(f"load {bearing_force:.1f} N on the bearing, {load:g} N commanded")
+        off.extend(f"load off: {line}" for line in load)
     off.extend(f"disturbed: {what}" for what in disturbances)
     return tuple(off)

@@ -249,7 +249,9 @@ class _Session:
         self.err = err
         self.printer = ProgressPrinter(out, quiet=options.quiet)
         lead = REALTIME_COMMAND_LEAD_S if options.realtime else COMMAND_LEAD_S  # without real time the simulator runs ahead
-        self.runner = ProgramRunner(program, command_lead_s=lead)
+        # set-points: in real time as the commands (a queue outliving an interrupted session holds
+        # at most a second); without real time every fixed start's at once (see the runner)
+        self.runner = ProgramRunner(program, command_lead_s=lead, setpoint_lead_s=lead if options.realtime else math.inf)
         self.view = view
         if view is not None:
             from bearing_rig_sim.live.foxglove import TeeWriter
@@ -479,15 +481,16 @@ class _Session:
             node.drain()
 
     def _send_commands(self, now: float) -> None:
-        """Send the spindle commands due (the running segment's and those of the next segments
-        whose start is fixed, ahead of time: :meth:`ProgramRunner.commands_due`)."""
+        """Send the spindle commands and load set-points due (the running segment's and those of
+        the next segments whose start is fixed, ahead of time, each stamped with its segment's
+        start: :meth:`ProgramRunner.commands_due`, :meth:`ProgramRunner.setpoints_due`)."""
         assert self.node is not None
         for plan in self.runner.commands_due(now):
             self.node.send_command(plan)
+        for plan in self.runner.setpoints_due(now):
+            self.node.send_setpoint(plan)
 
     def _start_segment(self, plan: SegmentPlan) -> None:
-        assert self.node is not None
-        self.node.send_setpoint(plan)
         seg = plan.segment
         hold = f"until stable (at most {seg.timeout:g} s)" if seg.until_stable else f"dwell {seg.dwell:g} s"
         self._event(

@@ -27,7 +27,7 @@ Rules (simulation time throughout, s):
   within the segment (stable, slipping, fault; unknown when no status came).
 * ``until_stable``: the segment ends at the first ``STATE_STABLE`` status that speaks for the
   new operating point, by the rule offline analysis also uses
-  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): P(slope >= k) at least 0.95 on
+  (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`): P(slope >= k) at least the monitor's ``stable_confidence`` (0.6) on
   slip windows that all started after the ramp end (the monitor's ``slope_span_s`` and
   ``min_slope_points`` say how far back its verdict reaches). Verdict "stable", time to stable =
   that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".

@@ -59,6 +59,11 @@ PULSE_READER_QOS = qos_profile("pulse_reader")
 STATUS_QOS = qos_profile("transient_local")
 """Latched state (slip status, spindle command): reliable, transient local, depth 10."""
 
+UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"
+"""The node name the ROS graph gives an endpoint whose node it has not discovered yet (rmw): the
+endpoint is matched before its node's participant data has arrived."""
+
+
 OK, WARN, ERROR, STALE = DiagnosticStatus.OK, DiagnosticStatus.WARN, DiagnosticStatus.ERROR, DiagnosticStatus.STALE
 
 

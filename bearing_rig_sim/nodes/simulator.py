@@ -82,6 +82,7 @@ from bearing_rig_sim.thermal import sensors as bench_sensors
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
+    UNKNOWN_NODE_NAME,
     drain,
     qos_profile,
     RELIABLE_QOS,
@@ -150,9 +151,6 @@ FORCE_SILENT_S = 10.0
 resort for a publisher gone without a word (as :data:`ACK_GIVE_UP_S` for a reliable reader; two
 busy loops on two cores starved the load controller for over 2 s). A stopped process (SIGSTOP)
 holds the simulation until then."""
-
-UNKNOWN_NODE_NAME = "_NODE_NAME_UNKNOWN_"
-"""The node name the ROS graph gives an endpoint whose node it has not discovered yet (rmw)."""
 
 GRAPH_RECHECK_S = 0.2
 """Wall time between two look-ups of the force stream's publishers while they change, s."""

@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import math
+import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -47,7 +48,7 @@ from bearing_rig_sim.interfaces import (
     TOPICS,
     TRUTH,
 )
-from bearing_rig_sim.nodes.common import STATUS_QOS, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -65,6 +66,14 @@ DRAIN_PERIOD_S = 0.02
 
 MAX_CLOCK_EVENTS = 10
 """Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
+
+NAME_WAIT_S = 2.0
+"""Longest wall time :meth:`SessionNode.publisher_names` waits for the graph to name a matched
+publisher's node, s (discovery's participant data normally follows within milliseconds)."""
+
+NAME_POLL_S = 0.01
+"""Wall time between two looks at the graph while waiting for a name, s."""
+
 
 RECORDER_DEPTH = 50000
 """Reader queue depth of each recorded topic: 50 s of a 1 kHz topic in real time, some 15 s at
@@ -226,12 +235,16 @@ class SessionNode(Node):
 
     def publisher_names(self, topic: str, reliability: ReliabilityPolicy | None = None) -> list[str]:
         """The nodes publishing ``topic`` (``/namespace/name``, sorted), only those offering
-        ``reliability`` when given."""
-        return sorted(
-            f"{info.node_namespace.rstrip('/')}/{info.node_name}"
-            for info in self.get_publishers_info_by_topic(topic)
-            if reliability is None or info.qos_profile.reliability == reliability
-        )
+        ``reliability`` when given. A publisher matched before the graph knows its node's name
+        is waited for, at most :data:`NAME_WAIT_S` of wall time (the discovery thread fills the
+        graph, no spinning needed); one still unnamed then is listed under the graph's
+        placeholder."""
+        deadline = time.monotonic() + NAME_WAIT_S
+        while True:
+            infos = [i for i in self.get_publishers_info_by_topic(topic) if reliability is None or i.qos_profile.reliability == reliability]
+            if all(i.node_name != UNKNOWN_NODE_NAME for i in infos) or time.monotonic() >= deadline:
+                return sorted(f"{info.node_namespace.rstrip('/')}/{info.node_name}" for info in infos)
+            time.sleep(NAME_POLL_S)
 
     def adapt_to_publishers(self) -> list[str]:
         """Read best effort every recorded topic that some publisher offers only best effort

@@ -175,6 +175,60 @@ class TimeToStable:
         return None if self.stable_at is None else self.stable_at - self.ramp_end
 
 
+class PulseMerger:
+    """Puts the two pulse topics back in time order before the schedule (the node's use).
+
+    A subscriber gets each topic from its own queue; after a hold-up the backlogs come one
+    message per topic in turn, so the sparser cage pulses run ahead in time of the spindle's (0.7 s
+    was seen), and a check on that clock finds the spindle silent. A bag's log order is the
+    recorder's reception order, held up the same way: ``analyze`` uses :class:`StampOrder`. Rule: a pulse goes on once it is no later than the other
+    shaft's latest pulse plus twice that shaft's last pulse interval (the other's next pulse is
+    due by then), or the other shaft has not been heard of for ``max_wait_s`` of the steady
+    clock (silent, which the schedule's checks then judge); pulses go on in time order.
+
+    Args:
+        max_wait_s: longest hold while the other shaft is silent, wall s.
+    """
+
+    def __init__(self, max_wait_s: float = 0.2) -> None:
+        self.max_wait_s = max_wait_s
+        self._held: dict[str, deque[Pulse]] = {"spindle": deque(), "cage": deque()}
+        self._latest: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
+        self._interval: dict[str, float] = {"spindle": math.inf, "cage": math.inf}
+        self._heard: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
+
+    def push(self, shaft: str, pulse: Pulse, wall_now: float) -> list[tuple[str, Pulse]]:
+        """Take one received pulse; the pulses (of either shaft) that may go on now, in order."""
+        t = pulse.time
+        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+            return [(shaft, pulse)]  # the monitor reports what is wrong with it
+        if t > self._latest[shaft]:
+            if math.isfinite(self._latest[shaft]):
+                self._interval[shaft] = t - self._latest[shaft]
+            self._latest[shaft] = t
+        self._heard[shaft] = wall_now
+        self._held[shaft].append(pulse)
+        return self._release(wall_now)
+
+    def expire(self, wall_now: float) -> list[tuple[str, Pulse]]:
+        """The held pulses that may go on because the other shaft has been silent too long."""
+        return self._release(wall_now)
+
+    def _release(self, wall_now: float) -> list[tuple[str, Pulse]]:
+        out: list[tuple[str, Pulse]] = []
+        while True:
+            heads = [(q[0].time, name) for name, q in self._held.items() if q]
+            if not heads:
+                return out
+            t, name = min(heads)
+            other = "cage" if name == "spindle" else "spindle"
+            due = self._latest[other] + 2.0 * self._interval[other]
+            silent = wall_now - self._heard[other] > self.max_wait_s
+            if not (self._held[other] or t <= due or silent):
+                return out
+            out.append((name, self._held[name].popleft()))
+
+
 ORDER_MAX_LEAD_S = 5.0
 """:class:`StampOrder` holds a pulse until the other shaft's stamps reach it, or its own shaft's
 run this far past it (the other is then silent), rig s: well beyond the 0.7 s by which one topic
@@ -190,11 +244,12 @@ class StampOrder:
     its subscriber, like the monitor's, gets the two topics' backlogs one message per topic in
     turn, and the sparse cage pulses run ahead of the spindle's (0.7 s was seen). Replayed in that
     order, the schedule's checks found the spindle silent for that long, a FAULT the live
-    monitor, whose :class:`PulseMerger` reorders the same way, never reported. Rule: a pulse goes on once the
+    monitor, whose :class:`PulseMerger` reorders, never reported. Rule: a pulse goes on once the
     other shaft has a pulse stamped at or after it, or its own shaft has run more than
     :data:`ORDER_MAX_LEAD_S` past it (the other is silent, which the schedule's checks then judge
-    on the same stamps); pulses go on in stamp order, each shaft's in its own order. Pulses
-    without a finite stamp go on at once (the monitor reports them).
+    on the same stamps); pulses go on in stamp order, each shaft's in its own order. Unlike
+    :class:`PulseMerger` it waits for the other shaft's next pulse, which costs latency live but
+    nothing offline. Pulses without a finite stamp go on at once (the monitor reports them).
 
     Args:
         max_lead_s: the silence after which a shaft's pulses no longer wait for the other's, rig s.
@@ -239,59 +294,3 @@ class StampOrder:
             if not (t <= until or self._latest[other] >= t or self._latest[name] - t > self.max_lead_s):
                 return out
             out.append((name, self._held[name].popleft()))
-
-
-MERGE_MAX_WAIT_S = 1.0
-""":class:`PulseMerger` (live) holds no pulse for a shaft not heard of for this long, steady-clock
-s: a dead sensor's silence reaches the schedule's checks this late at most, and a topic held up
-this long while the other runs on is the one case where the live order can differ from the
-replay's (the merger before it waited 0.2 s, and let pulses go up to two of the other shaft's
-pulse intervals early on any interleaving)."""
-
-
-class PulseMerger:
-    """Puts the two pulse topics back in time order before the schedule (the node's use), in the
-    order :class:`StampOrder` gives the replay, so that the live monitor and ``analyze`` of its
-    bag see the same sequence of pulses and give the same statuses.
-
-    A subscriber gets each topic from its own queue; after a hold-up the backlogs come one
-    message per topic in turn, so the sparser cage pulses run ahead in time of the spindle's (0.7 s
-    was seen), and a check on that clock finds the spindle silent. Rule, :class:`StampOrder`'s: a
-    pulse goes on once the other shaft has a pulse stamped at or after it (its next pulse: at most
-    one of that shaft's pulse intervals of extra latency), or its own shaft has run more than
-    ``max_lead_s`` past it; and every held pulse goes on while a shaft has not been heard of for
-    ``max_wait_s`` of the steady clock (since the first pulse of either, if never: a dead sensor, a
-    stop, the end of the stream), which the schedule's checks then judge. Pulses go on in stamp order (equal stamps: cage first), each
-    shaft's in its own order.
-
-    **The same order as the replay.** If each topic arrives in its own stamp order, the released
-    sequence is the merge of the two streams by stamp, whatever the interleaving, provided no
-    pulse arrives more than ``max_lead_s`` (rig) behind a later-stamped pulse of the other shaft,
-    nor after its shaft went unheard for ``max_wait_s`` (wall) while later-stamped pulses came: a
-    pulse released because the other shaft passed its stamp has every earlier pulse of that shaft
-    already received (its own order) and released before it (the least stamp goes first).
-
-    Args:
-        max_wait_s: a shaft not heard of for this long holds no pulse of the other, steady-clock s.
-        max_lead_s: a shaft's pulses no longer wait for the other once it has run this far past
-            them, rig s (the replay's).
-    """
-
-    def __init__(self, max_wait_s: float = MERGE_MAX_WAIT_S, max_lead_s: float = ORDER_MAX_LEAD_S) -> None:
-        self.max_wait_s = max_wait_s
-        self.order = StampOrder(max_lead_s)
-        self._heard: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
-
-    def push(self, shaft: str, pulse: Pulse, wall_now: float) -> list[tuple[str, Pulse]]:
-        """Take one received pulse at steady-clock time ``wall_now`` (s); the pulses (of either
-        shaft) that may go on now, in order."""
-        if shaft in self._heard:
-            if all(math.isinf(heard) for heard in self._heard.values()):
-                self._heard = dict.fromkeys(self._heard, wall_now)  # the other counts as heard of at the first pulse
-            self._heard[shaft] = wall_now
-        return self.order.push(shaft, pulse) + self.expire(wall_now)
-
-    def expire(self, wall_now: float) -> list[tuple[str, Pulse]]:
-        """Every held pulse if a shaft has not been heard of for ``max_wait_s`` by ``wall_now``
-        (steady-clock s), else none."""
-        return self.order.flush() if any(wall_now - heard > self.max_wait_s for heard in self._heard.values()) else []

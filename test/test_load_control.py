@@ -271,6 +271,20 @@ def radial_limits(radial_n: float, moment_n_m: float) -> RigLimits:
     return dataclasses.replace(RigLimits.from_rig_file(), source="radial.yaml", max_radial_load_n=radial_n, max_moment_n_m=moment_n_m)
 
 
+def radial_operation(config: LoadingChainConfig) -> AxialLoadOperation:
+    """An engaged operation with a 1 ms sample period on a rig file stating a radial loader of
+    800 N and 5 N m."""
+    return AxialLoadOperation(
+        LoadingChain(config),
+        state_period_s=0.01,
+        diagnostics_period_s=1.0,
+        max_clock_gap_s=0.5,
+        sample_period_s=0.001,
+        engage=True,
+        radial_limits=radial_limits(800.0, 5.0),
+    )
+
+
 def test_shipped_rig_refuses_any_radial_setpoint_naming_the_limit(config: LoadingChainConfig) -> None:
     """config/rig.yaml states 0 N and 0 N m: the paper's bench loads only axially."""
     op = AxialLoadOperation.from_config(config)
@@ -284,15 +298,7 @@ def test_shipped_rig_refuses_any_radial_setpoint_naming_the_limit(config: Loadin
 
 
 def test_radial_setpoint_within_the_limits_is_applied_as_given_and_refusals_keep_it(config: LoadingChainConfig) -> None:
-    op = AxialLoadOperation(
-        LoadingChain(config),
-        state_period_s=0.01,
-        diagnostics_period_s=1.0,
-        max_clock_gap_s=0.5,
-        sample_period_s=0.001,
-        engage=True,
-        radial_limits=radial_limits(800.0, 5.0),
-    )
+    op = radial_operation(config)
     # (300, 400) N is 500 N (3-4-5); (0.6, 0.8) N m is 1 N m
     accepted = op.request_radial(RadialLoad(300.0, 400.0, 0.6, 0.8), SetpointSource.TOPIC)
     assert accepted.accepted and "500 N, moment 1 N m" in accepted.message
@@ -356,15 +362,7 @@ def test_a_stamp_between_samples_splits_the_step_there(config: LoadingChainConfi
 
 
 def test_a_stamp_reached_already_or_none_applies_at_once_and_refusals_are_whole(config: LoadingChainConfig) -> None:
-    op = AxialLoadOperation(
-        LoadingChain(config),
-        state_period_s=0.01,
-        diagnostics_period_s=1.0,
-        max_clock_gap_s=0.5,
-        sample_period_s=0.001,
-        engage=True,
-        radial_limits=radial_limits(800.0, 5.0),
-    )
+    op = radial_operation(config)
     op.follow(2.0)
     assert op.request_load(200.0, RadialLoad(0.0, 500.0), None, SetpointSource.TOPIC).accepted
     assert op.setpoint == 200.0 and op.radial == RadialLoad(0.0, 500.0) and op.pending == 0

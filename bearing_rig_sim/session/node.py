@@ -68,11 +68,9 @@ MAX_CLOCK_EVENTS = 10
 """Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
 NAME_WAIT_S = 2.0
-"""Longest wall time :meth:`SessionNode.publisher_names` waits for the graph to name a matched
-publisher's node, s (discovery's participant data normally follows within milliseconds)."""
-
-NAME_POLL_S = 0.01
-"""Wall time between two looks at the graph while waiting for a name, s."""
+"""Longest wall time :meth:`SessionNode.adapt_to_publishers` defers a topic whose best-effort
+publisher the graph has not named yet, s (discovery's participant data normally follows within
+milliseconds: a matched endpoint can precede it)."""
 
 
 RECORDER_DEPTH = 50000
@@ -170,6 +168,9 @@ class SessionNode(Node):
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
             for topic in recorder.topics.values()
         ]
+        self._unnamed_since: dict[str, float] = {}
+        """Steady-clock time (s) each recorded topic was first seen with an unnamed best-effort
+        publisher (:meth:`adapt_to_publishers`)."""
         self._diagnostic_levels: dict[str, int] = {}
         self.simulator_stopped = ""
         """Why the simulator stopped for good (its diagnostics' ``simulation_stopped``), or ""."""
@@ -235,22 +236,21 @@ class SessionNode(Node):
 
     def publisher_names(self, topic: str, reliability: ReliabilityPolicy | None = None) -> list[str]:
         """The nodes publishing ``topic`` (``/namespace/name``, sorted), only those offering
-        ``reliability`` when given. A publisher matched before the graph knows its node's name
-        is waited for, at most :data:`NAME_WAIT_S` of wall time (the discovery thread fills the
-        graph, no spinning needed); one still unnamed then is listed under the graph's
-        placeholder."""
-        deadline = time.monotonic() + NAME_WAIT_S
-        while True:
-            infos = [i for i in self.get_publishers_info_by_topic(topic) if reliability is None or i.qos_profile.reliability == reliability]
-            if all(i.node_name != UNKNOWN_NODE_NAME for i in infos) or time.monotonic() >= deadline:
-                return sorted(f"{info.node_namespace.rstrip('/')}/{info.node_name}" for info in infos)
-            time.sleep(NAME_POLL_S)
+        ``reliability`` when given (a publisher whose node the graph has not named yet under the
+        graph's placeholder, :data:`UNKNOWN_NODE_NAME`)."""
+        return sorted(
+            f"{info.node_namespace.rstrip('/')}/{info.node_name}"
+            for info in self.get_publishers_info_by_topic(topic)
+            if reliability is None or info.qos_profile.reliability == reliability
+        )
 
     def adapt_to_publishers(self) -> list[str]:
         """Read best effort every recorded topic that some publisher offers only best effort
         (a bench's own sensor driver, attached to): a reliable reader never matches such a
         writer and would record nothing of it (rosbag2 adapts its readers in the same way). The
-        reliable reader is drained, then replaced. Returns a line per topic changed."""
+        reliable reader is drained, then replaced. A topic whose best-effort publisher the graph
+        has not named yet waits for a later call, at most :data:`NAME_WAIT_S`, so the line names
+        it. Returns a line per topic changed."""
         changes = []
         for i, (topic, msgtype, subscription) in enumerate(self._recorded):
             if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
@@ -258,6 +258,10 @@ class SessionNode(Node):
             weak = self.publisher_names(topic.name, ReliabilityPolicy.BEST_EFFORT)
             if not weak:
                 continue
+            if any(name.endswith(UNKNOWN_NODE_NAME) for name in weak):  # matched before its node's data came
+                first = self._unnamed_since.setdefault(topic.name, time.monotonic())
+                if time.monotonic() - first < NAME_WAIT_S:
+                    continue  # named by a later look, normally the next
             self.take()  # what the reliable reader holds goes to the bag first
             qos = reader_qos(topic)
             qos.reliability = ReliabilityPolicy.BEST_EFFORT

@@ -113,3 +113,33 @@ def test_a_transient_point_runs_up_from_rest(params: BearingParameters) -> None:
 def test_a_point_that_cannot_be_computed_is_a_row_with_its_error(params: BearingParameters) -> None:
     rows = evaluate(task(params, KIND_ROLLING_START, [{"inner_ring_speed_rpm": 1000.0, "axial_load_n": 100.0, "pocket_diameter_m": 0.001}]))
     assert rows[0]["error"] and math.isnan(rows[0]["slip_pct"])
+
+
+def test_a_run_up_under_a_radial_load_runs_to_its_end_with_stribecks_largest_ball_load(params: BearingParameters) -> None:
+    """A run-up from rest at 80 rad/s^2 for 0.5 s under F_r = 500 N and
+    F_a = 1.216 F_r tan 15 deg = 163 N (tilt held): it runs to its end (the last window's mean
+    speed 80 x 0.49 = 39.2 rad/s, as the axial run-up's) and the largest ball load at its end,
+    374 rpm (centrifugal force 0.005 N), is Stribeck/Sjovall's half-loaded ring,
+    Q_max = 4.37 F_r / (Z cos 15 deg) = 141.4 N, within 3 %."""
+    point = {"inner_ring_acceleration_rad_s2": 80.0, "axial_load_n": 163.0, "radial_load_n": 500.0}
+    row = evaluate(task(params, KIND_TRANSIENT, [point], transient_duration=0.5))[0]
+    assert row["error"] == ""
+    to_rpm = 60.0 / (2.0 * math.pi)
+    assert row["rpm"] == pytest.approx(39.2 * to_rpm, abs=80.0 * params.reduced_time_step * to_rpm)
+    assert row["branch"] == "transient" and row["method"] == "integration"
+    assert row["peak_slip_pct"] >= row["slip_pct"] and math.isfinite(row["slip_pct"])
+    assert row["ball_load_max_n"] == pytest.approx(4.37 * 500.0 / (16 * math.cos(math.radians(15.0))), rel=0.03)
+    assert row["radial_load_n"] == 500.0
+
+
+def test_a_combined_load_row_carries_the_cage_whirl(params: BearingParameters) -> None:
+    """The steady row under 163 N axial and 500 N radial at 900 rpm has the cage centre held
+    off the axis within its 100 um clearance and no whirl frequency, with the reason (the load
+    zone is fixed in space: docs/model.md, Cage whirl); an axial row has none of these."""
+    points = [{"inner_ring_speed_rpm": 900.0, "axial_load_n": 163.0, "radial_load_n": f} for f in (0.0, 500.0)]
+    rows = evaluate(task(params, KIND_ROLLING_START, points))
+    assert all(r["error"] == "" for r in rows)
+    assert math.isnan(rows[0]["cage_whirl_radius_um"]) and rows[0]["cage_whirl_reason"] == ""
+    assert 50.0 < rows[1]["cage_whirl_radius_um"] < 100.0
+    assert math.isnan(rows[1]["cage_whirl_frequency_hz"]) and math.isnan(rows[1]["cage_whirl_ratio"])
+    assert "no orbit" in rows[1]["cage_whirl_reason"]

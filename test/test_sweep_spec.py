@@ -59,10 +59,13 @@ def test_speed_and_acceleration_together_are_refused(tmp_path: Path) -> None:
         load_spec(path)
 
 
-def test_a_combined_load_needs_steady_points(tmp_path: Path) -> None:
-    path = write(tmp_path, HEAD + "grid: {inner_ring_acceleration_rad_s2: [20], axial_load_n: [200], radial_load_n: [100]}\n")
-    with pytest.raises(ConfigError, match="radial_load_n needs steady points"):
-        load_spec(path)
+def test_a_run_up_takes_a_combined_load(tmp_path: Path) -> None:
+    """Transient points cross the radial-load and moment axes as steady ones do."""
+    path = write(tmp_path, HEAD + "grid: {inner_ring_acceleration_rad_s2: [20], axial_load_n: [200], radial_load_n: [0, 100], moment_n_m: [1]}\n")
+    spec = load_spec(path)
+    assert spec.transient
+    assert sorted(p["radial_load_n"] for p in spec.points()) == [0.0, 100.0]
+    assert all(p["moment_n_m"] == 1.0 for p in spec.points())
 
 
 def test_radial_load_and_moment_axes_cross_the_grid(tmp_path: Path) -> None:

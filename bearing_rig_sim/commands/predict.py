@@ -19,8 +19,12 @@ distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max
 (no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. Such a point's slip, torque and power are
 the engine's under the combined load, averaged over whole ball-pass periods (the steady state is
 periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`), with
-``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end (and no
-uncertainty interval: the calibration's is an axial-load one). With ``--thermal`` such a
+``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end,
+``cage_whirl_frequency_hz`` the centre's orbital frequency about the axis over the window (signed:
+> 0 in the cage's direction of rotation) and ``cage_whirl_ratio`` that over the cage's rotation
+frequency, both null with ``cage_whirl_reason`` when the centre does not orbit
+(:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`), and no uncertainty interval (the
+calibration's is an axial-load one). With ``--thermal`` such a
 point is the coupled thermal steady state of that periodic state (its heat the mean over the
 window's whole ball-pass periods; the network's conductances those of the axial load), its
 ``isothermal`` values the periodic state at the bearing file's temperature. ``--transient``
@@ -40,7 +44,7 @@ from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
-from bearing_rig_sim.dynamics.steady import solver_for
+from bearing_rig_sim.dynamics.steady import CageWhirl, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.settings_model import read_file
 from bearing_rig_sim.studies.calibration import SteadyState, steady_states
@@ -105,12 +109,12 @@ def run(args: argparse.Namespace) -> int:
     unc = _uncertainty(args)
     for k, s in enumerate(states):
         combined = radial is not None and (radial[k] > 0.0 or args.moment is not None)
-        whirl = None
+        whirl: dict[str, Any] | None = None
         if radial is not None and combined:
             solver = solver_for(params)
             pt = solver.periodic(s.inner_ring_speed, s.axial_load, radial[k], moment=None if args.moment is None else (args.moment[0], args.moment[1]))
             s = SteadyState(pt.inner_ring_speed, pt.axial_load, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
-            whirl = solver.engine.cage_whirl_radius
+            whirl = whirl_row(solver.engine.cage_whirl_radius, solver.last_whirl)
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
         if unc is not None and not combined:
@@ -119,9 +123,25 @@ def run(args: argparse.Namespace) -> int:
         if radial is not None:
             row.update(load_distribution_row(params, s.inner_ring_speed, s.axial_load, radial[k], args.moment))
         if whirl is not None:
-            row["cage_whirl_radius_um"] = round(whirl * 1e6, 3)
+            row.update(whirl)
         _print(row, args.json)
     return 0
+
+
+def whirl_row(radius: float, whirl: CageWhirl | None) -> dict[str, Any]:
+    """The cage whirl's figures for ``predict``: ``cage_whirl_radius_um`` (the centre's distance
+    from the axis at the window's end, um), ``cage_whirl_frequency_hz`` (signed, > 0 in the
+    cage's direction of rotation) and ``cage_whirl_ratio`` (over the cage's rotation
+    frequency), both None with ``cage_whirl_reason`` when the centre does not orbit
+    (:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`)."""
+    frequency = None if whirl is None else whirl.frequency
+    ratio = None if whirl is None else whirl.ratio
+    return {
+        "cage_whirl_radius_um": round(radius * 1e6, 3),
+        "cage_whirl_frequency_hz": None if frequency is None else round(frequency, 4),
+        "cage_whirl_ratio": None if ratio is None else round(ratio, 4),
+        "cage_whirl_reason": "no averaging window" if whirl is None else whirl.reason,
+    }
 
 
 def _uncertainty(args: argparse.Namespace) -> Any:

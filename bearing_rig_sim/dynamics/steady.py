@@ -86,6 +86,14 @@ off the axis to where its land film carries the pockets' net push; it gets there
 0.2 s (docs/model.md, Cage whirl)."""
 METHOD_PERIODIC = "integration-periodic"
 """Combined load: integration averaged over whole ball-pass periods (:meth:`SteadySolver.periodic`)."""
+WHIRL_MIN_RADIUS = 0.01
+"""Cage whirl: the centre orbits only if its rms distance from the axis over the window is at
+least this fraction of the land clearance, 1 (1 um for the H7006C's 100 um: ten times the
+0.1 um to which the engine resolves the centre's offset, docs/model.md, Cage whirl)."""
+WHIRL_MIN_ANGLE = 0.25
+"""Cage whirl: the centre orbits only if its net angle turned about the axis over the window
+is at least this, rad (4 % of a turn; a centre held off the axis by a radial load turns by
+hundredths of a radian as the balls pass)."""
 
 _CONVERGED, _UNSTABLE, _NOT_CONVERGED = 0, 1, 2
 _STEP_TOL = 1e-11
@@ -230,6 +238,63 @@ def _newton(p: np.ndarray, x: np.ndarray, omega_i: float, load: float, h: float,
 
 
 @dataclass(frozen=True)
+class CageWhirl:
+    """The cage centre's orbit about the bearing axis over a window (:func:`cage_whirl`).
+
+    Attributes:
+        radius: rms distance of the centre from the axis over the window, m.
+        angle: net angle the centre turned about the axis, rad (> 0 in the cage's direction).
+        frequency: the orbit's frequency, Hz, signed as ``angle``; None when it does not orbit.
+        ratio: ``frequency`` over the cage's rotation frequency, 1; None when it does not orbit.
+        reason: why there is no frequency (None when there is one).
+    """
+
+    radius: float
+    angle: float
+    frequency: float | None
+    ratio: float | None
+    reason: str | None
+
+
+def cage_whirl(time: np.ndarray, x: np.ndarray, y: np.ndarray, *, land_clearance: float, cage_speed: float) -> CageWhirl:
+    """The cage centre's whirl from its trajectory (x, y) (m, bearing frame, the axis at the
+    origin) sampled at ``time`` (s, increasing), for a cage turning at ``cage_speed`` (rad/s,
+    > 0 in the direction of rotation) in a land of radial clearance ``land_clearance`` (m).
+
+    The rate of the centre's angle about the axis, unwrapped step by step, is averaged with
+    weights r^2: the mean angular momentum over the mean polar moment, x dy - y dx over
+    r^2 dt, formed from successive samples as
+    sum(x_k y_(k+1) - y_k x_(k+1)) / sum((x_k x_(k+1) + y_k y_(k+1)) dt_k). That is the
+    orbit's rate for a circular orbit, whole or partial (to (w dt)^2/3 relative: 8e-5 at 62 Hz
+    and 40 us steps); white noise on the positions adds nothing to either sum on average (the
+    two samples of each product are independent); and a step passing near the axis, where the
+    angle is undefined and jumps by about pi, carries no weight, so a radial oscillation
+    through the axis turns no net angle. No frequency (None, with the reason) when the rms
+    radius is below :data:`WHIRL_MIN_RADIUS` of the clearance or the net angle (the rate times
+    the window) below :data:`WHIRL_MIN_ANGLE`.
+    """
+    t = np.asarray(time, dtype=float)
+    px = np.asarray(x, dtype=float)
+    py = np.asarray(y, dtype=float)
+    r = np.hypot(px, py)
+    radius = float(np.sqrt(np.mean(r * r))) if r.size else 0.0
+    if t.size < 3:
+        return CageWhirl(radius, 0.0, None, None, "fewer than 3 samples of the cage centre")
+    momentum = float(np.sum(px[:-1] * py[1:] - py[:-1] * px[1:]))
+    polar = float(np.sum((px[:-1] * px[1:] + py[:-1] * py[1:]) * np.diff(t)))
+    rate = momentum / polar if polar > 0.0 else 0.0
+    angle = rate * float(t[-1] - t[0])
+    if radius < WHIRL_MIN_RADIUS * land_clearance:
+        reason = f"centred: rms {radius * 1e6:.3g} um from the axis, below {WHIRL_MIN_RADIUS:g} of the land clearance"
+        return CageWhirl(radius, angle, None, None, reason)
+    if abs(angle) < WHIRL_MIN_ANGLE:
+        return CageWhirl(radius, angle, None, None, f"no orbit: the centre turned {angle:.3g} rad about the axis, below {WHIRL_MIN_ANGLE:g} rad")
+    frequency = rate / (2.0 * math.pi)
+    ratio = rate / cage_speed if cage_speed > 0.0 else None
+    return CageWhirl(radius, angle, frequency, ratio, None)
+
+
+@dataclass(frozen=True)
 class SteadyPoint:
     """A steady operating point of the engine (SI; slip in percent at the nominal angle).
 
@@ -308,6 +373,8 @@ class SteadySolver:
         self._work = np.zeros((z, kn.NW))
         self.last_average: ChunkAverage | None = None
         """The averaging window of the last :meth:`periodic` point (its heat among them)."""
+        self.last_whirl: CageWhirl | None = None
+        """The cage centre's whirl over the last :meth:`periodic` point's window (:func:`cage_whirl`)."""
 
     # -- public --------------------------------------------------------------------------------
     def solve(self, inner_ring_speed: float, axial_load: float, start: SteadyPoint | None = None) -> SteadyPoint:
@@ -375,7 +442,8 @@ class SteadySolver:
         fewest whole ball-pass periods 2 pi / (Z Omega) covering :data:`AVERAGE_S` (to the step:
         0.4 % of a period at 900 rpm): cage speed, slip and the friction torque (the drive's
         work over the window) are averages over whole periods; ball speeds, pocket offset and
-        films are the window's last state.
+        films are the window's last state. The cage centre is sampled every step of the window:
+        its whirl is :attr:`last_whirl` (:func:`cage_whirl`).
 
         Raises:
             DynamicsInputError: a non-finite or out-of-range input.
@@ -385,11 +453,32 @@ class SteadySolver:
         e.initialise(omega, axial_load, radial_load=radial_load, radial_angle=radial_angle, moment=moment)
         e.advance(PERIODIC_SETTLE_S)
         period = 2.0 * math.pi / (self.params.ball_count * max(e.cage_speed, 1e-9))
-        avg = e.advance(math.ceil(AVERAGE_S / period) * period)
+        avg = self._window(math.ceil(AVERAGE_S / period) * period)
         self.last_average = avg
         x = self._vector_of_engine()
         x[2] = avg.cage_speed
         return self._engine_point(x, omega, axial_load, avg.drive_work / avg.duration, ORIGIN_ROLLING_START, METHOD_PERIODIC, 0, False)
+
+    def _window(self, duration: float) -> ChunkAverage:
+        """Advance ``duration`` s one step at a time (the same steps as one call), sampling the
+        cage centre each step into :attr:`last_whirl`; the window's averages."""
+        e = self.engine
+        n = max(int(round(duration / e.time_step)), 1)
+        times, xs, ys = np.empty(n + 1), np.empty(n + 1), np.empty(n + 1)
+        times[0], xs[0], ys[0] = e.time, e.ring[kn.R_CX], e.ring[kn.R_CY]
+        total = np.zeros(7)  # duration, cage and inner-ring angle, drive work, heats
+        for k in range(1, n + 1):
+            a = e.advance(e.time_step)
+            total += (a.duration, a.cage_speed * a.duration, a.inner_ring_speed * a.duration, a.drive_work, a.heat, a.damping_heat, a.contact_damping_heat)
+            times[k], xs[k], ys[k] = e.time, e.ring[kn.R_CX], e.ring[kn.R_CY]
+        t = float(total[0])
+        avg = (
+            ChunkAverage(t, float(total[1]) / t, float(total[2]) / t, *(float(v) for v in total[3:]))
+            if t > 0.0
+            else ChunkAverage(0.0, e.cage_speed, e.inner_ring_speed)
+        )
+        self.last_whirl = cage_whirl(times, xs, ys, land_clearance=self.params.land_clearance, cage_speed=avg.cage_speed)
+        return avg
 
     def _averaged(self, omega: float, axial_load: float, origin: str) -> SteadyPoint:
         avg = self.engine.advance(AVERAGE_S, axial_load=axial_load)

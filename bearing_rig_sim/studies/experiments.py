@@ -11,6 +11,7 @@ them with paper Eq. 11-12 at the nominal contact angle, as on the bench.
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass
 from collections.abc import Callable, Sequence
@@ -42,7 +43,8 @@ class AccelerationSeries:
     """Slip against time under constant inner-ring acceleration.
 
     Attributes: acceleration (rad/s^2), axial_load (N), time (s, from the start of the ramp,
-    window centres), inner_ring_speed and cage_speed (rad/s, window means), slip_pct (%).
+    window centres), inner_ring_speed and cage_speed (rad/s, window means), slip_pct (%);
+    ball_load_max (N, the largest contact load of any ball at the run's end, inner or outer).
     """
 
     acceleration: float
@@ -51,6 +53,7 @@ class AccelerationSeries:
     inner_ring_speed: np.ndarray
     cage_speed: np.ndarray
     slip_pct: np.ndarray
+    ball_load_max: float = math.nan
 
 
 def validation_table(
@@ -83,11 +86,16 @@ def acceleration_run(
     load: float = ACCELERATION_LOAD_N,
     duration: float = 3.0,
     window: float = 0.02,
+    *,
+    radial_load: float = 0.0,
+    moment: tuple[float, float] | None = None,
 ) -> AccelerationSeries:
     """Accelerate the inner ring from rest at ``acceleration`` (rad/s^2) under ``load`` (N) for
-    ``duration`` s, sampling mean speeds and slip over consecutive ``window`` s windows."""
+    ``duration`` s, sampling mean speeds and slip over consecutive ``window`` s windows; with
+    ``radial_load`` (N, along x) and ``moment`` ((M_x, M_y) N m, tilts free; None: held) the
+    run is under that combined load (:meth:`BearingDynamics.initialise`)."""
     engine = BearingDynamics(params)
-    engine.initialise(0.0, load)
+    engine.initialise(0.0, load, radial_load=radial_load, moment=moment)
     kin = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
     times, inner, cage = [], [], []
     n = int(round(duration / window))
@@ -99,7 +107,9 @@ def acceleration_run(
             cage.append(avg.cage_speed)
     inner_a, cage_a = np.array(inner), np.array(cage)
     slip = np.asarray(kin.slip_rate(cage_a, inner_a), dtype=float) if len(inner) else np.array([])
-    return AccelerationSeries(acceleration, load, np.array(times), inner_a, cage_a, slip)
+    obs = engine.observe()
+    q_max = float(max(obs.inner_contact_loads.max(), obs.outer_contact_loads.max()))
+    return AccelerationSeries(acceleration, load, np.array(times), inner_a, cage_a, slip, q_max)
 
 
 def _acceleration_job(job: tuple[BearingParameters, float, float, float]) -> AccelerationSeries:

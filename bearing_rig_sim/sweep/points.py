@@ -72,14 +72,26 @@ COLUMNS: dict[str, str] = {
     "peak_slip_pct": "float64",
     "ball_load_max_n": "float64",
     "loaded_balls": "int64",
+    "cage_whirl_radius_um": "float64",
+    "cage_whirl_frequency_hz": "float64",
+    "cage_whirl_ratio": "float64",
+    "cage_whirl_reason": "string",
     "error": "string",
 }
 """Result columns (besides one float64 column per axis) and their Arrow types. ``branch`` is
 how the point was reached (``rolling_start``, ``continuation`` or ``transient``); ``state`` is
 ``rolling`` or ``skid``; ``ball_load_max_n`` and ``loaded_balls`` are the quasi-static load
 distribution at the point's speed (dynamics/quasi_static.py, as ``predict --radial-load``
-gives it) on the steady points of a spec with a ``radial_load_n`` or ``moment_n_m`` axis (NaN
-and 0 elsewhere); ``error`` is empty unless the point could not be computed."""
+gives it) on the steady points of a spec with a ``radial_load_n`` or ``moment_n_m`` axis
+(NaN and 0 elsewhere); on such a spec's transient points ``ball_load_max_n`` is the engine's
+own at the run's end (the largest contact load of any ball) and ``loaded_balls`` 0; ``cage_whirl_radius_um`` (the cage centre's distance from the axis at the window's
+end), ``cage_whirl_frequency_hz`` (the centre's orbit about the axis, > 0 in the cage's
+direction) and ``cage_whirl_ratio`` (over the cage's rotation frequency) are those of the
+periodic steady state of the steady points under a combined load, as ``predict
+--radial-load`` gives them (NaN elsewhere, and frequency and ratio NaN with
+``cage_whirl_reason`` when the centre does not orbit:
+:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`); ``error`` is empty unless the point could
+not be computed."""
 
 
 @dataclass(frozen=True)
@@ -157,6 +169,10 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
         "peak_slip_pct": math.nan,
         "ball_load_max_n": math.nan,
         "loaded_balls": 0,
+        "cage_whirl_radius_um": math.nan,
+        "cage_whirl_frequency_hz": math.nan,
+        "cage_whirl_ratio": math.nan,
+        "cage_whirl_reason": "",
         "error": "",
     }
     row.update({k: float(v) for k, v in point.items()})
@@ -197,6 +213,14 @@ def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str,
         if combined is not None and (combined[0] > 0.0 or combined[1] is not None):
             # periodic at the ball-pass frequency: integrated and averaged over whole periods (either method)
             result = solver.periodic(omega, point[LOAD_AXIS], combined[0], moment=combined[1])
+            whirl = solver.last_whirl
+            row["cage_whirl_radius_um"] = solver.engine.cage_whirl_radius * 1e6
+            if whirl is not None:
+                row.update(
+                    cage_whirl_frequency_hz=math.nan if whirl.frequency is None else whirl.frequency,
+                    cage_whirl_ratio=math.nan if whirl.ratio is None else whirl.ratio,
+                    cage_whirl_reason=whirl.reason or "",
+                )
         elif task.method == INTEGRATE:
             result = solver.integrate(omega, point[LOAD_AXIS])
         else:
@@ -236,7 +260,9 @@ def _transient_row(task: SweepTask, point: dict[str, float], key: str) -> dict[s
     row = _base_row(point, key, KIND_TRANSIENT)
     try:
         params = parameters_for(task.params, point)
-        series = acceleration_run(params, point[ACCELERATION_AXIS], point[LOAD_AXIS], task.transient_duration)
+        combined = combined_load(point)
+        radial, moment = combined if combined is not None else (0.0, None)
+        series = acceleration_run(params, point[ACCELERATION_AXIS], point[LOAD_AXIS], task.transient_duration, radial_load=radial, moment=moment)
         if len(series.slip_pct) < 4:
             raise RigError(f"run-up of {task.transient_duration} s gives too few slip samples")
         fit = fit_gaussians(series.time, series.slip_pct, 1)
@@ -253,6 +279,8 @@ def _transient_row(task: SweepTask, point: dict[str, float], key: str) -> dict[s
             time_to_stable_s=math.nan if onset is None else float(onset),
             peak_slip_pct=peak,
         )
+        if combined is not None:
+            row["ball_load_max_n"] = series.ball_load_max
     except (RigError, ValueError, ArithmeticError, RuntimeError) as exc:
         row["error"] = str(exc) or type(exc).__name__
     return row

@@ -18,11 +18,12 @@ A spec names its axes with their unit in the name, as every configuration file d
 
 An axis is either ``inner_ring_speed_rpm`` (steady points at constant speed) or
 ``inner_ring_acceleration_rad_s2`` (transient points: a run-up from rest), always with
-``axial_load_n``. Steady points may add a combined load: ``radial_load_n`` (along the
+``axial_load_n``. Either kind may add a combined load: ``radial_load_n`` (along the
 bearing's x axis) and ``moment_n_m`` (M_x, the moment in the radial load's plane, counted as
 dynamics/quasi_static.py counts it; with this axis the inner ring's tilts are free, without it
-they are held). Such a point's steady state is periodic at the ball-pass frequency and is
-averaged over whole periods (:meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`).
+they are held). A steady point's steady state is then periodic at the ball-pass frequency and is
+averaged over whole periods (:meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`);
+a transient point runs up from rest under the combined load.
 Any other axis of :data:`AXES` changes one bearing parameter. Errors name the file and the key
 (``grid.axial_load_n[0]: must be >= 1.0, got -5``).
 """
@@ -78,8 +79,8 @@ AXES: dict[str, AxisDefinition] = {
         AxisDefinition(SPEED_AXIS, None, 1.0, 60000.0, "inner-ring speed, rpm (steady points)"),
         AxisDefinition(LOAD_AXIS, None, MIN_AXIAL_LOAD, 20000.0, "axial load on the inner ring, N"),
         AxisDefinition(ACCELERATION_AXIS, None, 0.1, 10000.0, "inner-ring acceleration from rest, rad/s^2 (transient points)"),
-        AxisDefinition(RADIAL_AXIS, None, 0.0, 20000.0, "radial load on the inner ring along x, N (steady points)"),
-        AxisDefinition(MOMENT_AXIS, None, -1000.0, 1000.0, "moment M_x on the inner ring in the radial load's plane, N m; tilts free (steady points)"),
+        AxisDefinition(RADIAL_AXIS, None, 0.0, 20000.0, "radial load on the inner ring along x, N (steady and transient)"),
+        AxisDefinition(MOMENT_AXIS, None, -1000.0, 1000.0, "moment M_x on the inner ring in the radial load's plane, N m; tilts free (steady and transient)"),
         # lubricant
         AxisDefinition("oil_viscosity_pa_s", "oil_viscosity", 1e-4, 10.0, "dynamic viscosity of the oil, Pa s"),
         AxisDefinition("oil_volume_fraction", "oil_volume_fraction", 0.0, 1.0, "oil share of the oil-air mixture, 1"),
@@ -302,9 +303,6 @@ class SweepFile(FileSection):
             raise field_error("grid", f"must include {LOAD_AXIS} (in grid or samples)")
         if (SPEED_AXIS in names) == (ACCELERATION_AXIS in names):
             raise field_error("grid", f"must include exactly one of {SPEED_AXIS} (steady points) and {ACCELERATION_AXIS} (transient points)")
-        for key in (RADIAL_AXIS, MOMENT_AXIS):
-            if key in names and ACCELERATION_AXIS in names:
-                raise field_error("grid", f"{key} needs steady points ({SPEED_AXIS}): a run-up takes the axial load only")
         return self
 
 

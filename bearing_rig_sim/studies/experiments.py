@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -53,7 +53,7 @@ class AccelerationSeries:
     inner_ring_speed: np.ndarray
     cage_speed: np.ndarray
     slip_pct: np.ndarray
-    ball_load_max: float = math.nan
+    ball_load_max: float = field(default=math.nan, kw_only=True)
 
 
 def validation_table(
@@ -109,7 +109,7 @@ def acceleration_run(
     slip = np.asarray(kin.slip_rate(cage_a, inner_a), dtype=float) if len(inner) else np.array([])
     obs = engine.observe()
     q_max = float(max(obs.inner_contact_loads.max(), obs.outer_contact_loads.max()))
-    return AccelerationSeries(acceleration, load, np.array(times), inner_a, cage_a, slip, q_max)
+    return AccelerationSeries(acceleration, load, np.array(times), inner_a, cage_a, slip, ball_load_max=q_max)
 
 
 def _acceleration_job(job: tuple[BearingParameters, float, float, float]) -> AccelerationSeries:

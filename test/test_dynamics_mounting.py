@@ -27,10 +27,14 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq, fsolve
 
+from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters, DynamicsInputError, Mounting
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.parameters import derive
+from bearing_rig_sim.thermal.bearing import ThermalConfig
+from bearing_rig_sim.thermal.coupling import ThermalCoupling
+from bearing_rig_sim.thermal.materials import BEARING_STEEL
 
 
 @pytest.fixture(scope="module")
@@ -261,3 +265,24 @@ def test_stiff_model_conserves_energy_with_a_rigid_preload_and_clearance(params:
     exchanged = float(np.ptp(partner))
     assert exchanged > 1e-5  # J: the partner takes part
     assert float(np.ptp(energies)) < 0.05 * exchanged
+
+
+def test_thermal_coupling_can_apply_the_rings_expansion(params: BearingParameters) -> None:
+    """With ``expansion`` the coupling sets the engine's clearance, at each network step, to its
+    starting one plus the rings' and balls' expansion since the start (Harris and Kotzalas: each
+    free body grows by alpha dT times its diameter, the outer raceway's diameter d_m + D_w
+    growing the clearance, the inner raceway's d_m - D_w and two balls taking it up); a warmer
+    inner ring takes clearance up."""
+    engine = BearingDynamics(params, mounting=Mounting(clearance=3e-6))
+    engine.initialise(6000 * math.pi / 30.0, 200.0)
+    coupling = ThermalCoupling(engine, ThermalConfig.from_yaml(config_path("bearings", "h7006c.yaml")), interval=0.05, tables=False, expansion=True)
+    start = {n: coupling.temperature(n) for n in ("inner_ring", "outer_ring", "balls")}
+    for _ in range(4):
+        engine.advance(0.05)
+        coupling.advance(0.05)
+    rise = {n: coupling.temperature(n) - start[n] for n in start}
+    assert rise["inner_ring"] > 0.0
+    dm, dw, alpha = params.pitch_diameter, params.ball_diameter, BEARING_STEEL.expansion
+    expected = 3e-6 + alpha * ((dm + dw) * rise["outer_ring"] - (dm - dw) * rise["inner_ring"] - 2.0 * dw * rise["balls"])
+    assert engine.clearance == pytest.approx(expected, rel=1e-9, abs=1e-15)
+    assert engine.clearance != 3e-6

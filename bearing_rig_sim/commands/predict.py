@@ -29,6 +29,17 @@ point is the coupled thermal steady state of that periodic state (its heat the m
 window's whole ball-pass periods; the network's conductances those of the axial load), its
 ``isothermal`` values the periodic state at the bearing file's temperature. ``--transient``
 takes the axial load only.
+
+The mounting (non-thermal path; docs/model.md, "Mounting"): ``--clearance M`` an extra diametral
+clearance (m, negative: interference), ``--misalignment RAD RAD`` the tilts held, ``--preload-n N``
+a spring preload added to each point's axial load and ``--preload-displacement M`` the rigid
+preload of a back-to-back pair, within the ranges of the rig file's ``mounting`` section
+(:mod:`bearing_rig_sim.rig.mounting`). Each row then states them (``clearance_um``,
+``misalignment_mrad``, ``preload_n``, ``preload_displacement_um``; ``axial_load_n`` stays the
+external load) and has no uncertainty interval (the calibration's is the nominal mounting's). A
+misalignment breaks the axial symmetry: its points are periodic steady states as under a radial
+load. The load distribution's row (``--radial-load``) takes the clearance, misalignment and
+spring preload; the rigid preload's partner is the engine's only.
 """
 
 from __future__ import annotations
@@ -40,13 +51,14 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.config import check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
-from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
-from bearing_rig_sim.dynamics.steady import CageWhirl, solver_for
+from bearing_rig_sim.dynamics.steady import CageWhirl, SteadySolver, solver_for
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.settings_model import read_file
+from bearing_rig_sim.rig.mounting import MountingConfig
+from bearing_rig_sim.settings_model import read_file, validate_mapping
 from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 
 
@@ -65,8 +77,26 @@ def register(subparsers: Any) -> None:
     p.add_argument("--thermal", action="store_true", help="at the thermal steady state (torque, temperatures)")
     p.add_argument("--transient", type=float, default=None, metavar="S", help="warm-up from ambient over S seconds (one row per step)")
     p.add_argument("--transient-step", type=float, default=10.0, metavar="S", help="step of the warm-up rows, s (default 10)")
+    p.add_argument("--clearance", type=float, default=0.0, metavar="M", help="extra diametral clearance, m (negative: interference fit)")
+    p.add_argument("--misalignment", type=float, nargs=2, default=None, metavar=("THETA_X", "THETA_Y"), help="inner ring tilts held against the outer, rad")
+    p.add_argument("--preload-n", type=float, default=0.0, metavar="N", help="spring preload added to the axial load, N")
+    p.add_argument("--preload-displacement", type=float, default=0.0, metavar="M", help="rigid preload of a back-to-back pair, m")
     p.add_argument("--json", action="store_true", help="one JSON object per line")
     p.set_defaults(func=run)
+
+
+def mounting_of(args: argparse.Namespace) -> Mounting | None:
+    """The mounting the command line gives (None: none), checked against the ranges of the rig
+    file's ``mounting`` section (:class:`~bearing_rig_sim.rig.mounting.MountingConfig`)."""
+    stated = {
+        "clearance_change_m": args.clearance,
+        "misalignment_rad": list(args.misalignment or (0.0, 0.0)),
+        "preload_n": args.preload_n,
+        "preload_displacement_m": args.preload_displacement,
+    }
+    fit = validate_mapping(MountingConfig, stated, "command line (--clearance, --misalignment, --preload-n, --preload-displacement)")
+    mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+    return None if mounting == Mounting() else mounting
 
 
 def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: Path | None) -> BearingParameters:
@@ -103,8 +133,13 @@ def run(args: argparse.Namespace) -> int:
     params = load_parameters(args.bearing, args.calibration, args.lubricant)
     if args.transient is not None and radial is not None:
         raise RigError("--transient takes the axial load only: give --thermal for the steady state under --radial-load")
+    mounting = mounting_of(args)
     if args.thermal or args.transient is not None:
+        if mounting is not None:
+            raise RigError("--clearance, --misalignment, --preload-n and --preload-displacement take the non-thermal path only (no --thermal, --transient)")
         return _run_thermal(args, params, loads, radial)
+    if mounting is not None:
+        return _run_mounted(args, params, loads, radial, mounting)
     states = steady_states(params, [(rpm_to_rad_s(n), f) for n, f in zip(args.rpm, loads)])
     unc = _uncertainty(args)
     for k, s in enumerate(states):
@@ -142,6 +177,32 @@ def whirl_row(radius: float, whirl: CageWhirl | None) -> dict[str, Any]:
         "cage_whirl_ratio": None if ratio is None else round(ratio, 4),
         "cage_whirl_reason": "no averaging window" if whirl is None else whirl.reason,
     }
+
+
+def _run_mounted(args: argparse.Namespace, params: BearingParameters, loads: list[float], radial: list[float] | None, mounting: Mounting) -> int:
+    """Each point's steady state with the engine mounted as ``mounting`` (one engine, in this
+    process): the direct solver, or the periodic state under a misalignment or a combined load."""
+    solver = SteadySolver(params, mounting=mounting)
+    moment = None if args.moment is None else (float(args.moment[0]), float(args.moment[1]))
+    for k, (n, f) in enumerate(zip(args.rpm, loads)):
+        omega = rpm_to_rad_s(n)
+        side = radial[k] if radial is not None else 0.0
+        periodic = mounting.misalignment != (0.0, 0.0) or side > 0.0 or moment is not None
+        pt = solver.periodic(omega, f, side, moment=moment) if periodic else solver.solve(omega, f)
+        s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+        row: dict[str, Any] = dict(s.as_row())
+        row["rpm"] = round(row["rpm"], 3)
+        row.update(s.losses_row(params.composite_roughness))
+        row["clearance_um"] = round(mounting.clearance * 1e6, 4)
+        row["misalignment_mrad"] = [round(t * 1e3, 5) + 0.0 for t in mounting.misalignment]
+        row["preload_n"] = mounting.preload_force
+        row["preload_displacement_um"] = round(mounting.preload_displacement * 1e6, 4)
+        if radial is not None:
+            row.update(load_distribution_row(params, omega, f + mounting.preload_force, side, args.moment, mounting))
+        if periodic:
+            row.update(whirl_row(solver.engine.cage_whirl_radius, solver.last_whirl))
+        _print(row, args.json)
+    return 0
 
 
 def _uncertainty(args: argparse.Namespace) -> Any:
@@ -265,9 +326,20 @@ def _radial_loads(args: argparse.Namespace) -> list[float] | None:
     return list(args.radial_load) * len(args.rpm) if len(args.radial_load) == 1 else list(args.radial_load)
 
 
-def load_distribution_row(params: BearingParameters, omega: float, axial: float, radial: float, moment: list[float] | None) -> dict[str, Any]:
-    """The quasi-static load distribution's figures for ``predict`` (N, deg, N m)."""
-    case = LoadCase(axial, radial, None if moment is None else (float(moment[0]), float(moment[1])), inner_ring_speed=omega)
+def load_distribution_row(
+    params: BearingParameters, omega: float, axial: float, radial: float, moment: list[float] | None, mounting: Mounting | None = None
+) -> dict[str, Any]:
+    """The quasi-static load distribution's figures for ``predict`` (N, deg, N m); with
+    ``mounting``, its clearance and misalignment (a spring preload is in ``axial``)."""
+    fit = mounting or Mounting()
+    case = LoadCase(
+        axial,
+        radial,
+        None if moment is None else (float(moment[0]), float(moment[1])),
+        inner_ring_speed=omega,
+        clearance=fit.clearance,
+        misalignment=fit.misalignment,
+    )
     sol = QuasiStaticBearing(params).solve(case)
     row: dict[str, Any] = {
         "radial_load_n": radial,

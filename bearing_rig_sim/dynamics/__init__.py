@@ -1,7 +1,7 @@
 """Bearing dynamics engine (numpy + numba; no ROS import).
 
 Public API: :class:`BearingParameters` (bearing data from YAML), :class:`BearingDynamics`
-(the integrator), :class:`Observation`, :class:`Snapshot`. The numba kernels live in the
+(the integrator), :class:`Mounting` (clearance, misalignment, preload), :class:`Observation`, :class:`Snapshot`. The numba kernels live in the
 private module :mod:`.kernels`.
 """
 
@@ -11,6 +11,7 @@ from bearing_rig_sim.dynamics.engine import (
     ChunkAverage,
     DynamicsDivergedError,
     DynamicsInputError,
+    Mounting,
     Observation,
     Snapshot,
 )
@@ -28,6 +29,7 @@ __all__ = [
     "DerivedGeometry",
     "DynamicsDivergedError",
     "DynamicsInputError",
+    "Mounting",
     "Observation",
     "OperatingEnvelope",
     "Snapshot",

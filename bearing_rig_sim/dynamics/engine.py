@@ -10,7 +10,9 @@ Two formulations of the same model (see :mod:`.kernels`):
 
 Inputs: the inner-ring speed follows a prescribed angular acceleration (constant over each
 call of :meth:`BearingDynamics.advance`); the axial load (N) is a time signal given per call.
-Cage speed and slip are outputs of the integration, never inputs.
+Cage speed and slip are outputs of the integration, never inputs. The mounting (an extra
+diametral clearance, a misalignment at which the tilts are held, a spring or a rigid preload;
+docs/model.md, "Mounting") is set when the engine is built and by its setters between steps.
 """
 
 from __future__ import annotations
@@ -39,7 +41,20 @@ from bearing_rig_sim.errors import RigError
 MODELS = ("reduced", "stiff")
 MIN_AXIAL_LOAD = 1.0
 """Smallest axial load (N) the engine accepts: an angular contact bearing with no axial load
-has no defined contact angle and the quasi-static normal problem becomes singular."""
+has no defined contact angle and the quasi-static normal problem becomes singular. With a
+preload (spring or rigid) the external load may be 0: the preload carries the balls."""
+
+MAX_MISALIGNMENT = 0.01
+"""Largest misalignment the engine accepts, rad per axis (34 arcmin: ten times what a single
+angular contact bearing tolerates, a few arcmin by the catalogues; beyond it the held tilt
+lifts the inner groove by more than its conformity can follow)."""
+
+MAX_PRELOAD_FORCE = 10_000.0
+"""Largest spring preload, N (the H7006C's static rating C0, 9-10 kN)."""
+
+MAX_PRELOAD_DISPLACEMENT = 1e-4
+"""Largest rigid preload displacement, m (100 um: tens of times a heavy preload of a spindle
+bearing of this size)."""
 
 
 SPEED_TOLERANCE = (0.01, 0.2)
@@ -68,6 +83,27 @@ class DynamicsDivergedError(RigError):
 @functools.lru_cache(maxsize=1)
 def _shipped_envelope() -> OperatingEnvelope:
     return OperatingEnvelope.from_rig_file()
+
+
+@dataclass(frozen=True)
+class Mounting:
+    """How the bearing is mounted (SI units; docs/model.md, "Mounting"). All 0: as the bearing
+    file describes it, a single bearing with the tilts held at zero.
+
+    Attributes:
+        clearance: extra diametral clearance P_d, m (negative: an interference fit;
+            :meth:`BearingDynamics.set_clearance`).
+        misalignment: (theta_x, theta_y) at which the inner ring's tilts are held with no
+            moment applied, rad (:meth:`BearingDynamics.set_misalignment`; reduced model).
+        preload_force: spring preload added to the axial load, N.
+        preload_displacement: rigid preload of a back-to-back pair of this bearing, m
+            (:meth:`BearingDynamics.set_preload`).
+    """
+
+    clearance: float = 0.0
+    misalignment: tuple[float, float] = (0.0, 0.0)
+    preload_force: float = 0.0
+    preload_displacement: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -183,6 +219,8 @@ class BearingDynamics:
             (default: the shipped ``config/rig.yaml``).
         check_step: refuse a step above the model's stability limit (:mod:`.step_limit`);
             False only to study a diverging integration.
+        mounting: clearance, misalignment and preload (:class:`Mounting`; default none), set
+            before the step's stability limit is found.
 
     Raises:
         StepLimitError: the step exceeds the model's stability limit over the envelope.
@@ -197,12 +235,26 @@ class BearingDynamics:
         strip_segment: int = 0,
         envelope: OperatingEnvelope | None = None,
         check_step: bool = True,
+        mounting: Mounting | None = None,
     ) -> None:
         if model not in MODELS:
             raise DynamicsInputError(f"model must be one of {', '.join(MODELS)}, got {model!r}")
         self.params = params
         self.model = model
         self.vector, self.geometry = derive(params)
+        self._outer_centre = float(self.vector[kn.P_CO_R])
+        self.clearance = 0.0
+        """Extra diametral clearance P_d, m (:meth:`set_clearance`)."""
+        self.misalignment = (0.0, 0.0)
+        """(theta_x, theta_y) at which the tilts are held with no moment applied, rad."""
+        self.preload_force = 0.0
+        """Spring preload added to the axial load, N."""
+        self.preload_displacement = 0.0
+        """Rigid preload displacement of a back-to-back pair, m (0: a single bearing)."""
+        mounting = mounting or Mounting()
+        self.set_clearance(mounting.clearance)
+        self.set_preload(mounting.preload_force, mounting.preload_displacement)
+        self.misalignment = self._misalignment(mounting.misalignment)
         default_dt = params.reduced_time_step if model == "reduced" else params.stiff_time_step
         self.time_step = _finite("time_step", time_step if time_step is not None else default_dt, 1e-9)
         z = params.ball_count
@@ -229,8 +281,8 @@ class BearingDynamics:
         """Azimuth of the radial load from the bearing's x axis, rad (the load zone's azimuth)."""
         self.moment: tuple[float, float] | None = None
         """Applied moment (M_x, M_y) on the inner ring, N m (counted as :mod:`.quasi_static`
-        does), or None: the tilts held at zero, as the spindle's second bearing holds them
-        (:meth:`set_moment`)."""
+        does), or None: the tilts held at :attr:`misalignment` (zero by default), as the
+        spindle's second bearing holds them (:meth:`set_moment`)."""
         self._step = kn.step_reduced if model == "reduced" else kn.step_stiff
         self._peak_speed = 0.0
         self.envelope = envelope if envelope is not None else _shipped_envelope()
@@ -286,7 +338,7 @@ class BearingDynamics:
         operating point.
         """
         omega = _finite("inner_ring_speed", inner_ring_speed, 0.0)
-        load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+        load = _finite("axial_load", axial_load, self._min_axial_load())
         radial = self._radial(radial_load)
         angle = _finite("radial_angle", radial_angle)
         applied = self._moment(moment)
@@ -294,10 +346,12 @@ class BearingDynamics:
         z = p.ball_count
         rm = v[kn.P_RM]
         # Initial approach along the contact line: Q = F/(Z sin a0) at both contacts.
-        q0 = load / (z * max(math.sin(p.contact_angle), 0.05))
+        q0 = (load + self.preload_force) / (z * max(math.sin(p.contact_angle), 0.05))
         approach = (q0 / v[kn.P_K_IN]) ** (2 / 3) + (q0 / v[kn.P_K_OUT]) ** (2 / 3)
         self.ring[:] = 0.0
-        self.ring[kn.R_DELTA] = approach / max(math.sin(p.contact_angle), 0.05)
+        # a rigid pair shares its preload displacement: at least half of it on this ring
+        self.ring[kn.R_DELTA] = max(approach / max(math.sin(p.contact_angle), 0.05), 0.5 * self.preload_displacement)
+        self.ring[kn.R_TX], self.ring[kn.R_TY] = self.misalignment
         self.ring[kn.R_OMEGA] = omega
         self.ring[kn.R_TIME] = time
         self._peak_speed = omega
@@ -306,6 +360,15 @@ class BearingDynamics:
         self.ball[:, kn.B_THETA] = theta
         self.ball[:, kn.B_R] = rm
         self.ball[:, kn.B_OMEGA] = omega * p.epicyclic_ratio
+        if self.clearance != 0.0:
+            # on the outer groove at the free contact angle the clearance gives, the inner ring
+            # moved axially by the change of the curvature centres' axial distance
+            big_a, gap_o = v[kn.P_RI_GAP] + v[kn.P_RO_GAP], v[kn.P_RO_GAP]
+            free = math.acos(min(max((v[kn.P_CI_R] - v[kn.P_CO_R]) / big_a, -1.0), 1.0))
+            self.ball[:, kn.B_R] = v[kn.P_CO_R] + gap_o * math.cos(free)
+            self.ball[:, kn.B_Z] = v[kn.P_CO_Z] + gap_o * math.sin(free)
+            lift = big_a * (math.sin(free) - math.sin(p.contact_angle))
+            self.ring[kn.R_DELTA] = max(lift + approach / max(math.sin(free), 0.05), 0.5 * self.preload_displacement)
         for _ in range(3):  # speeds and loaded angle depend on each other through centrifugal force
             # 1e-11 of the load; under a few newtons that is below the rounding of the contact
             # forces (K delta^1.5 with delta ~ 1e-7 m), so the steps' own 1e-9 is accepted there,
@@ -333,6 +396,7 @@ class BearingDynamics:
         """The normal problem (:func:`.kernels.solve_quasi_static`, or its tilted form under a
         moment) at the current ball positions and speeds; the Newton iterations used."""
         v, geo, scratch = self.vector, self.work[:, : kn.NG], self.work[:, kn.NG : kn.NG + 6]
+        load += self.preload_force
         if moment is None:
             return int(kn.solve_quasi_static(v, self.ball, self.ring, geo, scratch, load, tol, max_iter, radial, angle))
         loads = np.array([load, radial * math.cos(angle), radial * math.sin(angle), *moment])
@@ -351,12 +415,77 @@ class BearingDynamics:
     def set_moment(self, moment: tuple[float, float] | None) -> None:
         """Apply the moment (M_x, M_y) (N m, counted as :mod:`.quasi_static` does:
         M_x = sum Q_i sin a_i R_i cos psi) on the inner ring from the next step on, its two tilts
-        then free unknowns of the normal solve made every step; None holds the tilts at zero again
+        then free unknowns of the normal solve made every step; None holds the tilts at the misalignment again
         (as the spindle's second bearing holds them) and the ring's moment is the reaction
         (:attr:`Observation.ring_moment`). Reduced model only."""
         self.moment = self._moment(moment)
         if self.moment is None:
-            self.ring[kn.R_TX] = self.ring[kn.R_TY] = 0.0
+            self.ring[kn.R_TX], self.ring[kn.R_TY] = self.misalignment
+
+    @property
+    def mounting(self) -> Mounting:
+        """The current clearance, misalignment and preload."""
+        return Mounting(self.clearance, self.misalignment, self.preload_force, self.preload_displacement)
+
+    def _min_axial_load(self) -> float:
+        return 0.0 if self.preload_force > 0.0 or self.preload_displacement > 0.0 else MIN_AXIAL_LOAD
+
+    def set_clearance(self, clearance: float) -> None:
+        """Set the extra diametral clearance P_d (m; negative: an interference fit) from the next
+        step on: the outer groove curvature centres move radially out by P_d/2, so the free
+        contact angle becomes acos(cos a0 - P_d/(2A)) (A = (f_i + f_o - 1) D_w; the geometry of
+        :mod:`.quasi_static`). Usable between steps (a ring's thermal expansion,
+        :func:`.quasi_static.thermal_clearance_change`); the next step's normal solve (reduced
+        model) or the balls' contacts (stiff model) take it up.
+
+        Raises:
+            DynamicsInputError: not finite, or outside -A..2A (cos a0 - cos 80 deg) (a free
+                contact angle above 80 deg).
+        """
+        p_d = _finite("clearance", clearance)
+        v = self.vector
+        big_a = float(v[kn.P_RI_GAP] + v[kn.P_RO_GAP])
+        top = 2.0 * big_a * (math.cos(self.params.contact_angle) - math.cos(math.radians(80.0)))
+        if not -big_a <= p_d <= top:
+            raise DynamicsInputError(f"clearance must be within {-big_a:.4g}..{top:.4g} m (free contact angle below 80 deg), got {clearance!r}")
+        v[kn.P_CO_R] = self._outer_centre + 0.5 * p_d
+        self.clearance = p_d
+
+    def _misalignment(self, misalignment: tuple[float, float]) -> tuple[float, float]:
+        if len(misalignment) != 2:
+            raise DynamicsInputError(f"misalignment must be (theta_x, theta_y) in rad, got {misalignment!r}")
+        tx, ty = _finite("misalignment theta_x", misalignment[0]), _finite("misalignment theta_y", misalignment[1])
+        if max(abs(tx), abs(ty)) > MAX_MISALIGNMENT:
+            raise DynamicsInputError(f"misalignment must be within +-{MAX_MISALIGNMENT:g} rad per axis, got {misalignment!r}")
+        if (tx, ty) != (0.0, 0.0) and self.model != "reduced":
+            raise DynamicsInputError(f"misalignment needs the reduced model (the {self.model} model is axisymmetric), got {misalignment!r}")
+        return tx, ty
+
+    def set_misalignment(self, misalignment: tuple[float, float]) -> None:
+        """Hold the inner ring's tilts at (theta_x, theta_y) (rad, counted as
+        :mod:`.quasi_static` counts them: theta_x lifts the inner ring axially at psi = 0) from
+        the next step on while no moment is applied (as the spindle's second bearing holds them,
+        off line by this much); under an applied moment the tilts stay free. Reduced model."""
+        self.misalignment = self._misalignment(misalignment)
+        if self.moment is None:
+            self.ring[kn.R_TX], self.ring[kn.R_TY] = self.misalignment
+
+    def set_preload(self, force: float = 0.0, displacement: float = 0.0) -> None:
+        """Set the preload from the next step on: ``force`` (N, >= 0), a spring's constant axial
+        force added to the axial load (the rig's lever and wire rope acting through a spring);
+        ``displacement`` (m, >= 0), the rigid preload of a back-to-back pair of this bearing:
+        the partner, at rest and loaded axially only, pushes the inner ring with
+        F_p(d) = Z K_n (D - A)^1.5 (A sin a0 + d)/D, D = sqrt((A sin a0 + d)^2 + (A cos a0 - P_d/2)^2),
+        d = displacement - delta_a (:func:`.kernels.partner_force`). 0 and 0: no preload."""
+        f = _finite("preload force", force, 0.0)
+        s = _finite("preload displacement", displacement, 0.0)
+        if f > MAX_PRELOAD_FORCE:
+            raise DynamicsInputError(f"preload force must be within 0..{MAX_PRELOAD_FORCE:g} N, got {force!r}")
+        if s > MAX_PRELOAD_DISPLACEMENT:
+            raise DynamicsInputError(f"preload displacement must be within 0..{MAX_PRELOAD_DISPLACEMENT:g} m, got {displacement!r}")
+        self.preload_force = f
+        self.preload_displacement = s
+        self.vector[kn.P_PRELOAD_D] = s
 
     def _radial(self, radial_load: float) -> float:
         radial = _finite("radial_load", radial_load, 0.0)
@@ -411,7 +540,7 @@ class BearingDynamics:
         """
         duration = _finite("duration", duration, 0.0)
         if axial_load is not None:
-            self.axial_load = _finite("axial_load", axial_load, MIN_AXIAL_LOAD)
+            self.axial_load = _finite("axial_load", axial_load, self._min_axial_load())
         if radial_load is not None:
             self.radial_load = self._radial(radial_load)
         if radial_angle is not None:
@@ -433,7 +562,7 @@ class BearingDynamics:
                 self.work,
                 n,
                 self.time_step,
-                self.axial_load,
+                self.axial_load + self.preload_force,
                 accel,
                 0,
                 self.radial_load,
@@ -536,7 +665,7 @@ class BearingDynamics:
 
     def energy(self) -> float:
         """Total mechanical energy, J (meaningful for the stiff model, whose state is complete)."""
-        return float(kn.mechanical_energy(self.vector, self.ball, self.cage, self.ring, self.axial_load))
+        return float(kn.mechanical_energy(self.vector, self.ball, self.cage, self.ring, self.axial_load + self.preload_force))
 
     def power_loss(self) -> float:
         """Power dissipated in the bearing at the last step, W: raceway contacts (sliding, spin,

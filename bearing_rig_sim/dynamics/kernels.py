@@ -30,7 +30,8 @@ Conventions (every kernel):
 
 Frames: cylindrical (e_r, e_t, e_z) attached to each ball's orbital position, e_t in the
 direction of rotation. The outer ring is fixed; the axial load pushes the inner ring in +z.
-Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer).
+Groove curvature centres sit at (CI_R, CI_Z + delta_a) (inner) and (CO_R, CO_Z) (outer); an
+extra diametral clearance P_d moves CO_R out by P_d/2 (the engine's ``set_clearance``).
 Ball attitude: the reference rolling axis lies in the r-z plane at the pitch angle beta with
 tan(beta) = sin(alpha)/(cos(alpha) + gamma) (Harris and Kotzalas), alpha the mean loaded contact
 angle (raceway control: the ball's angular velocity relative to the orbiting frame has no
@@ -62,7 +63,7 @@ P_RI_GAP = 3  # inner groove radius minus ball radius, m
 P_RO_GAP = 4  # outer groove radius minus ball radius, m
 P_CI_R = 5  # inner groove curvature centre, radial, m (delta_a = 0)
 P_CI_Z = 6  # inner groove curvature centre, axial, m (delta_a = 0)
-P_CO_R = 7  # outer groove curvature centre, radial, m
+P_CO_R = 7  # outer groove curvature centre, radial, m (plus half the extra diametral clearance P_d)
 P_CO_Z = 8  # outer groove curvature centre, axial, m
 P_K_IN = 9  # Hertz constant ball-inner, N/m^1.5
 P_K_OUT = 10  # Hertz constant ball-outer, N/m^1.5
@@ -115,7 +116,9 @@ P_LAND_MU = 56  # cage-land contact friction coefficient, 1
 P_CAGE_GRAV_Y = 57  # gravity on the cage centre along y (horizontal spindle), N
 P_SPIN_IN = 58  # spin lever of the inner contact per sqrt(penetration), (3/8) a E(e^2), m^0.5 (x delta^0.5)
 P_SPIN_OUT = 59  # same, outer contact
-P_SIZE = 60
+P_PRELOAD_D = 60  # rigid preload displacement of a back-to-back partner bearing, m (0: no partner)
+P_PRELOAD_K = 61  # the partner's Z K_n (its balls at rest, the series Hertz constant), N/m^1.5
+P_SIZE = 62
 
 B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT, B_PITCH = 0, 1, 2, 3, 4, 5, 6, 7, 8
 NB = 9
@@ -290,6 +293,31 @@ def shifted_raceway_geometry(p: np.ndarray, rb: float, zb: float, delta_a: float
 
 
 @njit(cache=True)
+def partner_force(p: np.ndarray, delta_a: float) -> tuple[float, float, float]:
+    """The axial force (N, along +z on the inner ring), its stiffness -dF/d(delta_a) (N/m) and the
+    stored energy (J) of the rigidly preloaded partner of a back-to-back pair (P_PRELOAD_D, m;
+    docs/model.md, "Mounting"): an identical bearing, balls at rest, axially loaded only, whose
+    curvature centres are A sin a0 + d apart axially and A cos a0 - P_d/2 radially with
+    d = P_PRELOAD_D - delta_a, so F = Z K_n (D - A)^1.5 (A sin a0 + d) / D, D the centres'
+    distance, and the energy Z K_n (2/5) (D - A)^2.5. (0, 0, 0) without a partner."""
+    s = p[P_PRELOAD_D]
+    if s == 0.0:
+        return 0.0, 0.0, 0.0
+    big_a = p[P_RI_GAP] + p[P_RO_GAP]
+    x = p[P_CI_Z] - p[P_CO_Z] + s - delta_a
+    y = p[P_CI_R] - p[P_CO_R]
+    dist = math.sqrt(x * x + y * y)
+    gap = dist - big_a
+    if gap <= 0.0:
+        return 0.0, 0.0, 0.0
+    k = p[P_PRELOAD_K]
+    root = math.sqrt(gap)
+    force = k * gap * root * x / dist
+    stiff = k * (1.5 * root * x * x / (dist * dist) + gap * root * y * y / (dist * dist * dist))
+    return force, stiff, 0.4 * k * gap * gap * root
+
+
+@njit(cache=True)
 def contact_jacobian(q: float, dq: float, nr: float, nz: float, dist: float) -> tuple:
     """d(-Q n)/dx for a contact force -Q(dist) n acting on the ball: returns (h_rr, h_rz, h_zz)."""
     t = q / dist
@@ -396,9 +424,11 @@ def solve_quasi_static(
     """Newton solution of the normal (radial-axial) equilibrium of every ball and of the inner
     ring under ``axial_load`` (N, along +z) and ``radial_load`` (N, >= 0, at the azimuth
     ``radial_angle`` from +x, rad: the load zone's azimuth), with centrifugal
-    force m omega_m^2 r_b; gyroscopic moments neglected; tilts held at zero. Ring unknowns:
-    axial displacement and, with a radial load (or a displacement left by one), the radial
-    displacement (x, y); each ball's 2x2 block is eliminated onto them (a 3x3 Schur system).
+    force m omega_m^2 r_b; gyroscopic moments neglected; tilts held where the ring has them
+    (zero, or a misalignment: each ball's inner curvature centre then lifted axially by
+    R_i (theta_x cos theta_j + theta_y sin theta_j)); a rigidly preloaded partner's axial force
+    (:func:`partner_force`) added to the load. Ring unknowns: axial displacement and, with a
+    radial load, a tilt (or a displacement left by one), the radial displacement (x, y); each ball's 2x2 block is eliminated onto them (a 3x3 Schur system).
     Updates ball B_R, B_Z and ring R_DELTA, R_DX, R_DY, and leaves in ``geo`` (Z, NG) the contact
     loads, normals and penetrations at the solution. ``work`` is scratch of shape (Z, 6).
 
@@ -407,23 +437,33 @@ def solve_quasi_static(
     z = ball.shape[0]
     m = p[P_MBALL]
     ki, ko = p[P_K_IN], p[P_K_OUT]
-    scale = tol * max(axial_load, abs(radial_load), 1.0)
-    radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0
+    partner = p[P_PRELOAD_D] != 0.0
+    fp, kp, _ = partner_force(p, ring[R_DELTA])
+    scale = tol * max(axial_load, abs(radial_load), fp, 1.0)
+    tx, ty = ring[R_TX], ring[R_TY]
+    tilted = tx != 0.0 or ty != 0.0  # held at a misalignment: the balls' loads vary around the orbit
+    ri = p[P_CI_R]
+    radial = radial_load != 0.0 or ring[R_DX] != 0.0 or ring[R_DY] != 0.0 or tilted
     load_x, load_y = radial_load * math.cos(radial_angle), radial_load * math.sin(radial_angle)
     for it in range(max_iter + 1):
         delta_a, dx, dy = ring[R_DELTA], ring[R_DX], ring[R_DY]
         ga, gx, gy = axial_load, load_x, load_y
+        if partner:
+            fp, kp, _ = partner_force(p, delta_a)
+            ga += fp
         # Schur system S du = r of the ring's (delta_a, delta_x, delta_y), S symmetric in value
         s00 = s01 = s02 = s10 = s11 = s12 = s20 = s22 = 0.0
         r0 = r1 = r2 = 0.0
         worst = 0.0
         for j in range(z):
             rb, zb = ball[j, B_R], ball[j, B_Z]
-            cth = sth = shift = 0.0
+            cth = sth = shift = lift = 0.0
             if radial:
                 cth, sth = math.cos(ball[j, B_THETA]), math.sin(ball[j, B_THETA])
                 shift = dx * cth + dy * sth
-            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a, shift)
+                if tilted:
+                    lift = ri * (tx * cth + ty * sth)
+            di, nir, niz, disti, do, nor, noz, disto = shifted_raceway_geometry(p, rb, zb, delta_a + lift, shift)
             qi = ki * di * math.sqrt(di) if di > 0.0 else 0.0
             qo = ko * do * math.sqrt(do) if do > 0.0 else 0.0
             geo[j, G_QI], geo[j, G_QO], geo[j, G_DI], geo[j, G_DO] = qi, qo, di, do
@@ -471,6 +511,8 @@ def solve_quasi_static(
         if it == max_iter:
             break
         lim = 2e-6
+        if partner:
+            s00 -= kp
         if radial:
             r0 -= ga
             r1 -= gx
@@ -480,12 +522,22 @@ def solve_quasi_static(
             c01 = s12 * s20 - s10 * s22
             c02 = s10 * s12 - s11 * s20
             det3 = s00 * c00 + s01 * c01 + s02 * c02
-            dd = (r0 * c00 + s01 * (r2 * s12 - r1 * s22) + s02 * (r1 * s12 - r2 * s11)) / det3
-            ex = (s00 * (r1 * s22 - r2 * s12) + r0 * c01 + s02 * (r2 * s10 - r1 * s20)) / det3
-            ey = (s00 * (s11 * r2 - s12 * r1) + s01 * (r1 * s20 - r2 * s10) + r0 * c02) / det3
+            if det3 == 0.0:  # no ring stiffness: see the axial case below
+                dd, ex, ey = math.copysign(lim, -r0), 0.0, 0.0
+            else:
+                dd = (r0 * c00 + s01 * (r2 * s12 - r1 * s22) + s02 * (r1 * s12 - r2 * s11)) / det3
+                ex = (s00 * (r1 * s22 - r2 * s12) + r0 * c01 + s02 * (r2 * s10 - r1 * s20)) / det3
+                ey = (s00 * (s11 * r2 - s12 * r1) + s01 * (r1 * s20 - r2 * s10) + r0 * c02) / det3
             dd = min(max(dd, -lim), lim)
             ex = min(max(ex, -lim), lim)
             ey = min(max(ey, -lim), lim)
+        elif s00 == 0.0:
+            # no ring stiffness: every ball follows the ring, its outer contact open by more
+            # than its inner one is closed (at rest, after the clearance grew): the ring moves
+            # the step limit along the net force until the outer contacts close
+            dd = math.copysign(lim, ga - r0)
+            ex = 0.0
+            ey = 0.0
         else:
             dd = min(max((r0 - ga) / s00, -lim), lim)
             ex = 0.0
@@ -561,6 +613,9 @@ def solve_quasi_static_tilted(
         delta_a, dx, dy, tx, ty = ring[R_DELTA], ring[R_DX], ring[R_DY], ring[R_TX], ring[R_TY]
         g[:] = target
         s[:] = 0.0
+        fp, kp, _ = partner_force(p, delta_a)
+        g[0] += fp
+        s[0, 0] -= kp
         rhs = np.zeros(5)
         worst = 0.0
         for j in range(z):
@@ -1349,7 +1404,7 @@ def step_reduced(
         # pockets' forces cancel, the film has none) and skips the centre's terms. The cage's
         # weight (horizontal spindle) acts on a moving centre but does not set it moving alone:
         # it stays the land's boundary friction mu m_c g r (docs/model.md, "Cage whirl")
-        centre = radial_load != 0.0 or tilt_free or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
+        centre = radial_load != 0.0 or tilt_free or ring[R_TX] != 0.0 or ring[R_TY] != 0.0 or cx != 0.0 or cy != 0.0 or cvx != 0.0 or cvy != 0.0
         heat = 0.0
         damp = 0.0
         fcx = fcy = land_n = kxx = kxy = kyx = kyy = cxx = cxy = cyx = cyy = 0.0
@@ -1597,7 +1652,7 @@ def step_stiff(
         omega_i_old = ring[R_OMEGA]
         omega_i = omega_i_old + inner_acceleration * dt
         delta_a, vdelta = ring[R_DELTA], ring[R_VDELTA]
-        ring_force = axial_load
+        ring_force = axial_load + partner_force(p, delta_a)[0]
         drive = 0.0
         heat = 0.0
         damp = 0.0
@@ -1702,7 +1757,7 @@ def mechanical_energy(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, ring: n
     and moves the pockets' gaps by its offset (the stiff model's centre stays on the axis)."""
     z = ball.shape[0]
     m, ib, jseg, rm = p[P_MBALL], p[P_IBALL], p[P_JSEG], p[P_RM]
-    e = 0.5 * p[P_M_INNER] * ring[R_VDELTA] ** 2 - axial_load * ring[R_DELTA]
+    e = 0.5 * p[P_M_INNER] * ring[R_VDELTA] ** 2 - axial_load * ring[R_DELTA] + partner_force(p, ring[R_DELTA])[2]
     cx, cy = ring[R_CX], ring[R_CY]
     e += 0.5 * p[P_CAGE_MASS] * (ring[R_CVX] ** 2 + ring[R_CVY] ** 2) - p[P_CAGE_GRAV_Y] * cy
     d = math.sqrt(cx * cx + cy * cy) - p[P_LAND_CLEAR]

@@ -491,6 +491,7 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_LAND_CONS] = land_cons
     v[kn.P_LAND_K] = 0.25 * math.pi * e_star * p.land_width
     v[kn.P_LAND_MU] = p.cage_land_friction
+    v[kn.P_PRELOAD_K] = z * p.combined_constant  # a rigid preload's partner (the engine sets P_PRELOAD_D)
     v[kn.P_CAGE_GRAV_Y] = -cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     # spin lever of each contact: the Hertz pressure's mean distance from the centre,
     # (3/8) a E(e^2) (a the semi-major axis, E the complete elliptic integral of the second kind

@@ -47,7 +47,7 @@ from numba import njit
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.engine import BearingDynamics, ChunkAverage, DynamicsInputError
+from bearing_rig_sim.dynamics.engine import BearingDynamics, ChunkAverage, DynamicsInputError, Mounting
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 
 SKID_SLIP_PCT = 20.0
@@ -356,11 +356,13 @@ class SteadySolver:
         params: bearing data.
         step: the step h of the residual, s (default: the engine's reduced time step; the
             solution does not depend on it, only the conditioning does).
+        mounting: the engine's clearance, misalignment and preload (default none); a
+            misalignment breaks the axial symmetry: use :meth:`periodic` then.
     """
 
-    def __init__(self, params: BearingParameters, *, step: float | None = None) -> None:
+    def __init__(self, params: BearingParameters, *, step: float | None = None, mounting: Mounting | None = None) -> None:
         self.params = params
-        self.engine = BearingDynamics(params)
+        self.engine = BearingDynamics(params, mounting=mounting)
         self.step = float(step) if step is not None else self.engine.time_step
         self.basin_time = BASIN_S
         self.kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
@@ -527,7 +529,7 @@ class SteadySolver:
         base_ring = e.ring.copy()
         try:
             arrays = (base_ball, base_ring, self._ball, self._cage, self._ring, self._out, self._stats, self._work)
-            status, iterations, _ = _newton(e.vector, x, omega, load, self.step, arrays, _MAX_ITER)
+            status, iterations, _ = _newton(e.vector, x, omega, load + e.preload_force, self.step, arrays, _MAX_ITER)
         except np.linalg.LinAlgError:  # a singular Jacobian: no Newton step from here
             return _NOT_CONVERGED, 0
         return int(status), int(iterations)

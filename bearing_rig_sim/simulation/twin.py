@@ -35,9 +35,10 @@ import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import config_path
-from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Observation, OperatingEnvelope
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Mounting, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
+from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.rig.program import RigLimits
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
 from bearing_rig_sim.thermal.bearing import ThermalConfig
@@ -304,7 +305,8 @@ class RigTwin:
         Args:
             bearing_file: bearing data (default: the shipped ``config/bearings/h7006c.yaml``).
             calibration_file: calibration laid over it (None: none).
-            rig_file: rig data with the ``sensors`` section (default: ``config/rig.yaml``).
+            rig_file: rig data with the ``sensors`` section and the test bearing's ``mounting``
+                (clearance, misalignment, preload; default: ``config/rig.yaml``).
             model: the engine's model, ``"reduced"`` (real time) or ``"stiff"``.
             options: the keyword options of :class:`RigTwin`; ``max_radial_load`` and
                 ``max_moment`` default to the rig file's ``combined_loading`` limits (absent:
@@ -317,7 +319,9 @@ class RigTwin:
         """
         bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
         params = BearingParameters.from_yaml(bearing, calibration_file)
-        engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file))
+        fit = MountingConfig.from_rig_file(rig_file)
+        mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+        engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file), mounting=mounting)
         sensors = FibreOpticConfig.from_yaml(rig_file)
         limits = RigLimits.from_rig_file(rig_file)
         if "max_radial_load" not in options:

@@ -36,6 +36,7 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, traction_table
+from bearing_rig_sim.dynamics.quasi_static import thermal_clearance_change
 from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.dynamics.traction import (
@@ -302,6 +303,11 @@ class ThermalCoupling:
             follow).
         grid: a traction grid of this bearing built beforehand (its tables around the start
             temperature are built here when missing); default a new one.
+        expansion: at every network step set the engine's clearance to the one it had here plus
+            the rings' and balls' thermal change since the network's start temperatures
+            (:func:`~bearing_rig_sim.dynamics.quasi_static.thermal_clearance_change`, the nodes
+            ``inner_ring``, ``outer_ring``, ``balls``; :meth:`BearingDynamics.set_clearance`).
+            Off by default: the clearance then stays the engine's.
     """
 
     def __init__(
@@ -315,6 +321,7 @@ class ThermalCoupling:
         feedback: bool = True,
         tables: bool = True,
         grid: TractionTableGrid | None = None,
+        expansion: bool = False,
     ) -> None:
         if not math.isfinite(interval) or interval <= 0.0:
             raise ValueError(f"interval must be > 0 s, got {interval!r}")
@@ -326,6 +333,8 @@ class ThermalCoupling:
         self.params = engine.params
         self._operating = (max(engine.inner_ring_speed, 1.0), engine.axial_load)
         self.network = build_network(self.params, config, *self._operating, initial=initial)
+        self.expansion = bool(expansion)
+        self._fitted = (engine.clearance, *(self.network.temperature(n) for n in ("inner_ring", "outer_ring", "balls")))
         self._pending = 0.0
         self._dissipated = (engine.dissipated, engine.damping_dissipated)
         self.applied_temperature = self.params.lubricant_temperature
@@ -383,6 +392,10 @@ class ThermalCoupling:
         self.sources = split.scaled((heat - damping) / self._pending, damping / self._pending)
         self.network.step(self.network.heat_vector(node_heat(self.sources)), self._pending)
         self._pending = 0.0
+        if self.expansion:
+            clearance, t_in, t_out, t_balls = self._fitted
+            warm = [self.network.temperature(n) - t for n, t in (("inner_ring", t_in), ("outer_ring", t_out), ("balls", t_balls))]
+            engine.set_clearance(clearance + thermal_clearance_change(self.params, warm[0], warm[1], warm[2], 0.0))
         t_lub = self.network.temperature("lubricant")
         if self.feedback and abs(t_lub - self.applied_temperature) >= self.retune_k:
             self._retune(t_lub)

@@ -3,10 +3,9 @@
     with open_bag("bags/run-0001") as bag:
         for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]): ...
 
-Messages come in log-time order, streamed, decoded into rosbags objects with the definitions the
-bag carries (an old bag keeps decoding after a message changes), else ROS 2 Jazzy's and
-``bearing_rig_msgs``'. Damage is not fatal (``docs/bags.md``): each problem is a :class:`BagWarning`
-and a line in :attr:`BagReader.problems`; ``strict=True`` makes it a :class:`BagError`.
+Messages come in log-time order, streamed, decoded as docs/bags.md says. Damage is not fatal: each
+problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:class:`BagError` with
+``strict=True``).
 """
 
 from __future__ import annotations

@@ -9,7 +9,7 @@ import struct
 from dataclasses import dataclass, field
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, TypeVar
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
@@ -67,10 +67,16 @@ class McapIndex(FileIndex):
             self.definitions.setdefault(schema.name, (schema.encoding, schema.data.decode("utf-8", errors="replace")))
 
 
-def _one_record(stream: BinaryIO, offset: int) -> McapRecord:
-    """The record at ``offset`` (chunks not opened)."""
+Indexed = TypeVar("Indexed", Chunk, Metadata)
+
+
+def _one_record(stream: BinaryIO, offset: int, kind: type[Indexed]) -> Indexed:
+    """The record of type ``kind`` at ``offset`` (a chunk not opened); McapError for another record."""
     stream.seek(offset)
-    return next(iter(StreamReader(stream, skip_magic=True, emit_chunks=True).records))
+    record = next(iter(StreamReader(stream, skip_magic=True, emit_chunks=True).records))
+    if not isinstance(record, kind):
+        raise McapError(f"no {kind.__name__.lower()} record at offset {offset} ({type(record).__name__} found)")
+    return record
 
 
 @contextlib.contextmanager
@@ -108,9 +114,7 @@ def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, in
     """Messages of one chunk that ``keep(channel_id, log_time)`` accepts, stably sorted by log time;
     DamagedRecord for a chunk truncated, corrupt or not decompressing."""
     try:
-        chunk = _one_record(stream, ref.offset)
-        if not isinstance(chunk, Chunk):
-            raise DamagedRecord(f"no chunk record at offset {ref.offset}")
+        chunk = _one_record(stream, ref.offset, Chunk)
         with _opening_chunk():
             stream_of_data, size = get_chunk_data_stream(chunk, validate_crc=True)
             messages = _messages_in(stream_of_data.read(size), keep)
@@ -149,9 +153,7 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
     index.start_ns, index.end_ns = stats.message_start_time, stats.message_end_time
     for entry in summary.metadata_indexes:
         try:
-            record = _one_record(stream, entry.offset)
-            if not isinstance(record, Metadata):
-                raise McapError(f"{type(record).__name__} found")
+            record = _one_record(stream, entry.offset, Metadata)
         except (*_UNREADABLE, StopIteration):
             index.problems.append(f"{index.path.name}: metadata record {entry.name!r} is unreadable")
             continue

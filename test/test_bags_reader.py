@@ -20,7 +20,7 @@ from mcap.writer import Writer as McapWriter
 from mcap_ros2.writer import Writer as McapRos2Writer
 from rosbags.highlevel import AnyReader
 
-from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, repair_bag, rig_typestore
 from bearing_rig_sim.synthetic.traffic import (
     RIG_TRAFFIC_TOPICS,
     SPEEDS_TOPIC,
@@ -354,3 +354,44 @@ def test_reading_streams(tmp_path: Path) -> None:
             assert count == bag.message_count
     short, long = peaks
     assert long < 1.3 * short + 200_000, f"peak {long} B for the long bag vs {short} B for the short one"
+
+
+def test_unchunked_file_finished_and_cut(tmp_path: Path, traffic_bag: tuple[Path, int]) -> None:
+    """Messages outside chunks (an MCAP writer without chunking), written in an order that is not
+    the log-time order: read in log-time order, finished or cut inside a message (then every
+    message whose record the cut leaves complete, by the writer's own offsets)."""
+    source, _count = traffic_bag
+    with open(source / "traffic_0.mcap", "rb") as stream:
+        reader = make_reader(stream)
+        sent = [(channel.topic, schema.name, schema.data, message.log_time, message.data) for schema, channel, message in reader.iter_messages()]
+    sent = sent[1::2] + sent[::2]  # later messages first
+    path = tmp_path / "unchunked.mcap"
+    ends = []
+    with open(path, "wb") as stream:
+        writer = McapWriter(stream, use_chunking=False)
+        writer.start(profile="ros2", library="test")
+        channels: dict[str, int] = {}
+        for topic, msgtype, text, log_time, data in sent:
+            if topic not in channels:
+                schema = writer.register_schema(msgtype, "ros2msg", text)
+                channels[topic] = writer.register_channel(topic, "cdr", schema)
+            writer.add_message(channels[topic], log_time, data, log_time)
+            ends.append(stream.tell())
+        writer.finish()
+    expected = sorted(((t, topic, data) for topic, _type, _text, t, data in sent), key=lambda m: m[0])
+    with open_bag(path) as bag:
+        assert bag.complete and bag.message_count == len(sent)
+        assert [(m.log_time_ns, m.topic, m.message) for m in bag.messages(raw=True)] == expected
+    cut = (ends[len(ends) // 2 - 1] + ends[len(ends) // 2]) // 2  # inside a message record
+    os.truncate(path, cut)
+    kept = sorted(((t, topic, data) for (topic, _type, _text, t, data), end in zip(sent, ends) if end <= cut), key=lambda m: m[0])
+    with pytest.warns(BagWarning, match="cut by the end of the file"):
+        bag = open_bag(path)
+    assert bag.message_count == len(kept) == len(sent) // 2 and not bag.complete
+    assert [(m.log_time_ns, m.topic, m.message) for m in bag.messages(raw=True)] == kept
+    bag_dir = tmp_path / "cut"
+    bag_dir.mkdir()
+    shutil.copy(path, bag_dir / "cut_0.mcap")
+    assert repair_bag(bag_dir).messages_recovered == len(kept)
+    with open_bag(bag_dir) as repaired:
+        assert repaired.complete and [(m.log_time_ns, m.topic, m.message) for m in repaired.messages(raw=True)] == kept

@@ -1,8 +1,5 @@
-"""Recording runs to rosbag2 bags with MCAP storage (:class:`BagWriter`), reading them back with
-MCAP or SQLite 3 storage (:func:`open_bag`), repairing a killed recording (:func:`repair_bag`);
-the types are ROS 2 Jazzy's plus ``bearing_rig_msgs`` (:func:`rig_typestore`). No ROS import:
-bags are written and read with ``mcap`` and ``rosbags``.
-"""
+"""Recording runs (:class:`BagWriter`), reading bags (:func:`open_bag`), repairing a killed
+recording (:func:`repair_bag`), with ``mcap`` and ``rosbags``, no ROS import (docs/bags.md)."""
 
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import RUN_METADATA_RECORD

@@ -1,12 +1,8 @@
-"""CDR bytes as stored in bags: the project's one CDR module.
-
-Fast-CDR (behind ``rclpy.serialization.serialize_message``) pads a message with an empty sequence
-of 8-byte elements by 4 to 12 bytes, and rosbags' ``deserialize_cdr`` refuses more than 3.
-:func:`length_function` walks a message's lengths and alignment along its type's fields (a few
-microseconds) to its real length: the recorder stores messages cut to it (:func:`make_normaliser`),
-the reader decodes the cut bytes (:func:`make_decoder`), so padded bags from ``ros2 bag record``
-decode too. :func:`decode_pulse` and :func:`header_stamp_ns` read fields by hand, building no object.
-"""
+"""CDR bytes as stored in bags, the project's one CDR module: Fast-CDR pads a message with an empty
+sequence of 8-byte elements by 4 to 12 bytes and rosbags' ``deserialize_cdr`` refuses more than 3,
+so :func:`length_function` walks a message's fields to its real length, for the recorder
+(:func:`make_normaliser`) and the reader (:func:`make_decoder`); :func:`decode_pulse` and
+:func:`header_stamp_ns` read fields by hand, building no object."""
 
 from __future__ import annotations
 

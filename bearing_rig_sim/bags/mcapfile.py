@@ -1,7 +1,5 @@
 """One MCAP storage file read with the ``mcap`` library, for reading and repairing: its index
-from the summary of a finished file (``SeekingReader.get_summary``), else from a scan record by
-record (``StreamReader`` with ``emit_chunks``, chunks checksummed by ``breakup_chunk``) that skips
-a damaged chunk and stops at the first record cut by the end of the file; its messages in time order."""
+(from its summary, else a scan record by record) and its messages in time order (docs/bags.md)."""
 
 from __future__ import annotations
 
@@ -11,12 +9,12 @@ import struct
 from dataclasses import dataclass, field
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import BinaryIO
+from typing import BinaryIO, TypeVar
 
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
-from mcap.reader import SeekingReader
+from mcap.reader import NonSeekingReader, SeekingReader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Header, McapRecord, Message, Metadata, Schema
 from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_stream, read_magic
 from mcap.writer import MCAP0_MAGIC
@@ -34,21 +32,21 @@ class DamagedRecord(Exception):
 
 @dataclass(frozen=True)
 class ChunkRef:
-    """A chunk record, or a run of message records outside chunks (``loose``), from ``offset``
-    to ``stop`` in the file: its log-time range and channels (None when not indexed)."""
+    """A chunk record from ``offset`` to ``stop`` in the file: its log-time range and channels
+    (None when not indexed)."""
 
     offset: int
     stop: int
     start_ns: int
     end_ns: int
     channel_ids: frozenset[int] | None = None
-    loose: bool = False
 
 
 @dataclass
 class McapIndex(FileIndex):
-    """:class:`.storage.FileIndex` of an MCAP file, plus its header's profile and library, message
-    groups in file order, the offset after the last readable record, the first chunk's compression."""
+    """:class:`.storage.FileIndex` of an MCAP file, plus its header's profile and library, chunks in
+    file order, the offset after the last readable record, the first chunk's compression, and
+    whether messages lie outside chunks (``unchunked``: read by the mcap library's own reader)."""
 
     profile: str = ""
     library: str = ""
@@ -56,6 +54,7 @@ class McapIndex(FileIndex):
     readable_bytes: int = 0
     file_size: int = 0
     compression: str = ""
+    unchunked: bool = False
 
     def add_channel(self, channel: Channel, schemas: dict[int, Schema]) -> None:
         """Record a channel; its type is its schema's name."""
@@ -68,10 +67,16 @@ class McapIndex(FileIndex):
             self.definitions.setdefault(schema.name, (schema.encoding, schema.data.decode("utf-8", errors="replace")))
 
 
-def _one_record(stream: BinaryIO, offset: int) -> McapRecord:
-    """The record at ``offset`` (chunks not opened)."""
+Indexed = TypeVar("Indexed", Chunk, Metadata)
+
+
+def _one_record(stream: BinaryIO, offset: int, kind: type[Indexed]) -> Indexed:
+    """The record of type ``kind`` at ``offset`` (a chunk not opened); McapError for another record."""
     stream.seek(offset)
-    return next(iter(StreamReader(stream, skip_magic=True, emit_chunks=True).records))
+    record = next(iter(StreamReader(stream, skip_magic=True, emit_chunks=True).records))
+    if not isinstance(record, kind):
+        raise McapError(f"no {kind.__name__.lower()} record at offset {offset} ({type(record).__name__} found)")
+    return record
 
 
 @contextlib.contextmanager
@@ -88,8 +93,8 @@ _MESSAGE_HEAD = struct.Struct("<HIQQ")  # channel id, sequence, log time, publis
 
 
 def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageTuple]:
-    """The message records ``keep`` accepts in a run of records (a decompressed chunk, or messages
-    outside chunks), sliced out by hand: four times faster than ``breakup_chunk`` (docs/bags.md)."""
+    """The message records ``keep`` accepts in a decompressed chunk, sliced out by hand: four times
+    faster than ``breakup_chunk`` (docs/bags.md)."""
     out = []
     position, end = 0, len(data)
     head, message = _RECORD_HEAD.unpack_from, _MESSAGE_HEAD.unpack_from
@@ -106,20 +111,13 @@ def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageT
 
 
 def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool] = lambda _c, _t: True) -> list[MessageTuple]:
-    """Messages of one group that ``keep(channel_id, log_time)`` accepts, stably sorted by log time;
+    """Messages of one chunk that ``keep(channel_id, log_time)`` accepts, stably sorted by log time;
     DamagedRecord for a chunk truncated, corrupt or not decompressing."""
     try:
-        stream.seek(ref.offset)
-        if ref.loose:
-            data = stream.read(ref.stop - ref.offset)
-        else:
-            chunk = _one_record(stream, ref.offset)
-            if not isinstance(chunk, Chunk):
-                raise DamagedRecord(f"no chunk record at offset {ref.offset}")
-            with _opening_chunk():
-                stream_of_data, size = get_chunk_data_stream(chunk, validate_crc=True)
-                data = stream_of_data.read(size)
-        messages = _messages_in(data, keep)
+        chunk = _one_record(stream, ref.offset, Chunk)
+        with _opening_chunk():
+            stream_of_data, size = get_chunk_data_stream(chunk, validate_crc=True)
+            messages = _messages_in(stream_of_data.read(size), keep)
     except _UNREADABLE as exc:
         raise DamagedRecord(f"unreadable at offset {ref.offset} ({exc or type(exc).__name__})") from None
     messages.sort(key=lambda m: m[0])
@@ -138,8 +136,8 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
     if summary is None or summary.statistics is None:
         return False
     stats = summary.statistics
-    if stats.message_count and (not summary.chunk_indexes or not summary.channels):
-        return False  # messages outside chunks, or definitions not repeated: only a scan finds them
+    if stats.message_count and not summary.channels:
+        return False  # channels not repeated in the summary: only a scan finds them
     if any(c.chunk_start_offset + c.chunk_length > index.file_size for c in summary.chunk_indexes):
         return False
     for schema in summary.schemas.values():
@@ -150,13 +148,12 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
         channels = frozenset(c.message_index_offsets) if c.message_index_offsets else None
         index.chunks.append(ChunkRef(c.chunk_start_offset, c.chunk_start_offset + c.chunk_length, c.message_start_time, c.message_end_time, channels))
     index.compression = summary.chunk_indexes[0].compression if summary.chunk_indexes else ""
+    index.unchunked = bool(stats.message_count and not summary.chunk_indexes)
     index.message_count, index.channel_counts = stats.message_count, dict(stats.channel_message_counts)
     index.start_ns, index.end_ns = stats.message_start_time, stats.message_end_time
     for entry in summary.metadata_indexes:
         try:
-            record = _one_record(stream, entry.offset)
-            if not isinstance(record, Metadata):
-                raise McapError(f"{type(record).__name__} found")
+            record = _one_record(stream, entry.offset, Metadata)
         except (*_UNREADABLE, StopIteration):
             index.problems.append(f"{index.path.name}: metadata record {entry.name!r} is unreadable")
             continue
@@ -169,14 +166,8 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
 def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> None:
     """Fill ``index`` from the records after the header (see the module documentation)."""
     name = index.path.name
-    start = run_start = stream.tell()
+    start = stream.tell()
     schemas: dict[int, Schema] = {}
-    loose: list[tuple[int, int]] = []  # (channel, log time) of the current run of messages outside chunks
-
-    def add_group(offset: int, stop: int, messages: list[tuple[int, int]], is_loose: bool) -> None:
-        if messages:
-            times = [t for _c, t in messages]
-            index.chunks.append(ChunkRef(offset, stop, min(times), max(times), frozenset(c for c, _t in messages), is_loose))
 
     def note(record: McapRecord) -> None:
         if isinstance(record, Message):
@@ -192,12 +183,7 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
     try:
         for record in records:
             end = stream.tell()
-            if isinstance(record, Message):
-                run_start = run_start if loose else start
-                loose.append((record.channel_id, record.log_time))
-            else:
-                add_group(run_start, start, loose, True)
-                loose = []
+            index.unchunked = index.unchunked or isinstance(record, Message)
             inner: list[McapRecord] = [record]
             if isinstance(record, Chunk):
                 index.compression = index.compression or record.compression
@@ -207,7 +193,9 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
                 except DamagedRecord as exc:
                     index.problems.append(f"{name}: chunk record at offset {start} is damaged ({exc}); skipped")
                     inner = []
-                add_group(start, end, [(m.channel_id, m.log_time) for m in inner if isinstance(m, Message)], False)
+                if messages := [(m.channel_id, m.log_time) for m in inner if isinstance(m, Message)]:
+                    times = [t for _c, t in messages]
+                    index.chunks.append(ChunkRef(start, end, min(times), max(times), frozenset(c for c, _t in messages)))
             for item in inner:
                 note(item)
             start = end
@@ -223,7 +211,6 @@ def _scan(stream: BinaryIO, records: Iterator[McapRecord], index: McapIndex) -> 
             size = f" of {9 + _RECORD_HEAD.unpack(head)[1]}" if len(head) == 9 else ""  # none when the length itself is cut
             state = "cut by the end of the file" if isinstance(exc, (EndOfFile, struct.error)) else f"damaged ({exc})"
             index.problems.append(f"{name}: {kind} record at offset {start} is {state} ({index.file_size - start}{size} bytes present)")
-    add_group(run_start, start, loose, True)
     index.readable_bytes = start
 
 
@@ -308,8 +295,9 @@ class McapFormat:
         report: ProblemSink = drop_problem,
     ) -> Iterator[MessageTuple]:
         """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
-        in log-time order, streamed: memory holds the chunks whose time ranges overlap. Damaged
-        chunks are reported through ``report`` and skipped."""
+        in log-time order, streamed: memory holds the chunks whose time ranges overlap (the whole
+        file's wanted messages for an ``unchunked`` one, read by the mcap library up to its first
+        unreadable record). Damaged chunks are reported through ``report`` and skipped."""
         assert isinstance(index, McapIndex)
         wanted = None if channel_ids is None else frozenset(channel_ids)
         low = -1 if start_ns is None else start_ns
@@ -326,5 +314,13 @@ class McapFormat:
             report(f"{index.path}: cannot open ({exc.strerror or exc})")
             return
         with stream:
+            if index.unchunked:
+                found = []
+                with contextlib.suppress(Exception):  # what the library raises at a cut or damage (as _opening_chunk)
+                    for _schema, _channel, m in NonSeekingReader(stream, validate_crcs=True).iter_messages(log_time_order=False):
+                        if keep(m.channel_id, m.log_time):
+                            found.append((m.log_time, m.channel_id, m.publish_time, m.data))
+                yield from sorted(found, key=lambda m: m[0])
+                return
             chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
             yield from (m for m in merge_in_time(chunks) if m[1] >= 0)

@@ -3,10 +3,9 @@
     with open_bag("bags/run-0001") as bag:
         for topic, log_time_ns, msgtype, message in bag.messages(["/rig/cage/pulses"]): ...
 
-Messages come in log-time order, streamed, decoded into rosbags objects with the definitions the
-bag carries (an old bag keeps decoding after a message changes), else ROS 2 Jazzy's and
-``bearing_rig_msgs``'. Damage is not fatal (``docs/bags.md``): each problem is a :class:`BagWarning`
-and a line in :attr:`BagReader.problems`; ``strict=True`` makes it a :class:`BagError`.
+Messages come in log-time order, streamed, decoded as docs/bags.md says. Damage is not fatal: each
+problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:class:`BagError` with
+``strict=True``).
 """
 
 from __future__ import annotations
@@ -37,12 +36,12 @@ STORAGE_FORMATS: dict[str, StorageFormat] = {"mcap": McapFormat(), "sqlite3": Sq
 """The storage formats this project reads, by ``storage_identifier`` (see :mod:`.storage`)."""
 
 
-def storage_format(identifier: str) -> StorageFormat:
-    """The format of a ``storage_identifier``; BagError naming those read for another."""
+def storage_format(identifier: str, source: str = "") -> StorageFormat:
+    """The format of a ``storage_identifier`` (stated in ``source``); BagError naming those read for another."""
     try:
         return STORAGE_FORMATS[identifier]
     except KeyError:
-        raise BagError(f"storage {identifier!r} is not supported (this project reads: {', '.join(sorted(STORAGE_FORMATS))})") from None
+        raise BagError(f"{source}{': ' if source else ''}storage {identifier!r} is not supported (this project reads: {', '.join(sorted(STORAGE_FORMATS))})") from None
 
 
 class BagMessage(NamedTuple):
@@ -100,10 +99,7 @@ class BagReader:
         self._format = STORAGE_FORMATS["mcap"]
         if self.path.is_dir():
             self.layout = read_layout(self.path)
-            try:
-                self._format = storage_format(self.layout.storage_identifier)
-            except BagError as exc:
-                raise BagError(f"{self.path / 'metadata.yaml'}: {exc}") from None
+            self._format = storage_format(self.layout.storage_identifier, str(self.path / "metadata.yaml"))
             files = [self.path / f.path for f in self.layout.files]
             missing = [f for f in files if not f.is_file()]
             if files and len(missing) == len(files):

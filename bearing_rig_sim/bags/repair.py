@@ -1,9 +1,4 @@
-"""Repairing a bag whose recording was killed (``bearing-rig bag repair BAG...``, docs/bags.md):
-each storage file is indexed and its chunks checked; a damaged one is rewritten from its readable
-chunks as a finished file, the original kept as ``<name>.mcap.orig`` (a file that is not MCAP is
-moved aside so); ``metadata.yaml`` is rebuilt from the files (the old one kept as
-``metadata.yaml.orig``). A bag that needs nothing is left unchanged.
-"""
+"""Repairing a bag whose recording was killed: ``bearing-rig bag repair BAG...``, docs/bags.md."""
 
 from __future__ import annotations
 

@@ -1,6 +1,5 @@
-"""rosbag2 bags with SQLite 3 storage (``.db3``, rosbag2's default before Iron, what older benches
-record), read through rosbags as one :class:`~.storage.FileIndex` per bag. Every message is a
-committed row, so there is nothing to repair."""
+"""rosbag2 bags with SQLite 3 storage (``.db3``, docs/bags.md), read through rosbags as one
+:class:`~.storage.FileIndex` per bag."""
 
 from __future__ import annotations
 

@@ -51,7 +51,7 @@ from bearing_rig_sim.dynamics.traction import (
     ellipse_traction,
     spin_and_heathcote,
 )
-from bearing_rig_sim.thermal.bearing import HeatSources, ThermalConfig, build_network, heat_sources, node_heat
+from bearing_rig_sim.thermal.bearing import HeatLedger, HeatSources, ThermalConfig, build_network, heat_sources, node_heat
 from bearing_rig_sim.thermal.network import ThermalNetwork
 
 TEMPERATURE_DEPENDENT = (
@@ -464,8 +464,9 @@ MAX_LUBRICANT_C = 200.0
 class _HeatAtTemperature:
     """The engine's steady heat at a lubricant temperature, cached (each costs a traction table
     and a steady solution: about a second or two). Under a radial load (or a moment) the steady
-    state is periodic (:meth:`SteadySolver.periodic`): its heat is the mean over the whole
-    ball-pass periods of its window, split in the proportions of the window's last step."""
+    state is periodic (:meth:`SteadySolver.periodic`): its heat, term by term, is each term's
+    energy over a window of whole ball-pass periods, as long as the periodic state's averaging
+    window and following it, over the window's length (:class:`HeatLedger`)."""
 
     def __init__(
         self, params: BearingParameters, inner_ring_speed: float, axial_load: float, radial_load: float = 0.0, moment: tuple[float, float] | None = None
@@ -493,7 +494,11 @@ class _HeatAtTemperature:
                 point = solver.periodic(self.speed, self.load, self.radial, moment=self.moment)
                 window = solver.last_average
                 assert window is not None and window.duration > 0.0
-                sources = heat_sources(solver.engine).scaled(window.heat / window.duration, window.damping_heat / window.duration)
+                # the heat split: each term's energy over the next window of as many whole
+                # ball-pass periods, stepped and summed step by step
+                ledger = HeatLedger(solver.engine)
+                ledger.advance(window.duration)
+                sources = ledger.mean()
             else:
                 point = solver.solve(self.speed, self.load)
                 sources = heat_sources(solver.engine)
@@ -556,19 +561,30 @@ def thermal_steady_state(
 
 
 def warm_up(
-    params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, duration: float, *, step: float = 1.0, grid: int = 4
+    params: BearingParameters,
+    config: ThermalConfig,
+    inner_ring_speed: float,
+    axial_load: float,
+    duration: float,
+    *,
+    step: float = 1.0,
+    grid: int = 4,
+    radial_load: float = 0.0,
+    moment: tuple[float, float] | None = None,
 ) -> list[dict[str, float]]:
     """Temperatures and torque over ``duration`` seconds from ambient, at constant speed (rad/s)
     and axial load (N): the engine's steady heat at ``grid`` lubricant temperatures from
     ambient to the coupled steady one, interpolated in the lubricant's temperature as the
-    network warms (exact exponential steps of ``step`` s).
+    network warms (exact exponential steps of ``step`` s). With ``radial_load`` (N) or
+    ``moment`` (N m) the heat is the periodic state's under the combined load
+    (:func:`thermal_steady_state`).
 
     Returns:
         one row per step: ``time_s``, each node's ``<node>_c``, ``friction_torque_nm``,
         ``power_loss_w``.
     """
-    steady = thermal_steady_state(params, config, inner_ring_speed, axial_load)
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load)
+    steady = thermal_steady_state(params, config, inner_ring_speed, axial_load, radial_load=radial_load, moment=moment)
+    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     t_hi = max(steady.temperatures["lubricant"], config.ambient + 0.5)
     temps = list(np.linspace(config.ambient, t_hi, grid))
     table = [heat(t) for t in temps]

@@ -11,7 +11,7 @@ from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 from bearing_rig_sim.dynamics.steady import SteadySolver
 from bearing_rig_sim.thermal.bearing import HeatSources, ThermalConfig, build_network, heat_sources, node_heat
-from bearing_rig_sim.thermal.coupling import _HeatAtTemperature, thermal_steady_state, warm_up
+from bearing_rig_sim.thermal.coupling import HeatAtTemperature, thermal_steady_state, warm_up
 
 OMEGA = rpm_to_rad_s(900.0)
 AXIAL, RADIAL = 163.0, 500.0  # N, issue 23's case
@@ -29,7 +29,7 @@ def test_under_a_radial_load_each_terms_heat_is_its_energy_over_whole_ball_pass_
     length, not the last step's proportions. Independently here: the same periodic state, then
     as long a window stepped one step at a time, each step's terms times the step summed, and
     the engine's cumulative dissipation counter differenced over the window."""
-    _, got = _HeatAtTemperature(params, OMEGA, AXIAL, RADIAL)(params.lubricant_temperature)
+    _, got = HeatAtTemperature(params, OMEGA, AXIAL, RADIAL)(params.lubricant_temperature)
 
     solver = SteadySolver(params)
     solver.periodic(OMEGA, AXIAL, RADIAL)

@@ -498,12 +498,23 @@ MAX_LUBRICANT_C = 200.0
 """Highest lubricant temperature the steady search tries, degC (the lubricant files' range)."""
 
 
-class _HeatAtTemperature:
+class HeatAtTemperature:
     """The engine's steady heat at a lubricant temperature, cached (each costs a traction table
     and a steady solution: about a second or two). Under a radial load (or a moment) the steady
     state is periodic (:meth:`SteadySolver.periodic`): its heat, term by term, is each term's
     energy over a window of whole ball-pass periods, as long as the periodic state's averaging
-    window and following it, over the window's length (:class:`HeatLedger`)."""
+    window and following it, over the window's length (:class:`HeatLedger`).
+
+    Args:
+        params: the bearing (its lubricant at the file's temperature).
+        inner_ring_speed: rad/s (> 0).
+        axial_load: N.
+        radial_load: N (0: the axial steady state).
+        moment: (M_x, M_y) N m with the tilts free, or None.
+
+    Calling it with a lubricant temperature (degC) returns the engine's steady point there and
+    its heat, term by term (W).
+    """
 
     def __init__(
         self, params: BearingParameters, inner_ring_speed: float, axial_load: float, radial_load: float = 0.0, moment: tuple[float, float] | None = None
@@ -566,7 +577,7 @@ def thermal_steady_state(
     temperature (g falls with T: warmer lubricant, less heat). With ``radial_load`` (N) or
     ``moment`` (N m, tilts free) the engine's steady state is the periodic one under the
     combined load; the network's conductances stay those of the axial load."""
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
+    heat = HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     lub_i = 4  # "lubricant" in NODES
 
     def g(t: float) -> float:
@@ -621,7 +632,7 @@ def warm_up(
         ``power_loss_w``.
     """
     steady = thermal_steady_state(params, config, inner_ring_speed, axial_load, radial_load=radial_load, moment=moment)
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
+    heat = HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     t_hi = max(steady.temperatures["lubricant"], config.ambient + 0.5)
     temps = list(np.linspace(config.ambient, t_hi, grid))
     table = [heat(t) for t in temps]

@@ -57,7 +57,6 @@ def test_a_given_moment_tilts_the_ring_instead(capsys: pytest.CaptureFixture[str
         (["--radial-load", "1", "2", "3"], "one per speed"),
         (["--moment", "1", "0"], "--moment needs --radial-load"),
         (["--radial-load", "100", "--moment", "nan", "0"], "--moment"),
-        (["--radial-load", "100", "--transient", "10"], "--transient takes the axial load only"),
     ],
 )
 def test_bad_combined_load_options_are_refused(capsys: pytest.CaptureFixture[str], argv: list[str], needle: str) -> None:

@@ -124,8 +124,7 @@ def test_the_stiff_models_raceway_damping_takes_a_knocked_rings_energy() -> None
     takes the vibration's energy. The drive does no work; the damping's heat (raceway contacts,
     pockets and rim) equals the mechanical energy lost within 1 % over 10 ms, which is a good
     part of the knock's m v^2 / 2 (before the raceway contacts' damping was counted, the heat of
-    damping was 0). The friction heat is left out of this account: at rest the stiff model
-    dissipates a few milliwatts with no drive work (docs/thermal.md)."""
+    damping was 0). The friction heat is left out of this account (its own test below)."""
     params = grease_twin()
     engine = BearingDynamics(params, model="stiff")
     engine.initialise(0.0, 100.0)
@@ -141,6 +140,36 @@ def test_the_stiff_models_raceway_damping_takes_a_knocked_rings_energy() -> None
     assert work == 0.0
     assert lost > 0.3 * 0.5 * params.inner_ring_axial_mass * v0 * v0
     assert damping == pytest.approx(lost, rel=0.01)
+
+
+def test_the_stiff_model_at_rest_only_loses_energy_and_its_balls_stop() -> None:
+    """Stiff reference model under 100 N with the inner ring stopped: a passive system, so with
+    no drive work its mechanical energy can only fall, its heat is never negative, and its
+    balls, set spinning at 1 rad/s and orbiting at 0.1 rad/s, come to rest with the dissipation
+    going to zero. (Before, the balls' spin and pivot chattered at +-0.09 rad/s every other
+    step, the explicit step unstable on the traction's slope at the 1 mm/s entrainment floor,
+    and the rheology table's offset at SRR = 0, spin and Heathcote slip of a rolling contact,
+    pushed balls that did not roll: 4.5 mW of heat at rest with no drive work.)"""
+    engine = BearingDynamics(grease_twin(), model="stiff")
+    engine.initialise(0.0, 100.0)
+    engine.advance(1e-3)
+    engine.ball[:, kn.B_SPIN] += 1.0
+    engine.ball[:, kn.B_OMEGA] += 0.1
+    energy = [engine.energy()]
+    heat = []
+    for _ in range(30):
+        avg = engine.advance(CHUNK_S)
+        assert avg.drive_work == 0.0
+        heat.append(avg.heat + avg.damping_heat + avg.contact_damping_heat)
+        energy.append(engine.energy())
+    assert min(heat) >= 0.0
+    assert all(b <= a + 1e-15 for a, b in zip(energy, energy[1:]))  # J; the energy's rounding
+    # the energy lost is the kinetic energy given, and the heat accounts for it
+    kinetic = 0.5 * 16 * (engine.vector[kn.P_IBALL] * 1.0 + engine.vector[kn.P_MBALL] * engine.vector[kn.P_RM] ** 2 * 0.01)
+    assert energy[0] - energy[-1] == pytest.approx(sum(heat), rel=0.02)
+    assert energy[0] - energy[-1] == pytest.approx(kinetic, rel=0.1)
+    assert heat[-1] / CHUNK_S < 1e-9  # W: the dissipation has gone to zero
+    assert np.max(np.abs(engine.ball[:, [kn.B_OMEGA, kn.B_SPIN, kn.B_PIVOT]])) < 1e-6  # rad/s
 
 
 def test_reduced_model_conserves_energy_with_every_resistance_off() -> None:

@@ -25,10 +25,10 @@ periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`),
 frequency, both null with ``cage_whirl_reason`` when the centre does not orbit
 (:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`), and no uncertainty interval (the
 calibration's is an axial-load one). With ``--thermal`` such a
-point is the coupled thermal steady state of that periodic state (its heat the mean over the
-window's whole ball-pass periods; the network's conductances those of the axial load), its
-``isothermal`` values the periodic state at the bearing file's temperature. ``--transient``
-takes the axial load only.
+point is the coupled thermal steady state of that periodic state (its heat, term by term, each
+term's energy over whole ball-pass periods over their length; the network's conductances those
+of the axial load), its ``isothermal`` values the periodic state at the bearing file's
+temperature, and ``--transient`` warms up under the combined load.
 
 The mounting (non-thermal path; docs/model.md, "Mounting"): ``--clearance M`` an extra diametral
 clearance (m, negative: interference), ``--misalignment RAD RAD`` the tilts held, ``--preload-n N``
@@ -131,8 +131,6 @@ def run(args: argparse.Namespace) -> int:
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)
     radial = _radial_loads(args)
     params = load_parameters(args.bearing, args.calibration, args.lubricant)
-    if args.transient is not None and radial is not None:
-        raise RigError("--transient takes the axial load only: give --thermal for the steady state under --radial-load")
     mounting = mounting_of(args)
     if args.thermal or args.transient is not None:
         if mounting is not None:
@@ -267,12 +265,13 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
     moment = None if args.moment is None else (float(args.moment[0]), float(args.moment[1]))
     for k, (n, f) in enumerate(zip(args.rpm, loads)):
         omega = rpm_to_rad_s(n)
-        if args.transient is not None:
-            for r in warm_up(params, cfg, omega, f, args.transient, step=args.transient_step):
-                _print({"rpm": n, "axial_load_n": f, **r}, args.json)
-            continue
         f_r = radial[k] if radial is not None else 0.0
         combined = radial is not None and (f_r > 0.0 or moment is not None)
+        if args.transient is not None:
+            extra = {"radial_load_n": f_r} if combined else {}
+            for r in warm_up(params, cfg, omega, f, args.transient, step=args.transient_step, radial_load=f_r, moment=moment):
+                _print({"rpm": n, "axial_load_n": f, **extra, **r}, args.json)
+            continue
         ts = thermal_steady_state(params, cfg, omega, f, radial_load=f_r, moment=moment) if combined else thermal_steady_state(params, cfg, omega, f)
         pt = ts.point
         s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)

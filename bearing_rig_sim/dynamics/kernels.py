@@ -1611,6 +1611,11 @@ NW = NG + 8 + 35
 w0 + 29 onwards: the pivot's and the pitch's elimination)."""
 
 
+ENTRAINMENT_FLOOR = 1e-3
+"""The entrainment speed below which the rheology table is read at this speed, m/s
+(:func:`contact_traction`)."""
+
+
 @njit(cache=True)
 def step_stiff(
     p: np.ndarray,
@@ -1666,11 +1671,21 @@ def step_stiff(
             qo, _, _ = impact_force(do, rate_o, p[P_K_OUT], p)
             # the raceway contacts' Hunt-Crossley damping: the force beyond Hertz's, times the rate
             contact_damp += impact_damping_power(di, rate_i, qi, p[P_K_IN]) + impact_damping_power(do, rate_o, qo, p[P_K_OUT])
-            fi, fo, _, _, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
+            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
                 p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, di, do
             )
-            drive += fi * r_ci
             wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
+            if p[P_FRIC_MODEL] == 2.0:
+                # the rheology table's offset at SRR = 0 (spin and Heathcote slip, which go with
+                # the rolling) fades out below the table's entrainment floor: a contact that
+                # does not roll has no spin, and no traction without sliding
+                _, r_co, _, _, _, _, _, _, _ = ball_kinematics(p, nir, niz, nor, noz, rb)
+                uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
+                if uei < ENTRAINMENT_FLOOR and qi > 0.0:
+                    fi -= (1.0 - uei / ENTRAINMENT_FLOOR) * qi * contact_traction(p, 0, 0.0, uei, qi)[0]
+                if ueo < ENTRAINMENT_FLOOR and qo > 0.0:
+                    fo -= (1.0 - ueo / ENTRAINMENT_FLOOR) * qo * contact_traction(p, 1, 0.0, ueo, qo)[0]
+            drive += fi * r_ci
             g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
             fd, _ = ball_drag(p, rb * wm)
             gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
@@ -1703,13 +1718,30 @@ def step_stiff(
             # momenta at the current positions (p_theta first: p_r's update needs it)
             # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
             # pivot (symplectic Euler on the skew terms: bounded energy error)
-            wt = wt - dt * (g * (wa + cb * wm) + r * r * kpiv * wt) / ib
+            # the raceway tractions linearly implicit (their slopes, as step_reduced): at a low
+            # entrainment speed the traction's slope in the sliding speed grows as 1/u_e
+            # (u_e >= 1 mm/s), so that dt r^2 k_t / J reaches 3 for a ball at rest; explicit,
+            # its spin and pivot chattered at +-0.09 rad/s every other step, a bounded
+            # oscillation whose f s read as 4.5 mW of heat with no drive work
+            wt_old = wt
+            wt = (ib * wt - dt * g * (wa + cb * wm)) / (ib + dt * r * r * kpiv)
             ball[j, B_PIVOT] = wt
-            ptheta = m * rb * rb * wm + dt * (rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt)
-            wnew = ptheta / (m * rb * rb)
+            gm = rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt
+            ga = r * (ci * fi - co * fo) - mres + g * wt
+            b11 = m * rb * rb + dt * rb * (kti * aim + kto * aom)
+            b12 = dt * rb * (kti * aia - kto * aoa)
+            b21 = dt * r * (ci * kti * aim - co * kto * aom)
+            b22 = ib + dt * r * (ci * kti * aia + co * kto * aoa)
+            det = b11 * b22 - b12 * b21
+            d_wm = dt * (b22 * gm - b12 * ga) / det
+            d_wa = dt * (b11 * ga - b21 * gm) / det
+            d_drive = r_ci * kti * (aim * d_wm + aia * d_wa)  # the inner traction's implicit part
+            drive -= d_drive
+            ptheta = m * rb * rb * (wm + d_wm)
+            wnew = wm + d_wm
             vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
             vz_new = vz + dt * (-qi * niz - qo * noz) / m
-            ball[j, B_SPIN] = wa + dt * (r * (ci * fi - co * fo) - mres + g * wt) / ib
+            ball[j, B_SPIN] = wa + d_wa
             ball[j, B_THETA] += dt * wnew
             rb_new = rb + dt * vr_new
             ball[j, B_R] = rb_new
@@ -1718,12 +1750,18 @@ def step_stiff(
             ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
             ring_force += qi * niz
             torque[j] = rm * fs
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2)
+            # the tractions' heat as the implicit step applies them: the force at the step's end
+            # times the step's mean sliding (exactly the kinetic energy a linear law takes)
+            dsi, dso = -aim * d_wm - aia * d_wa, -aom * d_wm + aoa * d_wa
+            pivot = kpiv * r * r * wt * 0.5 * (wt_old + wt)
+            power = ball_power(
+                wm, wa, rb, omega_i, fi + kti * dsi, fo + kto * dso, si + 0.5 * dsi, so + 0.5 * dso, mres, fd, t_inner, m_ring, t_orbit, cb, pivot
+            )
             heat += power
             if keep:
                 record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
                 out[j, O_POWER] = power
-                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
+                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - d_drive
         stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)

@@ -209,6 +209,48 @@ def heat_sources(engine: BearingDynamics) -> HeatSources:
     return HeatSources(pin, pout, drag, land, rest)
 
 
+class HeatLedger:
+    """Cumulative heat of an engine, term by term, J: the engine stepped one time step at a time
+    and each step's terms (:func:`heat_sources` of its state) times the step, so the means over
+    a window are energy-weighted (a ball passing through a radial load zone, the terms vary over
+    a ball-pass period; the proportions of one step are not those of the period).
+
+    The four named terms (:attr:`energy` order: inner contacts, outer contacts, drag, land) are
+    the step sums; the rolling and pocket term is what the engine's own cumulative counter
+    (:attr:`BearingDynamics.dissipated` less its damping) holds beyond them, so the terms close
+    on the engine's dissipation exactly.
+    """
+
+    def __init__(self, engine: BearingDynamics) -> None:
+        self.engine = engine
+        self.energy = np.zeros(4)
+        """Inner contacts, outer contacts, drag and land heat since the ledger began, J."""
+        self.time = 0.0
+        """Simulated time since the ledger began, s."""
+        self._start = (engine.dissipated, engine.damping_dissipated)
+
+    def advance(self, duration: float) -> None:
+        """Step the engine ``duration`` seconds (whole steps), one step at a time."""
+        e = self.engine
+        dt = e.time_step
+        for _ in range(int(round(duration / dt))):
+            e.advance(dt)
+            s = heat_sources(e)
+            self.energy += dt * np.array([s.inner_contacts, s.outer_contacts, s.drag, s.land])
+            self.time += dt
+
+    def mean(self) -> HeatSources:
+        """The mean heat since the ledger began, term by term, W (each term's energy over the
+        time); the terms sum to the engine's dissipation over the time."""
+        if self.time <= 0.0:
+            raise ValueError("the ledger has not run: no mean")
+        heat = self.engine.dissipated - self._start[0]
+        damping = self.engine.damping_dissipated - self._start[1]
+        pin, pout, drag, land = self.energy / self.time
+        rest = (heat - damping) / self.time - (pin + pout + drag + land)
+        return HeatSources(float(pin), float(pout), float(drag), float(land), float(rest), damping / self.time)
+
+
 def node_heat(sources: HeatSources) -> dict[str, float]:
     """Heat into each node (W) by the partition rules of this module's doc."""
     s = sources

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
+from numba import njit
 
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
@@ -41,7 +42,6 @@ from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.dynamics.traction import (
     HEADER,
-    mu_nodes,
     LOAD_RANGE,
     N_LOAD,
     N_SPEED,
@@ -52,7 +52,7 @@ from bearing_rig_sim.dynamics.traction import (
     ellipse_traction,
     spin_and_heathcote,
 )
-from bearing_rig_sim.thermal.bearing import HeatSources, ThermalConfig, build_network, heat_sources, node_heat
+from bearing_rig_sim.thermal.bearing import HeatLedger, HeatSources, ThermalConfig, build_network, heat_sources, node_heat
 from bearing_rig_sim.thermal.network import ThermalNetwork
 
 TEMPERATURE_DEPENDENT = (
@@ -70,15 +70,20 @@ TEMPERATURE_DEPENDENT = (
 table aside)."""
 
 
-def params_at_temperature(params: BearingParameters, temperature_c: float) -> BearingParameters:
+def params_at_temperature(params: BearingParameters, temperature_c: float, **changes: object) -> BearingParameters:
     """``params`` with the lubricant at ``temperature_c`` (degC); the bearing file's temperature
-    is the reference of the grease's rheology (the calibration's values hold there)."""
+    is the reference of the grease's rheology (the calibration's values hold there). ``changes``
+    are other fields to set in the same copy."""
     lub = params.lubricant
     if lub is None:
-        return params
+        return params.replace(**changes) if changes else params
     warm = lub.at_temperature(temperature_c, params.lubricant_temperature)
     return params.replace(
-        lubricant=warm, lubricant_temperature=float(temperature_c), oil_viscosity=warm.dynamic_viscosity(temperature_c), oil_density=warm.density(temperature_c)
+        lubricant=warm,
+        lubricant_temperature=float(temperature_c),
+        oil_viscosity=warm.dynamic_viscosity(temperature_c),
+        oil_density=warm.density(temperature_c),
+        **changes,
     )
 
 
@@ -86,8 +91,7 @@ def resistance_vector(params: BearingParameters, temperature_c: float) -> np.nda
     """The kernel parameter vector's temperature-dependent entries at ``temperature_c`` (all
     :data:`kn.P_SIZE` entries; use those of :data:`TEMPERATURE_DEPENDENT`), without building a
     traction table (under a millisecond)."""
-    warm = params_at_temperature(params, temperature_c)
-    vector, _ = derive(warm.replace(friction_model="ehl_traction"))
+    vector, _ = derive(params_at_temperature(params, temperature_c, friction_model="ehl_traction"))  # one copy: the running retune's cost
     return vector[: kn.P_SIZE]
 
 
@@ -262,25 +266,58 @@ class TractionTableGrid:
         """The table at ``temperature_c``: the linear blend of the two neighbouring grid tables
         when both are built, else the nearer built one of them (None when neither is); with the
         temperature it stands for, degC."""
+        some = next(iter(self.tables.values()), None)
+        if some is None:
+            return None
+        out = np.empty_like(some)
+        stands_for = self.blend_into(out, temperature_c)
+        return None if stands_for is None else (out, stands_for)
+
+    def blend_into(self, out: np.ndarray, temperature_c: float) -> float | None:
+        """:meth:`blend` written into ``out`` (a table's size: the engine's parameter vector's
+        table, in place, without a copy); returns the temperature it stands for (None, ``out``
+        untouched, when neither neighbour is built)."""
         lo, hi, w = self.bracket(temperature_c)
         a, b = self.tables.get(lo), self.tables.get(hi)
         if a is not None and b is not None:
-            out = a.copy()
-            out[HEADER:] += w * (b[HEADER:] - a[HEADER:])
-            return out, float(temperature_c)
+            out[:HEADER] = a[:HEADER]
+            body = out[HEADER:]
+            np.subtract(b[HEADER:], a[HEADER:], out=body)
+            body *= w
+            body += a[HEADER:]  # a + w (b - a), as one expression would round it
+            return float(temperature_c)
         if a is not None:
-            return a, self.temperature(lo)
+            out[:] = a
+            return self.temperature(lo)
         if b is not None:
-            return b, self.temperature(hi)
+            out[:] = b
+            return self.temperature(hi)
         return None
+
+
+@njit(cache=True)
+def _largest_step(table: np.ndarray) -> float:
+    """max |mu[k+1] - mu[k]| between neighbouring SRR nodes of a table (layout of
+    :data:`~bearing_rig_sim.dynamics.traction.HEADER`: (mu, power) pairs, SRR fastest), in one
+    pass: ``np.max(np.abs(np.diff(mu_nodes(table, 0), axis=1)))`` without its copies (a fifth
+    of the running retune's time)."""
+    ns = int(table[0])
+    rows = 2 * int(table[1]) * int(table[2])
+    largest = 0.0
+    for row in range(rows):
+        start = HEADER + 2 * ns * row
+        for k in range(ns - 1):
+            d = abs(table[start + 2 * k + 2] - table[start + 2 * k])
+            if d > largest:
+                largest = d
+    return largest
 
 
 def steepest_traction_slope(table: np.ndarray) -> float:
     """The table's steepest d mu/d SRR (the kernel's ``P_MU_SLOPE_MAX``, as
     :func:`bearing_rig_sim.dynamics.parameters.derive` sets it)."""
     n_srr, xi_max = int(table[0]), table[3]
-    mu = mu_nodes(table, 0)
-    return float(np.max(np.abs(np.diff(mu, axis=1)))) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
+    return _largest_step(table) / (2.0 * xi_max / (n_srr - 1)) / SRR_REF
 
 
 class ThermalCoupling:
@@ -436,11 +473,11 @@ class ThermalCoupling:
         ahead = (hi + 1,) if temperature_c >= self._previous_temperature else (lo - 1,)
         grid.want(*((hi, lo) if w >= 0.5 else (lo, hi)), *ahead)
         self._previous_temperature = float(temperature_c)
-        got = grid.blend(temperature_c)
-        if got is not None:
-            table, self.table_temperature = got
-            base = int(vector[kn.P_TABLE])
-            vector[base : base + table.size] = table
+        base = int(vector[kn.P_TABLE])
+        table = vector[base:]  # the table ends the vector (parameters.derive)
+        stands_for = grid.blend_into(table, temperature_c)
+        if stands_for is not None:
+            self.table_temperature = stands_for
             vector[kn.P_MU_SLOPE_MAX] = steepest_traction_slope(table)
 
 
@@ -474,11 +511,23 @@ MAX_LUBRICANT_C = 200.0
 """Highest lubricant temperature the steady search tries, degC (the lubricant files' range)."""
 
 
-class _HeatAtTemperature:
+class HeatAtTemperature:
     """The engine's steady heat at a lubricant temperature, cached (each costs a traction table
     and a steady solution: about a second or two). Under a radial load (or a moment) the steady
-    state is periodic (:meth:`SteadySolver.periodic`): its heat is the mean over the whole
-    ball-pass periods of its window, split in the proportions of the window's last step."""
+    state is periodic (:meth:`SteadySolver.periodic`): its heat, term by term, is each term's
+    energy over a window of whole ball-pass periods, as long as the periodic state's averaging
+    window and following it, over the window's length (:class:`HeatLedger`).
+
+    Args:
+        params: the bearing (its lubricant at the file's temperature).
+        inner_ring_speed: rad/s (> 0).
+        axial_load: N.
+        radial_load: N (0: the axial steady state).
+        moment: (M_x, M_y) N m with the tilts free, or None.
+
+    Calling it with a lubricant temperature (degC) returns the engine's steady point there and
+    its heat, term by term (W).
+    """
 
     def __init__(
         self, params: BearingParameters, inner_ring_speed: float, axial_load: float, radial_load: float = 0.0, moment: tuple[float, float] | None = None
@@ -506,7 +555,11 @@ class _HeatAtTemperature:
                 point = solver.periodic(self.speed, self.load, self.radial, moment=self.moment)
                 window = solver.last_average
                 assert window is not None and window.duration > 0.0
-                sources = heat_sources(solver.engine).scaled(window.heat / window.duration, window.damping_heat / window.duration)
+                # the heat split: each term's energy over the next window of as many whole
+                # ball-pass periods, stepped and summed step by step
+                ledger = HeatLedger(solver.engine)
+                ledger.advance(window.duration)
+                sources = ledger.mean()
             else:
                 point = solver.solve(self.speed, self.load)
                 sources = heat_sources(solver.engine)
@@ -537,7 +590,7 @@ def thermal_steady_state(
     temperature (g falls with T: warmer lubricant, less heat). With ``radial_load`` (N) or
     ``moment`` (N m, tilts free) the engine's steady state is the periodic one under the
     combined load; the network's conductances stay those of the axial load."""
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
+    heat = HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     lub_i = 4  # "lubricant" in NODES
 
     def g(t: float) -> float:
@@ -569,19 +622,30 @@ def thermal_steady_state(
 
 
 def warm_up(
-    params: BearingParameters, config: ThermalConfig, inner_ring_speed: float, axial_load: float, duration: float, *, step: float = 1.0, grid: int = 4
+    params: BearingParameters,
+    config: ThermalConfig,
+    inner_ring_speed: float,
+    axial_load: float,
+    duration: float,
+    *,
+    step: float = 1.0,
+    grid: int = 4,
+    radial_load: float = 0.0,
+    moment: tuple[float, float] | None = None,
 ) -> list[dict[str, float]]:
     """Temperatures and torque over ``duration`` seconds from ambient, at constant speed (rad/s)
     and axial load (N): the engine's steady heat at ``grid`` lubricant temperatures from
     ambient to the coupled steady one, interpolated in the lubricant's temperature as the
-    network warms (exact exponential steps of ``step`` s).
+    network warms (exact exponential steps of ``step`` s). With ``radial_load`` (N) or
+    ``moment`` (N m) the heat is the periodic state's under the combined load
+    (:func:`thermal_steady_state`).
 
     Returns:
         one row per step: ``time_s``, each node's ``<node>_c``, ``friction_torque_nm``,
         ``power_loss_w``.
     """
-    steady = thermal_steady_state(params, config, inner_ring_speed, axial_load)
-    heat = _HeatAtTemperature(params, inner_ring_speed, axial_load)
+    steady = thermal_steady_state(params, config, inner_ring_speed, axial_load, radial_load=radial_load, moment=moment)
+    heat = HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     t_hi = max(steady.temperatures["lubricant"], config.ambient + 0.5)
     temps = list(np.linspace(config.ambient, t_hi, grid))
     table = [heat(t) for t in temps]

@@ -361,11 +361,19 @@ SIMULATOR_NODE = ("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-
 def start_rig_nodes(ros_graph: Any, *simulators: tuple[str, ...]) -> None:
     """Start the rig's nodes on the test's graph as a launch file would, for ``run --attach``:
     each simulator given (``python`` arguments; default: one shipped simulator without real
-    time), the load controller and the monitor."""
-    for simulator in simulators or (SIMULATOR_NODE,):
+    time), the load controller and the monitor. Returns once the graph has each node's output
+    (a publisher of ``/rig/truth`` per simulator, of ``/rig/axial_load/state``, of
+    ``/rig/slip_status``), so that a session started then finds every node running, however
+    long their start took on a loaded host (the session's start-up bound is not the test's)."""
+    simulators = simulators or (SIMULATOR_NODE,)
+    for simulator in simulators:
         ros_graph.spawn_python(*simulator)
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
+    observer = ros_graph.node("observer")
+    outputs = {"/rig/truth": len(simulators), "/rig/axial_load/state": 1, "/rig/slip_status": 1}
+    up = ros_graph.spin_until(lambda: all(observer.count_publishers(t) == n for t, n in outputs.items()), timeout=300.0, nodes=[observer])
+    assert up, {t: observer.count_publishers(t) for t in outputs}
 
 
 def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_path: Path) -> None:
@@ -485,12 +493,19 @@ def test_a_best_effort_writer_the_graph_has_not_named_yet_is_read_at_once_and_na
 def test_an_attached_session_refuses_a_graph_with_two_simulators(ros_graph: Any, tmp_path: Path) -> None:
     """Two simulators on one domain (a stray twin beside the one meant, or a twin beside the
     bench) would interleave two sim times and two bearings in one summary: the session ends,
-    exit 1, naming the topic and the two publishers."""
+    exit 1, naming the topic and the two publishers (each by its name, or as not named yet when
+    the session saw its writer before the graph had its node's name). The program holds 900 rpm
+    for ten minutes of sim time: only the second simulator, not the program's end, can end this
+    session within the test's guard."""
+    from bearing_rig_sim.session.node import UNNAMED_PUBLISHER
+
     start_rig_nodes(ros_graph, SIMULATOR_NODE, SIMULATOR_NODE)
-    session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
+    session = start_session(ros_graph, tmp_path, "--attach", "--no-record", program_text=LONG_HOLD_PROGRAM)
     out, err = session.communicate(timeout=150)
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
-    assert f"more than one rig on ROS domain {ros_graph.domain_id}: 2 nodes publish /rig/truth (/simulator, /simulator)" in out + err
+    found = re.search(rf"more than one rig on ROS domain {ros_graph.domain_id}: 2 nodes publish /rig/truth \(([^)]*)\);", out + err)
+    assert found is not None, f"{out[-3000:]}\n{err[-3000:]}"
+    assert set(found.group(1).split(", ")) <= {"/simulator", UNNAMED_PUBLISHER}, found.group(0)
 
 
 def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_graph: Any, tmp_path: Path) -> None:

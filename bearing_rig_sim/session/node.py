@@ -258,7 +258,7 @@ class SessionNode(Node):
         changes = []
         for i, (topic, msgtype, subscription) in enumerate(self._recorded):
             weak = self.publisher_names(topic.name, ReliabilityPolicy.BEST_EFFORT)
-            unnamed = [name for name in weak if name.endswith(UNKNOWN_NODE_NAME)]
+            unnamed = any(map(_unnamed, weak))
             if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
                 if topic.name in self._unnamed and weak and not unnamed:  # named since the change
                     self._unnamed.discard(topic.name)
@@ -273,22 +273,23 @@ class SessionNode(Node):
             self._recorded[i] = (topic, msgtype, self.tap.create_subscription(msgtype, topic.name, _unused, qos, raw=True))
             if unnamed:
                 self._unnamed.add(topic.name)
-            shown = [name for name in weak if name not in unnamed] + [UNNAMED_PUBLISHER] * len(unnamed)
             changes.append(
-                f"recording {topic.name} best effort: {', '.join(shown)} publishes it best effort (a reliable reader receives nothing from such a writer)"
+                f"recording {topic.name} best effort: {_shown(weak)} publishes it best effort (a reliable reader receives nothing from such a writer)"
             )
         return changes
 
     def rival_publishers(self) -> str:
         """What makes the graph hold more than one rig: a description of every topic of
-        :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does).
+        :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does;
+        a node the graph has not named yet is :data:`UNNAMED_PUBLISHER`: a second writer is a
+        second rig whether or not its name has come).
         Two simulators would interleave two sim times; two load controllers would fight over
         the load; two monitors would give two verdicts."""
         found = []
         for topic in ONE_PUBLISHER_TOPICS:
             names = self.publisher_names(topic)
             if len(names) > 1:
-                found.append(f"{len(names)} nodes publish {topic} ({', '.join(names)})")
+                found.append(f"{len(names)} nodes publish {topic} ({_shown(names)})")
         return "; ".join(found)
 
     def missing(self) -> dict[str, str]:
@@ -396,6 +397,18 @@ class SessionNode(Node):
             if level != previous and (level > 0 or previous > 0):
                 message = status.message if len(status.message) <= EVENT_WIDTH else status.message[: EVENT_WIDTH - 3] + "..."
                 self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {message}")
+
+
+def _unnamed(name: str) -> bool:
+    """Whether a ``/namespace/name`` of :meth:`SessionNode.publisher_names` is the graph's
+    placeholder for a node it has not named yet."""
+    return name.endswith(UNKNOWN_NODE_NAME)
+
+
+def _shown(names: list[str]) -> str:
+    """``names`` as an event line gives them: the named ones, then :data:`UNNAMED_PUBLISHER`
+    for each the graph has not named yet."""
+    return ", ".join([name for name in names if not _unnamed(name)] + [UNNAMED_PUBLISHER] * sum(map(_unnamed, names)))
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun

@@ -48,6 +48,7 @@ from bearing_rig_sim.interfaces import (
     TRUTH,
 )
 from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
@@ -171,6 +172,9 @@ class SessionNode(Node):
         """Topics read best effort whose best-effort publisher the graph had not named when the
         recorder adapted; :meth:`adapt_to_publishers` names them once it does."""
         self._diagnostic_levels: dict[str, int] = {}
+        self.last_lifecycle_status: tuple[str, str, str] | None = None
+        """(name, transition, state) of the last lifecycle manager's status taken from
+        ``/diagnostics`` (the session's own, :class:`~.manager.LifecycleManager`), or None."""
         self.simulator_stopped = ""
         """Why the simulator stopped for good (its diagnostics' ``simulation_stopped``), or ""."""
         self._pending: list[tuple[str, bytes]] = []
@@ -392,6 +396,9 @@ class SessionNode(Node):
         for status in msg.status:
             level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
             self.simulator_stopped = self.simulator_stopped or stopped_reason((kv.key, kv.value) for kv in status.values)
+            if status.name.startswith(DIAGNOSTIC_PREFIX):
+                values = {kv.key: kv.value for kv in status.values}
+                self.last_lifecycle_status = (status.name, values.get("transition", ""), values.get("state", ""))
             previous = self._diagnostic_levels.get(status.name, 0)
             self._diagnostic_levels[status.name] = level
             if level != previous and (level > 0 or previous > 0):

@@ -91,6 +91,11 @@ they are activated; attached (``--attach``), before the program starts (wall s).
 against a stream that never matches: the wait ends when the recorder has matched."""
 
 
+OWN_STATUS_GUARD_S = 30.0
+"""Longest wait at the end for the recorder to take the session's own last lifecycle status
+(wall s): a guard against a hang only, the wait ends when it is taken."""
+
+
 @dataclass(frozen=True)
 class SessionOptions:
     """Options of a session (``bearing-rig run``)."""
@@ -588,6 +593,7 @@ class _Session:
             if node is not None:
                 time.sleep(0.2)  # the nodes' last messages
                 node.drain()
+                self._take_own_statuses()
         finally:
             try:
                 self.writer.close()
@@ -598,6 +604,24 @@ class _Session:
                     node.close()
                     node.destroy_node()
                 context.try_shutdown()  # type: ignore[attr-defined]  # rclpy objects carry no type information
+
+    def _take_own_statuses(self) -> None:
+        """Take what comes until the recorder has the lifecycle manager's last ``/diagnostics``
+        status (one writer, reliable: in order, so every one before it too), published just
+        before the end, however slow its way back on a loaded host; at most
+        :data:`OWN_STATUS_GUARD_S`."""
+        manager, node = self.manager, self.node
+        if manager is None or node is None or not manager.records:
+            return
+        from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
+        from bearing_rig_sim.session.node import DRAIN_PERIOD_S
+
+        last = manager.records[-1]
+        expected = (DIAGNOSTIC_PREFIX + last.step.node, last.step.transition, last.state)
+        deadline = time.monotonic() + OWN_STATUS_GUARD_S
+        while node.last_lifecycle_status != expected and time.monotonic() < deadline:
+            time.sleep(DRAIN_PERIOD_S)
+            node.drain()
 
     def _report(self) -> int:
         self.printer.done()

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
+import time
 from datetime import datetime, timedelta, timezone
 from pathlib import Path
 
@@ -33,6 +34,20 @@ def python_child(tmp_path: Path, name: str, code: str) -> NodeProcess:
     return NodeProcess(name, [sys.executable, "-c", code], tmp_path / "logs" / f"{name}.log")
 
 
+GUARD_S = 300.0
+"""Longest wait for a child's own line, s: only a guard against a hang (a child's start on a
+loaded host is what is waited for, not this)."""
+
+
+def wait_for_output(child: NodeProcess, line: str) -> None:
+    """Wait until ``child`` has printed ``line`` (it flushes it), or fail past :data:`GUARD_S`."""
+    deadline = time.monotonic() + GUARD_S
+    while line not in child.output_tail().splitlines():
+        assert child.poll() is None, child.describe_exit()
+        assert time.monotonic() < deadline, f"{child.name} printed no {line!r} in {GUARD_S:g} s"
+        child.wait(0.02)
+
+
 def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Path) -> None:
     child = python_child(tmp_path, "simulator", "import sys\nfor i in range(40): print('line', i, file=sys.stderr)\nsys.exit(3)")
     child.start(os.environ)
@@ -44,31 +59,34 @@ def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Pat
 
 
 def test_stop_all_stops_a_child_that_ignores_sigint(tmp_path: Path) -> None:
-    stubborn = python_child(tmp_path, "monitor", "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nprint('up', flush=True)\ntime.sleep(60)")
-    polite = python_child(tmp_path, "load_controller", "import time\nprint('up', flush=True)\ntry:\n    time.sleep(60)\nexcept KeyboardInterrupt:\n    pass")
+    """SIGINT first: a child that takes it exits cleanly, and stop_all returns once it has (its
+    timeout only the bound for a child that does not); one that ignores it gets SIGTERM once the
+    timeout has passed. Each is stopped on its own, so neither outcome depends on how soon a
+    loaded host runs the polite child's handler."""
+    stubborn = python_child(tmp_path, "monitor", "import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\nprint('up', flush=True)\ntime.sleep(600)")
+    polite = python_child(
+        tmp_path, "load_controller", "import time\ntry:\n    print('up', flush=True)\n    time.sleep(600)\nexcept KeyboardInterrupt:\n    pass"
+    )
     for child in (stubborn, polite):
         child.start(os.environ)
-    for _ in range(200):  # until both have started (and the stubborn one ignores SIGINT)
-        if all("up" in child.output_tail() for child in (stubborn, polite)):
-            break
-        stubborn.wait(0.05)
-    # 5 s for SIGINT to take effect: on a loaded host a child niced below its parent was still
-    # running 1 s after it (and got the SIGTERM meant for the stubborn one)
-    stop_all([stubborn, polite], timeout=5.0)
+    for child in (stubborn, polite):
+        wait_for_output(child, "up")  # started, and the stubborn one ignores SIGINT
+    stop_all([polite], timeout=GUARD_S)
     assert polite.poll() == 0  # SIGINT: a clean exit
+    stop_all([stubborn], timeout=0.5)
     assert stubborn.poll() is not None and stubborn.poll() < 0  # SIGTERM after the timeout
     assert stubborn.stop_requested and polite.stop_requested
 
 
 def test_cpu_seconds_of_a_busy_child(tmp_path: Path) -> None:
-    busy = python_child(tmp_path, "busy", "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.3: pass\ntime.sleep(30)")
+    """The child spins until its own CPU time (``time.process_time``, since it started) has
+    passed 0.35 s and says so; /proc then gives at least 0.3 s (user and system time, each in
+    whole 10 ms ticks, lose at most 20 ms together)."""
+    busy = python_child(tmp_path, "busy", "import time\nwhile time.process_time() < 0.35: pass\nprint('spent', flush=True)\ntime.sleep(600)")
     busy.start(os.environ)
     try:
-        for _ in range(100):
-            used = busy.cpu_seconds()
-            if used is not None and used >= 0.3:
-                break
-            busy.wait(0.05)
+        wait_for_output(busy, "spent")
+        used = busy.cpu_seconds()
         assert used is not None and used >= 0.3
     finally:
         stop_all([busy])

@@ -16,7 +16,6 @@ from __future__ import annotations
 import dataclasses
 import importlib
 import math
-import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -49,12 +48,13 @@ from bearing_rig_sim.interfaces import (
     TRUTH,
 )
 from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
 from bearing_rig_sim.simulation.health import stopped_reason
 
-__all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "SessionNode", "message_class"]
+__all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "UNNAMED_PUBLISHER", "SessionNode", "message_class"]
 
 ONE_PUBLISHER_TOPICS = (TRUTH.name, AXIAL_LOAD_STATE.name, SLIP_STATUS.name)
 """Topics a session's graph must have one publisher of, each a node's own output: one simulator
@@ -67,10 +67,10 @@ DRAIN_PERIOD_S = 0.02
 MAX_CLOCK_EVENTS = 10
 """Most event lines about refused ``/clock`` stamps (the summary gives the count)."""
 
-NAME_WAIT_S = 2.0
-"""Longest wall time :meth:`SessionNode.adapt_to_publishers` defers a topic whose best-effort
-publisher the graph has not named yet, s (discovery's participant data normally follows within
-milliseconds: a matched endpoint can precede it)."""
+UNNAMED_PUBLISHER = "a node the graph has not named yet"
+"""How an event line names a publisher whose node the graph has not named (yet): its endpoint
+was matched before its node's participant data came (:data:`UNKNOWN_NODE_NAME`), which may come
+later, or never (a plain DDS writer, not a ROS node)."""
 
 
 RECORDER_DEPTH = 50000
@@ -168,10 +168,13 @@ class SessionNode(Node):
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
             for topic in recorder.topics.values()
         ]
-        self._unnamed_since: dict[str, float] = {}
-        """Steady-clock time (s) each recorded topic was first seen with an unnamed best-effort
-        publisher (:meth:`adapt_to_publishers`)."""
+        self._unnamed: set[str] = set()
+        """Topics read best effort whose best-effort publisher the graph had not named when the
+        recorder adapted; :meth:`adapt_to_publishers` names them once it does."""
         self._diagnostic_levels: dict[str, int] = {}
+        self.last_lifecycle_status: tuple[str, str, str] | None = None
+        """(name, transition, state) of the last lifecycle manager's status taken from
+        ``/diagnostics`` (the session's own, :class:`~.manager.LifecycleManager`), or None."""
         self.simulator_stopped = ""
         """Why the simulator stopped for good (its diagnostics' ``simulation_stopped``), or ""."""
         self._pending: list[tuple[str, bytes]] = []
@@ -222,13 +225,16 @@ class SessionNode(Node):
         self._setpoint.publish(setpoint)
 
     # -- readiness --------------------------------------------------------------------------------
-    def unmatched_streams(self) -> list[str]:
+    def unmatched_streams(self, *, published_only: bool = False) -> list[str]:
         """The managed nodes' streams (:data:`BRING_UP_STREAMS`) whose publisher the recorder's
         reader has not matched yet. Their publishers exist from configure on; the nodes publish
         only once active, so a session that activates them after this is empty records every
-        sample from the first."""
+        sample from the first. ``published_only``: only the streams the graph has a publisher of
+        (attached to nodes managed elsewhere, which may not publish them all: a bench has no
+        ground truth); such a stream's publisher offering only best effort is matched once
+        :meth:`adapt_to_publishers` has read it best effort."""
         counts = {topic.name: sub.get_publisher_count() for topic, _type, sub in self._recorded}
-        return [t.name for t in BRING_UP_STREAMS if counts.get(t.name, 1) == 0]
+        return [t.name for t in BRING_UP_STREAMS if counts.get(t.name, 1) == 0 and (not published_only or self.count_publishers(t.name) > 0)]
 
     def subscribers_besides_recorder(self, topic: str) -> int:
         """Subscriptions to ``topic`` other than the recorder's."""
@@ -248,40 +254,46 @@ class SessionNode(Node):
         """Read best effort every recorded topic that some publisher offers only best effort
         (a bench's own sensor driver, attached to): a reliable reader never matches such a
         writer and would record nothing of it (rosbag2 adapts its readers in the same way). The
-        reliable reader is drained, then replaced. A topic whose best-effort publisher the graph
-        has not named yet waits for a later call, at most :data:`NAME_WAIT_S`, so the line names
-        it. Returns a line per topic changed."""
+        reliable reader is drained, then replaced, at the first look that shows such a writer,
+        named or not. Returns a line per topic changed, naming its best-effort publishers; one
+        the graph has not named yet (its endpoint matched before its node's participant data
+        came) is :data:`UNNAMED_PUBLISHER`, and a later look that finds every best-effort
+        publisher of that topic named returns the line again with their names."""
         changes = []
         for i, (topic, msgtype, subscription) in enumerate(self._recorded):
-            if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
-                continue
             weak = self.publisher_names(topic.name, ReliabilityPolicy.BEST_EFFORT)
+            unnamed = any(map(_unnamed, weak))
+            if subscription.qos_profile.reliability != ReliabilityPolicy.RELIABLE:
+                if topic.name in self._unnamed and weak and not unnamed:  # named since the change
+                    self._unnamed.discard(topic.name)
+                    changes.append(f"recording {topic.name} best effort: {', '.join(weak)} publishes it best effort")
+                continue
             if not weak:
                 continue
-            if any(name.endswith(UNKNOWN_NODE_NAME) for name in weak):  # matched before its node's data came
-                first = self._unnamed_since.setdefault(topic.name, time.monotonic())
-                if time.monotonic() - first < NAME_WAIT_S:
-                    continue  # named by a later look, normally the next
             self.take()  # what the reliable reader holds goes to the bag first
             qos = reader_qos(topic)
             qos.reliability = ReliabilityPolicy.BEST_EFFORT
             self.tap.destroy_subscription(subscription)
             self._recorded[i] = (topic, msgtype, self.tap.create_subscription(msgtype, topic.name, _unused, qos, raw=True))
+            if unnamed:
+                self._unnamed.add(topic.name)
             changes.append(
-                f"recording {topic.name} best effort: {', '.join(weak)} publishes it best effort (a reliable reader receives nothing from such a writer)"
+                f"recording {topic.name} best effort: {_shown(weak)} publishes it best effort (a reliable reader receives nothing from such a writer)"
             )
         return changes
 
     def rival_publishers(self) -> str:
         """What makes the graph hold more than one rig: a description of every topic of
-        :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does).
+        :data:`ONE_PUBLISHER_TOPICS` that more than one node publishes (empty when none does;
+        a node the graph has not named yet is :data:`UNNAMED_PUBLISHER`: a second writer is a
+        second rig whether or not its name has come).
         Two simulators would interleave two sim times; two load controllers would fight over
         the load; two monitors would give two verdicts."""
         found = []
         for topic in ONE_PUBLISHER_TOPICS:
             names = self.publisher_names(topic)
             if len(names) > 1:
-                found.append(f"{len(names)} nodes publish {topic} ({', '.join(names)})")
+                found.append(f"{len(names)} nodes publish {topic} ({_shown(names)})")
         return "; ".join(found)
 
     def missing(self) -> dict[str, str]:
@@ -384,11 +396,26 @@ class SessionNode(Node):
         for status in msg.status:
             level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
             self.simulator_stopped = self.simulator_stopped or stopped_reason((kv.key, kv.value) for kv in status.values)
+            if status.name.startswith(DIAGNOSTIC_PREFIX):
+                values = {kv.key: kv.value for kv in status.values}
+                self.last_lifecycle_status = (status.name, values.get("transition", ""), values.get("state", ""))
             previous = self._diagnostic_levels.get(status.name, 0)
             self._diagnostic_levels[status.name] = level
             if level != previous and (level > 0 or previous > 0):
                 message = status.message if len(status.message) <= EVENT_WIDTH else status.message[: EVENT_WIDTH - 3] + "..."
                 self.on_event(f"{status.name}: {_LEVEL_NAMES.get(level, str(level))}: {message}")
+
+
+def _unnamed(name: str) -> bool:
+    """Whether a ``/namespace/name`` of :meth:`SessionNode.publisher_names` is the graph's
+    placeholder for a node it has not named yet."""
+    return name.endswith(UNKNOWN_NODE_NAME)
+
+
+def _shown(names: list[str]) -> str:
+    """``names`` as an event line gives them: the named ones, then :data:`UNNAMED_PUBLISHER`
+    for each the graph has not named yet."""
+    return ", ".join([name for name in names if not _unnamed(name)] + [UNNAMED_PUBLISHER] * sum(map(_unnamed, names)))
 
 
 def _unused(_msg: object) -> None:  # pragma: no cover - the recorder's node is never spun

@@ -18,7 +18,9 @@
 4. waits, up to ``startup_timeout_s`` in all, for each to come up: the simulator's first
    ``/clock`` and its command subscription, the load controller's first state and its set-point
    subscription, the monitor's status publisher and pulse subscription; otherwise stops with the
-   name of the process that did not, and the tail of its output;
+   name of the process that did not, and the tail of its output; attached to nodes managed
+   elsewhere (``--attach``), also until the recorder has matched the streams the graph has a
+   publisher of (read best effort where a publisher offers only that), at most ``MATCH_WAIT_S``;
 5. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
    clock while recording every rig topic and printing progress;
 6. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node fails or dies: stops the runner,
@@ -85,7 +87,13 @@ loses, and a chunk compressed in some 15 ms, a short hold-up of the session's lo
 
 MATCH_WAIT_S = 10.0
 """Longest wait, after every node is configured, for the recorder to match their streams before
-they are activated (wall s)."""
+they are activated; attached (``--attach``), before the program starts (wall s). Only a bound
+against a stream that never matches: the wait ends when the recorder has matched."""
+
+
+OWN_STATUS_GUARD_S = 30.0
+"""Longest wait at the end for the recorder to take the session's own last lifecycle status
+(wall s): a guard against a hang only, the wait ends when it is taken."""
 
 
 @dataclass(frozen=True)
@@ -371,6 +379,8 @@ class _Session:
             if not self._bring_up():
                 return
             missing = self.node.missing()
+            if not missing and self.options.attach and self._recorder_unmatched(attached=True):
+                return
             if not missing:
                 self.phase = _Phase.RUNNING
                 self._start_segment(self.runner.start(now))
@@ -435,20 +445,32 @@ class _Session:
         if manager.busy:
             return False
         if self._activations:
-            # Every node configured: activate once the recorder has matched their streams (or,
-            # failing that, after MATCH_WAIT_S with an event line naming what it has not).
-            unmatched = self.node.unmatched_streams() if self.options.record else []
-            if unmatched and self._match_deadline is None:
-                self._match_deadline = time.monotonic() + MATCH_WAIT_S
-            if unmatched and time.monotonic() < (self._match_deadline or 0.0):
+            # Every node configured: activate once the recorder has matched their streams
+            if self._recorder_unmatched(attached=False):
                 return False
-            if unmatched:
-                self._event(f"recorder: not matched after {MATCH_WAIT_S:g} s with {', '.join(unmatched)}; their first samples may be missing")
             manager.run(self._activations, self.options.startup_timeout_s)
             self._activations = []
             manager.poll()
             return False
         return True
+
+    def _recorder_unmatched(self, *, attached: bool) -> bool:
+        """True while the recorder has not matched the nodes' streams yet
+        (:meth:`SessionNode.unmatched_streams`; attached, those the graph has a publisher of,
+        read best effort where the publisher offers only that), so that the program's samples
+        are recorded from the first. Failing that within MATCH_WAIT_S, an event line names the
+        streams, and from then on False."""
+        if not self.options.record or self._match_deadline == math.inf:
+            return False
+        unmatched = self.node.unmatched_streams(published_only=attached)
+        if unmatched and self._match_deadline is None:
+            self._match_deadline = time.monotonic() + MATCH_WAIT_S
+        if unmatched and time.monotonic() < (self._match_deadline or 0.0):
+            return True
+        if unmatched:
+            self._event(f"recorder: not matched after {MATCH_WAIT_S:g} s with {', '.join(unmatched)}; their first samples may be missing")
+        self._match_deadline = math.inf  # settled: not looked at again
+        return False
 
     def _on_transition(self, record: TransitionRecord) -> None:
         """A transition answered: the node's own reason for a failure, an event line."""
@@ -571,6 +593,7 @@ class _Session:
             if node is not None:
                 time.sleep(0.2)  # the nodes' last messages
                 node.drain()
+                self._take_own_statuses()
         finally:
             try:
                 self.writer.close()
@@ -581,6 +604,24 @@ class _Session:
                     node.close()
                     node.destroy_node()
                 context.try_shutdown()  # type: ignore[attr-defined]  # rclpy objects carry no type information
+
+    def _take_own_statuses(self) -> None:
+        """Take what comes until the recorder has the lifecycle manager's last ``/diagnostics``
+        status (one writer, reliable: in order, so every one before it too), published just
+        before the end, however slow its way back on a loaded host; at most
+        :data:`OWN_STATUS_GUARD_S`."""
+        manager, node = self.manager, self.node
+        if manager is None or node is None or not manager.records:
+            return
+        from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
+        from bearing_rig_sim.session.node import DRAIN_PERIOD_S
+
+        last = manager.records[-1]
+        expected = (DIAGNOSTIC_PREFIX + last.step.node, last.step.transition, last.state)
+        deadline = time.monotonic() + OWN_STATUS_GUARD_S
+        while node.last_lifecycle_status != expected and time.monotonic() < deadline:
+            time.sleep(DRAIN_PERIOD_S)
+            node.drain()
 
     def _report(self) -> int:
         self.printer.done()

@@ -76,3 +76,15 @@ def test_predicts_spring_preload_is_axial_load(capsys: pytest.CaptureFixture[str
     assert sprung["axial_load_n"] == 140.0 and sprung["preload_n"] == 60.0
     assert sprung["slip_pct"] == pytest.approx(plain["slip_pct"], abs=1e-3)
     assert sprung["friction_torque_nm"] == pytest.approx(plain["friction_torque_nm"], rel=1e-4)
+
+
+def test_the_shadow_twin_builds_its_engine_mounted_and_keeps_it_on_recalibration(tmp_path: Path) -> None:
+    from bearing_rig_sim.shadow.settings import ShadowSettings
+    from bearing_rig_sim.shadow.twin import ShadowTwin
+
+    stated = {"clearance_change_m": -4e-6, "misalignment_rad": [0.0, 3e-4], "preload_n": 25.0, "preload_displacement_m": 0.0}
+    twin = ShadowTwin(ShadowSettings.from_yaml().replace(rig_file=str(_rig_with(tmp_path, stated))))
+    expected = Mounting(-4e-6, (0.0, 3e-4), 25.0, 0.0)
+    assert twin.drive.engine.mounting == expected
+    twin.drive.swap_parameters(twin.params)  # the online re-calibration's engine swap
+    assert twin.drive.engine.mounting == expected

@@ -36,7 +36,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Mounting
 from bearing_rig_sim.shadow.inputs import SpeedPoint
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling, TractionTableGrid
@@ -84,6 +84,8 @@ class MeasuredDrive:
             lubricant temperature).
         lubricant_feedback: with ``thermal``, the engine's lubricant follows the network's
             lubricant temperature (False: held at the bearing file's, the calibration's).
+        mounting: the test bearing's clearance, misalignment and preload (the rig file's
+            ``mounting`` section; default none).
     """
 
     def __init__(
@@ -96,8 +98,9 @@ class MeasuredDrive:
         load_at: Callable[[float], float],
         thermal: ThermalConfig | None = None,
         lubricant_feedback: bool = False,
+        mounting: Mounting | None = None,
     ) -> None:
-        self.engine = BearingDynamics(params, model=model)
+        self.engine = BearingDynamics(params, model=model, mounting=mounting)
         self.thermal_config = thermal
         self.coupling: ThermalCoupling | None = None
         """The engine's thermal network (None: isothermal); it starts warming at the first start."""
@@ -274,7 +277,7 @@ class MeasuredDrive:
     def swap_parameters(self, params: BearingParameters) -> None:
         """Go on with other bearing parameters from the present state (online re-calibration)."""
         snap = self.engine.snapshot()
-        engine = BearingDynamics(params, model=self.engine.model, time_step=self.engine.time_step)
+        engine = BearingDynamics(params, model=self.engine.model, time_step=self.engine.time_step, mounting=self.engine.mounting)
         engine.restore(snap)
         self.engine = engine
         if self.coupling is not None:

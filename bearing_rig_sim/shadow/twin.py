@@ -48,9 +48,10 @@ from typing import Any
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import ConfigError
-from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.shadow.measured import MeasuredWindow, MeasuredWindows
 from bearing_rig_sim.shadow.predictor import MeasuredDrive, Prediction
@@ -155,6 +156,9 @@ class ShadowTwin:
                 self.thermal_config = ThermalConfig.from_yaml(settings.bearing_file)
             except ConfigError:
                 self.thermal_config = None  # a bearing file without a thermal: section
+        fit = MountingConfig.from_rig_file(settings.rig_file)
+        self.mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+        """The test bearing's mounting, from the rig file (as the simulator's engine has it)."""
         self.drive = self._make_drive(self.params)
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
         self.temperature_rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
@@ -191,6 +195,7 @@ class ShadowTwin:
             load_at=self.load.force_at,
             thermal=self.thermal_config,
             lubricant_feedback=st.lubricant_feedback,
+            mounting=self.mounting,
         )
 
     # -- input ---------------------------------------------------------------------------------

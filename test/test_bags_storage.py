@@ -109,5 +109,7 @@ def test_messages_through_the_mcap_format_round_trip(tmp_path: Path) -> None:
     fmt = McapFormat()
     (index,) = fmt.indexes(bag, list(bag.glob("*.mcap")))
     assert index.indexed and not index.problems
-    assert [(t, d) for t, _c, _p, d in fmt.messages(index)] == [(1000 + i, d) for i, d in enumerate(payloads)]
+    problems: list[str] = []
+    assert [(t, d) for t, _c, _p, d in fmt.messages(index, problems.append)] == [(1000 + i, d) for i, d in enumerate(payloads)]
+    assert problems == []
     assert [(c.topic, c.msgtype, c.encoding) for c in index.channels.values()] == [("/x", "std_msgs/msg/Float64", "cdr")]

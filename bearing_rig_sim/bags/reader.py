@@ -230,7 +230,7 @@ class BagReader:
         for index, topic_of in zip(self._indexes, self._channel_topics):
             wanted = {cid: name for cid, name in topic_of.items() if name in selected}
             if wanted and index.message_count:
-                messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
+                messages = self._format.messages(index, self._report, wanted, start_ns, stop_ns)
                 streams.append((index.start_ns, index.end_ns, named(messages, wanted)))
         types = {name: self.topics[name].msgtype for name in selected}
         decoders = {} if raw else {name: make_decoder(self.typestore, msgtype) for name, msgtype in types.items()}
@@ -314,7 +314,7 @@ def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[Me
     with their format's ``messages``; a chunk that fails is named, messages the index counts but no
     chunk delivers are unreadable, log times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`."""
     check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
-    streams = [(i.start_ns, i.end_ns, messages(i, report=check.damaged.append)) for i in indexes]
+    streams = [(i.start_ns, i.end_ns, messages(i, check.damaged.append)) for i in indexes]
     for log_time, _channel, _publish, _data in merge_in_time(streams):
         check.messages_read += 1
         last = check.stretches[-1] if check.stretches else None

@@ -11,7 +11,7 @@ problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:clas
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
@@ -130,8 +130,9 @@ class BagReader:
                 f"`bearing-rig bag repair {self.path}` rewrites it)"
             )
 
-    def verify(self) -> BagCheck:
-        """Read every chunk (:func:`verify_indexes`); slower than opening, which reads the index only."""
+    def verify(self) -> list[str]:
+        """Read every chunk: a line per finding of :func:`verify_indexes` (none for a sound bag);
+        slower than opening, which reads the index only."""
         return verify_indexes(self._indexes, self._format.messages)
 
     @property
@@ -265,65 +266,36 @@ class Stretch:
     count: int
 
 
-@dataclass
-class BagCheck:
-    """What :func:`verify_indexes` found: a line per damaged chunk, messages read and counted by
-    the indexes, the timeline's stretches in time order."""
-
-    damaged: list[str] = field(default_factory=list)
-    messages_read: int = 0
-    messages_indexed: int = 0
-    stretches: list[Stretch] = field(default_factory=list)
-
-    @property
-    def messages_unreadable(self) -> int:
-        """Messages counted by the index that no chunk delivered."""
-        return max(0, self.messages_indexed - self.messages_read)
-
-    @property
-    def main(self) -> Stretch | None:
-        """The stretch with the most messages."""
-        return max(self.stretches, key=lambda s: s.count, default=None)
-
-    @property
-    def outliers(self) -> list[Stretch]:
-        """Every stretch but the main one."""
-        return [s for s in self.stretches if s is not self.main]
-
-    def problems(self) -> list[str]:
-        """One line per finding (empty for a sound bag)."""
-        lines = list(self.damaged)
-        if self.messages_unreadable:
-            share = 100.0 * self.messages_unreadable / self.messages_indexed
-            lines.append(f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that cannot be read")
-        main = self.main
-        for s in self.outliers:
-            assert main is not None  # there are outliers only beside a main stretch
-            after = s.start_ns > main.end_ns
-            distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
-            lines.append(
-                f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
-                f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
-                f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
-            )
-        return lines
-
-
-def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
-    """The full check of a bag (docs/bags.md): every message of the files read once, in time order,
-    with their format's ``messages``; a chunk that fails is named, messages the index counts but no
-    chunk delivers are unreadable, log times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`."""
-    check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
-    streams = [(i.start_ns, i.end_ns, messages(i, check.damaged.append)) for i in indexes]
-    for log_time, _channel, _publish, _data in merge_in_time(streams):
-        check.messages_read += 1
-        last = check.stretches[-1] if check.stretches else None
+def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> list[str]:
+    """The full check of a bag (docs/bags.md), one line per finding (none for a sound bag): every
+    message of the files read once, in time order, with their format's ``messages``; a chunk that
+    fails is named, messages the indexes count but no chunk delivers are unreadable, and the log
+    times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`: every stretch but the one
+    with the most messages is an outlier."""
+    lines: list[str] = []
+    stretches: list[Stretch] = []
+    for log_time, _channel, _publish, _data in merge_in_time([(i.start_ns, i.end_ns, messages(i, lines.append)) for i in indexes]):
+        last = stretches[-1] if stretches else None
         if last is not None and log_time - last.end_ns <= TIMELINE_GAP_NS:
             last.end_ns = max(last.end_ns, log_time)
             last.count += 1
         else:
-            check.stretches.append(Stretch(log_time, log_time, 1))
-    return check
+            stretches.append(Stretch(log_time, log_time, 1))
+    indexed = sum(i.message_count for i in indexes)
+    if (unreadable := indexed - sum(s.count for s in stretches)) > 0:
+        lines.append(f"{unreadable} of {indexed} messages ({100.0 * unreadable / indexed:.1f} %) are in chunks that cannot be read")
+    main = max(stretches, key=lambda s: s.count, default=None)
+    for s in stretches:
+        if main is None or s is main:
+            continue
+        after = s.start_ns > main.end_ns
+        distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
+        lines.append(
+            f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
+            f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
+            f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
+        )
+    return lines
 
 
 def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:

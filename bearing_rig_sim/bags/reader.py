@@ -23,7 +23,7 @@ from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
-from bearing_rig_sim.bags.layout import BagLayout, channel_msgtype, layout_from_indexes, read_layout
+from bearing_rig_sim.bags.layout import BagLayout, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
@@ -116,9 +116,9 @@ class BagReader:
         for index in self._indexes:
             for problem in index.problems:
                 self._report(problem)
-        self.typestore = self._build_typestore()
         self._channel_topics: list[dict[int, str]] = []  # per file, the topic of each channel read
         self._found = layout_from_indexes(self._indexes, self.layout, self._report, accepted=self._channel_topics)  # what the files hold
+        self.typestore = self._build_typestore()
         self.message_count, self.start_ns, self.end_ns = self._found.message_count, self._found.start_ns, self._found.end_ns
         self.duration_ns = self._found.duration_ns
         self.run_metadata = self._found.custom_data
@@ -199,10 +199,7 @@ class BagReader:
         except Exception as exc:  # TypesysError and parser errors
             self._report(f"{self.path}: the bag's message definitions are inconsistent ({exc}); using the built-in ones")
             return rig
-        needed = {channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels} | (
-            {t.msgtype for t in self.layout.topics} if self.layout else set()
-        )
-        missing = {name for name in dependencies(rig, needed) if name not in store.fielddefs}
+        missing = {name for name in dependencies(rig, (t.msgtype for t in self._found.topics)) if name not in store.fielddefs}
         if missing:
             try:
                 store.register({name: rig.fielddefs[name] for name in missing})

@@ -26,6 +26,8 @@ from typing import Literal
 
 QosName = Literal["reliable", "reliable_stream", "sensor_data", "transient_local"]
 """The contract's four QoS profiles (see :data:`QOS_DESCRIPTIONS`)."""
+Reliability = Literal["reliable", "best_effort"]
+Durability = Literal["volatile", "transient_local"]
 
 
 @dataclass(frozen=True)
@@ -39,8 +41,8 @@ class QosEntry:
         description: what it is, as the interface table says it.
     """
 
-    reliability: Literal["reliable", "best_effort"]
-    durability: Literal["volatile", "transient_local"]
+    reliability: Reliability
+    durability: Durability
     depth: int
     description: str
 

@@ -208,13 +208,6 @@ def read_layout(bag_dir: Path) -> BagLayout:
     )
 
 
-def channel_msgtype(index: FileIndex, channel_id: int, previous: BagLayout | None = None) -> str:
-    """Message type of a channel: from its storage, else from ``metadata.yaml``, else empty."""
-    channel = index.channels[channel_id]
-    stated = (t.msgtype for t in (previous.topics if previous is not None else []) if t.name == channel.topic)
-    return channel.msgtype or next(stated, "")
-
-
 def layout_from_indexes(
     indexes: Sequence[FileIndex], previous: BagLayout | None, report: Callable[[str], None],
     type_hash_of: Callable[[str], str] = lambda _msgtype: "", accepted: list[dict[int, str]] | None = None,
@@ -232,7 +225,8 @@ def layout_from_indexes(
             accepted.append(kept)
         for channel_id in sorted(index.channels):
             channel = index.channels[channel_id]
-            msgtype = channel_msgtype(index, channel_id, previous)
+            declared = (t.msgtype for t in (previous.topics if previous is not None else []) if t.name == channel.topic)
+            msgtype = channel.msgtype or next(declared, "")  # from the storage, else from metadata.yaml
             entry = topics.get(channel.topic)
             if entry is None:
                 try:

@@ -20,7 +20,7 @@ from mcap.stream_reader import StreamReader, breakup_chunk, get_chunk_data_strea
 from mcap.writer import MCAP0_MAGIC
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem, merge_in_time
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, merge_in_time
 
 _UNREADABLE = (McapError, struct.error, ValueError, UnicodeDecodeError, OSError)
 """What the mcap library raises on bytes that are not records (a CRC mismatch is a ValueError)."""
@@ -258,17 +258,17 @@ def index_file(path: Path) -> McapIndex:
     return index
 
 
-def check_chunks(index: McapIndex) -> tuple[list[str], int]:
-    """Decompress and checksum every chunk: a line per damaged chunk, and their bytes within the file."""
-    problems, damaged = [], 0
+def damaged_chunk_bytes(index: McapIndex) -> int:
+    """Decompress and checksum every chunk: the bytes within the file of those that fail (reading
+    the file's messages names each of them)."""
+    damaged = 0
     with open(index.path, "rb") as stream:
         for ref in index.chunks:
             try:
                 read_chunk_messages(stream, ref)
-            except DamagedRecord as exc:
-                problems.append(f"{index.path.name}: chunk at offset {ref.offset}: {exc}")
+            except DamagedRecord:
                 damaged += max(0, min(ref.stop, index.file_size) - ref.offset)
-    return problems, damaged
+    return damaged
 
 
 def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool], report: ProblemSink, label: str) -> Iterator[MessageTuple]:
@@ -291,8 +291,7 @@ class McapFormat:
         return [index_file(f) for f in files]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
-        report: ProblemSink = drop_problem,
+        self, index: FileIndex, report: ProblemSink, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None
     ) -> Iterator[MessageTuple]:
         """Messages of one file on ``channel_ids`` (None: all) with ``start_ns <= log_time < stop_ns``
         in log-time order, streamed: memory holds the chunks whose time ranges overlap (the whole

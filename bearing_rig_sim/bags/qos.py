@@ -10,10 +10,8 @@ from typing import Literal, get_args
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability, QosTime
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.interfaces import QOS_TABLE, QosName
+from bearing_rig_sim.interfaces import QOS_TABLE, Durability, QosName, Reliability
 
-Reliability = Literal["reliable", "best_effort"]
-Durability = Literal["volatile", "transient_local"]
 History = Literal["keep_last", "keep_all"]
 
 

@@ -11,7 +11,7 @@ problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:clas
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from types import TracebackType
@@ -23,7 +23,7 @@ from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
-from bearing_rig_sim.bags.layout import BagLayout, channel_msgtype, layout_from_indexes, read_layout
+from bearing_rig_sim.bags.layout import BagLayout, layout_from_indexes, read_layout
 from bearing_rig_sim.bags.mcapfile import McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
@@ -116,9 +116,9 @@ class BagReader:
         for index in self._indexes:
             for problem in index.problems:
                 self._report(problem)
-        self.typestore = self._build_typestore()
         self._channel_topics: list[dict[int, str]] = []  # per file, the topic of each channel read
         self._found = layout_from_indexes(self._indexes, self.layout, self._report, accepted=self._channel_topics)  # what the files hold
+        self.typestore = self._build_typestore()
         self.message_count, self.start_ns, self.end_ns = self._found.message_count, self._found.start_ns, self._found.end_ns
         self.duration_ns = self._found.duration_ns
         self.run_metadata = self._found.custom_data
@@ -130,8 +130,9 @@ class BagReader:
                 f"`bearing-rig bag repair {self.path}` rewrites it)"
             )
 
-    def verify(self) -> BagCheck:
-        """Read every chunk (:func:`verify_indexes`); slower than opening, which reads the index only."""
+    def verify(self) -> list[str]:
+        """Read every chunk: a line per finding of :func:`verify_indexes` (none for a sound bag);
+        slower than opening, which reads the index only."""
         return verify_indexes(self._indexes, self._format.messages)
 
     @property
@@ -198,10 +199,7 @@ class BagReader:
         except Exception as exc:  # TypesysError and parser errors
             self._report(f"{self.path}: the bag's message definitions are inconsistent ({exc}); using the built-in ones")
             return rig
-        needed = {channel_msgtype(index, cid, self.layout) for index in self._indexes for cid in index.channels} | (
-            {t.msgtype for t in self.layout.topics} if self.layout else set()
-        )
-        missing = {name for name in dependencies(rig, needed) if name not in store.fielddefs}
+        missing = {name for name in dependencies(rig, (t.msgtype for t in self._found.topics)) if name not in store.fielddefs}
         if missing:
             try:
                 store.register({name: rig.fielddefs[name] for name in missing})
@@ -230,7 +228,7 @@ class BagReader:
         for index, topic_of in zip(self._indexes, self._channel_topics):
             wanted = {cid: name for cid, name in topic_of.items() if name in selected}
             if wanted and index.message_count:
-                messages = self._format.messages(index, wanted, start_ns, stop_ns, self._report)
+                messages = self._format.messages(index, self._report, wanted, start_ns, stop_ns)
                 streams.append((index.start_ns, index.end_ns, named(messages, wanted)))
         types = {name: self.topics[name].msgtype for name in selected}
         decoders = {} if raw else {name: make_decoder(self.typestore, msgtype) for name, msgtype in types.items()}
@@ -265,65 +263,36 @@ class Stretch:
     count: int
 
 
-@dataclass
-class BagCheck:
-    """What :func:`verify_indexes` found: a line per damaged chunk, messages read and counted by
-    the indexes, the timeline's stretches in time order."""
-
-    damaged: list[str] = field(default_factory=list)
-    messages_read: int = 0
-    messages_indexed: int = 0
-    stretches: list[Stretch] = field(default_factory=list)
-
-    @property
-    def messages_unreadable(self) -> int:
-        """Messages counted by the index that no chunk delivered."""
-        return max(0, self.messages_indexed - self.messages_read)
-
-    @property
-    def main(self) -> Stretch | None:
-        """The stretch with the most messages."""
-        return max(self.stretches, key=lambda s: s.count, default=None)
-
-    @property
-    def outliers(self) -> list[Stretch]:
-        """Every stretch but the main one."""
-        return [s for s in self.stretches if s is not self.main]
-
-    def problems(self) -> list[str]:
-        """One line per finding (empty for a sound bag)."""
-        lines = list(self.damaged)
-        if self.messages_unreadable:
-            share = 100.0 * self.messages_unreadable / self.messages_indexed
-            lines.append(f"{self.messages_unreadable} of {self.messages_indexed} messages ({share:.1f} %) are in chunks that cannot be read")
-        main = self.main
-        for s in self.outliers:
-            assert main is not None  # there are outliers only beside a main stretch
-            after = s.start_ns > main.end_ns
-            distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
-            lines.append(
-                f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
-                f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
-                f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
-            )
-        return lines
-
-
-def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> BagCheck:
-    """The full check of a bag (docs/bags.md): every message of the files read once, in time order,
-    with their format's ``messages``; a chunk that fails is named, messages the index counts but no
-    chunk delivers are unreadable, log times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`."""
-    check = BagCheck(messages_indexed=sum(i.message_count for i in indexes))
-    streams = [(i.start_ns, i.end_ns, messages(i, report=check.damaged.append)) for i in indexes]
-    for log_time, _channel, _publish, _data in merge_in_time(streams):
-        check.messages_read += 1
-        last = check.stretches[-1] if check.stretches else None
+def verify_indexes(indexes: list[FileIndex], messages: Callable[..., Iterator[MessageTuple]]) -> list[str]:
+    """The full check of a bag (docs/bags.md), one line per finding (none for a sound bag): every
+    message of the files read once, in time order, with their format's ``messages``; a chunk that
+    fails is named, messages the indexes count but no chunk delivers are unreadable, and the log
+    times are cut into stretches at gaps over :data:`TIMELINE_GAP_NS`: every stretch but the one
+    with the most messages is an outlier."""
+    lines: list[str] = []
+    stretches: list[Stretch] = []
+    for log_time, _channel, _publish, _data in merge_in_time([(i.start_ns, i.end_ns, messages(i, lines.append)) for i in indexes]):
+        last = stretches[-1] if stretches else None
         if last is not None and log_time - last.end_ns <= TIMELINE_GAP_NS:
             last.end_ns = max(last.end_ns, log_time)
             last.count += 1
         else:
-            check.stretches.append(Stretch(log_time, log_time, 1))
-    return check
+            stretches.append(Stretch(log_time, log_time, 1))
+    indexed = sum(i.message_count for i in indexes)
+    if (unreadable := indexed - sum(s.count for s in stretches)) > 0:
+        lines.append(f"{unreadable} of {indexed} messages ({100.0 * unreadable / indexed:.1f} %) are in chunks that cannot be read")
+    main = max(stretches, key=lambda s: s.count, default=None)
+    for s in stretches:
+        if main is None or s is main:
+            continue
+        after = s.start_ns > main.end_ns
+        distance = (s.start_ns - main.end_ns) if after else (main.start_ns - s.end_ns)
+        lines.append(
+            f"log-time outliers: {s.count} message(s) at {s.start_ns * 1e-9:.3f}-{s.end_ns * 1e-9:.3f} s, "
+            f"{distance * 1e-9:.3f} s {'after' if after else 'before'} the main timeline ({main.start_ns * 1e-9:.3f}-"
+            f"{main.end_ns * 1e-9:.3f} s, {main.count} messages)"
+        )
+    return lines
 
 
 def open_bag(path: str | Path, *, strict: bool = False) -> BagReader:

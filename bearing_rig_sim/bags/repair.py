@@ -10,7 +10,7 @@ from typing import Literal
 
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import METADATA_FILE, BagLayout, layout_from_indexes, layout_to_dict, read_layout, write_layout
-from bearing_rig_sim.bags.mcapfile import McapFormat, McapIndex, check_chunks, index_file
+from bearing_rig_sim.bags.mcapfile import McapFormat, McapIndex, damaged_chunk_bytes, index_file
 from bearing_rig_sim.bags.typestore import rig_typestore, type_hash
 from bearing_rig_sim.bags.writer import DEFAULT_CHUNK_SIZE, CountingSink, register_topic, start_mcap
 
@@ -112,7 +112,7 @@ def _rewrite(index: McapIndex, previous: BagLayout | None, problems: list[str]) 
         for topic in previous.topics if previous is not None else []:
             if topic.name not in present and topic.msgtype in store.fielddefs:
                 register_topic(writer, schema_by_name, topic, store)
-        for log_time, channel_id, publish_time, data in McapFormat().messages(index, report=problems.append):
+        for log_time, channel_id, publish_time, data in McapFormat().messages(index, problems.append):
             writer.add_message(channel_ids[channel_id], log_time, data, publish_time)
         writer.finish()  # type: ignore[no-untyped-call, unused-ignore]  # mcap leaves it unannotated (an error under --strict only)
     except BaseException:
@@ -146,11 +146,8 @@ def repair_bag(path: str | Path) -> RepairReport:
             os.replace(file, backup)
             report.files.append(FileRepair(file.name, "removed", backup=backup, problems=[str(exc)]))
             continue
-        chunk_bytes_lost = 0
-        if index.indexed and not index.problems:
-            damaged, chunk_bytes_lost = check_chunks(index)
-            index.problems.extend(damaged)
-        if index.indexed and not index.problems:
+        chunk_bytes_lost = damaged_chunk_bytes(index) if index.indexed and not index.problems else 0
+        if index.indexed and not index.problems and not chunk_bytes_lost:
             report.files.append(FileRepair(file.name, "intact", index.message_count))
             indexes.append(index)
             continue

@@ -11,7 +11,7 @@ from rosbags.rosbag2 import Reader, ReaderError
 
 from bearing_rig_sim.bags.errors import BagError
 from bearing_rig_sim.bags.layout import qos_yaml
-from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink, drop_problem
+from bearing_rig_sim.bags.storage import ChannelInfo, FileIndex, MessageTuple, ProblemSink
 
 _ENCODINGS = {MessageDefinitionFormat.MSG: "ros2msg", MessageDefinitionFormat.IDL: "ros2idl"}
 
@@ -42,8 +42,7 @@ class Sqlite3Format:
         return [index]
 
     def messages(
-        self, index: FileIndex, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None,
-        report: ProblemSink = drop_problem,
+        self, index: FileIndex, report: ProblemSink, channel_ids: Iterable[int] | None = None, start_ns: int | None = None, stop_ns: int | None = None
     ) -> Iterator[MessageTuple]:
         """Messages with ``start_ns <= log_time < stop_ns`` in time order, as rosbags reads them."""
         wanted = None if channel_ids is None else set(channel_ids)

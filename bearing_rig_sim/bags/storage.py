@@ -14,9 +14,6 @@ ProblemSink = Callable[[str], None]
 """Receives a one-line description of each problem met while reading."""
 
 
-def drop_problem(_problem: str) -> None:
-    """A :data:`ProblemSink` that drops the problems."""
-
 MessageTuple = tuple[int, int, int, bytes]
 """A message as (log_time_ns, channel_id, publish_time_ns, serialized data)."""
 

@@ -90,7 +90,7 @@ def print_info(path: Path, out: TextIO, *, full_metadata: bool = False, index_on
 
     with open_bag(path) as bag:
         topics = bag.topics
-        found = [] if index_only else bag.verify().problems()
+        found = [] if index_only else bag.verify()
         out.write(f"bag:        {bag.path}\n")
         out.write(f"files:      {', '.join(f.name for f in bag.files) or 'none'}\n")
         state = "complete" if bag.complete and not found else "DAMAGED or unfinished (see problems)"

@@ -13,7 +13,7 @@ import re
 import sys
 from pathlib import Path
 from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import rclpy
 from builtin_interfaces.msg import Time
@@ -28,19 +28,15 @@ from bearing_rig_sim.config import config_path
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import QOS_DESCRIPTIONS, QOS_TABLE, QosEntry, Topic
 
-if TYPE_CHECKING:  # the bag package is not imported by every node
-    from bearing_rig_sim.bags.qos import QosSpec
 
-
-def qos_profile(which: Topic | str | QosEntry | QosSpec) -> QoSProfile:
+def qos_profile(which: Topic | str | QosEntry) -> QoSProfile:
     """The rclpy QoS profile of a topic of the contract (its publisher's), of a profile named in
-    :data:`bearing_rig_sim.interfaces.QOS_TABLE`, of an entry of that table, or of a profile
-    stored in a bag (whose history may be keep-all)."""
+    :data:`bearing_rig_sim.interfaces.QOS_TABLE`, or of an entry of that table."""
     if isinstance(which, Topic):
         which = which.qos
     entry = QOS_TABLE[which] if isinstance(which, str) else which
     return QoSProfile(
-        history=HistoryPolicy.KEEP_LAST if isinstance(entry, QosEntry) or entry.history == "keep_last" else HistoryPolicy.KEEP_ALL,
+        history=HistoryPolicy.KEEP_LAST,
         depth=entry.depth,
         reliability=ReliabilityPolicy.RELIABLE if entry.reliability == "reliable" else ReliabilityPolicy.BEST_EFFORT,
         durability=DurabilityPolicy.TRANSIENT_LOCAL if entry.durability == "transient_local" else DurabilityPolicy.VOLATILE,

@@ -306,6 +306,18 @@ def message_class(msgtype: str) -> type | None:
     return cls if isinstance(cls, type) else None
 
 
+def qos_profile(spec: QosSpec) -> Any:
+    """An rclpy ``QoSProfile`` for a stored profile."""
+    from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+
+    return QoSProfile(
+        history=HistoryPolicy.KEEP_LAST if spec.history == "keep_last" else HistoryPolicy.KEEP_ALL,
+        depth=spec.depth,
+        reliability=ReliabilityPolicy.RELIABLE if spec.reliability == "reliable" else ReliabilityPolicy.BEST_EFFORT,
+        durability=DurabilityPolicy.TRANSIENT_LOCAL if spec.durability == "transient_local" else DurabilityPolicy.VOLATILE,
+    )
+
+
 def offered_qos(topic: str, info: TopicInfo | None) -> QosSpec:
     """The QoS to offer on a replayed topic: the bag's, else the contract's, else reliable."""
     if info is not None and info.qos is not None:
@@ -331,7 +343,6 @@ class RosReplaySink:
         from rclpy.node import Node
 
         from bearing_rig_sim.dds_profile import use_rig_profile
-        from bearing_rig_sim.nodes.common import qos_profile
 
         self._rclpy = rclpy
         self.context = rclpy.Context()

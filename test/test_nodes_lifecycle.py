@@ -102,7 +102,7 @@ def test_simulator_streams_only_while_active(ros_graph: Any) -> None:
     def primary_goals() -> list[int]:
         return [e.goal_state.id for e in client.events if e.goal_state.id in (inactive, active, unconfigured)]
 
-    assert client.spin_until(lambda: primary_goals() == expected, timeout=30.0), primary_goals()
+    assert client.spin_until(lambda: primary_goals() == expected), primary_goals()
     assert process.poll() is None
 
 
@@ -115,7 +115,7 @@ def test_a_failed_configure_is_reported_and_the_node_stays_up(ros_graph: Any) ->
     assert client.node.count_publishers("/rig/slip_status") == 0
     assert process.poll() is None
     process.terminate()
-    _, err = process.communicate(timeout=30)
+    _, err = process.communicate(timeout=WAIT)
     failed = [line for line in err.splitlines() if "configure failed:" in line]
     assert len(failed) == 1 and "bearing_file" in failed[0] and "missing.yaml" in failed[0], err[-2000:]
 

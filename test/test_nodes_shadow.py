@@ -25,30 +25,43 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from rosbags.highlevel import AnyReader
 
-    bench = write_bench_bag(twin_bench_run([Hold(1800.0, 3.0)], clock_offset_s=1.7e9), tmp_path / "bench")
+    run = twin_bench_run([Hold(1800.0, 3.0)], clock_offset_s=1.7e9)
+    bench = write_bench_bag(run, tmp_path / "bench")
     offline = shadow_bag(bench, None)
     assert offline.counts["compared"] > 20 and offline.counts["anomalous"] == 0
 
     node = ros_graph.node("observer")
     received: list[tuple[str, bytes]] = []
     levels: list[str] = []
+    counts: dict[str, str] = {}  # the shadow node's latest diagnostic values
     qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
     node.create_subscription(ShadowResidual, TWIN_RESIDUAL.name, lambda data: received.append((TWIN_RESIDUAL.name, data)), qos, raw=True)
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
-        levels.extend(s.message for s in msg.status if s.name.startswith("shadow"))
+        for status in msg.status:
+            if status.name.startswith("shadow"):
+                levels.append(status.message)
+                counts.update((v.key, v.value) for v in status.values)
 
     node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, qos)
     executor = ros_graph.executor([node])
     shadow = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.shadow import main; sys.exit(main())", "--autostart")
     assert ros_graph.spin_until(lambda: bool(levels), timeout=60.0, executor=executor), "the shadow node did not come up"
     replay = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "replay", str(bench), "--wait-for-subscribers", "--delay", "20")
-    ros_graph.spin_until(lambda: replay.poll() is not None, timeout=60.0, executor=executor)
+    assert ros_graph.spin_until(lambda: replay.poll() is not None, timeout=120.0, executor=executor), "the replay did not end"
     assert replay.returncode == 0, replay.communicate()[1]
-    # the last windows come out once the engine has run past them: wait for the count to settle
-    expected = offline.counts["windows"]
-    ros_graph.spin_until(lambda: len(received) >= expected - 1, timeout=10.0, executor=executor)
+    # Done when the node's diagnostics say it has taken every pulse of the bag (the windows come
+    # from the pulses alone) and every residual it had published by then has arrived here: the
+    # count is then the one the whole bag makes. The timeout only guards against a hang.
+    pulses = {"spindle_pulses_received": str(len(run.spindle)), "cage_pulses_received": str(len(run.cage))}
+
+    def every_window_in() -> bool:
+        return all(counts.get(k) == v for k, v in pulses.items()) and len(received) >= int(counts["windows"])
+
+    done = ros_graph.spin_until(every_window_in, timeout=120.0, executor=executor)
+    assert done, f"the shadow node did not report every pulse and window: {counts} for {pulses}, {len(received)} residuals received"
     assert shadow.poll() is None, "the shadow node died"
+    expected = offline.counts["windows"]
 
     bag = tmp_path / "recorded"
     with BagWriter(bag) as writer:

@@ -21,6 +21,7 @@ CACHED_SOURCES: tuple[str, ...] = (
     "dynamics/steady.py",
     "dynamics/traction.py",
     "thermal/bearing.py",
+    "thermal/coupling.py",
 )
 """Every module with ``@njit(cache=True)`` functions, relative to the package (the test checks
 the list is complete)."""

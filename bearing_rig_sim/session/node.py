@@ -299,12 +299,17 @@ class SessionNode(Node):
     def missing(self) -> dict[str, str]:
         """Which node is not ready yet, and what is missing (empty when all are ready;
         :func:`~bearing_rig_sim.session.readiness.not_ready`)."""
-        return not_ready(
+        missing = not_ready(
             clock_seen=self.clock_count > 0,
             load_state_seen=self.live.state_count > 0,
             subscribers=self.subscribers_besides_recorder,
             publishers=self.count_publishers,
         )
+        # The graph lists a subscription before this publisher has matched it, and a set-point
+        # published before the match is lost (volatile): ready once every subscription matched.
+        if "load_controller" not in missing and self._setpoint.get_subscription_count() < self.count_subscribers(LOAD_SETPOINT.name):
+            missing["load_controller"] = f"{LOAD_SETPOINT.name}: the session's publisher has not matched every subscription yet"
+        return missing
 
     # -- recording --------------------------------------------------------------------------------
     def take(self) -> int:

@@ -94,8 +94,7 @@ def mounting_of(args: argparse.Namespace) -> Mounting | None:
         "preload_n": args.preload_n,
         "preload_displacement_m": args.preload_displacement,
     }
-    fit = validate_mapping(MountingConfig, stated, "command line (--clearance, --misalignment, --preload-n, --preload-displacement)")
-    mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+    mounting = Mounting.of(validate_mapping(MountingConfig, stated, "command line (--clearance, --misalignment, --preload-n, --preload-displacement)"))
     return None if mounting == Mounting() else mounting
 
 

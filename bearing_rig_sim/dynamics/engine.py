@@ -37,6 +37,7 @@ from bearing_rig_sim.dynamics.step_limit import (
     stiff_limit,
 )
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.rig.mounting import MountingConfig
 
 MODELS = ("reduced", "stiff")
 MIN_AXIAL_LOAD = 1.0
@@ -104,6 +105,12 @@ class Mounting:
     misalignment: tuple[float, float] = (0.0, 0.0)
     preload_force: float = 0.0
     preload_displacement: float = 0.0
+
+    @classmethod
+    def of(cls, section: MountingConfig) -> Mounting:
+        """The engine's mounting from a validated ``mounting`` section of a rig file (or the
+        command line's, checked against the same ranges)."""
+        return cls(section.clearance_change_m, section.misalignment_rad, section.preload_n, section.preload_displacement_m)
 
 
 @dataclass(frozen=True)

@@ -156,8 +156,7 @@ class ShadowTwin:
                 self.thermal_config = ThermalConfig.from_yaml(settings.bearing_file)
             except ConfigError:
                 self.thermal_config = None  # a bearing file without a thermal: section
-        fit = MountingConfig.from_rig_file(settings.rig_file)
-        self.mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+        self.mounting = Mounting.of(MountingConfig.from_rig_file(settings.rig_file))
         """The test bearing's mounting, from the rig file (as the simulator's engine has it)."""
         self.drive = self._make_drive(self.params)
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)

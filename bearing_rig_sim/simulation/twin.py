@@ -319,8 +319,7 @@ class RigTwin:
         """
         bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
         params = BearingParameters.from_yaml(bearing, calibration_file)
-        fit = MountingConfig.from_rig_file(rig_file)
-        mounting = Mounting(fit.clearance_change_m, fit.misalignment_rad, fit.preload_n, fit.preload_displacement_m)
+        mounting = Mounting.of(MountingConfig.from_rig_file(rig_file))
         engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file), mounting=mounting)
         sensors = FibreOpticConfig.from_yaml(rig_file)
         limits = RigLimits.from_rig_file(rig_file)

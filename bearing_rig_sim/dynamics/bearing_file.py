@@ -66,6 +66,8 @@ CALIBRATABLE: dict[str, tuple[str, str]] = {
     "consistency": ("lubricant", "consistency_pa_sn"),
     "fill_fraction": ("lubricant", "fill_fraction"),
     "eyring_stress": ("lubricant", "eyring_stress_pa"),
+    "ball_set_resistance": ("resistances", "ball_set_resistance_n"),
+    "ball_set_resistance_speed_exponent": ("resistances", "ball_set_resistance_speed_exponent"),
 }
 """Parameters a calibration file may set: field name -> (section, key) in the bearing file."""
 
@@ -207,6 +209,10 @@ class BearingLubricant(FileSection):
     density, viscosity and volume fraction."""
 
     file: Text | None = Field(None, description="lubricant file, a name in config/lubricants/ or a path")
+    dry: Flag = Field(
+        default=False,
+        description="no lubricant at all (the paper's own model): no film, no drag of oil or grease, no land film; the cavity air remains",
+    )
     temperature_c: Number = quantity(
         "operating temperature of the lubricant", unit="degC", source="greases and oils of spindles", ge=-40.0, le=200.0, default=40.0
     )
@@ -222,7 +228,9 @@ class BearingLubricant(FileSection):
 
     @model_validator(mode="after")
     def _inline_oil_complete(self) -> Self:
-        if self.file is None:
+        if self.dry and self.file is not None:
+            raise field_error("dry", "a dry bearing has no lubricant file (lubricant.file)")
+        if self.file is None and not self.dry:
             for key in ("oil_density_kg_m3", "oil_viscosity_pa_s", "oil_volume_fraction"):
                 if getattr(self, key) is None:
                     raise field_error(key, "missing (required)")
@@ -249,6 +257,33 @@ class Resistances(FileSection):
         "elastic hysteresis factor alpha_h", unit="1", source=f"{HARRIS} ch. 7 (bearing steel about 0.007)", ge=0.0, le=0.5
     )
     ehl_rolling_scale: Number = quantity("multiplier on Houpert's EHL rolling force", unit="1", source=SCALE, ge=0.0, default=1.0)
+    ball_set_resistance_n: Number = quantity(
+        "dry model only: resistance on each ball's orbit at an orbit speed of 1 m/s and a mean contact load of ball_set_resistance_reference_load_n",
+        unit="N",
+        source="the paper's model implies one and does not state it (docs/paper.md section 13): below the two raceway contacts' largest traction",
+        ge=0.0,
+        le=10.0,
+        default=0.0,
+    )
+    ball_set_resistance_speed_exponent: Number = quantity(
+        "dry model only: exponent m of the orbit speed in the ball-set resistance",
+        unit="1",
+        source="Coulomb (0) to inertial drag (2)",
+        ge=0.0,
+        le=2.0,
+        default=1.0,
+    )
+    ball_set_resistance_load_exponent: Number = quantity(
+        "dry model only: exponent k of the mean contact load in the ball-set resistance",
+        unit="1",
+        source="load independent (0) to proportional (1); 2n/3 = 0.741 follows the paper's contact damping C ~ delta^n, n = 10/9",
+        ge=0.0,
+        le=1.0,
+        default=0.0,
+    )
+    ball_set_resistance_reference_load_n: Number = quantity(
+        "dry model only: mean contact load at which ball_set_resistance_n is stated", unit="N", source="a load", gt=0.0, default=10.0
+    )
 
 
 class Integration(FileSection):
@@ -328,6 +363,11 @@ class BearingFile(FileSection):
         check_number(cage.width_m, "", "cage.width_m", gt=cage.pocket_diameter_m, lt=0.2)
         if self.friction.model == "rheology" and self.lubricant.file is None:
             raise field_error("friction.model", "rheology needs a lubricant file (lubricant.file)")
+        if self.resistances.ball_set_resistance_n > 0.0 and not self.lubricant.dry:
+            raise field_error(
+                "resistances.ball_set_resistance_n",
+                "is the dry model's stand-in for its unstated resistances; a lubricated bearing has its own (set lubricant.dry: true or 0)",
+            )
         return self
 
 

@@ -118,7 +118,9 @@ P_SPIN_IN = 58  # spin lever of the inner contact per sqrt(penetration), (3/8) a
 P_SPIN_OUT = 59  # same, outer contact
 P_PRELOAD_D = 60  # rigid preload displacement of a back-to-back partner bearing, m (0: no partner)
 P_PRELOAD_K = 61  # the partner's Z K_n (its balls at rest, the series Hertz constant), N/m^1.5
-P_SIZE = 62
+P_DRAG_LOAD_EXP = 62  # exponent k of the ball drag's load factor (Q_mean / P_DRAG_LOAD_REF)^k (0: no load factor)
+P_DRAG_LOAD_REF = 63  # reference contact load of that factor, N
+P_SIZE = 64
 
 B_THETA, B_OMEGA, B_SPIN, B_R, B_Z, B_VR, B_VZ, B_PIVOT, B_PITCH = 0, 1, 2, 3, 4, 5, 6, 7, 8
 NB = 9
@@ -1210,10 +1212,12 @@ def ball_power(
 
 
 @njit(cache=True)
-def ball_drag(p: np.ndarray, v: float) -> tuple[float, float]:
-    """Drag on a ball moving at ``v`` (m/s) through the cavity's lubricant and its derivative:
+def ball_drag(p: np.ndarray, v: float, load: float) -> tuple[float, float]:
+    """Drag on a ball moving at ``v`` (m/s) and its derivative:
     F = c1 v + c2 v|v| + (c_y + c_n |v|^n) sgn(v) (N; the sign smoothed over 1 cm/s),
-    dF/dv (N s/m)."""
+    dF/dv (N s/m). The plastic and power-law part is scaled by (load / Q_ref)^k when
+    ``P_DRAG_LOAD_EXP`` = k is not zero (the paper model's ball-set resistance, whose load law
+    follows its contact damping; ``load`` the ball's mean raceway load, N)."""
     f = p[P_DRAG_LIN] * v + p[P_DRAG_QUAD] * v * abs(v)
     df = p[P_DRAG_LIN] + 2.0 * p[P_DRAG_QUAD] * abs(v)
     if p[P_DRAG_YIELD] > 0.0 or p[P_DRAG_POW] > 0.0:
@@ -1222,8 +1226,13 @@ def ball_drag(p: np.ndarray, v: float) -> tuple[float, float]:
         a = max(abs(v), DRAG_SIGN_SPEED)
         an = math.sqrt(a) if p[P_DRAG_N] == 0.5 else a ** p[P_DRAG_N]
         plastic = p[P_DRAG_YIELD] + p[P_DRAG_POW] * an
+        dplastic = p[P_DRAG_POW] * p[P_DRAG_N] * an / a
+        if p[P_DRAG_LOAD_EXP] != 0.0:
+            scale = (max(load, 0.0) / p[P_DRAG_LOAD_REF]) ** p[P_DRAG_LOAD_EXP]
+            plastic *= scale
+            dplastic *= scale
         f += plastic * y * q
-        df += plastic * q * q * q / DRAG_SIGN_SPEED + p[P_DRAG_POW] * p[P_DRAG_N] * an / a
+        df += plastic * q * q * q / DRAG_SIGN_SPEED + dplastic
     return f, df
 
 
@@ -1436,7 +1445,7 @@ def step_reduced(
             )
             drive += fi * r_ci
             wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
-            fd, dfd = ball_drag(p, rb * wm)
+            fd, dfd = ball_drag(p, rb * wm, 0.5 * (qi + qo))
             dfd = implicit_slope(fd, dfd, rb * wm)
             cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
             # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
@@ -1687,7 +1696,7 @@ def step_stiff(
                     fo -= (1.0 - ueo / ENTRAINMENT_FLOOR) * qo * contact_traction(p, 1, 0.0, ueo, qo)[0]
             drive += fi * r_ci
             g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
-            fd, _ = ball_drag(p, rb * wm)
+            fd, _ = ball_drag(p, rb * wm, 0.5 * (qi + qo))
             gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
             fs, _, _ = pocket_force(p, gap, rate)
             x = abs(gap) - p[P_POCKET_CLEAR]

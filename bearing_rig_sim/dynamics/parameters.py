@@ -130,6 +130,11 @@ class BearingParameters:
     composite_roughness: float = 0.0
     spindle_axis: str = "horizontal"
     land_count: int = 1
+    dry: bool = False
+    ball_set_resistance: float = 0.0
+    ball_set_resistance_speed_exponent: float = 1.0
+    ball_set_resistance_load_exponent: float = 0.0
+    ball_set_resistance_reference_load: float = 10.0
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -198,11 +203,11 @@ class BearingParameters:
             ehl_max_coefficient=fr.ehl_max_coefficient,
             ehl_reference_srr=fr.ehl_reference_slide_roll_ratio,
             pocket_friction=fr.pocket_coefficient,
-            oil_density=lubricant.density(temperature) if lubricant else cast(float, lub.oil_density_kg_m3),
-            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else cast(float, lub.oil_viscosity_pa_s),
+            oil_density=lubricant.density(temperature) if lubricant else 0.0 if lub.dry else cast(float, lub.oil_density_kg_m3),
+            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else 0.0 if lub.dry else cast(float, lub.oil_viscosity_pa_s),
             air_density=lub.air_density_kg_m3,
             air_viscosity=lub.air_viscosity_pa_s,
-            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else cast(float, lub.oil_volume_fraction),
+            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else 0.0 if lub.dry else cast(float, lub.oil_volume_fraction),
             ball_drag_coefficient=res.ball_drag_coefficient,
             ball_drag_scale=res.ball_drag_scale,
             cage_land_viscous_scale=res.cage_land_viscous_scale,
@@ -218,6 +223,11 @@ class BearingParameters:
             composite_roughness=g.composite_roughness_rq_m,
             spindle_axis=doc.installation.spindle_axis,
             land_count=c.land_count,
+            dry=lub.dry,
+            ball_set_resistance=res.ball_set_resistance_n,
+            ball_set_resistance_speed_exponent=res.ball_set_resistance_speed_exponent,
+            ball_set_resistance_load_exponent=res.ball_set_resistance_load_exponent,
+            ball_set_resistance_reference_load=res.ball_set_resistance_reference_load_n,
             source=source,
         )
 
@@ -421,6 +431,10 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
         drag_quad = p.ball_drag_scale * 0.5 * rho_mix * p.ball_drag_coefficient * math.pi * 0.25 * dw * dw
         land_visc = p.cage_land_viscous_scale * fill * 2.0 * math.pi * p.oil_viscosity * r_land**3 * p.land_width / p.land_clearance
         land_yield = 0.0
+        if p.ball_set_resistance > 0.0:
+            # the dry model's stand-in for the resistance its source implies and does not state:
+            # c (v / 1 m/s)^m on each ball's orbit, times (Q_mean / Q_ref)^k in the kernel
+            drag_pow, drag_n = p.ball_set_resistance, p.ball_set_resistance_speed_exponent
     cage_weight_on_land = cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_weight_on_land * r_land
     b_in = inner.semi_axes(1.0)[1]
@@ -491,6 +505,8 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_LAND_CONS] = land_cons
     v[kn.P_LAND_K] = 0.25 * math.pi * e_star * p.land_width
     v[kn.P_LAND_MU] = p.cage_land_friction
+    v[kn.P_DRAG_LOAD_EXP] = p.ball_set_resistance_load_exponent if p.ball_set_resistance > 0.0 else 0.0
+    v[kn.P_DRAG_LOAD_REF] = p.ball_set_resistance_reference_load
     v[kn.P_PRELOAD_K] = z * p.combined_constant  # a rigid preload's partner (the engine sets P_PRELOAD_D)
     v[kn.P_CAGE_GRAV_Y] = -cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     # spin lever of each contact: the Hertz pressure's mean distance from the centre,

@@ -191,7 +191,7 @@ def _split(p: np.ndarray, ball: np.ndarray, cage: np.ndarray, out: np.ndarray, r
             pin += kn.contact_power(p, 0, out[j, kn.O_SI], abs((omega_i - wm) * r_ci), qi)
         if qo > 0.0:
             pout += kn.contact_power(p, 1, out[j, kn.O_SO], abs(wm * r_co), qo)
-        fd, _ = kn.ball_drag(p, rb * wm)
+        fd, _ = kn.ball_drag(p, rb * wm, 0.5 * (qi + qo))
         drag += abs(fd * rb * wm)
         w = cage[j, kn.C_OMEGA]
         # the whirling cage's film: its eccentricity's shear factor and the land contact's force

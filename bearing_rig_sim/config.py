@@ -46,6 +46,11 @@ class ConfigError(RigError, ValueError):
         super().__init__(f"{where}: {problem}")
 
 
+BEARING_MODELS: tuple[str, ...] = ("bench", "paper")
+"""The named models of the bearing's physics, the default first: ``bench`` (the bench twin) and
+``paper`` (the paper's own model); :mod:`bearing_rig_sim.dynamics.models` builds them."""
+
+
 def config_path(*parts: str) -> Path:
     """Path of a shipped configuration file, e.g. ``config_path("bearings", "h7006c.yaml")``.
 

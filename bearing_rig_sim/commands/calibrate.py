@@ -15,11 +15,12 @@ from typing import Any
 import numpy as np
 import yaml
 
-from bearing_rig_sim.studies.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
+from bearing_rig_sim.studies.calibration import DEFAULT_FITTED, PAPER_HEADER, CalibrationResult, calibrate, read_bench_csv, write_calibration
 from bearing_rig_sim.studies.uncertainty import LOAD_SIGMA_N, check_identifiable, fit_uncertainty
 from bearing_rig_sim.commands import output_file
-from bearing_rig_sim.config import check_number, rad_s_to_rpm
+from bearing_rig_sim.config import ConfigError, check_number, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.models import MODELS, PAPER, model_parameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 
@@ -29,6 +30,7 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
     p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
+    p.add_argument("--model", choices=MODELS, default=None, help="start from a named model's files, uncalibrated (instead of --bearing)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")
     p.add_argument(
         "--out",
@@ -55,7 +57,20 @@ def run(args: argparse.Namespace) -> int:
     out = output_file(args.out or Path("out") / "calibration" / f"{args.data.stem}.yaml", "--out", overwrite=args.force)
     check_number(args.load_sigma, "command line", "--load-sigma", ge=0.0, le=1000.0)
     thermal = ThermalConfig.from_yaml(args.bearing) if args.thermal else None
-    result = calibrate(BearingParameters.from_yaml(args.bearing), points, fitted=tuple(args.fit), thermal=thermal)
+    if args.model is not None and args.bearing is not None:
+        raise ConfigError("command line", "--model", "names the bearing file: give --model or --bearing, not both")
+    params = model_parameters(args.model, calibrated=False) if args.model is not None else BearingParameters.from_yaml(args.bearing)
+    result = calibrate(params, points, fitted=tuple(args.fit), thermal=thermal)
+    if args.model == PAPER:
+        # The paper model is fitted to another model's output, which has no bench noise and no
+        # load uncertainty: there is no interval to state, only the fit's RMS.
+        write_calibration(result, out, args.data.name, PAPER_HEADER)
+        _print_rows(result)
+        for name, value in result.fitted.items():
+            print(f"fitted {name} = {value:.6g}")
+        print(f"RMS difference: {result.rms_pct:.3f} percentage points ({result.evaluations} model evaluations)")
+        print(f"written: {out}")
+        return 0
     names = tuple(result.fitted)
     unc = fit_uncertainty(
         result.params,
@@ -83,12 +98,7 @@ def run(args: argparse.Namespace) -> int:
             )
         )
         return 0
-    print(f"{'rpm':>8} {'load N':>8} {'bench %':>8} {'twin %':>8} {'diff pp':>8}" + (f" {'lub degC':>8} {'outer degC':>10}" if result.thermal else ""))
-    for p, s in zip(result.points, result.predicted):
-        line = f"{rad_s_to_rpm(p.inner_ring_speed):8.0f} {p.axial_load:8.1f} {p.slip_pct:8.3f} {s.slip_pct:8.3f} {s.slip_pct - p.slip_pct:8.3f}"
-        if result.thermal:
-            line += f" {s.lubricant_temperature:8.2f} {s.outer_ring_temperature:10.2f}"
-        print(line)
+    _print_rows(result)
     for name, value, se in zip(unc.names, unc.values, unc.standard_errors):
         print(f"fitted {name} = {value:.6g} +- {100 * se:.1f} % (standard error, load uncertainty +-{unc.load_sigma_n:g} N included)")
     for a in range(len(names)):
@@ -101,3 +111,13 @@ def run(args: argparse.Namespace) -> int:
     print(f"RMS difference: {result.rms_pct:.3f} percentage points ({result.evaluations} model evaluations)")
     print(f"written: {out}")
     return 0
+
+
+def _print_rows(result: CalibrationResult) -> None:
+    """The data rows beside the fitted model's, and the fitted values."""
+    print(f"{'rpm':>8} {'load N':>8} {'data %':>8} {'model %':>8} {'diff pp':>8}" + (f" {'lub degC':>8} {'outer degC':>10}" if result.thermal else ""))
+    for p, s in zip(result.points, result.predicted):
+        line = f"{rad_s_to_rpm(p.inner_ring_speed):8.0f} {p.axial_load:8.1f} {p.slip_pct:8.3f} {s.slip_pct:8.3f} {s.slip_pct - p.slip_pct:8.3f}"
+        if result.thermal:
+            line += f" {s.lubricant_temperature:8.2f} {s.outer_ring_temperature:10.2f}"
+        print(line)

@@ -64,6 +64,10 @@ PHYSICAL_RANGES: dict[str, PhysicalRange] = {
     "consistency": PhysicalRange("Pa s^n", 1.0, 100.0, "Herschel-Bulkley consistency of NLGI 1-3 lithium greases (flow index 0.3-0.7)"),
     "fill_fraction": PhysicalRange("1", 0.02, 1.0, "share of the swept volume holding grease: channelled 0.02-0.1, running-in up to 1"),
     "eyring_stress": PhysicalRange("Pa", 2e6, 1e7, "Eyring stress of mineral and ester base oils (Johnson and Tevaarwerk 1977)"),
+    "ball_set_resistance": PhysicalRange(
+        "N", 0.01, 2.0, "paper model: below 2 mu_s Q_ref = 2 N, the largest traction a ball's two contacts carry at the reference load of 10 N"
+    ),
+    "ball_set_resistance_speed_exponent": PhysicalRange("1", 0.05, 2.0, "paper model: a Coulomb-like (near 0) to an inertial-drag (2) speed law"),
 }
 """Physical quantities :func:`calibrate` may fit, with their plausible ranges."""
 
@@ -327,9 +331,21 @@ def calibrate(
     return CalibrationResult(values, fixed, tuple(points), tuple(predicted), rms, evaluations, final, thermal is not None)
 
 
-def write_calibration(result: CalibrationResult, path: str | Path, data_name: str) -> None:
+PAPER_HEADER = (
+    "# Calibration of the paper model (config/models/paper.yaml) against the paper's own simulated\n"
+    "# slip (Table 3). Regenerate with `bearing-rig calibrate config/calibration/paper_table3.csv\n"
+    "# --model paper --fit ball_set_resistance ball_set_resistance_speed_exponent --out THIS --force`.\n"
+    "# The fitted quantities state the resistance on the ball set that the paper's results imply and\n"
+    "# its text leaves out; the RMS is large because the paper's friction law saturates at 100 mm/s of\n"
+    "# sliding, below what its 2100-2700 rpm rows need (docs/paper.md section 13).\n"
+)
+"""Header of the paper model's calibration file."""
+
+
+def write_calibration(result: CalibrationResult, path: str | Path, data_name: str, header: str | None = None) -> None:
     """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``: each
-    fitted value as ``{value, unit, range, source}``."""
+    fitted value as ``{value, unit, range, source}``; ``header`` replaces the bench
+    calibration's comment lines."""
 
     def entry(name: str, value: float) -> object:
         rng = PHYSICAL_RANGES.get(name)
@@ -366,7 +382,7 @@ def write_calibration(result: CalibrationResult, path: str | Path, data_name: st
         },
         "parameters": params,
     }
-    header = (
+    header = header or (
         "# Calibration of the twin against bench slip data. Regenerate with `bearing-rig calibrate`.\n"
         "# The fitted quantities are physical properties of the grease the balls and cage shear in the\n"
         "# bearing's running-in state; each carries its plausible range (a fit outside it fails).\n"

@@ -55,7 +55,9 @@ from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
-from bearing_rig_sim.dynamics.steady import CageWhirl, SteadySolver, solver_for
+from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
+from bearing_rig_sim.dynamics.models import BENCH, DEFAULT_MODEL, MODELS, model_parameters
+from bearing_rig_sim.dynamics.steady import SKID_SLIP_PCT, CageWhirl, SteadySolver, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.settings_model import read_file, validate_mapping
@@ -66,11 +68,12 @@ def register(subparsers: Any) -> None:
     """Add ``predict`` to the ``bearing-rig`` parser."""
     p = subparsers.add_parser("predict", help="steady slip of the calibrated twin", description=__doc__)
     p.add_argument("--rpm", type=float, nargs="+", required=True, help="inner-ring speeds, rpm")
-    p.add_argument("--load", type=float, nargs="+", required=True, help="axial loads, N (one, or one per speed)")
+    p.add_argument("--load", type=float, nargs="+", required=True, help="axial loads, N (one, or one per speed, or several at one speed)")
     p.add_argument("--radial-load", type=float, nargs="+", default=None, help="radial loads, N (one, or one per speed): adds the load distribution")
     p.add_argument(
         "--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)"
     )
+    p.add_argument("--model", choices=MODELS, default=None, help="named model: bench (the bench twin, default) or paper (the paper's own model; docs/paper.md)")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
     p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: config/calibration/h7006c_table3.yaml)")
     p.add_argument("--lubricant", type=Path, default=None, help="lubricant file replacing the bearing file's (config/lubricants/)")
@@ -98,6 +101,38 @@ def mounting_of(args: argparse.Namespace) -> Mounting | None:
     return None if mounting == Mounting() else mounting
 
 
+def parameters_of(args: argparse.Namespace) -> BearingParameters:
+    """The parameters the command line names: a named model (``--model``, with ``--calibration``
+    in place of its own), else the bearing, calibration and lubricant files."""
+    if args.model is None:
+        return load_parameters(args.bearing, args.calibration, args.lubricant)
+    if args.bearing is not None or args.lubricant is not None:
+        raise RigError("--model names the bearing and lubricant: give --bearing and --lubricant without it")
+    return model_parameters(args.model, calibration=args.calibration)
+
+
+def slip_readings(params: BearingParameters, s: SteadyState) -> dict[str, Any]:
+    """The slip against the pure-rolling cage speed at the loaded contact angle of the point's
+    axial load (Harris's thrust equilibrium, :class:`~bearing_rig_sim.analysis.slip.ThrustContact`;
+    ``slip_loaded_pct``, beside the paper's nominal ``slip_pct``) and ``gross_skid``: the cage
+    more than :data:`~bearing_rig_sim.dynamics.steady.SKID_SLIP_PCT` % behind (the balls slide
+    instead of rolling; the traction of the contacts cannot carry the resistances)."""
+    thrust = ThrustContact(
+        params.ball_count,
+        params.contact_angle,
+        params.inner_curvature_ratio + params.outer_curvature_ratio - 1.0,
+        params.ball_diameter,
+        params.combined_constant,
+    )
+    angle = thrust.loaded_contact_angle(s.axial_load)
+    loaded = BearingKinematics(params.ball_diameter, params.pitch_diameter, angle)
+    return {
+        "slip_loaded_pct": round(float(loaded.slip_rate(s.cage_speed, s.inner_ring_speed)), 4),
+        "loaded_contact_angle_deg": round(math.degrees(angle), 4),
+        "gross_skid": bool(s.slip_pct > SKID_SLIP_PCT),
+    }
+
+
 def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: Path | None) -> BearingParameters:
     """The bearing file with the calibration laid over it and, with ``lubricant``, that lubricant
     file in place of the bearing file's (the calibration then only when named explicitly). The
@@ -118,8 +153,10 @@ def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: P
 
 def run(args: argparse.Namespace) -> int:
     """Run each point to a steady state and print cage speed and slip."""
+    if len(args.rpm) == 1 and len(args.load) > 1:
+        args.rpm = args.rpm * len(args.load)  # several loads at one speed
     if len(args.load) not in (1, len(args.rpm)):
-        raise RigError(f"--load takes one value or one per speed ({len(args.rpm)}), got {len(args.load)}")
+        raise RigError(f"--load takes one value, one per speed ({len(args.rpm)}) or several at one speed, got {len(args.load)}")
     loads = args.load * len(args.rpm) if len(args.load) == 1 else args.load
     for n in args.rpm:
         check_number(n, "command line", "--rpm", gt=0.0, le=100000.0)
@@ -129,7 +166,7 @@ def run(args: argparse.Namespace) -> int:
         check_number(args.transient, "command line", "--transient", gt=0.0, le=36000.0)
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)
     radial = _radial_loads(args)
-    params = load_parameters(args.bearing, args.calibration, args.lubricant)
+    params = parameters_of(args)
     mounting = mounting_of(args)
     if args.thermal or args.transient is not None:
         if mounting is not None:
@@ -152,6 +189,9 @@ def run(args: argparse.Namespace) -> int:
         if unc is not None and not combined:
             _add_interval(row, params, unc, s.inner_ring_speed, s.axial_load, s.slip_pct)
         row.update(s.losses_row(params.composite_roughness))
+        if not combined:
+            row.update(slip_readings(params, s))
+        row["model"] = args.model or DEFAULT_MODEL
         if radial is not None:
             row.update(load_distribution_row(params, s.inner_ring_speed, s.axial_load, radial[k], args.moment))
         if whirl is not None:
@@ -208,6 +248,8 @@ def _uncertainty(args: argparse.Namespace) -> Any:
 
     if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
         return None
+    if args.model not in (None, BENCH) and args.calibration is None:
+        return None  # the paper model reproduces a model: no bench uncertainty to state
     return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
 
 
@@ -215,6 +257,8 @@ def _thermal_calibration(args: argparse.Namespace) -> bool:
     """Whether the calibration in use was fitted through the thermal steady states
     (``calibration.thermal`` of its file)."""
     if (args.lubricant is not None or args.bearing is not None) and args.calibration is None:
+        return False
+    if args.model not in (None, BENCH) and args.calibration is None:
         return False
     return read_file(CalibrationFile, args.calibration or config_path("calibration", "h7006c_table3.yaml")).calibration.thermal
 
@@ -245,6 +289,8 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
     )
     if "slip_pct_low" in row:
         line += f"   slip 95 % [{row['slip_pct_low']:.3f}, {row['slip_pct_high']:.3f}] %"
+    if "slip_loaded_pct" in row:
+        line += f"   loaded-angle slip {row['slip_loaded_pct']:7.3f} %" + ("   GROSS SKID" if row["gross_skid"] else "")
     if "loaded_balls" in row:
         line += (
             f"   Q {row['ball_load_min_n']:.1f}-{row['ball_load_max_n']:.1f} N on {row['loaded_balls']} balls at {row['contact_angle_max_load_deg']:.2f} deg"

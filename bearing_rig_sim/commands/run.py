@@ -14,7 +14,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import check_number, config_path
+from bearing_rig_sim.config import BEARING_MODELS, check_number, config_path
+from bearing_rig_sim.errors import RigError
 
 MAX_STARTUP_TIMEOUT_S = 3600.0
 """Longest ``--startup-timeout`` accepted, s: an hour covers the slowest first start (kernel
@@ -79,6 +80,12 @@ def register(subparsers: Any) -> None:
         help="run the program on nodes already running and managed elsewhere (launch/rig.launch.py): start no processes",
     )
     parser.add_argument("--no-record", action="store_true", help="record no bag (where ros2 bag record records)")
+    parser.add_argument(
+        "--model",
+        choices=BEARING_MODELS,
+        default=None,
+        help="the simulator's bearing model: bench (the bench twin, shipped) or paper (the paper's own model); its bearing_model parameter",
+    )
     add_foxglove_argument(parser)
     parser.set_defaults(func=run)
 
@@ -88,6 +95,8 @@ def run(args: argparse.Namespace) -> int:
     from bearing_rig_sim.session import SessionOptions, run_session
 
     program = args.program if args.program is not None else config_path(*DEFAULT_PROGRAM)
+    if args.model is not None and args.attach:
+        raise RigError("--model sets the simulator's bearing_model parameter: attached, set it where the nodes are started (-p bearing_model:=...)")
     options = SessionOptions(
         program=program,
         realtime=not args.no_realtime,
@@ -98,6 +107,7 @@ def run(args: argparse.Namespace) -> int:
         foxglove_port=args.foxglove,
         attach=args.attach,
         record=not args.no_record,
+        bearing_model=args.model,
         command_line=["bearing-rig", *sys.argv[1:]],
     )
     return run_session(options)

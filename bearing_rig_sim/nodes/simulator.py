@@ -191,6 +191,7 @@ class SimulatorNode(ManagedNode):
             s.calibration_file,
             s.rig_file,
             model=s.model,
+            bearing_model=s.bearing_model,
             chunk=s.chunk_s,
             initial_speed=s.initial_speed_rad_s,
             initial_axial_load=s.initial_axial_load_n,
@@ -283,7 +284,8 @@ class SimulatorNode(ManagedNode):
         self._clock_msg = ClockMsg()
         mode = f"real time x{s.rate:g}" if s.realtime else "as fast as possible"
         self.get_logger().info(
-            f"simulating {s.bearing_file.name} ({s.model} model, {s.chunk_s * 1e3:g} ms chunks, {mode}); "
+            f"simulating {s.bearing_file.name if s.bearing_model == 'bench' else s.bearing_model + ' model of the paper'} "
+            f"({s.model} engine, {s.chunk_s * 1e3:g} ms chunks, {mode}); "
             f"spindle {s.initial_speed_rad_s:g} rad/s, axial load {self.twin.axial_load:g} N"
         )
 

@@ -126,6 +126,8 @@ class SessionOptions:
     transition_timeout_s: float = 10.0
     """Longest wait for a node to answer a deactivate or cleanup, wall s (bring-up transitions
     have ``startup_timeout_s``: a first configure compiles the engine's kernels)."""
+    bearing_model: str | None = None
+    """The simulator's named bearing model (``bench``, ``paper``; None: its parameter file's)."""
 
 
 class _Phase(Enum):
@@ -151,6 +153,8 @@ def run_session(options: SessionOptions, out: TextIO | None = None, err: TextIO 
     overrides = {} if options.attach else node_parameters(program, simulator_defaults)  # the program's bearing, in every node
     if not options.realtime and not options.attach:
         overrides.setdefault("simulator", {})["realtime"] = False
+    if options.bearing_model is not None and not options.attach:
+        overrides.setdefault("simulator", {})["bearing_model"] = options.bearing_model
     if not options.attach:  # attached: the nodes' parameters are whoever started them's
         # the monitor judges slip against what the program's stability_criterion names
         overrides.setdefault("monitor", {})["criterion"] = program.stability_criterion

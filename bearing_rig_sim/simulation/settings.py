@@ -14,6 +14,7 @@ from typing import Annotated, Any, ClassVar
 
 from pydantic import PrivateAttr, ValidationInfo, field_validator
 
+from bearing_rig_sim.config import BEARING_MODELS
 from bearing_rig_sim.dynamics.engine import MODELS
 from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SPEEDS, TRUTH
 from bearing_rig_sim.rig.spindle import PLAUSIBLE_SPINDLE_SPEED_RAD_S, SpindleConfig
@@ -63,6 +64,9 @@ class SimulatorSettings(NodeSettings):
     calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = none; relative to config/)")
     rig_file: ConfigFile = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
     model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
+    bearing_model: Annotated[str, one_of(BEARING_MODELS)] = param(
+        "physics: 'bench' (the bench twin: bearing_file with calibration_file) or 'paper' (the paper's own model, config/models/paper.yaml, its own calibration; bearing_file and calibration_file unused)"
+    )
     chunk_s: Number = param(f"simulated time per engine call and per {CLOCK.name} message (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
     realtime: Flag = param("lock the simulated time to the wall clock (false: as fast as possible)")
     rate: Number = param("simulated seconds per wall second when in real time", unit="1", gt=0.0, le=100.0)

@@ -35,6 +35,7 @@ import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Mounting, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
@@ -298,6 +299,7 @@ class RigTwin:
         rig_file: str | Path | None = None,
         *,
         model: str = "reduced",
+        bearing_model: str = "bench",
         **options: Any,
     ) -> RigTwin:
         """A twin from a bearing file, an optional calibration overlay and a rig file.
@@ -308,6 +310,9 @@ class RigTwin:
             rig_file: rig data with the ``sensors`` section and the test bearing's ``mounting``
                 (clearance, misalignment, preload; default: ``config/rig.yaml``).
             model: the engine's model, ``"reduced"`` (real time) or ``"stiff"``.
+            bearing_model: the bearing's physics (:data:`~bearing_rig_sim.config.BEARING_MODELS`):
+                ``"bench"`` the bearing file with the calibration; ``"paper"`` the paper's own
+                model (:mod:`bearing_rig_sim.dynamics.models`; the two files are not used).
             options: the keyword options of :class:`RigTwin`; ``max_radial_load`` and
                 ``max_moment`` default to the rig file's ``combined_loading`` limits (absent:
                 0 N and 0 N m).
@@ -317,8 +322,11 @@ class RigTwin:
             StepLimitError: the bearing file's step exceeds the model's stability limit over
                 the rig file's envelope (top spindle speed, largest axial load).
         """
-        bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
-        params = BearingParameters.from_yaml(bearing, calibration_file)
+        if bearing_model == "bench":
+            bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
+            params = BearingParameters.from_yaml(bearing, calibration_file)
+        else:
+            params = model_parameters(bearing_model)
         mounting = Mounting.of(MountingConfig.from_rig_file(rig_file))
         engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file), mounting=mounting)
         sensors = FibreOpticConfig.from_yaml(rig_file)
@@ -329,7 +337,7 @@ class RigTwin:
         if "max_moment" not in options:
             options["max_moment"] = limits.max_moment_n_m
             options.setdefault("moment_limit_source", f"combined_loading.max_moment_setpoint_n_m in {limits.source}")
-        return cls(engine, sensors, BearingKinematics.from_config(bearing), **options)
+        return cls(engine, sensors, BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle), **options)
 
     def _check_chunk(self, chunk: float) -> float:
         if isinstance(chunk, bool) or not isinstance(chunk, (int, float)) or not math.isfinite(chunk) or not chunk > 0.0:

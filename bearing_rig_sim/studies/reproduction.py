@@ -17,7 +17,7 @@ import json
 import sys
 from pathlib import Path
 from typing import Any
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from tqdm import tqdm
@@ -38,6 +38,8 @@ from bearing_rig_sim.studies.experiments import (
     validation_table,
 )
 
+from bearing_rig_sim.dynamics.models import MODELS, model_parameters
+from bearing_rig_sim.studies.comparison import write_comparison
 from bearing_rig_sim.studies.reproduction_report import Outputs, RawResults, write_report
 
 ACCELERATION_DURATION_S = 3.0
@@ -130,12 +132,35 @@ def reproduce(
     """Run (or reuse) the experiments, analyse them and write CSVs, PNGs and report.md."""
     params = params or BearingParameters.calibrated()
     out = Path(out_dir)
+    raw, cached = experiments(out, params, workers, use_cache, progress)
+    return write_report(raw, out, params, cached)
+
+
+def experiments(out: Path, params: BearingParameters, workers: int | None, use_cache: bool, progress: bool) -> tuple[RawResults, bool]:
+    """The raw results of the three experiments for ``params``: from ``out``'s cache when its
+    inputs match (second value True), else run and cached."""
     out.mkdir(parents=True, exist_ok=True)
     cache = out / ".cache" / f"{inputs_key(params)}.json"
-    cached = use_cache and cache.exists()
-    if cached:
-        raw = load_raw(cache)
-    else:
-        raw = run_experiments(params, workers, progress)
-        save_raw(raw, cache)
-    return write_report(raw, out, params, cached)
+    if use_cache and cache.exists():
+        return load_raw(cache), True
+    raw = run_experiments(params, workers, progress)
+    save_raw(raw, cache)
+    return raw, False
+
+
+def reproduce_models(
+    out_dir: str | Path, models: Sequence[str] = MODELS, workers: int | None = None, use_cache: bool = True, progress: bool = True
+) -> dict[str, Outputs]:
+    """:func:`reproduce` for each named model (:mod:`bearing_rig_sim.dynamics.models`) into
+    ``out_dir/<model>/``, and, with more than one, ``out_dir/report.md`` setting them side by
+    side with the paper's Tables 3, 5 (1000 rpm row) and 7
+    (:func:`~bearing_rig_sim.studies.comparison.write_comparison`)."""
+    out = Path(out_dir)
+    results: dict[str, tuple[RawResults, Outputs]] = {}
+    for name in models:
+        params = model_parameters(name)
+        raw, cached = experiments(out / name, params, workers, use_cache, progress)
+        results[name] = (raw, write_report(raw, out / name, params, cached))
+    if len(results) > 1:
+        write_comparison(out, results)
+    return {name: outputs for name, (_, outputs) in results.items()}

@@ -8,7 +8,9 @@ bearing file's temperature under ``isothermal``. ``--transient S`` prints the wa
 ambient over S seconds instead (one row per ``--transient-step``). ``--lubricant FILE`` replaces
 the bearing file's lubricant (the calibration's lubricant values are laid over it only when
 ``--calibration`` is given); the shipped calibration belongs to the shipped bearing, so another
-``--bearing`` gets a calibration only when one is named. When the calibration file has an
+``--bearing`` gets a calibration only when one is named. ``--running-hours H`` takes the grease
+to its state after H hours of running by its file's ``running_in:`` law
+(:mod:`bearing_rig_sim.dynamics.running_in`; 0: the calibrated, freshly packed state). When the calibration file has an
 ``uncertainty:`` block (``bearing-rig calibrate`` writes it), each point gets ``slip_pct_low`` and
 ``slip_pct_high``, its 95 % interval from the parameter and load uncertainty
 (:mod:`bearing_rig_sim.studies.uncertainty`).
@@ -84,6 +86,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--misalignment", type=float, nargs=2, default=None, metavar=("THETA_X", "THETA_Y"), help="inner ring tilts held against the outer, rad")
     p.add_argument("--preload-n", type=float, default=0.0, metavar="N", help="spring preload added to the axial load, N")
     p.add_argument("--preload-displacement", type=float, default=0.0, metavar="M", help="rigid preload of a back-to-back pair, m")
+    p.add_argument(
+        "--running-hours", type=float, default=None, metavar="H", help="the grease's state after H hours of running (its file's running_in law; 0: as calibrated)"
+    )
     p.add_argument("--json", action="store_true", help="one JSON object per line")
     p.set_defaults(func=run)
 
@@ -167,6 +172,8 @@ def run(args: argparse.Namespace) -> int:
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)
     radial = _radial_loads(args)
     params = parameters_of(args)
+    if args.running_hours is not None:
+        params = _after_running(params, args.running_hours)
     mounting = mounting_of(args)
     if args.thermal or args.transient is not None:
         if mounting is not None:
@@ -240,6 +247,17 @@ def _run_mounted(args: argparse.Namespace, params: BearingParameters, loads: lis
             row.update(whirl_row(solver.engine.cage_whirl_radius, solver.last_whirl))
         _print(row, args.json)
     return 0
+
+
+def _after_running(params: BearingParameters, hours: float) -> BearingParameters:
+    """The bearing after ``hours`` of running (``--running-hours``; :mod:`~bearing_rig_sim.dynamics.running_in`)."""
+    from bearing_rig_sim.dynamics.running_in import SECONDS_PER_HOUR, RunningInError, at_running_time
+
+    check_number(hours, "command line", "--running-hours", ge=0.0, le=100000.0)
+    try:
+        return at_running_time(params, hours * SECONDS_PER_HOUR)
+    except RunningInError as exc:
+        raise RigError(f"--running-hours: {exc}") from None
 
 
 def _uncertainty(args: argparse.Namespace) -> Any:

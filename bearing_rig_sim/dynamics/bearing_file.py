@@ -437,15 +437,26 @@ class Grease(FileSection):
     )
 
 
+class RunningIn(FileSection):
+    """``running_in:`` of a grease file: the first-order law of its fill against running time,
+    fill(t) = f_end + (f_0 - f_end) exp(-t / tau) (:mod:`.running_in`), f_0 the supply's fill."""
+
+    time_constant_s: Number = quantity(
+        "time constant tau of the fill's fall to its channelled value", unit="s", source="running-in of greased bearings: minutes to a day", ge=60.0, le=86400.0
+    )
+    channelled_fill_fraction: Number = quantity("fill once channelled, f_end (at most the supply's fill)", unit="1", source="a fraction", ge=0.0, le=1.0)
+
+
 class LubricantFile(FileSection):
     """A lubricant file (``config/lubricants/*.yaml``): an oil-air lubricant states its oil share,
-    a grease its rheology."""
+    a grease its rheology (and may state its running-in)."""
 
     lubricant: LubricantIdentity
     base_oil: BaseOil
     film: Film
     supply: Supply
     grease: Grease | None = None
+    running_in: RunningIn | None = None
 
     @model_validator(mode="after")
     def _what_the_kind_needs(self) -> Self:
@@ -453,6 +464,10 @@ class LubricantFile(FileSection):
             raise field_error("supply.oil_volume_fraction", "missing (required)")
         if self.lubricant.kind == "grease" and self.grease is None:
             raise field_error("grease", "missing (required)")
+        if self.running_in is not None:
+            if self.lubricant.kind != "grease":
+                raise field_error("running_in", f"only a grease runs in, this lubricant is {self.lubricant.kind}")
+            check_number(self.running_in.channelled_fill_fraction, "", "running_in.channelled_fill_fraction", ge=0.0, le=self.supply.fill_fraction)
         return self
 
 

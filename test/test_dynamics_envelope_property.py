@@ -19,7 +19,9 @@ driven body; the cage no faster than pure rolling at any contact angle,
 omega_i (1 - Dw cos a / d_m) / 2 <= omega_i / 2; each with the engine's 0.2 rad/s tolerance),
 and the engine's own divergence check (which also bounds the cage centre) must not fire.
 
-Derandomised (a fixed sequence of examples, no example database): not flaky, the same 300
+Both named models are held to it (the bench twin and the paper's own model, whose balls skid
+beyond its friction law's peak; its dry cage, which nothing damps, may rebound backwards off
+balls the stopped ring pinches, at most as fast as the ring turned). Derandomised (a fixed sequence of examples, no example database): not flaky, the same 300
 sequences in every run. With the tangent slope of the traction in the implicit step (the scheme
 before kernels.implicit_slope) it fails within its first examples: a run-up from rest at 1 N;
 with the fictitious stiffness of every open contact in the quasi-static Jacobian (before
@@ -38,7 +40,8 @@ from hypothesis import strategies as st
 
 import numpy as np
 
-from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, OperatingEnvelope
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, OperatingEnvelope
+from bearing_rig_sim.dynamics.models import MODELS, model_parameters
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.rig.program import RigLimits
 from bearing_rig_sim.rig.spindle import SpindleConfig
@@ -95,9 +98,10 @@ starts = st.one_of(st.just(0.0), st.floats(0.0, 50.0 * RPM), st.just(ENVELOPE.ma
 sequences = st.tuples(starts, loads, radials, azimuths, moments, st.lists(segments, min_size=1, max_size=6))
 
 
-@pytest.fixture(scope="module")
-def engine() -> BearingDynamics:
-    return BearingDynamics(BearingParameters.calibrated())
+@pytest.fixture(scope="module", params=MODELS)
+def engine(request: pytest.FixtureRequest) -> BearingDynamics:
+    """The engine of each named model: the bench twin and the paper's own model."""
+    return BearingDynamics(model_parameters(request.param))
 
 
 def assert_physical(engine: BearingDynamics, peak: float) -> None:
@@ -105,7 +109,9 @@ def assert_physical(engine: BearingDynamics, peak: float) -> None:
     cage = engine.cage[:, kn.C_OMEGA]
     orbit = engine.ball[:, kn.B_OMEGA]
     assert np.all(np.isfinite(engine.ball)) and np.all(np.isfinite(engine.cage))
-    assert min(cage.min(), orbit.min()) >= -TOLERANCE, (engine.time, cage.min(), orbit.min())
+    # a dry cage may rebound off balls the stopped ring pinches, at most as fast as it came
+    backwards = peak if engine.params.dry else 0.0
+    assert min(cage.min(), orbit.min()) >= -backwards - TOLERANCE, (engine.time, cage.min(), orbit.min())
     assert max(cage.max(), orbit.max()) <= peak + TOLERANCE, (engine.time, cage.max(), orbit.max(), peak)
     assert engine.cage_speed <= 0.5 * peak + TOLERANCE, (engine.time, engine.cage_speed, peak)
 

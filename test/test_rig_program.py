@@ -130,9 +130,17 @@ def test_validation_program_matches_the_papers_table_3_conditions() -> None:
 def test_load_sweep_and_acceleration_programs_cover_the_papers_ranges() -> None:
     sweep = load_program(config_path("programs", "load_sweep.yaml"))
     assert sweep.stability_criterion == "axial_load"
-    assert {round(s.target_speed / RPM) for s in sweep.segments} == {1000, 3000, 5000, 7000, 9000}
+    assert {round(s.target_speed / RPM) for s in sweep.segments} == {0, 1000, 3000, 5000, 7000, 9000}
     loads = [s.axial_load for s in sweep.segments]
     assert min(loads) == 50.0 and max(loads) == 700.0
+    # every speed is run up from rest under the full load and left at rest under it (the
+    # program's comment: no run-up under a light load, no skid hysteresis in the points)
+    starts = sweep.start_speeds()
+    for k, seg in enumerate(sweep.segments):
+        if seg.target_speed > 0.0 and starts[k] != seg.target_speed:
+            assert starts[k] == 0.0 and seg.axial_load == 700.0, seg.name
+        if seg.target_speed == 0.0:
+            assert seg.axial_load == 700.0, seg.name
     accel = load_program(config_path("programs", "acceleration.yaml"))
     ramps = [s for s in accel.segments if s.profile is SpeedProfileKind.CONSTANT_ACCELERATION]
     assert [s.acceleration for s in ramps] == [20.0, 40.0, 60.0, 80.0]
@@ -238,9 +246,10 @@ def test_a_9000_rpm_program_is_refused_on_a_6000_rpm_rig_naming_the_segment() ->
     six_thousand = RigLimits(6000 * 2 * math.pi / 60, 1000.0, 1000.0, "rig.yaml")
     with pytest.raises(ConfigError) as info:
         load_program(config_path("programs", "load_sweep.yaml"), six_thousand)
-    # the first segment above 6000 rpm is the 25th (index 24), n7000_f050
-    assert info.value.key == "segments[24].speed_rpm"
-    assert "segment 'n7000_f050': 7000 rpm is above the rig's limit of 6000 rpm" in info.value.problem
+    # the first segment above 6000 rpm is the 28th (index 27; 9 segments per speed with its
+    # stop), n7000_f700
+    assert info.value.key == "segments[27].speed_rpm"
+    assert "segment 'n7000_f700': 7000 rpm is above the rig's limit of 6000 rpm" in info.value.problem
 
 
 def test_the_shortest_allowed_step_ramp_is_accepted(tmp_path: Path) -> None:

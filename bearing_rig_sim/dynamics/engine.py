@@ -590,9 +590,12 @@ class BearingDynamics:
         """Raise if the state is one no bearing can be in (a numerical fault).
 
         The inner ring is the only driven body; balls and cage are carried by friction, so none
-        can turn backwards or faster than the fastest the inner ring has turned since the
-        start (:data:`SPEED_TOLERANCE` margin). A finite state outside those bounds, like a
-        non-finite one, means the integration diverged.
+        can turn faster than the fastest the inner ring has turned since the start, nor
+        backwards (:data:`SPEED_TOLERANCE` margin). A dry bearing (``params.dry``: no fluid
+        damps the cage) is allowed to turn backwards as fast as that: a free cage that runs
+        into balls the stopped ring pinches rebounds off them, at most as fast as it came
+        (restitution below 1). A finite state outside those bounds, like a non-finite one,
+        means the integration diverged.
 
         Raises:
             DynamicsDivergedError: naming the quantity, its value, the bounds and the time.
@@ -601,7 +604,8 @@ class BearingDynamics:
         if omega > self._peak_speed:
             self._peak_speed = omega
         rel, absolute = SPEED_TOLERANCE
-        lo, hi = -absolute, self._peak_speed * (1.0 + rel) + absolute
+        hi = self._peak_speed * (1.0 + rel) + absolute
+        lo = -hi if self.params.dry else -absolute
         fault = kn.speed_outlier(self.ball, self.cage, self.ring, lo, hi)  # one compiled pass per chunk
         t = self.time
         if fault == 0:
@@ -617,7 +621,7 @@ class BearingDynamics:
         name, speeds = ("cage speed", self.cage[:, kn.C_OMEGA]) if fault == 2 else ("ball orbit speed", self.ball[:, kn.B_OMEGA])
         worst = float(speeds[np.argmax(np.abs(speeds - 0.5 * (lo + hi)))])
         raise DynamicsDivergedError(
-            f"dynamics diverged at t = {t:.6g} s: {name} {worst:.6g} rad/s outside [0, {self._peak_speed:.6g}] rad/s "
+            f"dynamics diverged at t = {t:.6g} s: {name} {worst:.6g} rad/s outside [{'-' if self.params.dry else ''}{0.0 if not self.params.dry else self._peak_speed:.6g}, {self._peak_speed:.6g}] rad/s "
             f"(the inner ring's fastest so far) ({self._step_hint()})"
         )
 

@@ -21,7 +21,8 @@ from typing import Any
 from collections.abc import Callable
 
 from bearing_rig_sim import __version__
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.executors import open_client
@@ -73,6 +74,12 @@ class SweepOutcome:
 
 def base_parameters(spec: SweepSpec) -> BearingParameters:
     """The bearing parameters of a spec before its parameter axes."""
+    if spec.model != "bench":
+        if spec.bearing is not None:
+            raise ConfigError(spec.source, "sweep.bearing", f"the {spec.model} model names its own bearing file; leave bearing out")
+        if spec.calibration in ("shipped", "none"):
+            return model_parameters(spec.model, calibrated=spec.calibration == "shipped")
+        return model_parameters(spec.model, calibration=Path(spec.calibration))
     if spec.calibration == "none":
         calibration: str | Path | None = None
     elif spec.calibration == "shipped":

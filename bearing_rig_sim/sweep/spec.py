@@ -42,7 +42,7 @@ from typing import Annotated, Any, Self
 import numpy as np
 from pydantic import BeforeValidator, ConfigDict, Field, model_validator
 
-from bearing_rig_sim.config import check_number, read_mapping
+from bearing_rig_sim.config import BEARING_MODELS, check_number, read_mapping
 from bearing_rig_sim.dynamics.engine import MIN_AXIAL_LOAD
 from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, field_error, one_of, quantity, validate_mapping
 
@@ -120,12 +120,13 @@ class SweepSpec:
         samples: rows of random values (axis name -> value), crossed with the grid; empty if
             the spec has no ``samples`` section.
         bearing: bearing file (``None``: the shipped H7006C).
-        calibration: ``"shipped"``, ``"none"`` or a calibration file path.
+        calibration: ``"shipped"`` (the model's own), ``"none"`` or a calibration file path.
         continuation: whether each load row is also followed upwards from its lowest load.
         transient_duration: s, simulated duration of a transient (acceleration) point.
         skid_slip_pct: slip (%) above which a point counts as skidding, for the map.
         minimum_load_factor_kn: SKF minimum axial load factor A, kN (F_am = A (n/1000)^2).
         document: the parsed spec (canonical form of its inputs), for the spec hash.
+        model: the named bearing model (:data:`~bearing_rig_sim.config.BEARING_MODELS`).
     """
 
     name: str
@@ -139,6 +140,7 @@ class SweepSpec:
     skid_slip_pct: float
     minimum_load_factor_kn: float
     document: dict[str, Any] = field(repr=False)
+    model: str = "bench"
 
     @property
     def transient(self) -> bool:
@@ -268,8 +270,9 @@ class SweepHead(FileSection):
 
     name: Text = Field(description="the sweep's name")
     description: Text | None = Field(None, description="what the sweep is for")
-    bearing: Text | None = Field(None, description="bearing file (absent: the shipped H7006C)")
-    calibration: Text = Field("shipped", description="shipped, none or a calibration file")
+    model: Annotated[str, one_of(BEARING_MODELS)] = Field("bench", description="the named bearing model: bench (the bench twin) or paper (the paper's own model)")
+    bearing: Text | None = Field(None, description="bearing file (absent: the shipped H7006C; bench model only)")
+    calibration: Text = Field("shipped", description="shipped (the model's own), none or a calibration file")
     continuation: Flag = Field(False, description="also follow each load row upwards from its lowest load")
     transient_duration_s: Number = quantity(
         "simulated duration of a transient (acceleration) point", unit="s", source="run-ups of the paper's rig last seconds", gt=0.0, le=60.0, default=3.0
@@ -315,6 +318,7 @@ def spec_from_mapping(data: Mapping[str, Any], source: str) -> SweepSpec:
         "name": head.name,
         "bearing": head.bearing,
         "calibration": head.calibration,
+        **({"model": head.model} if head.model != "bench" else {}),
         "continuation": head.continuation,
         "transient_duration_s": head.transient_duration_s,
         "grid": {k: list(v) for k, v in doc.grid.items()},
@@ -322,7 +326,7 @@ def spec_from_mapping(data: Mapping[str, Any], source: str) -> SweepSpec:
     }
     return SweepSpec(
         head.name, source, dict(doc.grid), samples, head.bearing, head.calibration, head.continuation, head.transient_duration_s,
-        view.skid_slip_pct, view.minimum_load_factor_kn, document,
+        view.skid_slip_pct, view.minimum_load_factor_kn, document, head.model,
     )  # fmt: skip
 
 

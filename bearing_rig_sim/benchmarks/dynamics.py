@@ -19,6 +19,8 @@ from collections.abc import Iterator
 
 from bearing_rig_sim.benchmarks.exudyn_bearing import run_exudyn
 from bearing_rig_sim.config import rpm_to_rad_s
+from bearing_rig_sim.config import BEARING_MODELS
+from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
 
 POINTS: tuple[tuple[float, float], ...] = ((900, 100), (2700, 100), (5000, 300), (9000, 700), (9000, 50))
@@ -38,11 +40,12 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--repeats", type=int, default=3, help="runs per point; the median is reported")
     parser.add_argument("--models", nargs="+", default=["reduced", "stiff", "exudyn"], choices=["reduced", "stiff", "exudyn"])
     parser.add_argument("--uncalibrated", action="store_true", help="use the clean bearing data instead of the bench calibration")
+    parser.add_argument("--bearing-model", choices=BEARING_MODELS, default="bench", help="the named bearing model (default bench; paper: the paper's own)")
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
     """Measure the real-time factor of each model at each operating point."""
-    params = BearingParameters.from_yaml() if args.uncalibrated else BearingParameters.calibrated()
+    params = model_parameters(args.bearing_model, calibrated=not args.uncalibrated)
     reduced_rtf: float | None = None
     for model in args.models:
         if model == "exudyn":

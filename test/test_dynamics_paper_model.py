@@ -138,3 +138,14 @@ def test_the_load_the_ball_set_needs_to_roll_grows_with_speed(paper):
                 assert f not in rolling, f"{rpm} rpm, {f} N: resistance {r:.2f} N over capacity {capacity:.2f} N, yet rolling"
     assert lightest[1000.0] <= lightest[5000.0] <= lightest[9000.0]
     assert lightest[9000.0] > lightest[1000.0]
+
+
+def test_both_integration_models_accept_the_paper_models_steps(paper):
+    """The shipped steps lie within each model's stability limit over the rig's envelope (the
+    engine refuses them otherwise, dynamics/step_limit.py): the paper's damping exponent needs a
+    shorter stiff step than the bench twin's."""
+    from bearing_rig_sim.dynamics import BearingDynamics
+
+    for model in ("reduced", "stiff"):
+        engine = BearingDynamics(paper, model=model)
+        assert engine.time_step <= engine.step_limit.limit

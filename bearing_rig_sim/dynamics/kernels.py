@@ -1341,6 +1341,248 @@ def land_centre_heat(
     return -(fx * mx + fy * my)
 
 
+@njit(cache=True, inline="always")
+def reduced_ball_row(
+    p: np.ndarray,
+    ball: np.ndarray,
+    cage: np.ndarray,
+    geo: np.ndarray,
+    work: np.ndarray,
+    out: np.ndarray,
+    j: int,
+    w0: int,
+    omega_i: float,
+    inner_scale: float,
+    dt: float,
+    centre: bool,
+    keep: bool,
+    cx: float,
+    cy: float,
+    cvx: float,
+    cvy: float,
+    drive: float,
+    heat: float,
+    damp: float,
+) -> tuple[float, float, float, float, float, float, float, float, float]:
+    """Ball ``j``'s stage of a reduced step (:func:`step_reduced`): its raceway tractions and
+    resistances at the step's start, its linearly implicit (orbit, spin) block with the pivot's
+    and pitch's rows eliminated onto it, and the elimination data the cage's solve and the
+    back-substitution read (``work[j, w0 + ...]``).
+
+    Returns the step's running sums with this ball's share added (``drive``: the drive torque
+    on the inner ring at the start, N m; ``heat``: W; ``damp``: the Hunt-Crossley heat of the
+    pockets, W; added here in the order of the single loop they came from, so the sums are
+    the same to the last bit) and the ball's terms of the cage centre's 2x2 block (m11, m12,
+    m21, m22, kg) and of its right side (rcx, rcy, N).
+    """
+    rm = p[P_RM]
+    r = p[P_RBALL]
+    rb = ball[j, B_R]
+    qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
+    fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, mpitch, kpitch = ball_tractions(
+        p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, geo[j, G_DI], geo[j, G_DO]
+    )
+    drive += fi * r_ci
+    wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
+    fd, dfd = ball_drag(p, rb * wm, 0.5 * (qi + qo))
+    dfd = implicit_slope(fd, dfd, rb * wm)
+    cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
+    # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
+    gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
+    rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
+    fs, ku, cu = pocket_force(p, gap, rate)
+    damp += cu * rate * rate  # Hunt-Crossley: the damping force c u_dot times u_dot
+    omega_roll = wa + cb * wm
+    sg = smooth_sign(omega_roll)
+    sroll = sg
+    t_inner, m_outer, m_ring, t_orbit = contact_moments(
+        p, inner_scale, wa, omega_roll, sg, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
+    )
+    drive += t_inner + m_ring * cb
+    mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sg + m_outer
+    kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
+    gm = rb * (fi + fo - fd) - rm * fs + t_orbit
+    ga = r * (ci * fi - co * fo) - mres
+    jmm = rb * (-kti * aim - kto * aom - dfd * rb)
+    jma = rb * (-kti * aia + kto * aoa)
+    jam = r * (-ci * kti * aim + co * kto * aom) - kres * cb
+    jaa = r * (-ci * kti * aia - co * kto * aoa) - kres
+    ee = cu + dt * ku
+    e = rm * rm * ee
+    ib = p[P_IBALL]
+    b11 = p[P_MBALL] * rb * rb - dt * jmm + dt * e
+    b12 = -dt * jma
+    b21 = -dt * jam
+    b22 = ib - dt * jaa
+    # the pivot omega_t and the pitch rate omega_p: the orbiting frame's gyroscopic terms,
+    # g = J omega_m sin(beta) times (cos(beta) omega_t, omega_t, -omega_roll) on (orbit, spin,
+    # pivot) and gc = J omega_m cos(beta) times (-omega_p, omega_t) on (pivot, pitch), skew and
+    # taken trapezoidally (they keep the energy exactly); the transverse tractions' moment
+    # -r k_pivot r omega_t and the spin moments' change -m_pitch implicitly (secants through
+    # zero); the (pivot, pitch) rows are eliminated onto the 2x2 block (Schur complement). With
+    # no traction at either contact (k_pivot = 0: frictionless or unloaded) the gyroscopic
+    # terms are left out
+    sbg = math.sqrt(max(1.0 - cb * cb, 0.0))
+    g = ib * wm * sbg if kpiv > 0.0 else 0.0
+    gc = ib * wm * cb if kpiv > 0.0 else 0.0
+    hg = 0.5 * dt * g
+    hgc = 0.5 * dt * gc
+    gm += g * cb * wt
+    ga += g * wt
+    s11 = ib + dt * r * r * kpiv
+    s22 = ib + dt * kpitch
+    dinv = 1.0 / (s11 * s22 + hgc * hgc)
+    rt = dt * (-g * omega_roll - gc * wp - r * r * kpiv * wt)
+    rp = dt * (gc * wt - mpitch)
+    r3 = (s22 * rt - hgc * rp) * dinv
+    t1, t2 = s22 * hg * cb * dinv, s22 * hg * dinv
+    b11 += hg * cb * t1
+    b12 += hg * cb * t2
+    b21 += hg * t1
+    b22 += hg * t2
+    work[j, w0 + 29] = r3
+    work[j, w0 + 30] = t1
+    work[j, w0 + 31] = t2
+    work[j, w0 + 32] = (hgc * rt + s11 * rp) * dinv
+    work[j, w0 + 33] = hgc * hg * cb * dinv
+    work[j, w0 + 34] = hgc * hg * dinv
+    det = b11 * b22 - b12 * b21
+    i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
+    r1 = dt * (gm - dt * rm * ku * rate) + hg * cb * r3
+    r2 = dt * ga + hg * r3
+    x2 = i11 * r1 + i12 * r2
+    work[j, w0 + 0] = i11
+    work[j, w0 + 1] = i21
+    work[j, w0 + 2] = x2
+    work[j, w0 + 3] = i21 * r1 + i22 * r2
+    work[j, w0 + 4] = e
+    work[j, w0 + 5] = ku * rate
+    work[j, w0 + 6] = fs
+    d11 = d12 = d21 = d22 = dcx = dcy = 0.0
+    if centre:
+        # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1)
+        # <= 0, its direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
+        mup = p[P_MU_POCKET]
+        g = dt * rm * ee * (dt * e * i11 - 1.0)
+        nx = -sph + mup * sroll * cph
+        ny = cph + mup * sroll * sph
+        work[j, w0 + 22] = g
+        work[j, w0 + 23] = nx
+        work[j, w0 + 24] = ny
+        work[j, w0 + 25] = g * -sph
+        work[j, w0 + 26] = g * cph
+        d11 = g / rm * nx * -sph
+        d12 = g / rm * nx * cph
+        d21 = g / rm * ny * -sph
+        d22 = g / rm * ny * cph
+        fp = fs + dt * ku * rate + ee * rm * x2
+        dcx = nx * fp
+        dcy = ny * fp
+    work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
+    work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
+    power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2 + mpitch * wp)
+    if keep:
+        record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+        out[j, O_POWER] = power
+        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
+    return drive, heat + power, damp, d11, d12, d21, d22, dcx, dcy
+
+
+@njit(cache=True, inline="always")
+def reduced_cage_rows(
+    p: np.ndarray, cage: np.ndarray, work: np.ndarray, w0: int, dt: float, land_f: float, land_n: float, heat: float, damp: float
+) -> tuple[float, float]:
+    """The cage segments' stage of a reduced step: each segment's diagonal and right side of
+    the cyclic tridiagonal system (``work[:, w0 + 7]`` and ``w0 + 8``), its rim, land and
+    pocket terms with the balls' blocks eliminated onto it. Returns the running sums ``heat``
+    with the land's heat and ``damp`` with the rims' damping heat added (W)."""
+    z = cage.shape[0]
+    rm = p[P_RM]
+    kl, cl = p[P_LINK_K], p[P_LINK_C]
+    lc = cl + dt * kl
+    diag = work[:, w0 + 7]
+    rhs = work[:, w0 + 8]
+    for k in range(z):
+        km = z - 1 if k == 0 else k - 1
+        kp = 0 if k == z - 1 else k + 1
+        tau, dtl = cage_segment_torque(p, cage, k, z, land_f, land_n)
+        w = cage[k, C_OMEGA]
+        tl, _ = cage_land_torque(p, w, z, land_f, land_n)
+        heat += abs(tl * w)
+        dw = cage[kp, C_OMEGA] - w
+        damp += cl * dw * dw  # the rim's damping between segments k and k+1
+        e = work[k, w0 + 4]
+        gc = rm * work[k, w0 + 6] + tau
+        diag[k] = p[P_JSEG] + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
+        rhs[k] = dt * (gc + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA]) + dt * rm * work[k, w0 + 5]) + dt * e * work[k, w0 + 2]
+    return heat, damp
+
+
+@njit(cache=True, inline="always")
+def reduced_centre_solve(
+    work: np.ndarray, w0: int, dt: float, lc: float, m11: float, m12: float, m21: float, m22: float, rcx: float, rcy: float
+) -> tuple[float, float]:
+    """The cage centre's stage of a reduced step: the segments' response to its velocity change
+    (A Y = g t, ``work[:, w0 + 27]`` and ``w0 + 28``) eliminated onto its 2x2 block, solved for
+    its velocity change (dv_x, dv_y, m/s); the segments' speed changes ``work[:, w0 + 9]`` take
+    their share of it."""
+    z = work.shape[0]
+    diag = work[:, w0 + 7]
+    d_omega = work[:, w0 + 9]
+    yx = work[:, w0 + 27]
+    yy = work[:, w0 + 28]
+    cyclic_tridiagonal_pair(diag, -dt * lc, work[:, w0 + 25], work[:, w0 + 26], yx, yy, work[:, NG : NG + 5])
+    for k in range(z):
+        g = work[k, w0 + 22]
+        nx, ny = work[k, w0 + 23], work[k, w0 + 24]
+        m11 -= g * nx * yx[k]
+        m12 -= g * nx * yy[k]
+        m21 -= g * ny * yx[k]
+        m22 -= g * ny * yy[k]
+        rcx += g / dt * nx * d_omega[k]
+        rcy += g / dt * ny * d_omega[k]
+    det2 = m11 * m22 - m12 * m21
+    dvx = dt * (m22 * rcx - m12 * rcy) / det2
+    dvy = dt * (m11 * rcy - m21 * rcx) / det2
+    for j in range(z):
+        d_omega[j] += yx[j] * dvx + yy[j] * dvy
+    return dvx, dvy
+
+
+@njit(cache=True, inline="always")
+def reduced_update(
+    p: np.ndarray, ball: np.ndarray, cage: np.ndarray, work: np.ndarray, out: np.ndarray, w0: int, dt: float, dvx: float, dvy: float, keep: bool, drive: float
+) -> tuple[float, float]:
+    """The back-substitution of a reduced step: each ball's orbit, spin, pivot and pitch from
+    its pocket's closing speed, the segments' speeds, and both advanced in angle. Returns the
+    running drive torque ``drive`` less the tractions' implicit parts (N m) and the sum of the
+    segments' new speeds (rad/s)."""
+    z = ball.shape[0]
+    rm = p[P_RM]
+    d_omega = work[:, w0 + 9]
+    cage_sum = 0.0
+    for j in range(z):
+        # the pocket's closing speed seen by the ball: r_m d Omega + t . d v (over r_m)
+        coup = dt * work[j, w0 + 4] * (d_omega[j] + (work[j, w0 + 20] * dvx + work[j, w0 + 21] * dvy) / rm)
+        d_wm = work[j, w0 + 2] + work[j, w0 + 0] * coup
+        d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
+        ball[j, B_OMEGA] += d_wm
+        ball[j, B_SPIN] += d_wa
+        ball[j, B_PIVOT] += work[j, w0 + 29] - work[j, w0 + 30] * d_wm - work[j, w0 + 31] * d_wa
+        ball[j, B_PITCH] += work[j, w0 + 32] - work[j, w0 + 33] * d_wm - work[j, w0 + 34] * d_wa
+        # the drive torque of the traction the step applied: Q mu at the start plus its
+        # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
+        d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
+        drive -= d_drive
+        if keep:
+            out[j, O_DRIVE] -= d_drive
+        cage[j, C_OMEGA] += d_omega[j]
+        ball[j, B_THETA] += dt * ball[j, B_OMEGA]
+        cage[j, C_PHI] += dt * cage[j, C_OMEGA]
+        cage_sum += cage[j, C_OMEGA]
+    return drive, cage_sum
+
+
 @njit(cache=True)
 def step_reduced(
     p: np.ndarray,
@@ -1377,16 +1619,16 @@ def step_reduced(
     scratch of shape (Z, NW). Diagnostics go to ``out`` on the last step and every
     ``record_every`` steps.
 
+    A step's stages: the contacts (the quasi-static normal solve), the cage centre's film and
+    land forces, each ball's tractions, resistances and block (:func:`reduced_ball_row`), the
+    cage segments' rows (:func:`reduced_cage_rows`) and their cyclic tridiagonal solve, the cage
+    centre's (:func:`reduced_centre_solve`), and the back-substitution
+    (:func:`reduced_update`).
+
     Returns the largest number of quasi-static Newton iterations used.
     """
     z = ball.shape[0]
-    rm = p[P_RM]
-    r = p[P_RBALL]
-    m = p[P_MBALL]
-    ib = p[P_IBALL]
-    jseg = p[P_JSEG]
     mc = p[P_CAGE_MASS]
-    mup = p[P_MU_POCKET]
     kl, cl = p[P_LINK_K], p[P_LINK_C]
     geo = work[:, 0:NG]
     qs_work = work[:, NG : NG + 6]  # the quasi-static solve's scratch, free again after it
@@ -1438,176 +1680,27 @@ def step_reduced(
         drive = 0.0
         inner_scale = inner_speed_scale(omega_i)
         for j in range(z):
-            rb = ball[j, B_R]
-            qi, qo, nir, niz, nor, noz = geo[j, G_QI], geo[j, G_QO], geo[j, G_NIR], geo[j, G_NIZ], geo[j, G_NOR], geo[j, G_NOZ]
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, mpitch, kpitch = ball_tractions(
-                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, geo[j, G_DI], geo[j, G_DO]
+            drive, heat, damp, d11, d12, d21, d22, dcx, dcy = reduced_ball_row(
+                p, ball, cage, geo, work, out, j, w0, omega_i, inner_scale, dt, centre, keep, cx, cy, cvx, cvy, drive, heat, damp
             )
-            drive += fi * r_ci
-            wm, wa, wt, wp = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT], ball[j, B_PITCH]
-            fd, dfd = ball_drag(p, rb * wm, 0.5 * (qi + qo))
-            dfd = implicit_slope(fd, dfd, rb * wm)
-            cph, sph = work[j, w0 + 21], -work[j, w0 + 20]
-            # pocket gap and its rate with the cage centre off the axis (t = (-sin, cos) phi)
-            gap = rm * (ball[j, B_THETA] - cage[j, C_PHI]) - (cy * cph - cx * sph)
-            rate = rm * (wm - cage[j, C_OMEGA]) - (cvy * cph - cvx * sph) + cage[j, C_OMEGA] * (cx * cph + cy * sph)
-            fs, ku, cu = pocket_force(p, gap, rate)
-            damp += cu * rate * rate  # Hunt-Crossley: the damping force c u_dot times u_dot
-            omega_roll = wa + cb * wm
-            sg = smooth_sign(omega_roll)
-            sroll = sg
-            t_inner, m_outer, m_ring, t_orbit = contact_moments(
-                p, inner_scale, wa, omega_roll, sg, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
-            )
-            drive += t_inner + m_ring * cb
-            mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sg + m_outer
-            kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
-            gm = rb * (fi + fo - fd) - rm * fs + t_orbit
-            ga = r * (ci * fi - co * fo) - mres
-            jmm = rb * (-kti * aim - kto * aom - dfd * rb)
-            jma = rb * (-kti * aia + kto * aoa)
-            jam = r * (-ci * kti * aim + co * kto * aom) - kres * cb
-            jaa = r * (-ci * kti * aia - co * kto * aoa) - kres
-            ee = cu + dt * ku
-            e = rm * rm * ee
-            b11 = m * rb * rb - dt * jmm + dt * e
-            b12 = -dt * jma
-            b21 = -dt * jam
-            b22 = ib - dt * jaa
-            # the pivot omega_t and the pitch rate omega_p: the orbiting frame's gyroscopic
-            # terms, g = J omega_m sin(beta) times (cos(beta) omega_t, omega_t, -omega_roll) on
-            # (orbit, spin, pivot) and gc = J omega_m cos(beta) times (-omega_p, omega_t) on
-            # (pivot, pitch), skew and taken trapezoidally (they keep the energy exactly); the
-            # transverse tractions' moment -r k_pivot r omega_t and the spin moments' change
-            # -m_pitch implicitly (secants through zero); the (pivot, pitch) rows are eliminated
-            # onto the 2x2 block (Schur complement). With no traction at either contact
-            # (k_pivot = 0: frictionless or unloaded) the gyroscopic terms are left out
-            sbg = math.sqrt(max(1.0 - cb * cb, 0.0))
-            g = ib * wm * sbg if kpiv > 0.0 else 0.0
-            gc = ib * wm * cb if kpiv > 0.0 else 0.0
-            hg = 0.5 * dt * g
-            hgc = 0.5 * dt * gc
-            gm += g * cb * wt
-            ga += g * wt
-            s11 = ib + dt * r * r * kpiv
-            s22 = ib + dt * kpitch
-            dinv = 1.0 / (s11 * s22 + hgc * hgc)
-            rt = dt * (-g * omega_roll - gc * wp - r * r * kpiv * wt)
-            rp = dt * (gc * wt - mpitch)
-            r3 = (s22 * rt - hgc * rp) * dinv
-            t1, t2 = s22 * hg * cb * dinv, s22 * hg * dinv
-            b11 += hg * cb * t1
-            b12 += hg * cb * t2
-            b21 += hg * t1
-            b22 += hg * t2
-            work[j, w0 + 29] = r3
-            work[j, w0 + 30] = t1
-            work[j, w0 + 31] = t2
-            work[j, w0 + 32] = (hgc * rt + s11 * rp) * dinv
-            work[j, w0 + 33] = hgc * hg * cb * dinv
-            work[j, w0 + 34] = hgc * hg * dinv
-            det = b11 * b22 - b12 * b21
-            i11, i12, i21, i22 = b22 / det, -b12 / det, -b21 / det, b11 / det
-            r1 = dt * (gm - dt * rm * ku * rate) + hg * cb * r3
-            r2 = dt * ga + hg * r3
-            x2 = i11 * r1 + i12 * r2
-            work[j, w0 + 0] = i11
-            work[j, w0 + 1] = i21
-            work[j, w0 + 2] = x2
-            work[j, w0 + 3] = i21 * r1 + i22 * r2
-            work[j, w0 + 4] = e
-            work[j, w0 + 5] = ku * rate
-            work[j, w0 + 6] = fs
             if centre:
-                # coupling of the pocket's force to the cage centre: g = dt r_m E (dt e i11 - 1)
-                # <= 0, its direction on the cage n = t + mu_p sgn(roll) r (pocket friction)
-                g = dt * rm * ee * (dt * e * i11 - 1.0)
-                nx = -sph + mup * sroll * cph
-                ny = cph + mup * sroll * sph
-                work[j, w0 + 22] = g
-                work[j, w0 + 23] = nx
-                work[j, w0 + 24] = ny
-                work[j, w0 + 25] = g * -sph
-                work[j, w0 + 26] = g * cph
-                m11 -= g / rm * nx * -sph
-                m12 -= g / rm * nx * cph
-                m21 -= g / rm * ny * -sph
-                m22 -= g / rm * ny * cph
-                fp = fs + dt * ku * rate + ee * rm * x2
-                rcx += nx * fp
-                rcy += ny * fp
-            work[j, w0 + 10] = r_ci * kti * aim  # the inner traction's implicit part, per d omega_m
-            work[j, w0 + 11] = r_ci * kti * aia  # and per d omega_a (for the drive torque)
-            power = ball_power(wm, wa, rb, omega_i, fi, fo, si, so, mres, fd, t_inner, m_ring, t_orbit, cb, kpiv * (r * wt) ** 2 + mpitch * wp)
-            heat += power
-            if keep:
-                record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = power
-                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
-        diag = work[:, w0 + 7]
-        rhs = work[:, w0 + 8]
-        d_omega = work[:, w0 + 9]
-        for k in range(z):
-            km = z - 1 if k == 0 else k - 1
-            kp = 0 if k == z - 1 else k + 1
-            tau, dtl = cage_segment_torque(p, cage, k, z, land_f, land_n)
-            w = cage[k, C_OMEGA]
-            tl, _ = cage_land_torque(p, w, z, land_f, land_n)
-            heat += abs(tl * w)
-            dw = cage[kp, C_OMEGA] - w
-            damp += cl * dw * dw  # the rim's damping between segments k and k+1
-            e = work[k, w0 + 4]
-            gc = rm * work[k, w0 + 6] + tau
-            diag[k] = jseg + 2.0 * dt * lc + dt * e + dt * dtl - dt * dt * e * e * work[k, w0 + 0]
-            rhs[k] = (
-                dt * (gc + dt * kl * (cage[kp, C_OMEGA] - 2.0 * cage[k, C_OMEGA] + cage[km, C_OMEGA]) + dt * rm * work[k, w0 + 5]) + dt * e * work[k, w0 + 2]
-            )
-        cyclic_tridiagonal(diag, -dt * lc, rhs, d_omega, tri_work)
+                m11 -= d11
+                m12 -= d12
+                m21 -= d21
+                m22 -= d22
+                rcx += dcx
+                rcy += dcy
+        heat, damp = reduced_cage_rows(p, cage, work, w0, dt, land_f, land_n, heat, damp)
+        cyclic_tridiagonal(work[:, w0 + 7], -dt * lc, work[:, w0 + 8], work[:, w0 + 9], tri_work)
         dvx = dvy = 0.0
         if centre:
-            # the segments' response to the cage centre's velocity change: A Y = g t
-            yx = work[:, w0 + 27]
-            yy = work[:, w0 + 28]
-            cyclic_tridiagonal_pair(diag, -dt * lc, work[:, w0 + 25], work[:, w0 + 26], yx, yy, work[:, NG : NG + 5])
-            for k in range(z):
-                g = work[k, w0 + 22]
-                nx, ny = work[k, w0 + 23], work[k, w0 + 24]
-                m11 -= g * nx * yx[k]
-                m12 -= g * nx * yy[k]
-                m21 -= g * ny * yx[k]
-                m22 -= g * ny * yy[k]
-                rcx += g / dt * nx * d_omega[k]
-                rcy += g / dt * ny * d_omega[k]
-            det2 = m11 * m22 - m12 * m21
-            dvx = dt * (m22 * rcx - m12 * rcy) / det2
-            dvy = dt * (m11 * rcy - m21 * rcx) / det2
+            dvx, dvy = reduced_centre_solve(work, w0, dt, lc, m11, m12, m21, m22, rcx, rcy)
             ring[R_CVX] = cvx + dvx
             ring[R_CVY] = cvy + dvy
             ring[R_CX] = cx + dt * ring[R_CVX]
             ring[R_CY] = cy + dt * ring[R_CVY]
             damp += land_centre_heat(p, cx, cy, cvx, cvy, dvx, dvy, dt, fcx, fcy, kxx, kxy, kyx, kyy, cxx, cxy, cyx, cyy)
-            for j in range(z):
-                d_omega[j] += yx[j] * dvx + yy[j] * dvy
-        cage_sum = 0.0
-        for j in range(z):
-            # the pocket's closing speed seen by the ball: r_m d Omega + t . d v (over r_m)
-            coup = dt * work[j, w0 + 4] * (d_omega[j] + (work[j, w0 + 20] * dvx + work[j, w0 + 21] * dvy) / rm)
-            d_wm = work[j, w0 + 2] + work[j, w0 + 0] * coup
-            d_wa = work[j, w0 + 3] + work[j, w0 + 1] * coup
-            ball[j, B_OMEGA] += d_wm
-            ball[j, B_SPIN] += d_wa
-            ball[j, B_PIVOT] += work[j, w0 + 29] - work[j, w0 + 30] * d_wm - work[j, w0 + 31] * d_wa
-            ball[j, B_PITCH] += work[j, w0 + 32] - work[j, w0 + 33] * d_wm - work[j, w0 + 34] * d_wa
-            # the drive torque of the traction the step applied: Q mu at the start plus its
-            # implicit part, k_t ds with ds = -(A_im d omega_m + A_ia d omega_a)
-            d_drive = work[j, w0 + 10] * d_wm + work[j, w0 + 11] * d_wa
-            drive -= d_drive
-            if keep:
-                out[j, O_DRIVE] -= d_drive
-            cage[j, C_OMEGA] += d_omega[j]
-            ball[j, B_THETA] += dt * ball[j, B_OMEGA]
-            cage[j, C_PHI] += dt * cage[j, C_OMEGA]
-            cage_sum += cage[j, C_OMEGA]
+        drive, cage_sum = reduced_update(p, ball, cage, work, out, w0, dt, dvx, dvy, keep, drive)
         stats[S_DRIVE] += drive * omega_i * dt
         stats[S_HEAT] += heat * dt
         stats[S_DAMP] += damp * dt
@@ -1623,6 +1716,136 @@ w0 + 29 onwards: the pivot's and the pitch's elimination)."""
 ENTRAINMENT_FLOOR = 1e-3
 """The entrainment speed below which the rheology table is read at this speed, m/s
 (:func:`contact_traction`)."""
+
+
+@njit(cache=True, inline="always")
+def stiff_ball_row(
+    p: np.ndarray,
+    ball: np.ndarray,
+    cage: np.ndarray,
+    out: np.ndarray,
+    torque: np.ndarray,
+    j: int,
+    omega_i: float,
+    dt: float,
+    delta_a: float,
+    vdelta: float,
+    keep: bool,
+    drive: float,
+    heat: float,
+    damp: float,
+    contact_damp: float,
+    ring_force: float,
+) -> tuple[float, float, float, float, float]:
+    """Ball ``j``'s stage of a stiff step (:func:`step_stiff`): its Hertz contacts with their
+    damping, tractions and resistances, then its momenta and position (symplectic Euler; the
+    pivot first, the raceway tractions linearly implicit). Returns the step's running sums with
+    this ball's share added, in the order of the single loop they came from: the drive torque
+    (N m), heat and pocket damping heat (W), the raceway contacts' damping heat (W) and the
+    axial force on the inner ring (N); ``torque[j]`` gets the pocket's torque on segment j."""
+    rm = p[P_RM]
+    r = p[P_RBALL]
+    m = p[P_MBALL]
+    ib = p[P_IBALL]
+    rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
+    di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
+    rate_i, rate_o = nir * vr + niz * (vz - vdelta), nor * vr + noz * vz
+    qi, _, _ = impact_force(di, rate_i, p[P_K_IN], p)
+    qo, _, _ = impact_force(do, rate_o, p[P_K_OUT], p)
+    # the raceway contacts' Hunt-Crossley damping: the force beyond Hertz's, times the rate
+    contact_damp += impact_damping_power(di, rate_i, qi, p[P_K_IN]) + impact_damping_power(do, rate_o, qo, p[P_K_OUT])
+    fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
+        p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, di, do
+    )
+    wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
+    if p[P_FRIC_MODEL] == 2.0:
+        # the rheology table's offset at SRR = 0 (spin and Heathcote slip, which go with
+        # the rolling) fades out below the table's entrainment floor: a contact that
+        # does not roll has no spin, and no traction without sliding
+        _, r_co, _, _, _, _, _, _, _ = ball_kinematics(p, nir, niz, nor, noz, rb)
+        uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
+        if uei < ENTRAINMENT_FLOOR and qi > 0.0:
+            fi -= (1.0 - uei / ENTRAINMENT_FLOOR) * qi * contact_traction(p, 0, 0.0, uei, qi)[0]
+        if ueo < ENTRAINMENT_FLOOR and qo > 0.0:
+            fo -= (1.0 - ueo / ENTRAINMENT_FLOOR) * qo * contact_traction(p, 1, 0.0, ueo, qo)[0]
+    drive += fi * r_ci
+    g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
+    fd, _ = ball_drag(p, rb * wm, 0.5 * (qi + qo))
+    gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
+    fs, _, _ = pocket_force(p, gap, rate)
+    x = abs(gap) - p[P_POCKET_CLEAR]
+    damp += impact_damping_power(x, rate if gap > 0.0 else -rate, abs(fs), p[P_K_POCKET])
+    t_inner, m_outer, m_ring, t_orbit = contact_moments(
+        p,
+        inner_speed_scale(omega_i),
+        wa,
+        wa + cb * wm,
+        smooth_sign(wa + cb * wm),
+        rb,
+        r_ci,
+        aom + r * co * cb,
+        fi,
+        fo,
+        si,
+        so,
+        pi,
+        po,
+        fri,
+        froll - fri,
+        qi,
+        qo,
+        di,
+    )
+    drive += t_inner + m_ring * cb
+    mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
+    # momenta at the current positions (p_theta first: p_r's update needs it)
+    # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
+    # pivot (symplectic Euler on the skew terms: bounded energy error)
+    # the raceway tractions linearly implicit (their slopes, as step_reduced): at a low
+    # entrainment speed the traction's slope in the sliding speed grows as 1/u_e
+    # (u_e >= 1 mm/s), so that dt r^2 k_t / J reaches 3 for a ball at rest; explicit,
+    # its spin and pivot chattered at +-0.09 rad/s every other step, a bounded
+    # oscillation whose f s read as 4.5 mW of heat with no drive work
+    wt_old = wt
+    wt = (ib * wt - dt * g * (wa + cb * wm)) / (ib + dt * r * r * kpiv)
+    ball[j, B_PIVOT] = wt
+    gm = rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt
+    ga = r * (ci * fi - co * fo) - mres + g * wt
+    b11 = m * rb * rb + dt * rb * (kti * aim + kto * aom)
+    b12 = dt * rb * (kti * aia - kto * aoa)
+    b21 = dt * r * (ci * kti * aim - co * kto * aom)
+    b22 = ib + dt * r * (ci * kti * aia + co * kto * aoa)
+    det = b11 * b22 - b12 * b21
+    d_wm = dt * (b22 * gm - b12 * ga) / det
+    d_wa = dt * (b11 * ga - b21 * gm) / det
+    d_drive = r_ci * kti * (aim * d_wm + aia * d_wa)  # the inner traction's implicit part
+    drive -= d_drive
+    ptheta = m * rb * rb * (wm + d_wm)
+    wnew = wm + d_wm
+    vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
+    vz_new = vz + dt * (-qi * niz - qo * noz) / m
+    ball[j, B_SPIN] = wa + d_wa
+    ball[j, B_THETA] += dt * wnew
+    rb_new = rb + dt * vr_new
+    ball[j, B_R] = rb_new
+    ball[j, B_Z] = zb + dt * vz_new
+    ball[j, B_VR], ball[j, B_VZ] = vr_new, vz_new
+    ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
+    ring_force += qi * niz
+    torque[j] = rm * fs
+    # the tractions' heat as the implicit step applies them: the force at the step's end
+    # times the step's mean sliding (exactly the kinetic energy a linear law takes)
+    dsi, dso = -aim * d_wm - aia * d_wa, -aom * d_wm + aoa * d_wa
+    pivot = kpiv * r * r * wt * 0.5 * (wt_old + wt)
+    power = ball_power(
+        wm, wa, rb, omega_i, fi + kti * dsi, fo + kto * dso, si + 0.5 * dsi, so + 0.5 * dso, mres, fd, t_inner, m_ring, t_orbit, cb, pivot
+    )
+    heat += power
+    if keep:
+        record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
+        out[j, O_POWER] = power
+        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - d_drive
+    return drive, heat, damp, contact_damp, ring_force
 
 
 @njit(cache=True)
@@ -1656,10 +1879,6 @@ def step_stiff(
     and the moment unused, ``tilt_free`` False). Returns 0.
     """
     z = ball.shape[0]
-    rm = p[P_RM]
-    r = p[P_RBALL]
-    m = p[P_MBALL]
-    ib = p[P_IBALL]
     jseg = p[P_JSEG]
     torque = work[:, 0]
     for step in range(n_steps):
@@ -1673,104 +1892,9 @@ def step_stiff(
         contact_damp = 0.0
         keep = step == n_steps - 1 or (record_every > 0 and step % record_every == 0)
         for j in range(z):
-            rb, zb, vr, vz = ball[j, B_R], ball[j, B_Z], ball[j, B_VR], ball[j, B_VZ]
-            di, nir, niz, disti, do, nor, noz, disto = raceway_geometry(p, rb, zb, delta_a)
-            rate_i, rate_o = nir * vr + niz * (vz - vdelta), nor * vr + noz * vz
-            qi, _, _ = impact_force(di, rate_i, p[P_K_IN], p)
-            qo, _, _ = impact_force(do, rate_o, p[P_K_OUT], p)
-            # the raceway contacts' Hunt-Crossley damping: the force beyond Hertz's, times the rate
-            contact_damp += impact_damping_power(di, rate_i, qi, p[P_K_IN]) + impact_damping_power(do, rate_o, qo, p[P_K_OUT])
-            fi, fo, kti, kto, si, so, r_ci, ci, co, aim, aia, aom, aoa, cb, froll, pi, po, fri, kpiv, _, _ = ball_tractions(
-                p, ball, j, omega_i, qi, qo, nir, niz, nor, noz, di, do
+            drive, heat, damp, contact_damp, ring_force = stiff_ball_row(
+                p, ball, cage, out, torque, j, omega_i, dt, delta_a, vdelta, keep, drive, heat, damp, contact_damp, ring_force
             )
-            wm, wa, wt = ball[j, B_OMEGA], ball[j, B_SPIN], ball[j, B_PIVOT]
-            if p[P_FRIC_MODEL] == 2.0:
-                # the rheology table's offset at SRR = 0 (spin and Heathcote slip, which go with
-                # the rolling) fades out below the table's entrainment floor: a contact that
-                # does not roll has no spin, and no traction without sliding
-                _, r_co, _, _, _, _, _, _, _ = ball_kinematics(p, nir, niz, nor, noz, rb)
-                uei, ueo = abs((omega_i - wm) * r_ci), abs(wm * r_co)
-                if uei < ENTRAINMENT_FLOOR and qi > 0.0:
-                    fi -= (1.0 - uei / ENTRAINMENT_FLOOR) * qi * contact_traction(p, 0, 0.0, uei, qi)[0]
-                if ueo < ENTRAINMENT_FLOOR and qo > 0.0:
-                    fo -= (1.0 - ueo / ENTRAINMENT_FLOOR) * qo * contact_traction(p, 1, 0.0, ueo, qo)[0]
-            drive += fi * r_ci
-            g = ib * wm * math.sqrt(max(1.0 - cb * cb, 0.0)) if kpiv > 0.0 else 0.0  # gyroscopic terms (see step_reduced)
-            fd, _ = ball_drag(p, rb * wm, 0.5 * (qi + qo))
-            gap, rate = rm * (ball[j, B_THETA] - cage[j, C_PHI]), rm * (wm - cage[j, C_OMEGA])
-            fs, _, _ = pocket_force(p, gap, rate)
-            x = abs(gap) - p[P_POCKET_CLEAR]
-            damp += impact_damping_power(x, rate if gap > 0.0 else -rate, abs(fs), p[P_K_POCKET])
-            t_inner, m_outer, m_ring, t_orbit = contact_moments(
-                p,
-                inner_speed_scale(omega_i),
-                wa,
-                wa + cb * wm,
-                smooth_sign(wa + cb * wm),
-                rb,
-                r_ci,
-                aom + r * co * cb,
-                fi,
-                fo,
-                si,
-                so,
-                pi,
-                po,
-                fri,
-                froll - fri,
-                qi,
-                qo,
-                di,
-            )
-            drive += t_inner + m_ring * cb
-            mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
-            # momenta at the current positions (p_theta first: p_r's update needs it)
-            # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
-            # pivot (symplectic Euler on the skew terms: bounded energy error)
-            # the raceway tractions linearly implicit (their slopes, as step_reduced): at a low
-            # entrainment speed the traction's slope in the sliding speed grows as 1/u_e
-            # (u_e >= 1 mm/s), so that dt r^2 k_t / J reaches 3 for a ball at rest; explicit,
-            # its spin and pivot chattered at +-0.09 rad/s every other step, a bounded
-            # oscillation whose f s read as 4.5 mW of heat with no drive work
-            wt_old = wt
-            wt = (ib * wt - dt * g * (wa + cb * wm)) / (ib + dt * r * r * kpiv)
-            ball[j, B_PIVOT] = wt
-            gm = rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt
-            ga = r * (ci * fi - co * fo) - mres + g * wt
-            b11 = m * rb * rb + dt * rb * (kti * aim + kto * aom)
-            b12 = dt * rb * (kti * aia - kto * aoa)
-            b21 = dt * r * (ci * kti * aim - co * kto * aom)
-            b22 = ib + dt * r * (ci * kti * aia + co * kto * aoa)
-            det = b11 * b22 - b12 * b21
-            d_wm = dt * (b22 * gm - b12 * ga) / det
-            d_wa = dt * (b11 * ga - b21 * gm) / det
-            d_drive = r_ci * kti * (aim * d_wm + aia * d_wa)  # the inner traction's implicit part
-            drive -= d_drive
-            ptheta = m * rb * rb * (wm + d_wm)
-            wnew = wm + d_wm
-            vr_new = vr + dt * (rb * wnew * wnew + (-qi * nir - qo * nor) / m)
-            vz_new = vz + dt * (-qi * niz - qo * noz) / m
-            ball[j, B_SPIN] = wa + d_wa
-            ball[j, B_THETA] += dt * wnew
-            rb_new = rb + dt * vr_new
-            ball[j, B_R] = rb_new
-            ball[j, B_Z] = zb + dt * vz_new
-            ball[j, B_VR], ball[j, B_VZ] = vr_new, vz_new
-            ball[j, B_OMEGA] = ptheta / (m * rb_new * rb_new)
-            ring_force += qi * niz
-            torque[j] = rm * fs
-            # the tractions' heat as the implicit step applies them: the force at the step's end
-            # times the step's mean sliding (exactly the kinetic energy a linear law takes)
-            dsi, dso = -aim * d_wm - aia * d_wa, -aom * d_wm + aoa * d_wa
-            pivot = kpiv * r * r * wt * 0.5 * (wt_old + wt)
-            power = ball_power(
-                wm, wa, rb, omega_i, fi + kti * dsi, fo + kto * dso, si + 0.5 * dsi, so + 0.5 * dso, mres, fd, t_inner, m_ring, t_orbit, cb, pivot
-            )
-            heat += power
-            if keep:
-                record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
-                out[j, O_POWER] = power
-                out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - d_drive
         stats[S_DRIVE] += drive * omega_i * dt
         for k in range(z):
             tau, _ = cage_segment_torque(p, cage, k, z)

@@ -366,42 +366,12 @@ class DerivedGeometry:
     pocket_clearance: float
 
 
-def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
-    """Compute the kernel parameter vector and the derived geometry.
-
-    Returns:
-        (vector, geometry): the float64 vector laid out as :mod:`.kernels` ``P_*`` indices,
-        and the derived quantities.
-    """
-    dw, dm, a0, z = p.ball_diameter, p.pitch_diameter, p.contact_angle, p.ball_count
-    rball = 0.5 * dw
-    rm = 0.5 * dm
-    ri = p.inner_curvature_ratio * dw
-    ro = p.outer_curvature_ratio * dw
-    # Groove curvature centres (r, z) with zero clearance at the free contact angle.
-    ci_r, ci_z = rm + (ri - rball) * math.cos(a0), (ri - rball) * math.sin(a0)
-    co_r, co_z = rm - (ro - rball) * math.cos(a0), -(ro - rball) * math.sin(a0)
-    inner, outer = p.raceway_contacts()
-    # Ball in a cylindrical pocket (axis radial): concave radius d_p/2 across, straight along.
-    pocket = point_contact(2.0 / dw, 2.0 / dw, -2.0 / p.pocket_diameter, 0.0, p.ball_modulus, p.ball_poisson, p.cage_modulus, p.cage_poisson)
-    ball_mass = p.ball_density * math.pi * dw**3 / 6.0
-    ball_inertia = 0.4 * ball_mass * rball**2
-    # Cage: annulus less the pockets; one segment per pocket; rims carry the circumferential load.
-    r_ci, r_co = 0.5 * p.cage_inner_diameter, 0.5 * p.cage_outer_diameter
-    thickness = r_co - r_ci
-    volume = math.pi * (r_co**2 - r_ci**2) * p.cage_width - z * math.pi * 0.25 * p.pocket_diameter**2 * thickness
-    cage_mass = p.cage_density * volume
-    seg_mass = cage_mass / z
-    seg_inertia = seg_mass * 0.5 * (r_co**2 + r_ci**2)
-    r_cage = 0.5 * (r_ci + r_co)
-    pitch_len = 2.0 * math.pi * r_cage / z
-    rim_area = 2.0 * 0.5 * (p.cage_width - p.pocket_diameter) * thickness
-    link_k = p.cage_modulus * rim_area / pitch_len  # N/m
-    link_kt = link_k * r_cage**2  # N m/rad
-    link_omega = math.sqrt(4.0 * link_kt / seg_inertia)
-    link_ct = p.cage_loss_factor * link_kt / link_omega
-    # Resistances (by lubrication mode; see module doc).
-    r_land = r_co
+def _resistance_entries(p: BearingParameters, r_land: float, cage_mass: float) -> dict[int, float]:
+    """The kernel entries of the resistances by lubrication mode (module doc; docs/model.md,
+    Resistances): the ball drag (linear, quadratic, plastic and power-law terms, and the dry
+    model's ball-set resistance with its load factor), the cage land's torque and its film's
+    Ocvirk force terms. ``r_land`` the land radius (m), ``cage_mass`` kg."""
+    dw = p.ball_diameter
     drag_yield = drag_pow = land_pow = 0.0
     drag_n = land_n = 1.0
     lub = p.lubricant
@@ -437,8 +407,6 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
             drag_pow, drag_n = p.ball_set_resistance, p.ball_set_resistance_speed_exponent
     cage_weight_on_land = cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     land_coulomb = land_yield + p.cage_land_boundary_torque_scale * p.cage_land_friction * cage_weight_on_land * r_land
-    b_in = inner.semi_axes(1.0)[1]
-    b_out = outer.semi_axes(1.0)[1]
     # Land film (Ocvirk short journal bearing, kernels.land_force): the same fluid and fill as
     # the land torque; land_count lands of width land_width / land_count each.
     land_scale = p.cage_land_viscous_scale * fill
@@ -448,6 +416,64 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
         land_eta, land_tauy, land_cons = 0.0, land_scale * lub.yield_stress, land_scale * lub.consistency
     else:
         land_eta, land_tauy, land_cons = land_scale * p.oil_viscosity, 0.0, 0.0
+    return {
+        kn.P_DRAG_LIN: drag_lin,
+        kn.P_DRAG_QUAD: drag_quad,
+        kn.P_LAND_VISC: land_visc,
+        kn.P_LAND_COULOMB: land_coulomb,
+        kn.P_DRAG_YIELD: drag_yield,
+        kn.P_DRAG_POW: drag_pow,
+        kn.P_DRAG_N: drag_n,
+        kn.P_LAND_POW: land_pow,
+        kn.P_LAND_N: land_n,
+        kn.P_LAND_OCV: land_ocv,
+        kn.P_LAND_ETA: land_eta,
+        kn.P_LAND_TAUY: land_tauy,
+        kn.P_LAND_CONS: land_cons,
+        kn.P_DRAG_LOAD_EXP: p.ball_set_resistance_load_exponent if p.ball_set_resistance > 0.0 else 0.0,
+        kn.P_DRAG_LOAD_REF: p.ball_set_resistance_reference_load,
+    }
+
+
+def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
+    """Compute the kernel parameter vector and the derived geometry.
+
+    Returns:
+        (vector, geometry): the float64 vector laid out as :mod:`.kernels` ``P_*`` indices,
+        and the derived quantities.
+    """
+    dw, dm, a0, z = p.ball_diameter, p.pitch_diameter, p.contact_angle, p.ball_count
+    rball = 0.5 * dw
+    rm = 0.5 * dm
+    ri = p.inner_curvature_ratio * dw
+    ro = p.outer_curvature_ratio * dw
+    # Groove curvature centres (r, z) with zero clearance at the free contact angle.
+    ci_r, ci_z = rm + (ri - rball) * math.cos(a0), (ri - rball) * math.sin(a0)
+    co_r, co_z = rm - (ro - rball) * math.cos(a0), -(ro - rball) * math.sin(a0)
+    inner, outer = p.raceway_contacts()
+    # Ball in a cylindrical pocket (axis radial): concave radius d_p/2 across, straight along.
+    pocket = point_contact(2.0 / dw, 2.0 / dw, -2.0 / p.pocket_diameter, 0.0, p.ball_modulus, p.ball_poisson, p.cage_modulus, p.cage_poisson)
+    ball_mass = p.ball_density * math.pi * dw**3 / 6.0
+    ball_inertia = 0.4 * ball_mass * rball**2
+    # Cage: annulus less the pockets; one segment per pocket; rims carry the circumferential load.
+    r_ci, r_co = 0.5 * p.cage_inner_diameter, 0.5 * p.cage_outer_diameter
+    thickness = r_co - r_ci
+    volume = math.pi * (r_co**2 - r_ci**2) * p.cage_width - z * math.pi * 0.25 * p.pocket_diameter**2 * thickness
+    cage_mass = p.cage_density * volume
+    seg_mass = cage_mass / z
+    seg_inertia = seg_mass * 0.5 * (r_co**2 + r_ci**2)
+    r_cage = 0.5 * (r_ci + r_co)
+    pitch_len = 2.0 * math.pi * r_cage / z
+    rim_area = 2.0 * 0.5 * (p.cage_width - p.pocket_diameter) * thickness
+    link_k = p.cage_modulus * rim_area / pitch_len  # N/m
+    link_kt = link_k * r_cage**2  # N m/rad
+    link_omega = math.sqrt(4.0 * link_kt / seg_inertia)
+    link_ct = p.cage_loss_factor * link_kt / link_omega
+    r_land = r_co
+    resistances = _resistance_entries(p, r_land, cage_mass)
+    lub = p.lubricant
+    b_in = inner.semi_axes(1.0)[1]
+    b_out = outer.semi_axes(1.0)[1]
     # Cage on its land at eps = 1: two conforming cylinders (cage OD in the land bore, nearly equal
     # radii), linearised line-contact stiffness (pi/4) E* L (Johnson, Contact Mechanics, 5.3).
     e_star = 1.0 / ((1.0 - p.cage_poisson**2) / p.cage_modulus + (1.0 - p.ring_poisson**2) / p.ring_modulus)
@@ -483,30 +509,17 @@ def derive(p: BearingParameters) -> tuple[np.ndarray, DerivedGeometry]:
     v[kn.P_HYST] = p.rolling_hysteresis_factor
     v[kn.P_B_IN] = b_in
     v[kn.P_B_OUT] = b_out
-    v[kn.P_DRAG_LIN] = drag_lin
-    v[kn.P_DRAG_QUAD] = drag_quad
-    v[kn.P_LAND_VISC] = land_visc
-    v[kn.P_LAND_COULOMB] = land_coulomb
     v[kn.P_M_INNER] = p.inner_ring_axial_mass
     # Q b = b(1 N) Q^(4/3) = b(1 N) K^(4/3) delta^2
     v[kn.P_HYST_IN] = 0.1875 * p.rolling_hysteresis_factor * b_in * inner.stiffness ** (4.0 / 3.0)
     v[kn.P_HYST_OUT] = 0.1875 * p.rolling_hysteresis_factor * b_out * outer.stiffness ** (4.0 / 3.0)
-    v[kn.P_DRAG_YIELD] = drag_yield
-    v[kn.P_DRAG_POW] = drag_pow
-    v[kn.P_DRAG_N] = drag_n
-    v[kn.P_LAND_POW] = land_pow
-    v[kn.P_LAND_N] = land_n
+    for index, value in resistances.items():
+        v[index] = value
     v[kn.P_CAGE_MASS] = cage_mass
     v[kn.P_LAND_R] = r_land
     v[kn.P_LAND_CLEAR] = p.land_clearance
-    v[kn.P_LAND_OCV] = land_ocv
-    v[kn.P_LAND_ETA] = land_eta
-    v[kn.P_LAND_TAUY] = land_tauy
-    v[kn.P_LAND_CONS] = land_cons
     v[kn.P_LAND_K] = 0.25 * math.pi * e_star * p.land_width
     v[kn.P_LAND_MU] = p.cage_land_friction
-    v[kn.P_DRAG_LOAD_EXP] = p.ball_set_resistance_load_exponent if p.ball_set_resistance > 0.0 else 0.0
-    v[kn.P_DRAG_LOAD_REF] = p.ball_set_resistance_reference_load
     v[kn.P_PRELOAD_K] = z * p.combined_constant  # a rigid preload's partner (the engine sets P_PRELOAD_D)
     v[kn.P_CAGE_GRAV_Y] = -cage_mass * GRAVITY if p.spindle_axis == "horizontal" else 0.0
     # spin lever of each contact: the Hertz pressure's mean distance from the centre,

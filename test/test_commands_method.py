@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import csv
 import json
 from pathlib import Path
@@ -29,14 +31,32 @@ def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[
         "power_loss_w",
         "film_min_um",
         "lambda_ratio",
+        "slip_loaded_pct",
+        "loaded_contact_angle_deg",
+        "gross_skid",
+        "model",
     }
+    assert {r["model"] for r in rows} == {"bench"} and not any(r["gross_skid"] for r in rows)
     assert all(r["slip_pct_low"] < r["slip_pct"] < r["slip_pct_high"] for r in rows)
     assert rows[1]["power_loss_w"] > rows[0]["power_loss_w"] > 0.0
     assert rows[0]["power_loss_w"] == pytest.approx(rows[0]["friction_torque_nm"] * 1200 * 2 * 3.141592653589793 / 60, rel=1e-3)
     assert 0.0 < rows[0]["film_min_um"]["inner"] < 1.0 and 0.0 < rows[0]["film_min_um"]["outer"] < 1.0
-    for r in rows:  # cage speed and slip are consistent with Eq. 11-12 at the nominal angle
-        ratio = BearingParameters.from_yaml().epicyclic_ratio
+    g = BearingParameters.from_yaml()
+    for r in rows:  # cage speed and slip are consistent with Eq. 11-12 at the nominal and the loaded angle
+        ratio = g.epicyclic_ratio
         assert r["slip_pct"] == pytest.approx((1 - r["cage_rpm"] / (ratio * r["rpm"])) * 100, abs=2e-3)
+        loaded = 0.5 * (1.0 - g.ball_diameter * math.cos(math.radians(r["loaded_contact_angle_deg"])) / g.pitch_diameter)
+        assert r["slip_loaded_pct"] == pytest.approx((1 - r["cage_rpm"] / (loaded * r["rpm"])) * 100, abs=2e-3)
+        # the loaded angle at 100 N: 16.3 deg (docs/method.md, Harris's thrust equilibrium, hand-checked there)
+        assert r["loaded_contact_angle_deg"] == pytest.approx(16.3, abs=0.05)
+
+
+def test_predict_takes_several_loads_at_one_speed_and_the_paper_model(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["predict", "--model", "paper", "--rpm", "1000", "--load", "50", "100", "700", "--json"]) == 0
+    rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
+    assert [(r["rpm"], r["axial_load_n"], r["model"]) for r in rows] == [(1000.0, 50.0, "paper"), (1000.0, 100.0, "paper"), (1000.0, 700.0, "paper")]
+    assert all("slip_pct_low" not in r for r in rows)  # a model of a model: no bench interval
+    assert rows[0]["slip_pct"] > rows[1]["slip_pct"] > rows[2]["slip_pct"]
 
 
 @pytest.mark.parametrize(
@@ -78,8 +98,15 @@ def test_calibrate_refuses_a_fit_outside_the_physical_range(tmp_path: Path, caps
 def test_reproduce_writes_csvs_figures_and_report_then_reuses_its_cache(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["reproduce", "--out", str(tmp_path), "--quiet"]) == 0
     assert "ran the experiments" in capsys.readouterr().out
-    for name in ("validation.csv", "load_sweep.csv", "acceleration.csv", "report.md"):
-        assert (tmp_path / name).stat().st_size > 100
+    both = (tmp_path / "report.md").read_text()  # the two models beside the paper's tables
+    for rpm, (bench, paper) in PAPER_TABLE3.items():
+        assert f"| {rpm} | {bench:.2f} | {paper:.2f} |" in both
+    for heading in ("## Table 3", "## Table 5", "## Load sweep", "## Table 7", "## Run-up slip at equal", "## Where and why"):
+        assert heading in both
+    for model in ("bench", "paper"):
+        for name in ("validation.csv", "load_sweep.csv", "acceleration.csv", "report.md"):
+            assert (tmp_path / model / name).stat().st_size > 100
+    tmp_path = tmp_path / "bench"  # the bench twin's own report
     for k in range(5, 11):
         png = next(tmp_path.glob(f"fig{k:02d}_*.png"))
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and png.stat().st_size > 10_000
@@ -91,9 +118,9 @@ def test_reproduce_writes_csvs_figures_and_report_then_reuses_its_cache(tmp_path
         assert f"| {rpm} | {bench:.3g} | {paper:.3g} |" in report
     with (tmp_path / "acceleration.csv").open() as fh:
         assert {float(r["acceleration_rad_s2"]) for r in csv.DictReader(fh)} == {20.0, 40.0, 60.0, 80.0}
-    assert main(["reproduce", "--out", str(tmp_path), "--quiet"]) == 0
+    assert main(["reproduce", "--out", str(tmp_path.parent), "--quiet"]) == 0
     printed = capsys.readouterr().out
-    assert "reused cached results" in printed
+    assert printed.count("reused cached results") == 2
     # no fit outside the gates: every row of the acceleration table has lambda below 100 % or says why
     section = report.split("## Constant acceleration", 1)[1].split("###", 1)[0]
     rows = [line.split(" | ") for line in section.splitlines() if line.startswith("| ") and line[2].isdigit()]

@@ -225,6 +225,26 @@ TWIN_ESTIMATE = Topic(
     "the parameter's",
     "shadow",
 )
+TWIN_TEMPERATURE_RESIDUAL = Topic(
+    "/twin/outer_ring/temperature_residual",
+    "geometry_msgs/msg/Vector3Stamped",
+    "reliable",
+    "one per compared slip window with a thermocouple reading",
+    "K (x, y), degC (z)",
+    "shadow",
+    note="x the outer-ring thermocouple's residual (measured minus predicted), y its threshold (the band's half-width, "
+    "config/shadow.yaml), z the twin's predicted reading",
+)
+TWIN_TORQUE_RESIDUAL = Topic(
+    "/twin/housing/torque_residual",
+    "geometry_msgs/msg/Vector3Stamped",
+    "reliable",
+    "one per compared slip window with torque-meter samples",
+    "N m",
+    "shadow",
+    note="x the housing torque meter's residual (measured minus predicted), y its threshold (the band's half-width, "
+    "config/shadow.yaml), z the twin's predicted friction torque",
+)
 OUTER_RING_TEMPERATURE = Topic(
     "/rig/outer_ring/temperature",
     "sensor_msgs/msg/Temperature",
@@ -260,6 +280,8 @@ TOPICS: tuple[Topic, ...] = (
     SLIP_STATUS,
     TWIN_RESIDUAL,
     TWIN_ESTIMATE,
+    TWIN_TEMPERATURE_RESIDUAL,
+    TWIN_TORQUE_RESIDUAL,
     OUTER_RING_TEMPERATURE,
     HOUSING_TORQUE,
     DIAGNOSTICS,

@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 
 from bearing_rig_sim.bags import BagWriter
-from bearing_rig_sim.interfaces import DIAGNOSTICS, TWIN_RESIDUAL
+from bearing_rig_sim.interfaces import DIAGNOSTICS, TWIN_RESIDUAL, TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL
 from bearing_rig_sim.session.recorder import SessionRecorder
 from bearing_rig_sim.shadow.offline import shadow_bag
 from bearing_rig_sim.synthetic.twin_bench import Hold, twin_bench_run, write_bench_bag
@@ -20,6 +20,7 @@ from bearing_rig_sim.synthetic.twin_bench import Hold, twin_bench_run, write_ben
 def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path) -> None:
     from bearing_rig_msgs.msg import ShadowResidual
     from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import Vector3Stamped
     from mcap.reader import make_reader
     from mcap_ros2.decoder import DecoderFactory
     from rclpy.qos import QoSProfile, ReliabilityPolicy
@@ -36,6 +37,9 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     counts: dict[str, str] = {}  # the shadow node's latest diagnostic values
     qos = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
     node.create_subscription(ShadowResidual, TWIN_RESIDUAL.name, lambda data: received.append((TWIN_RESIDUAL.name, data)), qos, raw=True)
+    sensors: dict[str, list[Vector3Stamped]] = {TWIN_TEMPERATURE_RESIDUAL.name: [], TWIN_TORQUE_RESIDUAL.name: []}
+    for name, into in sensors.items():
+        node.create_subscription(Vector3Stamped, name, into.append, qos)
 
     def on_diagnostics(msg: DiagnosticArray) -> None:
         for status in msg.status:
@@ -92,6 +96,19 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
             assert m.measured_slip == pytest.approx(same[0].measured_slip, abs=1e-9)
     assert matched >= len(by_rosbags) - 2
     assert math.isfinite(by_rosbags[-1].predicted_slip)
+    # the thermocouple's and the torque meter's residuals on their own topics, each with its
+    # threshold, one per window that compared them (the window's stamp): the same bench, inside
+    with_sensor = {name: [m for m in by_rosbags if math.isfinite(getattr(m, field))] for name, field in
+                   ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature_residual"), (TWIN_TORQUE_RESIDUAL.name, "torque_residual"))}
+    done = ros_graph.spin_until(lambda: all(len(sensors[n]) >= len(with_sensor[n]) for n in sensors), timeout=60.0, executor=executor)
+    assert done, {n: (len(sensors[n]), len(with_sensor[n])) for n in sensors}
+    for name, field in ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature"), (TWIN_TORQUE_RESIDUAL.name, "torque")):
+        assert len(with_sensor[name]) >= 0.9 * len(live_compared) > 0
+        by_stamp = {(m.header.stamp.sec, m.header.stamp.nanosec): m for m in with_sensor[name]}
+        for v in sensors[name]:
+            row = by_stamp[(v.header.stamp.sec, v.header.stamp.nanosec)]
+            assert (v.vector.x, v.vector.y, v.vector.z) == (getattr(row, f"{field}_residual"), getattr(row, f"{field}_band"), getattr(row, f"predicted_{field}"))
+            assert 0.0 < v.vector.y and abs(v.vector.x) <= v.vector.y
 
 
 def test_the_session_records_the_shadow_topics_too() -> None:
@@ -99,5 +116,5 @@ def test_the_session_records_the_shadow_topics_too() -> None:
     from bearing_rig_sim.interfaces import TOPICS, TWIN_ESTIMATE
     from bearing_rig_sim.session.node import MESSAGE_TYPES
 
-    assert {TWIN_RESIDUAL, TWIN_ESTIMATE} <= set(TOPICS)
+    assert {TWIN_RESIDUAL, TWIN_ESTIMATE, TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL} <= set(TOPICS)
     assert {t.msgtype for t in TOPICS} <= MESSAGE_TYPES.keys()

@@ -6,6 +6,7 @@ from __future__ import annotations
 import contextlib
 import io
 import json
+import math
 from pathlib import Path
 from typing import Any
 
@@ -29,19 +30,29 @@ secondary source: the report itself could not be read. The same repository's lat
 (paper/manuscript_applsci.tex, commit dd2220c) says instead that per-node temperatures are not
 available in TP-2275 for the 35 mm bearing, so the outer-ring values are the weaker of the two."""
 
-HOUSING_DEFICIT_K = (20.0, 35.0)
-"""How much cooler than the report's outer ring the twin's runs, K, at every speed: the assumed
-housing and shaft (config/bearings/tp2275.yaml, thermal:) lead heat to 22 degC air, while the
-report's rig is not described in anything read here (its jet oil at 394 K, its heat exchanger;
-the laboratory's 35 mm rig of TP-1732 had provisions for outer-ring cooling). Measured: 22.9-28.8 K. The
-band is that deficit, stated, with +-7 K for reading temperatures off the report's figures
-(about 1 % of 420 K, twice) and the secant steady-state solver; it is not agreement."""
-TREND_K = 8.5
-"""The deficit may vary by at most this much over 28 000-72 000 rpm, K: the twin's outer ring
-rises with speed as the report's does (measured 30 K, the twin 34.4 K), whatever the housing's
-offset; a housing-independent check of the heat's growth with speed reaching the outer ring.
-The bound is the reading uncertainty alone: two temperatures read off the report's figures, each
-to about 1 % of 420 K (4.2 K)."""
+HEAT_DIGITISATION = 0.03
+"""Relative uncertainty of the heat values read off the report's figure: the secondary source's
+own statement (paper/manuscript_applsci.tex, commit dd2220c: "digital curve-reading,
+introducing an estimated digitization uncertainty of +-3 %")."""
+HEAT_ACCEPTANCE = 0.30
+"""Issue 33's acceptance: the twin's heat within 30 % of the report's at each speed."""
+TEMPERATURE_READING_K = 0.01 * 420.0
+"""Uncertainty of an outer-ring temperature read off the report's figures, K: ASSUMPTION, 1 % of
+the value (no statement for the temperatures in the source; +-3 % of the heat's reading would be
++-13 K here, 1 % is the tighter and more usual figure-reading accuracy)."""
+TREND_K = math.sqrt(2.0) * TEMPERATURE_READING_K
+"""The rise of the outer ring from 28 000 to 72 000 rpm (the report's 30 K) holds two readings:
+their uncertainties in quadrature, 5.9 K. It does not depend on the housing's offset."""
+MODEL_FORM = (
+    "model-form deficit, issue 33 item 3: without any drag the twin's heat is 127 / 1006 W at 28 000 / 72 000 rpm "
+    "(its EHL rolling force grows as about n^2, with no inlet shear heating); a drag whose oil share falls as 1/n "
+    "(Parker's correlation) adds an n^2 term, so the total stays steeper than the report's n^1.5 and meets 30 % only "
+    "with the cavity's oil share tuned to within 5 % (docs/thermal.md, A second bearing)"
+)
+HOUSING = (
+    "the assumed housing and shaft lead heat to 22 degC air; the report's rig (oil at 394 K, outer-ring cooling) "
+    "is not described in anything read here (docs/thermal.md, Outer ring)"
+)
 
 
 @pytest.fixture(scope="module")
@@ -56,19 +67,16 @@ def predictions() -> list[dict[str, Any]]:
 
 
 @pytest.mark.slow
-def test_tp2275_heat_generation_against_the_reports_measurements(predictions: list[dict[str, Any]]) -> None:
-    """28 000-72 000 rpm at 667 N, oil in at 394 K, no tuning and no calibration: the heat is
-    within a factor of 2 of the report's measured heat generation at every speed (SHABERTH's own
-    comparison in the report is of that order; the twin gives 0.6-1.6 x, docs/thermal.md), it
-    grows with speed, and the jet carries at most all of it (housing and shaft lead the rest to
-    the colder ambient), so the lubricant's rise over the inlet is below power / (rho Q c_p)."""
+def test_tp2275_heat_is_accounted_for_and_grows_with_speed(predictions: list[dict[str, Any]]) -> None:
+    """28 000-72 000 rpm at 667 N, oil in at 394 K, no tuning and no calibration: the heat terms add
+    up to the power loss, the heat grows with speed, and the jet carries at most all of it
+    (housing and shaft lead the rest to the colder ambient), so the lubricant's rise over the
+    inlet is below power / (rho Q c_p)."""
     rows = predictions
     powers = [r["power_loss_w"] for r in rows]
     assert powers == sorted(powers) and powers[0] > 0.0
     jet = 1000.0 * 3.15e-5 * 2000.0  # rho Q c_p of the file's jet, W/K (density at 15 degC: an upper bound)
     for r in rows:
-        measured_w, _ = REPORT[r["rpm"]]
-        assert 0.5 <= r["power_loss_w"] / measured_w <= 2.0, (r["rpm"], r["power_loss_w"], measured_w)
         assert "slip_pct_low" not in r
         rise = r["lubricant_temperature_c"] - 120.85
         assert rise < 1.05 * r["power_loss_w"] / jet
@@ -77,18 +85,36 @@ def test_tp2275_heat_generation_against_the_reports_measurements(predictions: li
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=MODEL_FORM)
+def test_tp2275_heat_generation_within_30_percent_of_the_report(predictions: list[dict[str, Any]]) -> None:
+    """The acceptance of issue 33: the heat within 30 % of the report's at every speed, widened by
+    the reading's +-3 % (:data:`HEAT_DIGITISATION`). Today 0.65 / 1.25 / 1.65 / 1.72 x: expected to
+    fail (strict: a pass is reported, so the marker goes when the model is fixed)."""
+    bound = HEAT_ACCEPTANCE + HEAT_DIGITISATION
+    ratios = {r["rpm"]: r["power_loss_w"] / REPORT[r["rpm"]][0] for r in predictions}
+    assert all(abs(ratio - 1.0) <= bound for ratio in ratios.values()), ratios
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=HOUSING)
 def test_tp2275_outer_ring_temperature_against_the_reports_measurements(predictions: list[dict[str, Any]]) -> None:
-    """The outer ring at thermal steady state against the report's measured outer-ring
-    temperatures (413 / 425 / 435 / 443 K): cooler by the assumed housing's deficit
-    (:data:`HOUSING_DEFICIT_K`) at every speed, and rising with speed as the measured one does
-    (:data:`TREND_K`)."""
-    deficits = []
+    """The outer ring at thermal steady state against the report's 413 / 425 / 435 / 443 K within
+    twice the reading's uncertainty (:data:`TEMPERATURE_READING_K`). The twin's runs 23-29 K
+    cooler: expected to fail (strict)."""
     for r in predictions:
-        _, measured_k = REPORT[r["rpm"]]
-        deficit = measured_k - (r["outer_ring_temperature_c"] + 273.15)
-        assert HOUSING_DEFICIT_K[0] <= deficit <= HOUSING_DEFICIT_K[1], (r["rpm"], r["outer_ring_temperature_c"], measured_k)
-        deficits.append(deficit)
-    assert max(deficits) - min(deficits) <= TREND_K, deficits
+        measured_k = REPORT[r["rpm"]][1]
+        assert abs(r["outer_ring_temperature_c"] + 273.15 - measured_k) <= 2.0 * TEMPERATURE_READING_K, (r["rpm"], r["outer_ring_temperature_c"])
+
+
+@pytest.mark.slow
+def test_tp2275_outer_ring_rises_with_speed_as_the_reports(predictions: list[dict[str, Any]]) -> None:
+    """The outer ring's rise from 28 000 to 72 000 rpm, the report's 443 - 413 = 30 K, within the
+    two readings' uncertainty (:data:`TREND_K`): a check of the heat's growth reaching the outer
+    ring that the housing's offset does not enter (the twin: 34.4 K)."""
+    by_rpm = {r["rpm"]: r["outer_ring_temperature_c"] for r in predictions}
+    twin_rise = by_rpm[72000.0] - by_rpm[28000.0]
+    report_rise = REPORT[72000.0][1] - REPORT[28000.0][1]
+    assert abs(twin_rise - report_rise) <= TREND_K, (twin_rise, report_rise)
 
 
 @pytest.mark.parametrize(

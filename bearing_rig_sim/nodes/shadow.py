@@ -7,6 +7,10 @@ Subscribes the bench's own topics: ``/rig/spindle/pulses`` and ``/rig/cage/pulse
 
 * ``/twin/residual`` (bearing_rig_msgs/ShadowResidual): one per slip window, measured and
   predicted slip, residual, band, anomaly;
+* ``/twin/outer_ring/temperature_residual`` and ``/twin/housing/torque_residual``
+  (geometry_msgs/Vector3Stamped): per window whose thermocouple or torque meter was compared, x
+  the residual (measured minus predicted; K, N m), y its threshold (the band's half-width), z the
+  twin's prediction (degC, N m);
 * ``/twin/calibration_estimate`` (bearing_rig_msgs/ShadowEstimate): with ``recalibrate: true``,
   after each steady window used;
 * ``/diagnostics``: ``diagnostics_rate_hz`` (wall) and on every change of level: OK, WARN (an
@@ -30,7 +34,7 @@ from typing import Any
 from collections.abc import Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import WrenchStamped
+from geometry_msgs.msg import Vector3Stamped, WrenchStamped
 from rclpy.clock import Clock, ClockType
 from sensor_msgs.msg import Temperature
 
@@ -38,7 +42,7 @@ from bearing_rig_msgs.msg import FibreOpticPulse, ShadowEstimate, ShadowResidual
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, DIAGNOSTICS, SPINDLE_PULSES, TWIN_ESTIMATE, TWIN_RESIDUAL
-from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE
+from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE, TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL
 from bearing_rig_sim.nodes.common import PULSE_READER_QOS, diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -74,6 +78,18 @@ def residual_fields(row: ResidualWindow) -> dict[str, Any]:
     }
 
 
+def sensor_residuals(row: ResidualWindow) -> dict[str, tuple[float, float, float]]:
+    """The thermocouple's and the torque meter's residual of a row, by topic name, as
+    (residual, threshold, prediction): K, K, degC and N m, N m, N m; only those compared (a
+    finite residual)."""
+    out: dict[str, tuple[float, float, float]] = {}
+    if math.isfinite(row.temperature_residual):
+        out[TWIN_TEMPERATURE_RESIDUAL.name] = (row.temperature_residual, row.temperature_band, row.predicted_temperature)
+    if math.isfinite(row.torque_residual):
+        out[TWIN_TORQUE_RESIDUAL.name] = (row.torque_residual, row.torque_band, row.predicted_torque)
+    return out
+
+
 class ShadowNode(ManagedNode):
     """The shadow node (see the module docstring): a managed node like the rig's other three.
 
@@ -101,6 +117,9 @@ class ShadowNode(ManagedNode):
         self._received = {"spindle": 0, "cage": 0, "force": 0}
         self._estimate_updates = 0
         self._residual_pub = self.publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
+        self._sensor_pubs = {
+            t.name: self.publisher(Vector3Stamped, t.name, qos_profile(t)) for t in (TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL)
+        }
         self._estimate_pub = self.publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         sensor = PULSE_READER_QOS  # best effort: matches a bench counter publishing sensor data, and the twin's reliable streams
@@ -183,6 +202,11 @@ class ShadowNode(ManagedNode):
             msg.header.stamp = to_stamp(max(row.time, 0.0))
             msg.header.frame_id = "bearing"
             self._residual_pub.publish(msg)
+            for name, (residual, threshold, predicted) in sensor_residuals(row).items():
+                vec = Vector3Stamped()
+                vec.header = msg.header
+                vec.vector.x, vec.vector.y, vec.vector.z = residual, threshold, predicted
+                self._sensor_pubs[name].publish(vec)
         if rows and self.twin.calibration is not None and self.twin.calibration.updates != self._estimate_updates:
             e = self.twin.calibration.estimate()
             self._estimate_updates = e.updates

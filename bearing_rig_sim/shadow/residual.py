@@ -27,8 +27,8 @@ The sign names the likely class (see :func:`likely_cause`).
 network's start ``T_start`` (the bench thermocouple's first reading, or ambient; its
 conductances: convection films and contact conductances are known to about +-30 %), ``u_tc``
 the thermocouple's standard uncertainty (its accuracy class); ``f_M`` the friction torque's
-relative uncertainty from the calibration (the grease parameters' standard errors, 6-12 %, and
-what they leave out), ``sigma_M`` the torque meter's noise averaged over its ``n`` samples in the
+relative uncertainty propagated from the calibration's covariance and its load uncertainty (about
+3 %), ``sigma_M`` the torque meter's noise averaged over its ``n`` samples in the
 window. The settings carry the values and their sources (``config/shadow.yaml``).
 
 Units: s; slip, residual and band in percentage points; temperature in K, torque in N m.

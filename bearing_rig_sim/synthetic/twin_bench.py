@@ -8,13 +8,15 @@ load cell's force at 1 kHz with its noise (``config/rig.yaml``: 1 N standard dev
 may be put on a bench system clock (``clock_offset_s``). With the bearing's thermal network
 (``thermal=True``, the default, coupled both ways as in the rig session) it also records the
 outer-ring thermocouple (10 Hz) and the housing torque meter (100 Hz) as the simulator node
-emits them. :func:`write_bench_bag` writes them as a bag with the topics shadow mode reads.
+emits them. :func:`departed` makes of a run a bench whose outer ring runs hotter or whose
+torque is higher than the twin's from a given time. :func:`write_bench_bag` writes them as a bag with the topics shadow mode reads.
 
 Units: s, rpm and N at this edge (the programme), SI in the events.
 """
 
 from __future__ import annotations
 
+import math
 import random
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -133,6 +135,21 @@ def twin_bench_run(
         truth = twin.truth()
         run.truth_slip.append(truth.slip_rate)
     return run
+
+
+def departed(run: BenchRun, *, from_s: float, outer_ring_hotter_k: float = 0.0, torque_factor: float = 1.0) -> BenchRun:
+    """The bench of ``run`` departing from the twin at bench time ``from_s`` (s): its outer ring
+    ``outer_ring_hotter_k`` K hotter, seen through the thermocouple's first-order lag
+    (:data:`~bearing_rig_sim.thermal.sensors.THERMOCOUPLE_TIME_CONSTANT_S`: the reading's offset
+    is dT (1 - exp(-(t - from_s) / tau))), and its friction torque ``torque_factor`` times the
+    twin's (the torque meter's 10 ms lag and its 0.2 mN m noise, under 0.3 % of the torque, are
+    scaled with it). Pulses and load-cell samples are those of ``run``."""
+    tau = bench_sensors.THERMOCOUPLE_TIME_CONSTANT_S
+    temperatures = [
+        (t, v + (outer_ring_hotter_k * (1.0 - math.exp(-(t - from_s) / tau)) if t > from_s else 0.0)) for t, v in run.temperatures
+    ]
+    torques = [(t, v * torque_factor if t > from_s else v) for t, v in run.torques]
+    return BenchRun(list(run.spindle), list(run.cage), list(run.forces), list(run.truth_slip), temperatures, torques)
 
 
 def write_bench_bag(run: BenchRun, path: str | Path) -> Path:

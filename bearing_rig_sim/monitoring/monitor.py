@@ -193,6 +193,7 @@ class SlipMonitor:
         self.thrust = ThrustContact.from_config(settings.bearing_file)
         """The loaded contact angle from the measured load (Harris's thrust equilibrium)."""
         self.loaded = settings.slip_reference == "loaded"
+        self.sweep_loaded = settings.sweep_slip_reference == "loaded"
         self.slope = TrailingSlope(
             critical_slope=settings.critical_slope_pct_per_s,
             span=settings.slope_span_s,
@@ -391,7 +392,7 @@ class SlipMonitor:
             inner = window.inner_ring_speed
             load = self._mean_load(window.start_time, window.end_time)
             slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0
-            if self.loaded:
+            if self.sweep_loaded:
                 angle = self.thrust.loaded_contact_angle(load)
                 ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio() if math.isfinite(angle) else math.nan
                 slip = (1.0 - window.cage_speed / (ratio * inner)) * 100.0

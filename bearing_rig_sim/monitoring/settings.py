@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar
+from typing import Annotated, ClassVar, Self
+from collections.abc import Mapping
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.interfaces import DIAGNOSTICS
@@ -16,6 +17,17 @@ NODE_NAME = "monitor"
 
 SHIPPED_FILE = "monitor.yaml"
 """The shipped parameter file, under ``config/``."""
+
+DIAGNOSTIC_NAME = f"{NODE_NAME}: cage slip"
+"""Name of the monitor's status in ``/diagnostics``."""
+
+PUBLISHED_PARAMETERS = ("stable_confidence", "window_revolutions", "min_window_s", "slope_span_s", "min_slope_points")
+"""Parameters whose running values the monitor publishes on its ``/diagnostics`` status (key =
+parameter name), because whoever judges its statuses needs them: the time to stable counts a
+STABLE status only at ``stable_confidence`` and on windows its verdict can reach back to
+(:func:`~bearing_rig_sim.monitoring.schedule.evidence_start`). The session summary reads them
+live, ``analyze`` from the recorded ``/diagnostics``, so both use the node's values, not the
+file's."""
 
 SLIP_REFERENCES = ("nominal", "loaded")
 """Which slip the criterion judges: the paper's, against the pure-rolling cage speed at the
@@ -33,7 +45,8 @@ class MonitorSettings(NodeSettings):
 
     ``slip_reference`` "nominal" is the paper's slip (Eq. 11-12 at ``contact_angle_deg``),
     "loaded" the kinematic slip at the contact angle of the measured axial load (Harris's thrust
-    equilibrium); both are reported, the criterion judges the one named. The sustained-loss rules
+    equilibrium); both are reported, the time criterion judges the one named and the load sweep
+    the one ``sweep_slip_reference`` names. The sustained-loss rules
     are :class:`~bearing_rig_sim.monitoring.windows.LossRules`; the load sweep
     :mod:`~bearing_rig_sim.monitoring.load_sweep`.
     """
@@ -48,6 +61,9 @@ class MonitorSettings(NodeSettings):
     criterion: Annotated[str, one_of(CRITERIA)] = param("abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)")
     slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
         "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"
+    )
+    sweep_slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
+        "slip the load sweep judges (axial_load criterion): 'nominal' (the paper's) or 'loaded' (kinematic, at the measured load's angle)"
     )
     critical_slope_pct_per_s: Number = param("critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0)
     critical_slope_pct_per_n: Number = param("critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0)
@@ -99,6 +115,32 @@ class MonitorSettings(NodeSettings):
             loss_min_timeout_s=self.loss_min_timeout_s,
             silent_shaft_revolutions=self.silent_shaft_revolutions,
         )
+
+    def published_parameters(self) -> dict[str, str]:
+        """The values of :data:`PUBLISHED_PARAMETERS` as the monitor's diagnostics carry them."""
+        return {name: repr(getattr(self, name)) for name in PUBLISHED_PARAMETERS}
+
+    def with_published(self, values: Mapping[str, str]) -> tuple[Self, str]:
+        """These settings with the :data:`PUBLISHED_PARAMETERS` found in ``values`` (a monitor's
+        diagnostic key/values), each checked by its own field; returns (settings, problem), the
+        problem "" or naming a value refused (which is then left as it was)."""
+        changes: dict[str, object] = {}
+        problems = []
+        for name in PUBLISHED_PARAMETERS:
+            if name not in values:
+                continue
+            current = getattr(self, name)
+            try:
+                value = type(current)(float(values[name])) if isinstance(current, float) else int(values[name])
+            except ValueError:
+                problems.append(f"{name}={values[name]!r} is not a number")
+                continue
+            why = type(self).check_value(name, value)
+            if why:
+                problems.append(f"{name}={values[name]!r}: {why}")
+            elif value != current:
+                changes[name] = value
+        return (self.replace(**changes) if changes else self), "; ".join(problems)
 
     @property
     def critical_slope(self) -> float:

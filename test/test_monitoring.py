@@ -425,14 +425,14 @@ def test_a_segment_is_stable_only_at_its_commanded_speed() -> None:
     target = 1500 * rpm  # 157.08 rad/s; 1 % of it is 1.57 rad/s (> 1 rad/s)
     assert speed_tolerance(target) == 0.01 * target
     assert speed_tolerance(50 * rpm) == 1.0  # near rest the counter's 1 rad/s governs
-    rule = TimeToStable(ramp_end=10.0, target_speed=target)
+    rule = TimeToStable(ramp_end=10.0, target_speed=target, min_confidence=0.6)
     stable = int(SlipState.STABLE)
     assert not rule.observe(11.0, 10.5, stable, 0.99, 900 * rpm)  # the previous speed
     assert not rule.observe(11.5, 10.5, stable, 0.99, target - 2.0)  # 1.3 % short
     assert rule.observe(12.0, 10.5, stable, 0.99, target - 1.0)  # within 1 %
     assert rule.time_to_stable == 2.0
     # without a commanded speed (a stretch found by speed in a bag without a program) no check
-    free = TimeToStable(ramp_end=10.0)
+    free = TimeToStable(ramp_end=10.0, min_confidence=0.6)
     assert free.observe(11.0, 10.5, stable, 0.99)
 
 

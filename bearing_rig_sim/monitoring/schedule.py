@@ -135,8 +135,8 @@ class TimeToStable:
         target_speed: the commanded inner-ring speed, rad/s; None: not checked.
         run_up_start: start of a run-up, rig s; None for any other segment.
         min_confidence: least P(slope >= k) of the status that makes it stable (1): the running
-            monitor's ``stable_confidence`` (live: :func:`published_parameters` on its
-            /diagnostics; offline: the same, recorded in the bag), no default of its own.
+            monitor's ``stable_confidence`` (live: as it publishes them on its /diagnostics,
+            ``MonitorSettings.published_parameters``; offline: the same, recorded in the bag), no default of its own.
     """
 
     def __init__(self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None, *, min_confidence: float) -> None:

@@ -8,6 +8,7 @@ from typing import Annotated, ClassVar, Self
 from collections.abc import Mapping
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.monitoring.windows import LossRules
 from bearing_rig_sim.settings_model import ConfigFile, Integer, NodeSettings, Number, one_of, param
@@ -21,13 +22,9 @@ SHIPPED_FILE = "monitor.yaml"
 DIAGNOSTIC_NAME = f"{NODE_NAME}: cage slip"
 """Name of the monitor's status in ``/diagnostics``."""
 
-PUBLISHED_PARAMETERS = ("stable_confidence", "window_revolutions", "min_window_s", "slope_span_s", "min_slope_points")
-"""Parameters whose running values the monitor publishes on its ``/diagnostics`` status (key =
-parameter name), because whoever judges its statuses needs them: the time to stable counts a
-STABLE status only at ``stable_confidence`` and on windows its verdict can reach back to
-(:func:`~bearing_rig_sim.monitoring.schedule.evidence_start`). The session summary reads them
-live, ``analyze`` from the recorded ``/diagnostics``, so both use the node's values, not the
-file's."""
+PARAMETER_KEY_PREFIX = "parameter/"
+"""The monitor's ``/diagnostics`` status carries each of its running parameter values under this
+prefix and the parameter's name (:meth:`MonitorSettings.published_parameters`)."""
 
 SLIP_REFERENCES = ("nominal", "loaded")
 """Which slip the criterion judges: the paper's, against the pure-rolling cage speed at the
@@ -117,30 +114,36 @@ class MonitorSettings(NodeSettings):
         )
 
     def published_parameters(self) -> dict[str, str]:
-        """The values of :data:`PUBLISHED_PARAMETERS` as the monitor's diagnostics carry them."""
-        return {name: repr(getattr(self, name)) for name in PUBLISHED_PARAMETERS}
+        """The running values as the monitor's diagnostics carry them: every parameter but the
+        bearing file (whose path is the node's machine's; a bag records the file's text) under
+        :data:`PARAMETER_KEY_PREFIX`. Whoever judges the monitor's statuses needs them: the time
+        to stable counts a STABLE only at ``stable_confidence`` and on windows its verdict can
+        reach back to (``window_revolutions``, ``min_window_s``, ``slope_span_s``,
+        ``min_slope_points``), and ``analyze`` reruns the monitor with all of them."""
+        return {PARAMETER_KEY_PREFIX + name: str(value) for name, value in self.model_dump().items() if name != "bearing_file"}
 
-    def with_published(self, values: Mapping[str, str]) -> tuple[Self, str]:
-        """These settings with the :data:`PUBLISHED_PARAMETERS` found in ``values`` (a monitor's
-        diagnostic key/values), each checked by its own field; returns (settings, problem), the
-        problem "" or naming a value refused (which is then left as it was)."""
-        changes: dict[str, object] = {}
-        problems = []
-        for name in PUBLISHED_PARAMETERS:
-            if name not in values:
+    def with_published(self, values: Mapping[str, str], source: str = "the monitor's published parameters") -> tuple[Self, str]:
+        """These settings with the running values found in ``values`` (a monitor's diagnostic
+        key/values, :meth:`published_parameters`), validated as a whole; returns (settings,
+        problem): on a value refused, these settings unchanged and the reason."""
+        raw = {name: str(value) if name == "bearing_file" else value for name, value in self.model_dump().items()}
+        changed = False
+        for name, current in raw.items():
+            text = values.get(PARAMETER_KEY_PREFIX + name)
+            if text is None or name == "bearing_file":
                 continue
-            current = getattr(self, name)
             try:
-                value = type(current)(float(values[name])) if isinstance(current, float) else int(values[name])
+                value: object = text if isinstance(current, str) else float(text) if isinstance(current, float) else int(text)
             except ValueError:
-                problems.append(f"{name}={values[name]!r} is not a number")
-                continue
-            why = type(self).check_value(name, value)
-            if why:
-                problems.append(f"{name}={values[name]!r}: {why}")
-            elif value != current:
-                changes[name] = value
-        return (self.replace(**changes) if changes else self), "; ".join(problems)
+                return self, f"{name}: {text!r} is not a number"
+            changed = changed or value != current
+            raw[name] = value
+        if not changed:
+            return self, ""
+        try:
+            return type(self).from_values(raw, source), ""
+        except ConfigError as exc:
+            return self, str(exc)
 
     @property
     def critical_slope(self) -> float:

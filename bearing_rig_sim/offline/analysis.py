@@ -58,7 +58,7 @@ from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
-from bearing_rig_sim.monitoring import NODE_NAME, PUBLISHED_PARAMETERS, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
+from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -263,16 +263,16 @@ def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> Moni
 
 
 def monitor_published_parameters(bag: BagReader) -> dict[str, str]:
-    """The parameters the running monitor published on its ``/diagnostics`` status
-    (:data:`~bearing_rig_sim.monitoring.settings.PUBLISHED_PARAMETERS`), from the first such status
-    recorded in the bag; {} when it has none (a bag of another recorder, or an older monitor)."""
+    """The parameter values the running monitor published on its ``/diagnostics`` status
+    (:meth:`~bearing_rig_sim.monitoring.MonitorSettings.published_parameters`), from the first such
+    status recorded in the bag; {} when it has none (a bag of another recorder, an older monitor)."""
     if DIAGNOSTICS not in bag.topics or not bag.topics[DIAGNOSTICS].decodable:
         return {}
     try:
         for _topic, _log_time_ns, _msgtype, message in bag.messages([DIAGNOSTICS]):
             for status in getattr(message, "status", ()):  # diagnostic_msgs/DiagnosticArray
                 if status.name == MONITOR_DIAGNOSTIC_NAME:
-                    values = {kv.key: kv.value for kv in status.values if kv.key in PUBLISHED_PARAMETERS}
+                    values = {kv.key: kv.value for kv in status.values if kv.key.startswith(PARAMETER_KEY_PREFIX)}
                     if values:
                         return values
     except BagError:
@@ -391,10 +391,11 @@ class OfflineAnalysis:
         )
         published = monitor_published_parameters(self.bag)
         if published:
-            settings, problem = settings.with_published(published)
+            settings, problem = settings.with_published(published, f"{self.bag.path.name}: {DIAGNOSTICS}")
             if problem:
-                self._report(f"{self.bag.path.name}: the monitor's recorded parameters: {problem}; the file's value kept")
-            source += f", {', '.join(sorted(published))} as the running monitor published them ({DIAGNOSTICS})"
+                self._report(f"{self.bag.path.name}: the monitor's recorded parameters: {problem}; the file's values kept")
+            else:
+                source += f", over it the values the running monitor published on {DIAGNOSTICS}"
         return settings, source
 
     # -- the pass ------------------------------------------------------------------------------

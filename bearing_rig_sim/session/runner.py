@@ -480,9 +480,9 @@ class ProgramRunner:
     # -- observations -----------------------------------------------------------------------------
     def observe_monitor_parameters(self, values: Mapping[str, str]) -> str:
         """The running monitor's parameters as its ``/diagnostics`` status publishes them
-        (:data:`~bearing_rig_sim.monitoring.settings.PUBLISHED_PARAMETERS`): the time to stable
-        judges its statuses by them from now on, the running segment's included. Returns a
-        problem with a value ("" when none)."""
+        (:meth:`~bearing_rig_sim.monitoring.MonitorSettings.published_parameters`): the time to
+        stable judges its statuses by them from now on, the running segment's included. Returns
+        a problem with a value ("" when none)."""
         self.monitor_settings, problem = self.monitor_settings.with_published(values)
         if self._data is not None and self._data.rule is not None:
             self._data.rule.min_confidence = self.monitor_settings.stable_confidence

@@ -425,14 +425,14 @@ def test_a_segment_is_stable_only_at_its_commanded_speed() -> None:
     target = 1500 * rpm  # 157.08 rad/s; 1 % of it is 1.57 rad/s (> 1 rad/s)
     assert speed_tolerance(target) == 0.01 * target
     assert speed_tolerance(50 * rpm) == 1.0  # near rest the counter's 1 rad/s governs
-    rule = TimeToStable(ramp_end=10.0, target_speed=target)
+    rule = TimeToStable(ramp_end=10.0, target_speed=target, min_confidence=0.6)
     stable = int(SlipState.STABLE)
     assert not rule.observe(11.0, 10.5, stable, 0.99, 900 * rpm)  # the previous speed
     assert not rule.observe(11.5, 10.5, stable, 0.99, target - 2.0)  # 1.3 % short
     assert rule.observe(12.0, 10.5, stable, 0.99, target - 1.0)  # within 1 %
     assert rule.time_to_stable == 2.0
     # without a commanded speed (a stretch found by speed in a bag without a program) no check
-    free = TimeToStable(ramp_end=10.0)
+    free = TimeToStable(ramp_end=10.0, min_confidence=0.6)
     assert free.observe(11.0, 10.5, stable, 0.99)
 
 
@@ -447,3 +447,20 @@ def test_a_window_lasts_at_least_min_window_s_in_whole_revolutions():
     assert window is not None and window.window.revolutions == 4
     assert window.end_time - window.start_time == pytest.approx(4 * period, rel=1e-9)
     assert monitor.status().slip_rate == pytest.approx(expected_slip(INNER, CAGE), abs=1e-8)
+
+
+def test_the_published_parameters_give_back_the_running_settings():
+    """What the monitor publishes on /diagnostics (every parameter but the bearing file's path)
+    gives a consumer holding the file's settings the node's: a round trip; a refused value is
+    named and leaves the consumer's settings as they were."""
+    from bearing_rig_sim.monitoring import MonitorSettings
+
+    shipped = MonitorSettings.from_yaml()
+    running = shipped.replace(stable_confidence=0.9, slope_span_s=2.5, min_slope_points=7, criterion="axial_load")
+    published = running.published_parameters()
+    assert published["parameter/stable_confidence"] == "0.9" and "parameter/bearing_file" not in published
+    taken, problem = shipped.with_published(published)
+    assert problem == "" and taken == running
+    kept, problem = shipped.with_published({**published, "parameter/stable_confidence": "1.5"})
+    assert kept == shipped and "stable_confidence" in problem
+    assert shipped.with_published({"state": "stable"}) == (shipped, "")  # nothing published: as it was

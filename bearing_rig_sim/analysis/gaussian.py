@@ -166,6 +166,9 @@ class GaussianFit:
             (a_1, b_1, c_1, a_2, ...): rmse^2 (J^T J)^-1 at the optimum, J the Jacobian of the
             model. Entries are inf or nan where J is singular (parameter combinations the data
             do not determine, e.g. a term far from every point).
+        residuals: y - fit at each data point, in increasing order of x (ties in the data's
+            order), unit of y: their pattern (runs of one sign) says whether the curve follows
+            the data or only passes near them.
     """
 
     params: FloatArray
@@ -177,6 +180,7 @@ class GaussianFit:
     n_points: int
     x_range: tuple[float, float]
     covariance: FloatArray = field(repr=False)
+    residuals: FloatArray = field(repr=False)
     _directions: FloatArray = field(repr=False)  # rows rmse v_i / s_i from the SVD of J
 
     @overload
@@ -323,6 +327,7 @@ def _fit(
 
 def _summary(x: FloatArray, y: FloatArray, params: FloatArray) -> GaussianFit:
     resid = y - _value(x, params)
+    in_order = resid[np.argsort(x, kind="stable")]
     sse = float(resid @ resid)
     sst = float(np.sum((y - y.mean()) ** 2))
     dof = x.size - params.size
@@ -333,7 +338,7 @@ def _summary(x: FloatArray, y: FloatArray, params: FloatArray) -> GaussianFit:
         directions = rmse * vt / sv[:, None]
         cov = directions.T @ directions
     directions[np.isnan(directions)] = np.inf  # a zero singular value with rmse = 0
-    for arr in (params, cov, directions):
+    for arr in (params, cov, directions, in_order):
         arr.setflags(write=False)
     return GaussianFit(
         params=params,
@@ -345,6 +350,7 @@ def _summary(x: FloatArray, y: FloatArray, params: FloatArray) -> GaussianFit:
         n_points=x.size,
         x_range=(float(x.min()), float(x.max())),
         covariance=cov,
+        residuals=in_order,
         _directions=directions,
     )
 

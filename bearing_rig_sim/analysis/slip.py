@@ -361,3 +361,13 @@ class ThrustContact:
             return math.sin(a) * max(cos0 / math.cos(a) - 1.0, 0.0) ** 1.5 - rhs
 
         return float(brentq(balance, self.free_angle, math.radians(89.9), xtol=1e-12))
+
+
+def loaded_slip_rate(kinematics: BearingKinematics, thrust: ThrustContact, cage_speed: float, inner_ring_speed: float, axial_load: float) -> float:
+    """The kinematic slip, %: 100 (1 - n_c / n_s(a)) against the pure-rolling cage speed at the
+    contact angle a of the axial load ``axial_load`` (N, :meth:`ThrustContact.loaded_contact_angle`)
+    rather than at the nominal angle; speeds in rad/s. NaN without a finite load."""
+    angle = thrust.loaded_contact_angle(axial_load)
+    if not math.isfinite(angle):
+        return math.nan
+    return (1.0 - cage_speed / (kinematics.at_contact_angle(angle).epicyclic_ratio() * inner_ring_speed)) * 100.0

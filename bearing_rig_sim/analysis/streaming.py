@@ -151,7 +151,8 @@ class TrailingSlope:
         max_span: longest stretch of the series the slope may rest on when the trailing window
             cannot decide, unit of x (None: the trailing window only; >= span).
         stable_confidence: one-sided confidence of the STABLE test (0.5-1): a false STABLE at a
-            true slope of k with P = 1 - this per test (docs/method.md).
+            true slope of k with P = 1 - this per test (docs/method.md); no default: the monitor's
+            ``stable_confidence`` parameter is the one source.
     """
 
     def __init__(
@@ -162,7 +163,8 @@ class TrailingSlope:
         resolution: float = 0.01,
         change_threshold: float = 4.0,
         max_span: float | None = None,
-        stable_confidence: float = 0.95,
+        *,
+        stable_confidence: float,
     ) -> None:
         self.stable_confidence = finite_number("stable_confidence", stable_confidence)
         if not 0.5 <= self.stable_confidence < 1.0:

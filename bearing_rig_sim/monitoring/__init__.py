@@ -11,11 +11,13 @@ the monitor and verdict, and the check/report schedule that the node and offline
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorState, MonitorStatus, MonitorWindow, SlipMonitor
 from bearing_rig_sim.monitoring.schedule import PulseMerger, ScheduledStatus, StampOrder, StatusSchedule, TimeToStable
-from bearing_rig_sim.monitoring.settings import NODE_NAME, SHIPPED_FILE, MonitorSettings, shipped_parameters
+from bearing_rig_sim.monitoring.settings import DIAGNOSTIC_NAME, NODE_NAME, PARAMETER_KEY_PREFIX, SHIPPED_FILE, MonitorSettings, shipped_parameters
 from bearing_rig_sim.monitoring.windows import LossRules, SlipWindow, SlipWindows, unstamped
 
 __all__ = [
+    "DIAGNOSTIC_NAME",
     "NODE_NAME",
+    "PARAMETER_KEY_PREFIX",
     "SHIPPED_FILE",
     "LossRules",
     "MonitorSettings",

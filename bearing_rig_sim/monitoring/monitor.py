@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.inputs import AnalysisError
 from bearing_rig_sim.analysis.phase import PhaseSlope
-from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
+from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact, loaded_slip_rate
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.analysis.streaming import TrailingSlope
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
@@ -193,6 +193,7 @@ class SlipMonitor:
         self.thrust = ThrustContact.from_config(settings.bearing_file)
         """The loaded contact angle from the measured load (Harris's thrust equilibrium)."""
         self.loaded = settings.slip_reference == "loaded"
+        self.sweep_loaded = settings.sweep_slip_reference == "loaded"
         self.slope = TrailingSlope(
             critical_slope=settings.critical_slope_pct_per_s,
             span=settings.slope_span_s,
@@ -390,11 +391,10 @@ class SlipMonitor:
             window = self._sweep_pending.popleft()
             inner = window.inner_ring_speed
             load = self._mean_load(window.start_time, window.end_time)
-            slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0
-            if self.loaded:
-                angle = self.thrust.loaded_contact_angle(load)
-                ratio = self.kinematics.at_contact_angle(angle).epicyclic_ratio() if math.isfinite(angle) else math.nan
-                slip = (1.0 - window.cage_speed / (ratio * inner)) * 100.0
+            if self.sweep_loaded:
+                slip = loaded_slip_rate(self.kinematics, self.thrust, window.cage_speed, inner, load)
+            else:
+                slip = (1.0 - window.cage_speed / (self._ratio * inner)) * 100.0
             verdict = self.sweep.add_window(window.start_time, window.end_time, load, slip, inner)
             if verdict is not None:
                 self._notes.append((window.end_time, f"load sweep at {verdict.inner_ring_speed * 30.0 / math.pi:.0f} rpm: {verdict.describe()}"))

@@ -11,8 +11,8 @@ silent sensor is still reported; offline the ticks catch up at the next pulse, a
 :meth:`StatusSchedule.finish` closes the series.
 
 **Time to stable** (:class:`TimeToStable`): a segment is stable at the first status that is
-STABLE *on evidence from after the ramp's end*: its confidence P(slope >= k) is at least
-:data:`STABLE_CONFIDENCE` (so the present points, not a state held by hysteresis, say stable)
+STABLE *on evidence from after the ramp's end*: its confidence P(slope >= k) is at least the
+monitor's ``stable_confidence`` (so the present points, not a state held by hysteresis, say stable)
 and every slip window its slope rests on started at or after the ramp's end
 (:func:`evidence_start`), at the commanded speed: the status's inner-ring speed within
 :func:`speed_tolerance` of the segment's target (a spindle that took the command late, or never
@@ -95,12 +95,6 @@ class StatusSchedule:
         return ScheduledStatus(self.clock, "end", self.monitor.status())
 
 
-STABLE_CONFIDENCE = 0.6
-"""A stable status counts for the time to stable when P(slope >= k) is at least this (1): the
-confidence of the STABLE test itself, the shipped ``stable_confidence`` of config/monitor.yaml
-(a test keeps the two equal; a caller with other settings passes its own)."""
-
-
 def evidence_start(stamp: float, cage_speed: float, window_revolutions: int, slope_span_s: float, min_slope_points: int, min_window_s: float = 0.0) -> float:
     """The earliest time the verdict of a status stamped ``stamp`` (s) can rest on, s.
 
@@ -140,13 +134,12 @@ class TimeToStable:
         ramp_end: end of the segment's ramp, rig s.
         target_speed: the commanded inner-ring speed, rad/s; None: not checked.
         run_up_start: start of a run-up, rig s; None for any other segment.
-        min_confidence: least P(slope >= k) of the status that makes it stable (1): the monitor's
-            ``stable_confidence``.
+        min_confidence: least P(slope >= k) of the status that makes it stable (1): the running
+            monitor's ``stable_confidence`` (live: as it publishes them on its /diagnostics,
+            ``MonitorSettings.published_parameters``; offline: the same, recorded in the bag), no default of its own.
     """
 
-    def __init__(
-        self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None, min_confidence: float = STABLE_CONFIDENCE
-    ) -> None:
+    def __init__(self, ramp_end: float, target_speed: float | None = None, run_up_start: float | None = None, *, min_confidence: float) -> None:
         self.min_confidence = min_confidence
         self.run_up_start = run_up_start
         self.ramp_end = ramp_end if run_up_start is None else run_up_start

@@ -4,9 +4,11 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, ClassVar
+from typing import Annotated, ClassVar, Self
+from collections.abc import Mapping
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.monitoring.windows import LossRules
 from bearing_rig_sim.settings_model import ConfigFile, Integer, NodeSettings, Number, one_of, param
@@ -16,6 +18,13 @@ NODE_NAME = "monitor"
 
 SHIPPED_FILE = "monitor.yaml"
 """The shipped parameter file, under ``config/``."""
+
+DIAGNOSTIC_NAME = f"{NODE_NAME}: cage slip"
+"""Name of the monitor's status in ``/diagnostics``."""
+
+PARAMETER_KEY_PREFIX = "parameter/"
+"""The monitor's ``/diagnostics`` status carries each of its running parameter values under this
+prefix and the parameter's name (:meth:`MonitorSettings.published_parameters`)."""
 
 SLIP_REFERENCES = ("nominal", "loaded")
 """Which slip the criterion judges: the paper's, against the pure-rolling cage speed at the
@@ -33,7 +42,8 @@ class MonitorSettings(NodeSettings):
 
     ``slip_reference`` "nominal" is the paper's slip (Eq. 11-12 at ``contact_angle_deg``),
     "loaded" the kinematic slip at the contact angle of the measured axial load (Harris's thrust
-    equilibrium); both are reported, the criterion judges the one named. The sustained-loss rules
+    equilibrium); both are reported, the time criterion judges the one named and the load sweep
+    the one ``sweep_slip_reference`` names. The sustained-loss rules
     are :class:`~bearing_rig_sim.monitoring.windows.LossRules`; the load sweep
     :mod:`~bearing_rig_sim.monitoring.load_sweep`.
     """
@@ -48,6 +58,9 @@ class MonitorSettings(NodeSettings):
     criterion: Annotated[str, one_of(CRITERIA)] = param("abscissa of the slope criterion: 'time' (k2) or 'axial_load' (k1, against the load cell)")
     slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
         "slip the criterion judges: 'nominal' (the paper's, at the nominal contact angle) or 'loaded' (kinematic, at the measured load's angle)"
+    )
+    sweep_slip_reference: Annotated[str, one_of(SLIP_REFERENCES)] = param(
+        "slip the load sweep judges (axial_load criterion): 'nominal' (the paper's) or 'loaded' (kinematic, at the measured load's angle)"
     )
     critical_slope_pct_per_s: Number = param("critical slope k2 of the stability criterion (slip against time)", unit="%/s", ge=-10.0, le=0.0)
     critical_slope_pct_per_n: Number = param("critical slope k1 of the stability criterion (slip against axial load)", unit="%/N", ge=-1.0, le=0.0)
@@ -99,6 +112,38 @@ class MonitorSettings(NodeSettings):
             loss_min_timeout_s=self.loss_min_timeout_s,
             silent_shaft_revolutions=self.silent_shaft_revolutions,
         )
+
+    def published_parameters(self) -> dict[str, str]:
+        """The running values as the monitor's diagnostics carry them: every parameter but the
+        bearing file (whose path is the node's machine's; a bag records the file's text) under
+        :data:`PARAMETER_KEY_PREFIX`. Whoever judges the monitor's statuses needs them: the time
+        to stable counts a STABLE only at ``stable_confidence`` and on windows its verdict can
+        reach back to (``window_revolutions``, ``min_window_s``, ``slope_span_s``,
+        ``min_slope_points``), and ``analyze`` reruns the monitor with all of them."""
+        return {PARAMETER_KEY_PREFIX + name: str(value) for name, value in self.model_dump().items() if name != "bearing_file"}
+
+    def with_published(self, values: Mapping[str, str], source: str = "the monitor's published parameters") -> tuple[Self, str]:
+        """These settings with the running values found in ``values`` (a monitor's diagnostic
+        key/values, :meth:`published_parameters`), validated as a whole; returns (settings,
+        problem): on a value refused, these settings unchanged and the reason."""
+        raw = {name: str(value) if name == "bearing_file" else value for name, value in self.model_dump().items()}
+        changed = False
+        for name, current in raw.items():
+            text = values.get(PARAMETER_KEY_PREFIX + name)
+            if text is None or name == "bearing_file":
+                continue
+            try:
+                value: object = text if isinstance(current, str) else float(text) if isinstance(current, float) else int(text)
+            except ValueError:
+                return self, f"{name}: {text!r} is not a number"
+            changed = changed or value != current
+            raw[name] = value
+        if not changed:
+            return self, ""
+        try:
+            return type(self).from_values(raw, source), ""
+        except ConfigError as exc:
+            return self, str(exc)
 
     @property
     def critical_slope(self) -> float:

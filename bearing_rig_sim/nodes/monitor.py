@@ -40,6 +40,7 @@ from bearing_rig_sim.interfaces import DIAGNOSTICS, SLIP_STATUS
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS
 from bearing_rig_sim.monitoring import (
+    DIAGNOSTIC_NAME,
     NODE_NAME,
     MonitorSettings,
     MonitorStatus,
@@ -224,9 +225,10 @@ class MonitorNode(ManagedNode):
             "cage_pulses_duplicated": status.duplicates[1],
             "faults": " | ".join(status.faults),
             "warnings": " | ".join(status.warnings),
+            **self.settings.published_parameters(),  # what judging these statuses takes: the running values
         }
         message = f"{status.state.label}: {status.detail}"
-        array = diagnostic_array(to_stamp(max(self._clock_now(), 0.0)), [diagnostic_status(f"{NODE_NAME}: cage slip", level, message, values)])
+        array = diagnostic_array(to_stamp(max(self._clock_now(), 0.0)), [diagnostic_status(DIAGNOSTIC_NAME, level, message, values)])
         self._diag_pub.publish(array)
 
 

@@ -57,7 +57,8 @@ from collections.abc import Callable
 from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
-from bearing_rig_sim.monitoring import NODE_NAME, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
+from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
+from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -83,6 +84,8 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype
+DIAGNOSTICS = contract.DIAGNOSTICS.name
+"""Where the monitor publishes the parameters its statuses are judged by."""
 PULSE_TOPICS: dict[str, str] = {shaft: t.name for shaft, t in contract.PULSE_TOPICS.items()}
 """Shaft -> pulse topic: what the analysis cannot do without."""
 
@@ -163,6 +166,8 @@ class OfflineResult:
     """Every problem met (the reader's and the analysis'), one line each."""
     settings_source: str
     """Where the monitor's parameters came from."""
+    stable_confidence: float
+    """The monitor's ``stable_confidence`` the time to stable was judged at (1)."""
     segment_source: str
     """``"program"`` (spindle commands) or ``"stretches"`` (detected constant speeds)."""
     bag_start: float
@@ -257,6 +262,24 @@ def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> Moni
     return MonitorSettings.from_values({**shipped_parameters(), **recorded}, source)
 
 
+def monitor_published_parameters(bag: BagReader) -> dict[str, str]:
+    """The parameter values the running monitor published on its ``/diagnostics`` status
+    (:meth:`~bearing_rig_sim.monitoring.MonitorSettings.published_parameters`), from the first such
+    status recorded in the bag; {} when it has none (a bag of another recorder, an older monitor)."""
+    if DIAGNOSTICS not in bag.topics or not bag.topics[DIAGNOSTICS].decodable:
+        return {}
+    try:
+        for _topic, _log_time_ns, _msgtype, message in bag.messages([DIAGNOSTICS]):
+            for status in getattr(message, "status", ()):  # diagnostic_msgs/DiagnosticArray
+                if status.name == MONITOR_DIAGNOSTIC_NAME:
+                    values = {kv.key: kv.value for kv in status.values if kv.key.startswith(PARAMETER_KEY_PREFIX)}
+                    if values:
+                        return values
+    except BagError:
+        return {}
+    return {}
+
+
 # ---------------------------------------------------------------------------------------------
 # The analysis
 # ---------------------------------------------------------------------------------------------
@@ -294,6 +317,7 @@ class OfflineAnalysis:
             complete=bag.complete,
             problems=[],
             settings_source=source,
+            stable_confidence=settings.stable_confidence,
             segment_source="program" if topics.get(COMMAND) and topics[COMMAND].message_count else "stretches",
             bag_start=bag.start_ns * 1e-9,
             bag_end=bag.end_ns * 1e-9,
@@ -361,9 +385,18 @@ class OfflineAnalysis:
         except ConfigError as exc:
             self._report(f"{exc}; using the shipped config/monitor.yaml")
             recorded = None
-        if recorded is not None:
-            return recorded, "the bag's run context (parameters/monitor)"
-        return MonitorSettings.from_yaml(), "the shipped config/monitor.yaml (the bag records none)"
+        settings, source = (recorded, "the bag's run context (parameters/monitor)") if recorded is not None else (
+            MonitorSettings.from_yaml(),
+            "the shipped config/monitor.yaml (the bag records none)",
+        )
+        published = monitor_published_parameters(self.bag)
+        if published:
+            settings, problem = settings.with_published(published, f"{self.bag.path.name}: {DIAGNOSTICS}")
+            if problem:
+                self._report(f"{self.bag.path.name}: the monitor's recorded parameters: {problem}; the file's values kept")
+            else:
+                source += f", over it the values the running monitor published on {DIAGNOSTICS}"
+        return settings, source
 
     # -- the pass ------------------------------------------------------------------------------
     def run(self) -> OfflineResult:

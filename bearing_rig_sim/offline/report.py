@@ -48,7 +48,6 @@ from bearing_rig_sim.offline.analysis import (
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV, SegmentSummary
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
-from bearing_rig_sim.monitoring.schedule import STABLE_CONFIDENCE
 
 REPORT_FILE = "report.md"
 PLOT_FILES = ("speeds.png", "slip.png", "axial_load.png", "status.png")
@@ -365,7 +364,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
     if result.segments:
         lines += [
             "Means are taken from the ramp's end to the segment's end; verdicts are the last state in the segment; "
-            f"time to stable counts from the ramp's end to the first stable status (P(slope >= k) >= {STABLE_CONFIDENCE:g}) whose "
+            f"time to stable counts from the ramp's end to the first stable status (P(slope >= k) >= {result.stable_confidence:g}, the monitor's stable_confidence) whose "
             "slip windows all follow the ramp's end, the rule the live session summary uses.",
             "",
             *_segment_table(result),

@@ -90,8 +90,9 @@ class _Segment:
         self.settings = settings
         commanded = target if math.isfinite(target) else None  # a stretch found by speed has no command
         start_of_run_up = start if run_up else None
-        self.stable = TimeToStable(ramp_end, commanded, start_of_run_up)
-        self.recorded_stable = TimeToStable(ramp_end, commanded, start_of_run_up)
+        confidence = settings.stable_confidence  # the running monitor's when the bag recorded it (offline.analysis)
+        self.stable = TimeToStable(ramp_end, commanded, start_of_run_up, min_confidence=confidence)
+        self.recorded_stable = TimeToStable(ramp_end, commanded, start_of_run_up, min_confidence=confidence)
 
     def _add(self, key: str, value: float) -> None:
         if math.isfinite(value):

@@ -48,6 +48,7 @@ from bearing_rig_sim.interfaces import (
     TRUTH,
 )
 from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.monitoring.settings import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
@@ -172,6 +173,7 @@ class SessionNode(Node):
         """Topics read best effort whose best-effort publisher the graph had not named when the
         recorder adapted; :meth:`adapt_to_publishers` names them once it does."""
         self._diagnostic_levels: dict[str, int] = {}
+        self._monitor_parameter_problem = ""
         self.last_lifecycle_status: tuple[str, str, str] | None = None
         """(name, transition, state) of the last lifecycle manager's status taken from
         ``/diagnostics`` (the session's own, :class:`~.manager.LifecycleManager`), or None."""
@@ -401,6 +403,11 @@ class SessionNode(Node):
         for status in msg.status:
             level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
             self.simulator_stopped = self.simulator_stopped or stopped_reason((kv.key, kv.value) for kv in status.values)
+            if status.name == MONITOR_DIAGNOSTIC_NAME:  # the running monitor's parameters: the time to stable's
+                problem = self.runner.observe_monitor_parameters({kv.key: kv.value for kv in status.values})
+                if problem and problem != self._monitor_parameter_problem:
+                    self.on_event(f"{status.name}: parameters not taken: {problem}")
+                self._monitor_parameter_problem = problem
             if status.name.startswith(DIAGNOSTIC_PREFIX):
                 values = {kv.key: kv.value for kv in status.values}
                 self.last_lifecycle_status = (status.name, values.get("transition", ""), values.get("state", ""))

@@ -76,7 +76,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
@@ -296,7 +296,9 @@ class ProgramRunner:
         self.setpoint_lead_s = setpoint_lead_s
         """How long before a segment's fixed start its load set-point is sent, s (:meth:`setpoints_due`)."""
         self.monitor_settings = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
-        """The monitor's parameters: how far back its verdicts reach (the shipped ones by default)."""
+        """The monitor's parameters: how far back its verdicts reach and at what confidence a
+        STABLE counts (the shipped ones until the running monitor publishes its own,
+        :meth:`observe_monitor_parameters`)."""
         self.outcomes: list[SegmentOutcome] = []
         self._data: _SegmentData | None = None
         self._truth: deque[tuple[float, float]] = deque(maxlen=TRUTH_HISTORY)
@@ -362,7 +364,7 @@ class ProgramRunner:
         plan = self._ahead.pop(index, None) or self._plan(index, start)
         run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
         fixed = index > 0 and self.program.segments[index - 1].dwell is not None
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up), fixed_start=fixed)
+        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up, min_confidence=self.monitor_settings.stable_confidence), fixed_start=fixed)
         early, self._early = self._early, []
         for observe, args in early:  # stamped within this segment, or beyond it (kept again)
             observe(*args)
@@ -476,6 +478,16 @@ class ProgramRunner:
         return outcome
 
     # -- observations -----------------------------------------------------------------------------
+    def observe_monitor_parameters(self, values: Mapping[str, str]) -> str:
+        """The running monitor's parameters as its ``/diagnostics`` status publishes them
+        (:meth:`~bearing_rig_sim.monitoring.MonitorSettings.published_parameters`): the time to
+        stable judges its statuses by them from now on, the running segment's included. Returns
+        a problem with a value ("" when none)."""
+        self.monitor_settings, problem = self.monitor_settings.with_published(values)
+        if self._data is not None and self._data.rule is not None:
+            self._data.rule.min_confidence = self.monitor_settings.stable_confidence
+        return problem
+
     def observe_status(self, status: SlipObservation) -> None:
         """A slip status of the monitor (any order relative to :meth:`update`)."""
         self.latest_status = status

@@ -139,7 +139,23 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         "",
     ]
 
-    # -- 1. validation table ----------------------------------------------------------------
+    reasons: dict[str, str] = {}
+    rms = _validation_section(raw, out, params, plt, lines, files)
+    load_onsets = _load_sweep_section(raw, out, plt, lines, files, reasons)
+    acc_onsets, accepted = _acceleration_section(raw, out, plt, lines, files, reasons)
+    plt.close("all")
+    lines += run_up_section(raw, params, accepted)
+    lines += friction_section(raw, params)
+
+    report = out / "report.md"
+    report.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    files.append(report)
+    return Outputs(out, files, rms, load_onsets, acc_onsets, cached, accepted, reasons)
+
+
+def _validation_section(raw: RawResults, out: Path, params: BearingParameters, plt: Any, lines: list[str], files: list[Path]) -> float:
+    """Table 3's analogue and Figures 5-6: appends to ``lines`` and ``files``; returns the RMS of
+    the model's slip against the bench's four calibration rows, pp."""
     rows = [s.as_row() for s in raw.validation]
     path = out / "validation.csv"
     _write_csv(path, ["rpm", "axial_load_n", "cage_rpm", "slip_pct"], [[r[k] for k in ("rpm", "axial_load_n", "cage_rpm", "slip_pct")] for r in rows])
@@ -175,7 +191,12 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         _finish(ax, fig, out / "fig06_validation_cage_speed.png", "inner-ring speed n_i (rpm)", "cage speed n_c (rpm)", "Fig. 6 analogue: cage speed at 100 N")
     )
 
-    # -- 2. load sweep ----------------------------------------------------------------------
+    return rms
+
+
+def _load_sweep_section(raw: RawResults, out: Path, plt: Any, lines: list[str], files: list[Path], reasons: dict[str, str]) -> dict[float, float | None]:
+    """Figures 7-8 and Tables 4-5's analogues: the paper's method per speed; appends to ``lines``,
+    ``files`` and ``reasons``; returns each speed's "stable from" load (None: no stable state)."""
     path = out / "load_sweep.csv"
     _write_csv(
         path,
@@ -184,7 +205,6 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
     )
     files.append(path)
     load_onsets: dict[float, float | None] = {}
-    reasons: dict[str, str] = {}
     lines += [
         "## Load sweep (Figures 7-8; Tables 4-5 analogues)",
         "",
@@ -265,7 +285,14 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
         )
     )
 
-    # -- 3. acceleration sweep --------------------------------------------------------------
+    return load_onsets
+
+
+def _acceleration_section(
+    raw: RawResults, out: Path, plt: Any, lines: list[str], files: list[Path], reasons: dict[str, str]
+) -> tuple[dict[float, float | None], dict[float, tuple[float, float, float] | None]]:
+    """Figures 9-10 and Tables 6-7's analogues: the run-ups' Gaussian fits; appends to ``lines``,
+    ``files`` and ``reasons``; returns each run-up's time to stable and accepted fit."""
     path = out / "acceleration.csv"
     _write_csv(
         path,
@@ -360,14 +387,7 @@ def write_report(raw: RawResults, out: Path, params: BearingParameters, cached: 
             "Fig. 10 analogue: twin slip (dots, lines: accepted fits) beside the paper's Table 7 (dashed)",
         )
     )
-    plt.close("all")
-    lines += run_up_section(raw, params, accepted)
-    lines += friction_section(raw, params)
-
-    report = out / "report.md"
-    report.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    files.append(report)
-    return Outputs(out, files, rms, load_onsets, acc_onsets, cached, accepted, reasons)
+    return acc_onsets, accepted
 
 
 RUN_UP_SPEEDS_RAD_S = (10.0, 20.0, 40.0, 80.0)

@@ -36,6 +36,7 @@ import ctypes
 import fcntl
 import os
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -43,8 +44,8 @@ import tempfile
 import time
 import warnings
 from pathlib import Path
-from typing import IO, Any
-from collections.abc import Callable, Iterator, Sequence
+from typing import IO, Any, NoReturn
+from collections.abc import Callable, Generator, Iterator, Sequence
 
 import pytest
 
@@ -385,3 +386,164 @@ def bearing_section(section: str, bearing: str = "h7006c.yaml") -> dict[str, Any
 
     raw = yaml.safe_load(config_path("bearings", bearing).read_text())[section]
     return {key: entry["value"] if isinstance(entry, dict) and "value" in entry else entry for key, entry in raw.items()}
+
+
+# -- tiers: a test that cannot run for want of a tool fails in CI --------------------------------
+TIERS: dict[str, str] = {
+    "ros": "rclpy and the ROS 2 Jazzy wheels with bearing_rig_msgs (./bootstrap.sh setup)",
+    "ros2-cli": "the stock ros2 command line and launch (../shared/ros2/setup.sh beside the clone, or a ROS 2 Jazzy install)",
+    "foxglove": "the foxglove-sdk, foxglove-websocket and websockets packages (requirements.lock)",
+    "foxglove-client": "Node.js 20 and npm with access to the npm registry (Foxglove's published client, test/foxglove_client)",
+    "distributed": "dask distributed (requirements.lock)",
+    "colcon": "colcon with its ROS extensions (requirements.lock)",
+}
+"""The optional parts of the suite, by name: what each needs. A test skipped because its tier's
+tools are missing fails instead when ``CI`` is set, unless :data:`ALLOW_MISSING` names the tier."""
+
+ALLOW_MISSING = "BEARING_RIG_ALLOW_MISSING"
+"""Environment variable: tiers (comma-separated names of :data:`TIERS`) that may be absent in CI."""
+
+IMPORT_TIERS: dict[str, str] = {
+    "rclpy": "ros",
+    "bearing_rig_msgs": "ros",
+    "foxglove": "foxglove",
+    "foxglove_websocket": "foxglove",
+    "websockets": "foxglove",
+    "distributed": "distributed",
+}
+"""The tier of a module a test imports with ``pytest.importorskip`` (by its top-level name)."""
+
+
+def skip_missing(tier: str, reason: str) -> NoReturn:
+    """Skip the running test because a tool of ``tier`` (a key of :data:`TIERS`) is missing; in
+    CI that skip is a failure unless the tier is allowed (see :func:`skip_failure`)."""
+    __tracebackhide__ = True  # the skip is reported at its caller's line
+    if tier not in TIERS:
+        raise ValueError(f"unknown tier {tier!r} (tiers: {', '.join(TIERS)})")
+    pytest.skip(f"missing {tier}: {reason}")
+
+
+def in_ci() -> bool:
+    """Whether the suite runs in CI: ``CI`` set to anything but empty, 0, false or no."""
+    return os.environ.get("CI", "").strip().lower() not in ("", "0", "false", "no")
+
+
+def allowed_missing() -> set[str]:
+    """The tiers :data:`ALLOW_MISSING` allows to be absent.
+
+    Raises:
+        pytest.UsageError: it names a tier that does not exist.
+    """
+    named = {name.strip() for name in os.environ.get(ALLOW_MISSING, "").split(",") if name.strip()}
+    unknown = sorted(named - set(TIERS))
+    if unknown:
+        raise pytest.UsageError(f"{ALLOW_MISSING}: unknown tier(s) {', '.join(unknown)} (tiers: {', '.join(TIERS)})")
+    return named
+
+
+def skip_tier(reason: str) -> str | None:
+    """The tier a skip's reason names (:func:`skip_missing`, or ``importorskip`` of a module of
+    :data:`IMPORT_TIERS`); None for any other skip."""
+    match = re.match(r"(?:Skipped: )?missing ([a-z0-9-]+): ", reason)
+    if match and match.group(1) in TIERS:
+        return match.group(1)
+    match = re.match(r"(?:Skipped: )?could not import '([\w.]+)'", reason)
+    if match:
+        return IMPORT_TIERS.get(match.group(1).split(".")[0])
+    return None
+
+
+def skip_failure(reason: str) -> str | None:
+    """The failure a skip with ``reason`` is in CI, or None where it may stand (not in CI, or its
+    tier allowed by :data:`ALLOW_MISSING`). In CI a skip that names no tier fails too: no test is
+    left out without saying so."""
+    if not in_ci():
+        return None
+    tier = skip_tier(reason)
+    if tier is not None and tier in allowed_missing():
+        return None
+    if tier is None:
+        return f"skipped in CI: {reason}. CI (CI is set) runs every test; only a missing tier may be allowed ({ALLOW_MISSING}; tiers: {', '.join(TIERS)})."
+    return (
+        f"skipped in CI: {reason}. Tier {tier!r} needs {TIERS[tier]}: provide it (./bootstrap.sh test on a machine set up as README.md says), "
+        f"or let it be absent with {ALLOW_MISSING}={tier} (comma-separated; tiers: {', '.join(TIERS)})."
+    )
+
+
+def _skip_reason(longrepr: Any) -> str:
+    if isinstance(longrepr, tuple) and len(longrepr) == 3:
+        return str(longrepr[2])
+    return str(longrepr)
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    allowed_missing()  # a wrong name in the variable stops the run at once, naming it
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Generator[None, Any, Any]:
+    report: Any = yield
+    if report.skipped and not hasattr(report, "wasxfail"):
+        failure = skip_failure(_skip_reason(report.longrepr))
+        if failure is not None:
+            report.outcome = "failed"
+            report.longrepr = failure
+    return report
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_make_collect_report(collector: pytest.Collector) -> Generator[None, Any, Any]:
+    report: Any = yield
+    if report.skipped:  # a module-level importorskip
+        failure = skip_failure(_skip_reason(report.longrepr))
+        if failure is not None:
+            report.outcome = "failed"
+            report.longrepr = failure
+    return report
+
+
+# -- one timeout per test, and every wait inside it bounded by what is left of it ------------------
+GUARD_MARGIN_S = 20.0
+"""Time a test's own waits leave before its pytest timeout, s: a hung wait then fails with the
+test's own message (the wait's timeout, naming what it waited for), and the teardown (stopping
+the processes it started, 10-60 s at most) runs, before pytest-timeout would kill the test."""
+
+_running: dict[str, Any] = {}
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Generator[None, Any, Any]:
+    _running.update(item=item, start=time.monotonic())
+    try:
+        return (yield)
+    finally:
+        _running.clear()
+
+
+def timeout_of(item: pytest.Item) -> float:
+    """A test's pytest timeout, s: its ``timeout`` marker (the one limit a long test declares),
+    else ``--timeout``, else pytest.ini's. It counts set-up (module fixtures made for the test
+    included), call and teardown."""
+    marker = item.get_closest_marker("timeout")
+    if marker is not None:
+        value = marker.args[0] if marker.args else marker.kwargs["timeout"]
+    else:
+        value = item.config.getoption("timeout", None) or item.config.getini("timeout")
+    return float(value)
+
+
+def time_left(margin_s: float = GUARD_MARGIN_S) -> float:
+    """Seconds the running test's waits may still take: its :func:`timeout_of` less the time it
+    has run (set-up included) and ``margin_s``; at least 1 s. Every hang guard inside a test is
+    this, so the test's timeout marker is the one number that bounds it. Where pytest's timeout
+    is off (0), a day.
+
+    Raises:
+        RuntimeError: called outside a running test.
+    """
+    if "item" not in _running:
+        raise RuntimeError("time_left() is for code that runs inside a test (its set-up, call or teardown)")
+    limit = timeout_of(_running["item"])
+    if limit <= 0.0:
+        return 86400.0
+    return max(1.0, limit - (time.monotonic() - _running["start"]) - margin_s)

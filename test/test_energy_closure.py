@@ -32,6 +32,21 @@ BEARING = CONFIG / "bearings" / "h7006c.yaml"
 CHUNK_S = 1e-3
 """Chunk and thermal interval, s: the network takes the engine's heat after every chunk."""
 
+BOOKING_GAP = 7.5e-4
+"""A loss the engine does not book as heat, as a fraction of the drive work: at a steady hold the
+drive power exceeds the dissipated power by 6.6e-5 (grease, 900 rpm / 100 N) to 6.7e-4 (oil-air,
+2700 rpm / 700 N), and a run-up with the cage whirling under 200 N radial closes to -7.3e-4; the
+same at steps of 40, 20 and 10 us, so it is not the step's error.
+:func:`test_at_a_steady_hold_the_drive_power_is_the_dissipated_power` states the law exactly
+and fails until the loss is found (strict: it says so when it passes)."""
+STEP_ERROR = 1e-4
+"""The account's dependence on the step, as a fraction of the drive work: halving the 40 us step
+(an independent reference: the same run, the contact state twice as fresh) moves the closure by
+at most 8.7e-5 (oil-air, 2700 rpm / 700 N) and a further halving by 3.2e-5 (first order)."""
+CLOSURE = BOOKING_GAP + STEP_ERROR
+"""Closure of a run-up and hold, relative to the drive work: the known gap plus the step's error
+(before: 1 %, 14 times the largest closure measured)."""
+
 
 def grease_twin() -> BearingParameters:
     """The shipped bench twin: H7006C with the calibrated running-in grease."""
@@ -73,25 +88,51 @@ def run_up_and_hold(
 @pytest.mark.parametrize(("rpm", "load"), [(900.0, 100.0), (2700.0, 700.0)])
 def test_drive_work_is_heat_plus_mechanical_energy(twin: object, rpm: float, load: float) -> None:
     """Run-up from rest at 500 rad/s^2 and a 0.5 s hold: drive work = heat + energy change within
-    1 %; the drive did work (the balls and cage gained energy and the network was heated)."""
+    :data:`CLOSURE`; the drive did work (the balls and cage gained energy and the network was
+    heated)."""
     assert callable(twin)
     work, heat, gained, engine = run_up_and_hold(twin(), rpm, load, 500.0, 0.5)
     assert work > 0.0 and heat > 0.0 and gained > 0.0
-    assert heat + gained == pytest.approx(work, rel=0.01), (work, heat, gained)
-    # at the hold the drive torque carries the whole friction torque
-    assert engine.drive_torque() == pytest.approx(engine.friction_torque(), rel=0.01)
+    assert heat + gained == pytest.approx(work, rel=CLOSURE), (work, heat, gained)
+    # at the hold the drive torque carries the whole friction torque (the same account per second)
+    assert engine.drive_torque() == pytest.approx(engine.friction_torque(), rel=CLOSURE)
+
+
+@pytest.mark.xfail(strict=True, reason="at a steady hold the drive power exceeds the dissipated power by 6.7e-4 of it, at any step (BOOKING_GAP)")
+def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power() -> None:
+    """Oil-air twin held at 2700 rpm / 700 N after its run-up: the bodies' energy no longer
+    changes, so over 0.2 s the drive's work is the heat, to rounding: each of the 5000 steps adds
+    its work and heat to sums of at most the total, and the energy is read twice (a relative
+    error of eps each, on the largest term)."""
+    params = oil_air_twin()
+    engine = BearingDynamics(params)
+    engine.initialise(0.0, 700.0)
+    target = rpm_to_rad_s(2700.0)
+    n_up = int(round(target / 500.0 / CHUNK_S))
+    for k in range(n_up + 100):
+        accel = 500.0 if k < n_up else 0.0
+        if k == n_up - 1:
+            accel = (target - engine.inner_ring_speed) / CHUNK_S
+        engine.advance(CHUNK_S, inner_ring_acceleration=accel)
+    e0, d0 = engine.energy(), engine.dissipated
+    steps = int(round(0.2 / engine.time_step))
+    work = sum(engine.advance(CHUNK_S).drive_work for _ in range(int(round(0.2 / CHUNK_S))))
+    heat, gained = engine.dissipated - d0, engine.energy() - e0
+    eps = float(np.finfo(float).eps)
+    assert abs(gained) < 1e-9 * work  # steady: the balls and cage hold their energy
+    assert abs(heat + gained - work) <= steps * eps * (work + heat) + 2 * eps * abs(e0), (work, heat, gained)
 
 
 def test_energy_closes_with_the_cage_whirling_under_a_radial_load() -> None:
     """Grease twin, 100 N axial and 200 N radial: the radial load pushes the cage centre off the
     axis and it whirls in its land clearance. Run-up to 900 rpm and a 0.3 s hold close within
-    1 % (measured -0.07 %). Before the land's work on the moving centre was heat and the stored
+    :data:`CLOSURE` (measured -0.073 %, at 20 and 10 us too). Before the land's work on the moving centre was heat and the stored
     energy moved the pockets' gaps by the centre's offset, the same run gave +2.4 %: the whirling
     centre's offset read as a pocket penetration of tens of micrometres."""
     params = grease_twin()
     work, heat, gained, engine = run_up_and_hold(params, 900.0, 100.0, 500.0, 0.3, radial=200.0)
     assert engine.cage_whirl_radius > 0.5 * params.land_clearance  # the centre moved
-    assert heat + gained == pytest.approx(work, rel=0.01), (work, heat, gained)
+    assert heat + gained == pytest.approx(work, rel=CLOSURE), (work, heat, gained)
 
 
 def test_the_lands_work_on_a_knocked_cage_centre_is_heat() -> None:

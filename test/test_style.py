@@ -8,12 +8,14 @@ import subprocess
 import sys
 from pathlib import Path
 
+from conftest import time_left
+
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
 
 
 def run(tool: str, *args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([str(BIN / tool), *args], cwd=ROOT, capture_output=True, text=True, timeout=600, check=False)
+    return subprocess.run([str(BIN / tool), *args], cwd=ROOT, capture_output=True, text=True, timeout=time_left(), check=False)
 
 
 def test_ruff_passes() -> None:

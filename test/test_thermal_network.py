@@ -99,7 +99,7 @@ def test_lubricant_follows_the_walther_law_and_the_grease_softens() -> None:
 
 def test_heat_split_adds_up_to_the_engine_power_and_energy_closes_while_running() -> None:
     """The split (contacts, drag, land, rest) sums to the engine's power loss; coupled to a
-    running engine for 1 s at 2700 rpm the network's heat in = stored + out within 1 %, and the
+    running engine for 1 s at 2700 rpm the network's heat in = stored + out to rounding, and the
     heat in is the sampled power over the time."""
     p = BearingParameters.from_yaml(BEARING, CONFIG / "calibration" / "h7006c_table3.yaml")
     engine = BearingDynamics(p)
@@ -118,7 +118,11 @@ def test_heat_split_adds_up_to_the_engine_power_and_energy_closes_while_running(
     net = coupling.network
     assert len(powers) == 10
     assert net.heat_in == pytest.approx(sum(powers) * 0.1, rel=1e-9)
-    assert abs(net.heat_in - net.stored_energy() - net.heat_out) < 0.01 * net.heat_in
+    # the step integrates its heat exactly (docs/thermal.md): what is left is rounding, each of the
+    # 10 steps rounding, node by node, sums whose largest terms are C_i T_i (the stored energy is
+    # a difference of such sums) and the heats in and out: eps of the largest, per node and step
+    largest = float(np.sum(net.capacity * np.maximum(np.abs(net.temperatures), np.abs(net.initial_temperatures)))) + net.heat_in + abs(net.heat_out)
+    assert abs(net.energy_residual()) <= len(powers) * len(net.names) * np.finfo(float).eps * largest, (net.energy_residual(), largest)
     assert net.temperature("balls") > net.temperature("housing") > ThermalConfig.from_yaml(BEARING).ambient
 
 

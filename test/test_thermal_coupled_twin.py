@@ -6,10 +6,14 @@ logged bench run recalibrates it.
   seconds (the bearing's own bodies: the network's fast time constants, 0.3-5 s; the housing's
   17-20 minutes barely starts), and the slip falls with it by what the engine's steady slip at
   the lubricant's temperature says (an independent steady solution at each end), within the
-  traction table's lag (its 5 K grid, docs/model.md) and the cage's settling: 0.05 pp.
+  traction table's lag (its 5 K grid, docs/model.md) and the cage's settling: 0.05 pp. Measured
+  when written: the lubricant 24.4 -> 30.0 degC between 0.3 and 5 s (the fast time constants
+  0.26-5.3 s, the housing +0.07 K), the slip 7.17 -> 6.96 %, the steady solutions 7.16 -> 6.95 %:
+  the warm-up's first seconds take 0.2 pp off; the rest of the way to the steady 5.29 % (lubricant
+  55.7 degC) follows the housing over an hour.
 * A bench run generated from known parameters (the coupled calibration with the consistency's
   temperature exponent x = 0.3, a settled reading at 2700 rpm with slip, outer-ring temperature
-  and torque) gives x back from a start at 0.6 within 0.05 (the thermal steady state is found
+  and torque) gives x back from a start at 0.5 within 0.05 (the thermal steady state is found
   to 0.2 K, which moves the slip by about 0.01 pp and the torque by 0.1 %).
 """
 
@@ -55,7 +59,7 @@ def test_a_held_speeds_slip_follows_the_lubricants_temperature() -> None:
     assert coupling.temperature("housing") - coupling.config.ambient < 0.2 * (t_end - coupling.config.ambient)
     params = BearingParameters.from_yaml(BEARING, cal)
     expected = [SteadySolver(params_at_temperature(params, t)).solve(OMEGA, 100.0).slip_pct for t in (t_start, t_end)]
-    assert expected[1] < expected[0]  # warmer grease: less resistance, less slip
+    assert expected[0] - expected[1] > 0.1  # warmer grease: less resistance, measurably less slip
     assert slip_start == pytest.approx(expected[0], abs=0.05)
     assert slip_end == pytest.approx(expected[1], abs=0.05)
     assert slip_start - slip_end == pytest.approx(expected[0] - expected[1], abs=0.05)
@@ -93,7 +97,7 @@ def test_a_synthetic_run_gives_back_the_exponent_it_was_made_with(tmp_path: Path
     write_run(rows, run_states(truth, cfg, rows), path)
     logged = read_bench_run(path)
     assert set(logged[0].measured()) == {"slip_pct", "outer_ring_temperature_c", "friction_torque_n_mm"}
-    start = with_values(params, {"consistency_temperature_exponent": 0.6})
+    start = with_values(params, {"consistency_temperature_exponent": 0.5})
     fit = fit_run(start, cfg, logged, ("consistency_temperature_exponent",))
     assert fit.fitted["consistency_temperature_exponent"] == pytest.approx(0.3, abs=0.05)
     assert fit.rms["slip_pct"] < 0.05 and fit.rms["outer_ring_temperature_c"] < 0.5

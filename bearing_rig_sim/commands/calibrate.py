@@ -3,7 +3,11 @@
 With ``--thermal`` every row is the coupled thermal steady state (the bearing file's
 ``thermal:`` section): the bench's slips are steady, warm values, and the fitted values are the
 grease's at the bearing file's lubricant temperature (the reference of its temperature laws).
-The shipped calibration is made so (docs/model.md, section Calibration)."""
+The shipped coupled calibration is made so (docs/thermal.md, "Named calibrations"), with
+``--fix consistency_temperature_exponent=0``. A bench run (a CSV adding ``hold_s``,
+``outer_ring_temperature_c``, ``friction_torque_n_mm``: :mod:`bearing_rig_sim.studies.bench_run`)
+is fitted with ``--thermal`` through every measured quantity at once (docs/thermal.md, "The bench
+run that settles the priors")."""
 
 from __future__ import annotations
 
@@ -38,7 +42,11 @@ from bearing_rig_sim.thermal.bearing import ThermalConfig
 def register(subparsers: Any) -> None:
     """Add ``calibrate`` to the ``bearing-rig`` parser."""
     p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
-    p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
+    p.add_argument(
+        "data",
+        type=Path,
+        help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct; or a bench run adding hold_s, outer_ring_temperature_c, friction_torque_n_mm (with --thermal)",
+    )
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
     p.add_argument("--model", choices=MODELS, default=None, help="start from a named model's files, uncalibrated (instead of --bearing)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")

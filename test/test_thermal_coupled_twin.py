@@ -101,3 +101,24 @@ def test_a_synthetic_run_gives_back_the_exponent_it_was_made_with(tmp_path: Path
     fit = fit_run(start, cfg, logged, ("consistency_temperature_exponent",))
     assert fit.fitted["consistency_temperature_exponent"] == pytest.approx(0.3, abs=0.05)
     assert fit.rms["slip_pct"] < 0.05 and fit.rms["outer_ring_temperature_c"] < 0.5
+
+
+@pytest.mark.slow
+def test_predict_by_default_is_the_coupled_twin_with_a_model_form_interval(capsys: pytest.CaptureFixture[str]) -> None:
+    """``predict`` without a calibration named: the coupled twin at its thermal steady state.
+    Between two bench rows (Table 3: 4.07 % at 1500 rpm, 4.64 % at 2100 rpm, 100 N) its slip
+    lies between theirs; its interval holds the parametric one, is widened by the unmeasured
+    inputs, and is at most 1.0 pp wide (the issue's bound)."""
+    import json
+
+    from bearing_rig_sim.cli import main
+
+    assert main(["predict", "--rpm", "1800", "--load", "100", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)
+    assert row["calibration"] == "h7006c_coupled.yaml" and row["model"] == "bench"
+    assert 4.07 < row["slip_pct"] < 4.64
+    assert row["slip_pct_low"] <= row["slip_pct_parametric_low"] < row["slip_pct"] < row["slip_pct_parametric_high"] <= row["slip_pct_high"]
+    assert row["slip_pct_high"] - row["slip_pct_low"] <= 1.0
+    assert row["model_form_pp"]["draws_kept"] > 0
+    # warm: the lubricant above the bearing file's 35 degC, the outer ring between it and ambient
+    assert 22.0 < row["outer_ring_temperature_c"] < row["lubricant_temperature_c"]

@@ -34,6 +34,7 @@ from bearing_rig_sim.studies.uncertainty import LOAD_SIGMA_N, check_identifiable
 from bearing_rig_sim.commands import output_file
 from bearing_rig_sim.config import ConfigError, check_number, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.calibrations import NAMED, calibration_file
 from bearing_rig_sim.dynamics.models import MODELS, PAPER, model_parameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.thermal.bearing import ThermalConfig
@@ -61,7 +62,7 @@ def register(subparsers: Any) -> None:
         "--out",
         type=Path,
         default=None,
-        help="calibration file to write (default: out/calibration/<data>.yaml; the shipped config/calibration/ files change only when named here)",
+        help="calibration file to write, or a named calibration (coupled, isothermal: its shipped file) (default: out/calibration/<data>.yaml; the shipped files change only when named here, with --force)",
     )
     p.add_argument("--force", action="store_true", help="replace the --out file if it exists")
     p.add_argument(
@@ -79,7 +80,8 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Calibrate, write the calibration file, print the RMS difference."""
     points = [] if is_run_file(args.data) else read_bench_csv(args.data)
-    out = output_file(args.out or Path("out") / "calibration" / f"{args.data.stem}.yaml", "--out", overwrite=args.force)
+    target = calibration_file(str(args.out)) if args.out is not None and str(args.out) in NAMED else args.out  # a named calibration's file
+    out = output_file(target or Path("out") / "calibration" / f"{args.data.stem}.yaml", "--out", overwrite=args.force)
     check_number(args.load_sigma, "command line", "--load-sigma", ge=0.0, le=1000.0)
     thermal = ThermalConfig.from_yaml(args.bearing) if args.thermal else None
     if args.model is not None and args.bearing is not None:

@@ -98,8 +98,13 @@ class RunState:
 
 
 def is_run_file(path: str | Path) -> bool:
-    """Whether a bench CSV has any column beyond the slip table's (a run, not Table 3)."""
-    for line in Path(path).read_text(encoding="utf-8").splitlines():
+    """Whether a bench CSV has any column beyond the slip table's (a run, not Table 3); False
+    for a file that cannot be read as text (the slip table's reader then names the problem)."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    for line in text.splitlines():
         if line.strip() and not line.lstrip().startswith("#"):
             names = [c.strip() for c in line.split(",")]
             return any(c in names for c in ("hold_s", "outer_ring_temperature_c", "friction_torque_n_mm"))
@@ -118,6 +123,8 @@ def read_bench_run(path: str | Path) -> list[RunRow]:
         lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
     except OSError as exc:
         raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
     reader = csv.DictReader(lines)
     names = [n.strip() for n in reader.fieldnames or ()]
     unknown = [n for n in names if n not in COLUMNS]

@@ -17,7 +17,7 @@ from bearing_rig_sim.studies.paper_data import PAPER_TABLE3
 
 
 def test_predict_prints_one_json_object_per_point(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["predict", "--rpm", "1200", "2400", "--load", "100", "--json"]) == 0
+    assert main(["predict", "--rpm", "1200", "2400", "--load", "100", "--calibration", "isothermal", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [r["rpm"] for r in rows] == [1200.0, 2400.0]
     assert set(rows[0]) == {

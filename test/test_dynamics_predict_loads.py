@@ -20,7 +20,7 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
     the tilt held with a reaction moment about the axis across the load (M_x > 0, M_y = 0), the
     cage pushed off the axis within its land clearance, and a slip other than the axial load's
     alone."""
-    assert main(["predict", "--rpm", "900", "--load", "163", "--radial-load", "500", "--json"]) == 0
+    assert main(["predict", "--rpm", "900", "--load", "163", "--radial-load", "500", "--calibration", "isothermal", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["ball_load_max_n"] == pytest.approx(4.37 * 500 / (16 * math.cos(math.radians(15.0))), rel=0.03)
     assert row["ball_load_min_n"] == 0.0
@@ -29,7 +29,7 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
     mx, my = row["reaction_moment_n_m"]
     assert mx > 0.0 and abs(my) < 1e-6
     assert 1.0 < row["cage_whirl_radius_um"] < 100.0  # the H7006C's land clearance: 100 um
-    assert main(["predict", "--rpm", "900", "--load", "163", "--json"]) == 0
+    assert main(["predict", "--rpm", "900", "--load", "163", "--calibration", "isothermal", "--json"]) == 0
     axial = json.loads(capsys.readouterr().out)
     assert abs(row["slip_pct"] - axial["slip_pct"]) > 0.1
 
@@ -37,14 +37,14 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
 def test_a_given_moment_tilts_the_ring_instead(capsys: pytest.CaptureFixture[str]) -> None:
     """With --moment the tilt is free and reported; no radial load and no moment: every ball
     alike (pure thrust), and the slip that of the axial load alone within 0.01 pp."""
-    assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--radial-load", "0", "--moment", "0", "0", "--json"]) == 0
+    assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--radial-load", "0", "--moment", "0", "0", "--calibration", "isothermal", "--json"]) == 0
     rows = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     for row in rows:
         assert row["loaded_balls"] == 16
         assert row["ball_load_min_n"] == pytest.approx(row["ball_load_max_n"], rel=0.05)  # outer carries F_c too
         assert max(abs(t) for t in row["tilt_mrad"]) < 1e-6
         assert "reaction_moment_n_m" not in row
-    assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--json"]) == 0
+    assert main(["predict", "--rpm", "900", "2700", "--load", "200", "--calibration", "isothermal", "--json"]) == 0
     axial = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     for row, plain in zip(rows, axial, strict=True):
         assert row["slip_pct"] == pytest.approx(plain["slip_pct"], abs=0.01)

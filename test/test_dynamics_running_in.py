@@ -130,7 +130,7 @@ def test_predict_at_zero_hours_gives_the_table_3_calibration(capsys: pytest.Capt
     """``--running-hours 0`` is the calibration's state: each Table 3 row's slip as the calibration
     file records it (to its 4 decimals, within 5e-4 pp)."""
     rows = yaml.safe_load(CALIBRATION.read_text())["calibration"]["rows"]
-    argv = ["predict", "--rpm", *[str(r["rpm"]) for r in rows], "--load", "100", "--running-hours", "0", "--json"]
+    argv = ["predict", "--rpm", *[str(r["rpm"]) for r in rows], "--load", "100", "--running-hours", "0", "--calibration", "isothermal", "--json"]
     assert main(argv) == 0
     out = [json.loads(line) for line in capsys.readouterr().out.splitlines()]
     assert [o["slip_pct"] for o in out] == pytest.approx([r["model_slip_pct"] for r in rows], abs=5e-4)

@@ -69,9 +69,9 @@ def test_predict_refuses_a_mounting_out_of_range(capsys: pytest.CaptureFixture[s
 def test_predicts_spring_preload_is_axial_load(capsys: pytest.CaptureFixture[str]) -> None:
     """A 60 N spring under a 140 N lever load is the bearing under 200 N: the same steady slip
     and torque; the row states the mounting and the external load."""
-    assert main(["predict", "--rpm", "2000", "--load", "200", "--json"]) == 0
+    assert main(["predict", "--rpm", "2000", "--load", "200", "--calibration", "isothermal", "--json"]) == 0
     plain = json.loads(capsys.readouterr().out)
-    assert main(["predict", "--rpm", "2000", "--load", "140", "--preload-n", "60", "--json"]) == 0
+    assert main(["predict", "--rpm", "2000", "--load", "140", "--preload-n", "60", "--calibration", "isothermal", "--json"]) == 0
     sprung = json.loads(capsys.readouterr().out)
     assert sprung["axial_load_n"] == 140.0 and sprung["preload_n"] == 60.0
     assert sprung["slip_pct"] == pytest.approx(plain["slip_pct"], abs=1e-3)

@@ -17,10 +17,19 @@ def shipped() -> dict:
 def test_the_shipped_file_is_valid_and_resolves_its_files():
     s = SimulatorSettings.from_yaml()
     assert s.bearing_file == config_path("bearings", "h7006c.yaml")
-    assert s.calibration_file == config_path("calibration", "h7006c_table3.yaml")
+    assert s.calibration_file == config_path("calibration", "h7006c_coupled.yaml")  # the named default, coupled
+    assert s.lubricant_feedback  # the coupled calibration runs with the lubricant following the network
     assert s.rig_file == config_path("rig.yaml")
     assert (s.chunk_s, s.realtime, s.speeds_rate_hz, s.truth_rate_hz) == (0.001, True, 1000.0, 100.0)
     assert shipped_parameters() == shipped()
+
+
+def test_a_calibration_is_named_or_a_file():
+    assert SimulatorSettings.from_values(shipped() | {"calibration_file": "isothermal"}).calibration_file == config_path("calibration", "h7006c_table3.yaml")
+    path = "calibration/h7006c_table3.yaml"
+    assert SimulatorSettings.from_values(shipped() | {"calibration_file": path}).calibration_file == config_path("calibration", "h7006c_table3.yaml")
+    with pytest.raises(ConfigError, match="calibration_file"):
+        SimulatorSettings.from_values(shipped() | {"calibration_file": "warm"})
 
 
 def test_integers_are_accepted_for_numbers_and_an_empty_calibration_means_none():

@@ -55,6 +55,7 @@ from typing import Any
 from bearing_rig_sim.config import check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
+from bearing_rig_sim.dynamics.calibrations import DEFAULT_CALIBRATION, calibration_file
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
@@ -77,7 +78,12 @@ def register(subparsers: Any) -> None:
     )
     p.add_argument("--model", choices=MODELS, default=None, help="named model: bench (the bench twin, default) or paper (the paper's own model; docs/paper.md)")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
-    p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: config/calibration/h7006c_table3.yaml)")
+    p.add_argument(
+        "--calibration",
+        type=str,
+        default=None,
+        help="named calibration (coupled, the default; isothermal) or a calibration file; a coupled one predicts at the thermal steady state",
+    )
     p.add_argument("--lubricant", type=Path, default=None, help="lubricant file replacing the bearing file's (config/lubricants/)")
     p.add_argument("--thermal", action="store_true", help="at the thermal steady state (torque, temperatures)")
     p.add_argument("--transient", type=float, default=None, metavar="S", help="warm-up from ambient over S seconds (one row per step)")
@@ -109,6 +115,10 @@ def mounting_of(args: argparse.Namespace) -> Mounting | None:
 def parameters_of(args: argparse.Namespace) -> BearingParameters:
     """The parameters the command line names: a named model (``--model``, with ``--calibration``
     in place of its own), else the bearing, calibration and lubricant files."""
+    if args.calibration is not None:
+        args.calibration = calibration_file(args.calibration)  # a name of the bench twin's calibrations, or a file
+    elif args.model in (None, BENCH) and args.bearing is None and args.lubricant is None:
+        args.calibration = calibration_file(DEFAULT_CALIBRATION)
     if args.model is None:
         return load_parameters(args.bearing, args.calibration, args.lubricant)
     if args.bearing is not None or args.lubricant is not None:
@@ -151,7 +161,7 @@ def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: P
     if bearing is not None and calibration is None:
         return BearingParameters.from_mapping(doc, source)
     if lubricant is None or calibration is not None:
-        calibration = calibration or config_path("calibration", "h7006c_table3.yaml")
+        calibration = calibration or calibration_file(DEFAULT_CALIBRATION)
         doc, source = overlay_calibration(doc, read_file(CalibrationFile, calibration)), f"{source} + {calibration}"
     return BearingParameters.from_mapping(doc, source)
 
@@ -175,6 +185,8 @@ def run(args: argparse.Namespace) -> int:
     if args.running_hours is not None:
         params = _after_running(params, args.running_hours)
     mounting = mounting_of(args)
+    if radial is None and mounting is None and _thermal_calibration(args):
+        args.thermal = True  # the coupled twin: its lubricant at the temperature its heat gives it
     if args.thermal or args.transient is not None:
         if mounting is not None:
             raise RigError("--clearance, --misalignment, --preload-n and --preload-displacement take the non-thermal path only (no --thermal, --transient)")
@@ -268,7 +280,16 @@ def _uncertainty(args: argparse.Namespace) -> Any:
         return None
     if args.model not in (None, BENCH) and args.calibration is None:
         return None  # the paper model reproduces a model: no bench uncertainty to state
-    return read_uncertainty(args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+    return read_uncertainty(args.calibration or calibration_file(DEFAULT_CALIBRATION))
+
+
+def _model_form(args: argparse.Namespace) -> Any:
+    """The calibration's model-form block (:class:`~bearing_rig_sim.studies.priors.ModelForm`),
+    or None."""
+    from bearing_rig_sim.studies.priors import ModelForm
+
+    block = read_file(CalibrationFile, args.calibration or calibration_file(DEFAULT_CALIBRATION)).uncertainty or {}
+    return ModelForm.from_dict(block["model_form"]) if "model_form" in block else None
 
 
 def _thermal_calibration(args: argparse.Namespace) -> bool:
@@ -278,18 +299,45 @@ def _thermal_calibration(args: argparse.Namespace) -> bool:
         return False
     if args.model not in (None, BENCH) and args.calibration is None:
         return False
-    return read_file(CalibrationFile, args.calibration or config_path("calibration", "h7006c_table3.yaml")).calibration.thermal
+    return read_file(CalibrationFile, args.calibration or calibration_file(DEFAULT_CALIBRATION)).calibration.thermal
 
 
-def _add_interval(row: dict[str, Any], params: BearingParameters, unc: Any, omega: float, load: float, slip: float, thermal: Any = None) -> None:
+def _add_interval(
+    row: dict[str, Any],
+    params: BearingParameters,
+    unc: Any,
+    omega: float,
+    load: float,
+    slip: float,
+    thermal: Any = None,
+    form: Any = None,
+    reference: BearingParameters | None = None,
+) -> None:
     """``slip_pct_low`` / ``slip_pct_high``: the 95 % interval from the parameter and load
     uncertainty (:func:`bearing_rig_sim.studies.uncertainty.slip_interval`; with ``thermal``,
-    through the coupled thermal steady state)."""
-    from bearing_rig_sim.studies.uncertainty import slip_interval
+    through the coupled thermal steady state); with the calibration's ``form``
+    (:class:`~bearing_rig_sim.studies.priors.ModelForm`), widened on each side in quadrature by
+    the spread of the refitted twin over its unmeasured inputs (:mod:`bearing_rig_sim.studies.priors`,
+    at the point with ``reference``, the calibration's parameters, and the thermal data
+    ``thermal``; the gradients are then ``params``' at the steady temperature;
+    ``slip_pct_parametric_low`` / ``_high`` and ``model_form_pp`` state the parts)."""
+    from bearing_rig_sim.studies.priors import point_effects, spread, widen
+    from bearing_rig_sim.studies.uncertainty import Z95, parametric_sd, slip_gradients
 
-    low, high, _ = slip_interval(params, unc, omega, load, slip, thermal)
+    g_theta, g_load = slip_gradients(params, unc, omega, load, slip, thermal if form is None else None)
+    sd = parametric_sd(unc, g_theta, g_load)
+    if form is None or reference is None:
+        row["slip_pct_low"] = round(slip - Z95 * sd, 4)
+        row["slip_pct_high"] = round(slip + Z95 * sd, 4)
+        return
+    effects = point_effects(reference, thermal, omega, load)
+    lo_shift, hi_shift, kept = spread(effects.effects, form, g_theta)
+    low, high = widen(slip, sd, lo_shift, hi_shift)
     row["slip_pct_low"] = round(low, 4)
     row["slip_pct_high"] = round(high, 4)
+    row["slip_pct_parametric_low"] = round(slip - Z95 * sd, 4)
+    row["slip_pct_parametric_high"] = round(slip + Z95 * sd, 4)
+    row["model_form_pp"] = {"low": round(lo_shift, 4), "high": round(hi_shift, 4), "draws_kept": kept, "short_hold_lubricant_c": round(effects.short_hold_temperature_c, 2)}
 
 
 def _print(row: dict[str, Any], as_json: bool) -> None:
@@ -355,7 +403,13 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
         row["thermal_residual_k"] = round(ts.residual_k, 3)
         unc = None if combined else _uncertainty(args)  # the calibration's interval is an axial-load one
         if unc is not None:
-            if _thermal_calibration(args):
+            form = _model_form(args) if _thermal_calibration(args) else None
+            if form is not None:
+                # the coupled twin: its unmeasured inputs widen the interval (model form); the
+                # parameters' gradients are taken at the steady temperature
+                warm = params_at_temperature(params, ts.temperatures["lubricant"])
+                _add_interval(row, warm, unc, omega, f, pt.slip_pct, cfg, form, reference=params)
+            elif _thermal_calibration(args):
                 # fitted through the thermal steady states: so are the interval's gradients
                 _add_interval(row, params, unc, omega, f, pt.slip_pct, cfg)
             else:
@@ -367,6 +421,9 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
             iso = steady_states(params, [(omega, f)], workers=1)[0]
             iso_slip, iso_torque = iso.slip_pct, iso.friction_torque
         row["isothermal"] = {"temperature_c": params.lubricant_temperature, "slip_pct": round(iso_slip, 4), "friction_torque_nm": round(iso_torque, 6)}
+        row["model"] = args.model or DEFAULT_MODEL
+        if args.calibration is not None:
+            row["calibration"] = Path(args.calibration).name
         if radial is not None:
             row.update(load_distribution_row(params, omega, f, f_r, args.moment))
         _print(row, args.json)

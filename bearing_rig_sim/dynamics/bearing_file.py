@@ -50,6 +50,7 @@ LUBRICANT_OVERRIDES = {
     "consistency_pa_sn": "consistency",
     "fill_fraction": "fill_fraction",
     "eyring_stress_pa": "eyring_stress",
+    "consistency_temperature_exponent": "consistency_temperature_exponent",
 }
 """Keys of the bearing file's ``lubricant:`` section that override the lubricant file (a
 calibration sets them): key -> :class:`~.lubrication.Lubricant` field."""
@@ -66,6 +67,7 @@ CALIBRATABLE: dict[str, tuple[str, str]] = {
     "consistency": ("lubricant", "consistency_pa_sn"),
     "fill_fraction": ("lubricant", "fill_fraction"),
     "eyring_stress": ("lubricant", "eyring_stress_pa"),
+    "consistency_temperature_exponent": ("lubricant", "consistency_temperature_exponent"),
     "ball_set_resistance": ("resistances", "ball_set_resistance_n"),
     "ball_set_resistance_speed_exponent": ("resistances", "ball_set_resistance_speed_exponent"),
 }
@@ -225,6 +227,9 @@ class BearingLubricant(FileSection):
     consistency_pa_sn: Number | None = quantity("grease consistency override", unit="Pa s^n", source="sheared NLGI 1-3 greases", ge=0.0, le=1e3, default=None)
     fill_fraction: Number | None = quantity("fill fraction override", unit="1", source="a fraction", ge=0.0, le=1.0, default=None)
     eyring_stress_pa: Number | None = quantity("Eyring stress override", unit="Pa", source="EHL films of mineral and ester oils", ge=1e5, le=5e7, default=None)
+    consistency_temperature_exponent: Number | None = quantity(
+        "grease consistency's temperature exponent override", unit="1", source="between the thickener alone (0) and the base oil (1)", ge=0.0, le=1.0, default=None
+    )
 
     @model_validator(mode="after")
     def _inline_oil_complete(self) -> Self:
@@ -434,6 +439,9 @@ class Grease(FileSection):
     flow_index: Number = quantity("flow index n (shear thinning below 1)", unit="1", source="rheometer data of NLGI 1-3 greases", gt=0.0, le=1.0)
     yield_stress_temperature_coefficient_1_k: Number = quantity(
         "c of tau_y(T) = tau_y(T_ref) exp(-c (T - T_ref))", unit="1/K", source="lithium greases between 25 and 75 degC", ge=0.0, le=0.05, default=0.0
+    )
+    consistency_temperature_exponent: Number = quantity(
+        "x of K(T) = K(T_ref) (eta(T) / eta(T_ref))^x", unit="1", source="between the thickener alone (0) and the base oil (1)", ge=0.0, le=1.0, default=1.0
     )
 
 

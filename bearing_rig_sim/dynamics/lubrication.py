@@ -62,6 +62,9 @@ class Lubricant:
         specific_heat: of the lubricant (grease or oil), J/(kg K).
         yield_stress_temperature_coefficient: c of tau_y(T) = tau_y(T_ref) exp(-c (T - T_ref)),
             1/K (grease; :meth:`at_temperature`).
+        consistency_temperature_exponent: x of K(T) = K(T_ref) (eta(T) / eta(T_ref))^x, 1
+            (grease; 1: the consistency follows the base oil's viscosity, 0: the thickener's
+            alone; :meth:`at_temperature`).
         source: file name.
     """
 
@@ -84,6 +87,7 @@ class Lubricant:
     source: str = "<memory>"
     specific_heat: float = 1900.0
     yield_stress_temperature_coefficient: float = 0.0
+    consistency_temperature_exponent: float = 1.0
 
     @classmethod
     def from_yaml(cls, path: str | Path) -> Lubricant:
@@ -121,6 +125,7 @@ class Lubricant:
             yield_stress_temperature_coefficient=(
                 grease.yield_stress_temperature_coefficient_1_k if grease is not None and doc.lubricant.kind == "grease" else 0.0
             ),
+            consistency_temperature_exponent=grease.consistency_temperature_exponent if grease is not None and doc.lubricant.kind == "grease" else 1.0,
         )
 
     # -- base-oil properties at temperature ---------------------------------------------------
@@ -158,14 +163,15 @@ class Lubricant:
 
     def at_temperature(self, temperature_c: float, reference_c: float) -> Lubricant:
         """The grease's bulk rheology at ``temperature_c`` given its values at ``reference_c``
-        (degC): the consistency K follows the base oil's dynamic viscosity,
-        K(T) = K(T_ref) eta(T) / eta(T_ref) (the sheared grease's plastic viscosity scales with
-        its base oil's), and the yield stress falls as tau_y(T_ref) exp(-c (T - T_ref)) with c
+        (degC): the consistency K follows the base oil's dynamic viscosity to the power x
+        (:attr:`consistency_temperature_exponent`), K(T) = K(T_ref) (eta(T) / eta(T_ref))^x (x = 1:
+        the sheared grease's plastic viscosity scales with its base oil's; x = 0: the thickener
+        sets it alone; neither is measured for this grease), and the yield stress falls as tau_y(T_ref) exp(-c (T - T_ref)) with c
         :attr:`yield_stress_temperature_coefficient`. An oil is returned unchanged (its viscosity
         is a function of temperature already)."""
         if self.kind != "grease" or temperature_c == reference_c:
             return self
-        ratio = self.dynamic_viscosity(temperature_c) / self.dynamic_viscosity(reference_c)
+        ratio = (self.dynamic_viscosity(temperature_c) / self.dynamic_viscosity(reference_c)) ** self.consistency_temperature_exponent
         shift = math.exp(-self.yield_stress_temperature_coefficient * (temperature_c - reference_c))
         return dataclasses.replace(self, consistency=self.consistency * ratio, yield_stress=self.yield_stress * shift)
 

@@ -61,7 +61,9 @@ class SimulatorSettings(NodeSettings):
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     bearing_file: ConfigFile = param("bearing data file (absolute, or relative to the package's config/)")
-    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = none; relative to config/)")
+    calibration_file: OptionalConfigFile = param(
+        "calibration laid over the bearing data: a name of the bench twin's (coupled, isothermal), a file relative to config/, or '' for none"
+    )
     rig_file: ConfigFile = param("rig data file: sensors (strip counts, jitter, drop probability) and loading chain")
     model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
     bearing_model: Annotated[str, one_of(BEARING_MODELS)] = param(
@@ -91,6 +93,14 @@ class SimulatorSettings(NodeSettings):
     fault_hold_s: Number = param(f"a refused command or force keeps {DIAGNOSTICS.name} at ERROR this long (wall clock)", unit="s", ge=0.0, le=600.0)
 
     _spindle: SpindleConfig = PrivateAttr()
+
+    @field_validator("calibration_file", mode="before")
+    @classmethod
+    def _named_calibration(cls, value: object) -> object:
+        """A calibration's name (:data:`~bearing_rig_sim.dynamics.calibrations.NAMED`) as its file."""
+        from bearing_rig_sim.dynamics.calibrations import NAMED
+
+        return f"calibration/{NAMED[value]}" if isinstance(value, str) and value in NAMED else value
 
     @field_validator("initial_speed_rad_s")
     @classmethod

@@ -64,6 +64,9 @@ PHYSICAL_RANGES: dict[str, PhysicalRange] = {
     "consistency": PhysicalRange("Pa s^n", 1.0, 100.0, "Herschel-Bulkley consistency of NLGI 1-3 lithium greases (flow index 0.3-0.7)"),
     "fill_fraction": PhysicalRange("1", 0.02, 1.0, "share of the swept volume holding grease: channelled 0.02-0.1, running-in up to 1"),
     "eyring_stress": PhysicalRange("Pa", 2e6, 1e7, "Eyring stress of mineral and ester base oils (Johnson and Tevaarwerk 1977)"),
+    "consistency_temperature_exponent": PhysicalRange(
+        "1", 0.0, 1.0, "x of K(T) = K(T_ref) (eta(T)/eta(T_ref))^x: between the thickener alone (0) and the base oil's viscosity (1)"
+    ),
     "ball_set_resistance": PhysicalRange(
         "N", 0.01, 2.0, "paper model: below 2 mu_s Q_ref = 2 N, the largest traction a ball's two contacts carry at the reference load of 10 N"
     ),
@@ -234,7 +237,7 @@ def _collect(results: Iterable[SteadyState], total: int, progress: Callable[[int
     return out
 
 
-LUBRICANT_FIELDS = ("yield_stress", "consistency", "fill_fraction", "eyring_stress")
+LUBRICANT_FIELDS = ("yield_stress", "consistency", "fill_fraction", "eyring_stress", "consistency_temperature_exponent")
 """Calibratable names that are properties of the bearing's lubricant."""
 
 
@@ -342,10 +345,9 @@ PAPER_HEADER = (
 """Header of the paper model's calibration file."""
 
 
-def write_calibration(result: CalibrationResult, path: str | Path, data_name: str, header: str | None = None) -> None:
-    """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``: each
-    fitted value as ``{value, unit, range, source}``; ``header`` replaces the bench
-    calibration's comment lines."""
+def calibration_entries(values: dict[str, float], data_name: str) -> dict[str, object]:
+    """A calibration file's ``parameters:``: ``section.key`` -> ``{value, unit, range, source}``
+    (a plain number for a parameter without a physical range)."""
 
     def entry(name: str, value: float) -> object:
         rng = PHYSICAL_RANGES.get(name)
@@ -353,8 +355,16 @@ def write_calibration(result: CalibrationResult, path: str | Path, data_name: st
             return float(f"{value:.6g}")
         return {"value": float(f"{value:.6g}"), "unit": rng.unit, "range": [rng.low, rng.high], "source": f"fitted to {data_name}; range: {rng.reason}"}
 
+    return {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": entry(k, v) for k, v in values.items()}
+
+
+def write_calibration(result: CalibrationResult, path: str | Path, data_name: str, header: str | None = None) -> None:
+    """Write a calibration file readable by ``BearingParameters.from_yaml(bearing, path)``: each
+    fitted value as ``{value, unit, range, source}``; ``header`` replaces the bench
+    calibration's comment lines."""
+
     names = {**result.fixed, **result.fitted}
-    params = {f"{CALIBRATABLE[k][0]}.{CALIBRATABLE[k][1]}": entry(k, v) for k, v in names.items()}
+    params = calibration_entries(names, data_name)
     doc = {
         "calibration": {
             "data": data_name,

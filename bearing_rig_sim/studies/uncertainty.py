@@ -77,6 +77,8 @@ class FitUncertainty:
         condition_number: of the column-scaled Jacobian, 1.
         noise_covariance: C_noise of the log-parameters.
         load_sensitivity: dtheta/ddelta of the log-parameters, 1/N.
+        jacobian: J_theta at the rows, d slip / d log-parameter, pp (n x p; empty when not
+            stored): the fit's refit to a change of its rows (:mod:`.priors`).
     """
 
     names: tuple[str, ...]
@@ -91,6 +93,7 @@ class FitUncertainty:
     condition_number: float
     noise_covariance: tuple[tuple[float, ...], ...]
     load_sensitivity: tuple[float, ...]
+    jacobian: tuple[tuple[float, ...], ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         """For the calibration file and ``--json`` (plain floats)."""
@@ -106,6 +109,7 @@ class FitUncertainty:
             "condition_number": r(self.condition_number),
             "log_noise_covariance": [[r(c) for c in row] for row in self.noise_covariance],
             "log_load_sensitivity_1_n": [r(c) for c in self.load_sensitivity],
+            **({"row_jacobian_pp": [[r(c) for c in row] for row in self.jacobian]} if self.jacobian else {}),
         }
 
     @classmethod
@@ -126,6 +130,7 @@ class FitUncertainty:
             condition_number=float(doc["condition_number"]),
             noise_covariance=tup(doc["log_noise_covariance"]),
             load_sensitivity=tuple(float(c) for c in doc["log_load_sensitivity_1_n"]),
+            jacobian=tup(doc.get("row_jacobian_pp", ())),
         )
 
 
@@ -227,6 +232,7 @@ def fit_uncertainty(
         condition_number=float(lin["condition"]),
         noise_covariance=tup(lin["noise_cov"]),
         load_sensitivity=tuple(float(c) for c in lin["dtheta_dload"]),
+        jacobian=tup(j_theta),
     )
 
 
@@ -234,6 +240,28 @@ def read_uncertainty(calibration_file: str | Path) -> FitUncertainty | None:
     """The ``uncertainty:`` block of a calibration file, or None."""
     block = read_file(CalibrationFile, calibration_file).uncertainty
     return FitUncertainty.from_dict(block) if block is not None else None
+
+
+def slip_gradients(
+    params: BearingParameters, unc: FitUncertainty, inner_ring_speed: float, axial_load: float, slip_pct: float, thermal: ThermalConfig | None = None
+) -> tuple[np.ndarray, float]:
+    """The prediction's gradients at one point: d slip / d log-parameter (pp) and d slip / d load
+    (pp/N), finite differences of the steady states (with ``thermal``, the coupled ones)."""
+    from bearing_rig_sim.studies.calibration import current_value
+
+    rows = [(inner_ring_speed, axial_load)]
+    here = [current_value(params, n) for n in unc.names]  # the calibration's, or moved to a temperature
+    g_theta = np.array([(_slips(_shifted(params, unc.names, here, k), rows, thermal)[0] - slip_pct) / LOG_STEP for k in range(len(unc.names))])
+    g_load = (_slips(params, [(inner_ring_speed, axial_load + LOAD_STEP_N)], thermal)[0] - slip_pct) / LOAD_STEP_N
+    return g_theta, float(g_load)
+
+
+def parametric_sd(unc: FitUncertainty, g_theta: np.ndarray, g_load: float) -> float:
+    """Standard deviation of a prediction from the parameter and load uncertainty (module doc)."""
+    cov = np.array(unc.noise_covariance)
+    through_fit = float(g_theta @ np.array(unc.load_sensitivity)) + g_load
+    var = float(g_theta @ cov @ g_theta) + (through_fit * unc.load_sigma_n) ** 2
+    return math.sqrt(max(var, 0.0))
 
 
 def slip_interval(
@@ -244,14 +272,6 @@ def slip_interval(
     values moved to another lubricant temperature); ``slip_pct`` is their slip there. With
     ``thermal`` the gradients are those of the coupled thermal steady state (``params`` then
     carry the calibration's values at its reference temperature)."""
-    from bearing_rig_sim.studies.calibration import current_value
-
-    rows = [(inner_ring_speed, axial_load)]
-    here = [current_value(params, n) for n in unc.names]  # the calibration's, or moved to a temperature
-    g_theta = np.array([(_slips(_shifted(params, unc.names, here, k), rows, thermal)[0] - slip_pct) / LOG_STEP for k in range(len(unc.names))])
-    g_load = (_slips(params, [(inner_ring_speed, axial_load + LOAD_STEP_N)], thermal)[0] - slip_pct) / LOAD_STEP_N
-    cov = np.array(unc.noise_covariance)
-    through_fit = float(g_theta @ np.array(unc.load_sensitivity)) + g_load
-    var = float(g_theta @ cov @ g_theta) + (through_fit * unc.load_sigma_n) ** 2
-    sd = math.sqrt(max(var, 0.0))
+    g_theta, g_load = slip_gradients(params, unc, inner_ring_speed, axial_load, slip_pct, thermal)
+    sd = parametric_sd(unc, g_theta, g_load)
     return slip_pct - Z95 * sd, slip_pct + Z95 * sd, sd

@@ -18,6 +18,7 @@ and its compiled kernels are loaded once per worker process.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -39,12 +40,15 @@ from bearing_rig_sim.dynamics.steady import (
 )
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.sweep.spec import ACCELERATION_AXIS, AXES, LOAD_AXIS, MOMENT_AXIS, RADIAL_AXIS, SPEED_AXIS
 
 KIND_ROLLING_START = ORIGIN_ROLLING_START
 KIND_CONTINUATION = ORIGIN_CONTINUATION
 KIND_TRANSIENT = "transient"
 
+THERMAL_PREFIX = "thermal."
+"""Axes whose parameter starts so set a field of the bearing's thermal data (:class:`ThermalConfig`)."""
 LUBRICANT_PREFIX = "lubricant."
 """Axes whose parameter starts so set a rheology field of the bearing's lubricant file."""
 
@@ -76,6 +80,8 @@ COLUMNS: dict[str, str] = {
     "cage_whirl_frequency_hz": "float64",
     "cage_whirl_ratio": "float64",
     "cage_whirl_reason": "string",
+    "lubricant_temperature_c": "float64",
+    "outer_ring_temperature_c": "float64",
     "error": "string",
 }
 """Result columns (besides one float64 column per axis) and their Arrow types. ``branch`` is
@@ -108,6 +114,8 @@ class SweepTask:
             its missing points are returned).
         method: :data:`SOLVE` or :data:`INTEGRATE`.
         transient_duration: s, for transient points.
+        thermal: the bearing's thermal data: each steady point is the coupled thermal steady
+            state (``thermal.*`` axes change these data), None: isothermal.
     """
 
     task_id: str
@@ -118,6 +126,7 @@ class SweepTask:
     wanted: frozenset[str]
     method: str = SOLVE
     transient_duration: float = 3.0
+    thermal: ThermalConfig | None = None
 
 
 def point_key(point: dict[str, float], branch: str) -> str:
@@ -132,12 +141,20 @@ def parameters_for(base: BearingParameters, point: dict[str, float]) -> BearingP
     rheology: dict[str, float] = {}
     for name, value in point.items():
         field = AXES[name].parameter
+        if field is not None and field.startswith(THERMAL_PREFIX):
+            continue  # the thermal data's (thermal_for)
         if field is not None and field.startswith(LUBRICANT_PREFIX):
             rheology[field[len(LUBRICANT_PREFIX) :]] = value
         elif field is not None:
             changes[field] = value
     params = base.replace(**changes) if changes else base
     return params.with_lubricant(**rheology) if rheology else params
+
+
+def thermal_for(base: ThermalConfig, point: dict[str, float]) -> ThermalConfig:
+    """``base`` with the point's thermal axes applied."""
+    changes: dict[str, Any] = {f[len(THERMAL_PREFIX) :]: v for n, v in point.items() if (f := AXES[n].parameter) is not None and f.startswith(THERMAL_PREFIX)}
+    return dataclasses.replace(base, **changes) if changes else base
 
 
 def evaluate(task: SweepTask) -> list[dict[str, Any]]:
@@ -173,6 +190,8 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
         "cage_whirl_frequency_hz": math.nan,
         "cage_whirl_ratio": math.nan,
         "cage_whirl_reason": "",
+        "lubricant_temperature_c": math.nan,
+        "outer_ring_temperature_c": math.nan,
         "error": "",
     }
     row.update({k: float(v) for k, v in point.items()})
@@ -210,6 +229,12 @@ def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str,
         solver = solver_for(parameters_for(task.params, point))
         omega = rpm_to_rad_s(point[SPEED_AXIS])
         combined = combined_load(point)
+        if task.thermal is not None and combined is None:
+            from bearing_rig_sim.thermal.coupling import thermal_steady_state
+
+            ts = thermal_steady_state(solver.params, thermal_for(task.thermal, point), omega, point[LOAD_AXIS])
+            row.update(lubricant_temperature_c=ts.temperatures["lubricant"], outer_ring_temperature_c=ts.temperatures["outer_ring"])
+            return _fill(row, ts.point)
         if combined is not None and (combined[0] > 0.0 or combined[1] is not None):
             # periodic at the ball-pass frequency: integrated and averaged over whole periods (either method)
             result = solver.periodic(omega, point[LOAD_AXIS], combined[0], moment=combined[1])

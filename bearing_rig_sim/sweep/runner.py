@@ -24,6 +24,8 @@ from bearing_rig_sim import __version__
 from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.calibrations import NAMED, calibration_file
+from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.executors import open_client
 from bearing_rig_sim.sweep.points import (
@@ -84,6 +86,8 @@ def base_parameters(spec: SweepSpec) -> BearingParameters:
         calibration: str | Path | None = None
     elif spec.calibration == "shipped":
         calibration = config_path("calibration", "h7006c_table3.yaml")
+    elif spec.calibration in NAMED:
+        calibration = calibration_file(spec.calibration)
     else:
         calibration = Path(spec.calibration)
     return BearingParameters.from_yaml(spec.bearing, calibration)
@@ -97,6 +101,8 @@ def run_context(spec: SweepSpec, params: BearingParameters, method: str) -> dict
     sources = hashlib.sha256(b"".join((here / f).read_bytes() for f in ("kernels.py", "engine.py", "steady.py"))).hexdigest()
     fields = {k: v for k, v in dataclasses.asdict(params).items() if k != "source"}
     key_doc = {"params": fields, "method": method, "version": __version__, "sources": sources, "transient_s": spec.transient_duration}
+    if spec.thermal:
+        key_doc["thermal"] = dataclasses.asdict(ThermalConfig.from_yaml(spec.bearing))
     return {
         "context_key": hashlib.sha256(json.dumps(key_doc, sort_keys=True, default=str).encode()).hexdigest()[:16],
         "sweep": spec.name,
@@ -135,6 +141,7 @@ def plan_tasks(spec: SweepSpec, params: BearingParameters, done: set[str], metho
                 tuple(k for _, k in chunk),
                 frozenset(k for _, k in chunk),
                 method,
+                thermal=ThermalConfig.from_yaml(spec.bearing) if spec.thermal else None,
             )
         )
     if spec.continuation and method == SOLVE:

@@ -88,6 +88,11 @@ AXES: dict[str, AxisDefinition] = {
         AxisDefinition("consistency_pa_sn", "lubricant.consistency", 0.0, 1e4, "Herschel-Bulkley consistency of the grease, Pa s^n"),
         AxisDefinition("fill_fraction", "lubricant.fill_fraction", 0.0, 1.0, "share of the swept volume holding grease, 1"),
         AxisDefinition("eyring_stress_pa", "lubricant.eyring_stress", 1e5, 1e9, "Eyring stress of the base oil, Pa"),
+        AxisDefinition(
+            "consistency_temperature_exponent", "lubricant.consistency_temperature_exponent", 0.0, 1.0, "x of the grease's K(T) = K_ref (eta/eta_ref)^x, 1"
+        ),
+        # thermal data (a spec with thermal: true)
+        AxisDefinition("frame_conductance_w_k", "thermal.frame_conductance", 0.0, 5.0, "the housing's conduction to the bench frame, W/K"),
         # geometry tolerances
         AxisDefinition("ball_diameter_m", "ball_diameter", 1e-4, 0.1, "ball diameter Dw, m"),
         AxisDefinition("inner_groove_curvature_ratio", "inner_curvature_ratio", 0.5001, 0.5999, "inner groove radius / Dw, 1"),
@@ -127,6 +132,8 @@ class SweepSpec:
         minimum_load_factor_kn: SKF minimum axial load factor A, kN (F_am = A (n/1000)^2).
         document: the parsed spec (canonical form of its inputs), for the spec hash.
         model: the named bearing model (:data:`~bearing_rig_sim.config.BEARING_MODELS`).
+        thermal: each steady point is the coupled thermal steady state (the bearing file's
+            ``thermal:`` section; axes ``thermal.*`` change its data).
     """
 
     name: str
@@ -141,6 +148,7 @@ class SweepSpec:
     minimum_load_factor_kn: float
     document: dict[str, Any] = field(repr=False)
     model: str = "bench"
+    thermal: bool = False
 
     @property
     def transient(self) -> bool:
@@ -272,7 +280,10 @@ class SweepHead(FileSection):
     description: Text | None = Field(None, description="what the sweep is for")
     model: Annotated[str, one_of(BEARING_MODELS)] = Field("bench", description="the named bearing model: bench (the bench twin) or paper (the paper's own model)")
     bearing: Text | None = Field(None, description="bearing file (absent: the shipped H7006C; bench model only)")
-    calibration: Text = Field("shipped", description="shipped (the model's own), none or a calibration file")
+    calibration: Text = Field(
+        "shipped", description="shipped (the model's own; the bench twin's isothermal one), none, a named calibration (coupled, isothermal) or a file"
+    )
+    thermal: Flag = Field(False, description="each steady point at the coupled thermal steady state")
     continuation: Flag = Field(False, description="also follow each load row upwards from its lowest load")
     transient_duration_s: Number = quantity(
         "simulated duration of a transient (acceleration) point", unit="s", source="run-ups of the paper's rig last seconds", gt=0.0, le=60.0, default=3.0
@@ -306,6 +317,10 @@ class SweepFile(FileSection):
             raise field_error("grid", f"must include {LOAD_AXIS} (in grid or samples)")
         if (SPEED_AXIS in names) == (ACCELERATION_AXIS in names):
             raise field_error("grid", f"must include exactly one of {SPEED_AXIS} (steady points) and {ACCELERATION_AXIS} (transient points)")
+        for key in names:
+            parameter = AXES[key].parameter
+            if parameter is not None and parameter.startswith("thermal.") and (not self.sweep.thermal or ACCELERATION_AXIS in names):
+                raise field_error(key, "changes the thermal data: needs sweep.thermal true and steady points")
         return self
 
 
@@ -323,10 +338,11 @@ def spec_from_mapping(data: Mapping[str, Any], source: str) -> SweepSpec:
         "transient_duration_s": head.transient_duration_s,
         "grid": {k: list(v) for k, v in doc.grid.items()},
         "samples": [dict(s) for s in samples],
+        **({"thermal": True} if head.thermal else {}),
     }
     return SweepSpec(
         head.name, source, dict(doc.grid), samples, head.bearing, head.calibration, head.continuation, head.transient_duration_s,
-        view.skid_slip_pct, view.minimum_load_factor_kn, document, head.model,
+        view.skid_slip_pct, view.minimum_load_factor_kn, document, head.model, head.thermal,
     )  # fmt: skip
 
 

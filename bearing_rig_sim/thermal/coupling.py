@@ -584,13 +584,17 @@ def thermal_steady_state(
     max_iter: int = 10,
     radial_load: float = 0.0,
     moment: tuple[float, float] | None = None,
+    heat: HeatAtTemperature | None = None,
+    start_c: float | None = None,
 ) -> ThermalSteadyState:
     """The steady state where the dissipation at the lubricant temperature T heats the network to
     T: the root of g(T) = T_lub,ss(heat(T)) - T by secant steps from the bearing file's
     temperature (g falls with T: warmer lubricant, less heat). With ``radial_load`` (N) or
     ``moment`` (N m, tilts free) the engine's steady state is the periodic one under the
-    combined load; the network's conductances stay those of the axial load."""
-    heat = HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
+    combined load; the network's conductances stay those of the axial load. ``heat``: the
+    engine's heat at this point, cached (shared by steady states of other thermal data);
+    ``start_c``: the secant's first temperature (default the bearing file's), degC."""
+    heat = heat if heat is not None else HeatAtTemperature(params, inner_ring_speed, axial_load, radial_load, moment)
     lub_i = 4  # "lubricant" in NODES
 
     def g(t: float) -> float:
@@ -603,7 +607,7 @@ def thermal_steady_state(
     def clamp(t: float) -> float:
         return min(max(t, lo), hi)
 
-    t0 = clamp(params.lubricant_temperature)
+    t0 = clamp(params.lubricant_temperature if start_c is None else start_c)
     g0 = g(t0)
     t1 = clamp(t0 + max(min(g0, MAX_STEP_K), -MAX_STEP_K))
     g1 = g(t1)

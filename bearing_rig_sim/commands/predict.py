@@ -389,6 +389,8 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(rad_s_to_rpm(omega), 3)
         row.update(s.losses_row(params.composite_roughness))
+        if not combined:
+            row.update(slip_readings(params, s))
         row["outer_ring_temperature_c"] = round(ts.temperatures["outer_ring"], 2)
         row["lubricant_temperature_c"] = round(ts.temperatures["lubricant"], 2)
         row["temperatures_c"] = {k: round(v, 2) for k, v in ts.temperatures.items()}

@@ -268,3 +268,46 @@ def test_run_refuses_a_program_beyond_the_shipped_rig_naming_the_segment(tmp_pat
     err = one_line_error(["run", str(program), "--bag-dir", str(tmp_path / "bags")], capsys)
     assert "segments[1].speed_rpm: segment 'n12000': 12000 rpm is above the rig's limit of 10000 rpm" in err
     assert not (tmp_path / "bags").exists()  # nothing started, nothing recorded
+
+
+def _rig_limits() -> tuple[float, float]:
+    """The shipped rig's spindle speed limit (rpm) and set-point limit (N), read with PyYAML."""
+    import yaml
+
+    from bearing_rig_sim.config import config_path
+
+    rig = yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))
+    return rig["spindle"]["max_speed_rad_s"] * 30.0 / np.pi, rig["loading_chain"]["max_setpoint_n"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "key", "limit"),
+    [
+        (["predict", "--rpm", "900", "--load", "5000"], "loading_chain.max_setpoint_n", "1000 N"),
+        (["predict", "--rpm", "12000", "--load", "100"], "spindle.max_speed_rad_s", "10000 rpm"),
+    ],
+)
+def test_predict_refuses_what_the_rig_file_does_not_allow(argv: list[str], key: str, limit: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """One line naming the option, the rig file's limit and where it is written (config/rig.yaml:
+    10 000 rpm, 1000 N); the limits themselves are accepted."""
+    speed, load = _rig_limits()
+    assert f"{speed:.6g} rpm" == "10000 rpm" and f"{load:g} N" == "1000 N"
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("bearing-rig: error: command line: --") and f"must be <= {limit}, the rig's limit ({key} in " in err, err
+    assert cli.main(["predict", "--rpm", f"{speed:.6g}", "--load", f"{load:g}", "--json"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("axis", "value", "key"), [("axial_load_n", 5000, "loading_chain.max_setpoint_n"), ("inner_ring_speed_rpm", 12000, "spindle.max_speed_rad_s")]
+)
+def test_a_sweep_axis_beyond_the_rig_is_refused_before_any_point_runs(
+    axis: str, value: float, key: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    grid = {"inner_ring_speed_rpm": [1000], "axial_load_n": [100]} | {axis: [value]}
+    spec = tmp_path / "beyond.yaml"
+    spec.write_text(json.dumps({"sweep": {"name": "beyond"}, "grid": grid}), encoding="utf-8")
+    assert cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"grid.{axis}[0]: must be <= " in err and f"the rig's limit ({key} in " in err, err
+    assert not (tmp_path / "out" / "results.parquet").exists()

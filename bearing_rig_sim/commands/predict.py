@@ -50,15 +50,15 @@ import math
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
-from bearing_rig_sim.dynamics import BearingParameters, Mounting
+from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.dynamics.steady import CageWhirl, SteadySolver, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.mounting import MountingConfig
-from bearing_rig_sim.settings_model import read_file, validate_mapping
+from bearing_rig_sim.settings_model import check_within_rig, read_file, validate_mapping
 from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 
 
@@ -122,9 +122,11 @@ def run(args: argparse.Namespace) -> int:
         raise RigError(f"--load takes one value or one per speed ({len(args.rpm)}), got {len(args.load)}")
     loads = args.load * len(args.rpm) if len(args.load) == 1 else args.load
     for n in args.rpm:
-        check_number(n, "command line", "--rpm", gt=0.0, le=100000.0)
+        check_within_rig(
+            check_number(n, "command line", "--rpm", gt=0.0), "command line", "--rpm", "spindle.max_speed_rad_s", unit_in_si=RPM_TO_RAD_S, unit=" rpm"
+        )
     for f in loads:
-        check_number(f, "command line", "--load", ge=1.0, le=20000.0)
+        check_within_rig(check_number(f, "command line", "--load", ge=MIN_AXIAL_LOAD), "command line", "--load", "loading_chain.max_setpoint_n", unit=" N")
     if args.transient is not None:
         check_number(args.transient, "command line", "--transient", gt=0.0, le=36000.0)
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)

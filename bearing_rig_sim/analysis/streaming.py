@@ -158,9 +158,9 @@ class TrailingSlope:
         self,
         critical_slope: float,
         span: float,
-        min_points: int = 5,
-        resolution: float = 0.01,
-        change_threshold: float = 4.0,
+        min_points: int,
+        resolution: float,
+        change_threshold: float,
         max_span: float | None = None,
         stable_confidence: float = 0.95,
     ) -> None:

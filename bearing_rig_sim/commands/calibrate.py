@@ -28,7 +28,7 @@ def register(subparsers: Any) -> None:
     """Add ``calibrate`` to the ``bearing-rig`` parser."""
     p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
     p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
-    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
+    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")
     p.add_argument(
         "--out",

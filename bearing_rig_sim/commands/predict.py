@@ -71,8 +71,8 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)"
     )
-    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
-    p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: config/calibration/h7006c_table3.yaml)")
+    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
+    p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: the shipped bearing's, none for another --bearing)")
     p.add_argument("--lubricant", type=Path, default=None, help="lubricant file replacing the bearing file's (config/lubricants/)")
     p.add_argument("--thermal", action="store_true", help="at the thermal steady state (torque, temperatures)")
     p.add_argument("--transient", type=float, default=None, metavar="S", help="warm-up from ambient over S seconds (one row per step)")

@@ -25,14 +25,14 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run or reuse the experiments and write the outputs."""
     from bearing_rig_sim.commands import output_folder
-    from bearing_rig_sim.config import config_path
+    from bearing_rig_sim.config import shipped_calibration_file
     from bearing_rig_sim.errors import RigError
     from bearing_rig_sim.studies.reproduction import reproduce
 
     if args.workers is not None and args.workers < 1:
         raise RigError(f"--workers must be >= 1, got {args.workers}")
     output_folder(args.out, "--out")  # before the experiments, not after them
-    params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+    params = BearingParameters.from_yaml(args.bearing, args.calibration or shipped_calibration_file())
     out = reproduce(args.out, params, workers=args.workers, use_cache=not args.no_cache, progress=not args.quiet)
     print(f"{'reused cached results' if out.cached else 'ran the experiments'}; wrote {len(out.files)} files to {out.out_dir}")
     print(f"validation RMS (twin - bench, 4 rows): {out.validation_rms_pct:.3f} pp")

@@ -21,7 +21,7 @@ from typing import Any
 from collections.abc import Callable
 
 from bearing_rig_sim import __version__
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.config import shipped_calibration_file
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.executors import open_client
@@ -76,7 +76,7 @@ def base_parameters(spec: SweepSpec) -> BearingParameters:
     if spec.calibration == "none":
         calibration: str | Path | None = None
     elif spec.calibration == "shipped":
-        calibration = config_path("calibration", "h7006c_table3.yaml")
+        calibration = shipped_calibration_file()
     else:
         calibration = Path(spec.calibration)
     return BearingParameters.from_yaml(spec.bearing, calibration)

@@ -1,9 +1,6 @@
 """``bearing-rig calibrate DATA.csv``: fit the engine's uncertain resistances to bench slip data.
 
-With ``--thermal`` every row is the coupled thermal steady state (the bearing file's
-``thermal:`` section): the bench's slips are steady, warm values, and the fitted values are the
-grease's at the bearing file's lubricant temperature (the reference of its temperature laws).
-The shipped calibration is made so (docs/model.md, section Calibration)."""
+The thermal fit and where the result goes: docs/guide.md, section ``bearing-rig calibrate``."""
 
 from __future__ import annotations
 
@@ -17,7 +14,7 @@ import yaml
 
 from bearing_rig_sim.studies.calibration import DEFAULT_FITTED, calibrate, read_bench_csv, write_calibration
 from bearing_rig_sim.studies.uncertainty import LOAD_SIGMA_N, check_identifiable, fit_uncertainty
-from bearing_rig_sim.commands import output_file
+from bearing_rig_sim.commands import describe, output_file
 from bearing_rig_sim.config import check_number, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
@@ -26,7 +23,7 @@ from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 def register(subparsers: Any) -> None:
     """Add ``calibrate`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
+    p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=describe(__doc__, "calibrate"))
     p.add_argument("data", type=Path, help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")

@@ -1,45 +1,8 @@
-"""``bearing-rig predict --rpm R [R ...] --load N``: steady cage speed and slip from the calibrated
-engine (one JSON object per line with ``--json``).
+"""``bearing-rig predict --rpm R [R ...] --load N``: steady cage speed and slip of the calibrated
+twin at given speeds and axial loads; on request the thermal steady state, combined loads and
+the mounting.
 
-With ``--thermal`` each point is the coupled thermal steady state (bearing_rig_sim/thermal,
-docs/thermal.md): slip, ``friction_torque_nm`` and ``power_loss_w`` at the lubricant's steady
-temperature, with ``outer_ring_temperature_c``, ``lubricant_temperature_c`` and the values at the
-bearing file's temperature under ``isothermal``. ``--transient S`` prints the warm-up from
-ambient over S seconds instead (one row per ``--transient-step``). ``--lubricant FILE`` replaces
-the bearing file's lubricant (the calibration's lubricant values are laid over it only when
-``--calibration`` is given); the shipped calibration belongs to the shipped bearing, so another
-``--bearing`` gets a calibration only when one is named. When the calibration file has an
-``uncertainty:`` block (``bearing-rig calibrate`` writes it), each point gets ``slip_pct_low`` and
-``slip_pct_high``, its 95 % interval from the parameter and load uncertainty
-(:mod:`bearing_rig_sim.studies.uncertainty`).
-
-With ``--radial-load`` (and ``--moment``) each point also gets the quasi-static load
-distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max_n``,
-``ball_load_min_n``, ``loaded_balls``, ``contact_angle_max_load_deg`` and, with the tilt held
-(no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. Such a point's slip, torque and power are
-the engine's under the combined load, averaged over whole ball-pass periods (the steady state is
-periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`), with
-``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end,
-``cage_whirl_frequency_hz`` the centre's orbital frequency about the axis over the window (signed:
-> 0 in the cage's direction of rotation) and ``cage_whirl_ratio`` that over the cage's rotation
-frequency, both null with ``cage_whirl_reason`` when the centre does not orbit
-(:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`), and no uncertainty interval (the
-calibration's is an axial-load one). With ``--thermal`` such a
-point is the coupled thermal steady state of that periodic state (its heat, term by term, each
-term's energy over whole ball-pass periods over their length; the network's conductances those
-of the axial load), its ``isothermal`` values the periodic state at the bearing file's
-temperature, and ``--transient`` warms up under the combined load.
-
-The mounting (non-thermal path; docs/model.md, "Mounting"): ``--clearance M`` an extra diametral
-clearance (m, negative: interference), ``--misalignment RAD RAD`` the tilts held, ``--preload-n N``
-a spring preload added to each point's axial load and ``--preload-displacement M`` the rigid
-preload of a back-to-back pair, within the ranges of the rig file's ``mounting`` section
-(:mod:`bearing_rig_sim.rig.mounting`). Each row then states them (``clearance_um``,
-``misalignment_mrad``, ``preload_n``, ``preload_displacement_um``; ``axial_load_n`` stays the
-external load) and has no uncertainty interval (the calibration's is the nominal mounting's). A
-misalignment breaks the axial symmetry: its points are periodic steady states as under a radial
-load. The load distribution's row (``--radial-load``) takes the clearance, misalignment and
-spring preload; the rigid preload's partner is the engine's only.
+What each row holds and every option: docs/guide.md, section ``bearing-rig predict``.
 """
 
 from __future__ import annotations
@@ -50,6 +13,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import describe, rig_limit_text
 from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
@@ -64,9 +28,21 @@ from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 
 def register(subparsers: Any) -> None:
     """Add ``predict`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("predict", help="steady slip of the calibrated twin", description=__doc__)
-    p.add_argument("--rpm", type=float, nargs="+", required=True, help="inner-ring speeds, rpm")
-    p.add_argument("--load", type=float, nargs="+", required=True, help="axial loads, N (one, or one per speed)")
+    p = subparsers.add_parser("predict", help="steady slip of the calibrated twin", description=describe(__doc__, "predict"))
+    p.add_argument(
+        "--rpm",
+        type=float,
+        nargs="+",
+        required=True,
+        help=f"inner-ring speeds, rpm, {rig_limit_text('spindle.max_speed_rad_s', unit_in_si=RPM_TO_RAD_S, unit=' rpm')}",
+    )
+    p.add_argument(
+        "--load",
+        type=float,
+        nargs="+",
+        required=True,
+        help=f"axial loads, N (one, or one per speed), {rig_limit_text('loading_chain.max_setpoint_n', unit=' N')}",
+    )
     p.add_argument("--radial-load", type=float, nargs="+", default=None, help="radial loads, N (one, or one per speed): adds the load distribution")
     p.add_argument(
         "--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)"

@@ -7,12 +7,13 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import describe
 from bearing_rig_sim.dynamics import BearingParameters
 
 
 def register(subparsers: Any) -> None:
     """Add ``reproduce`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("reproduce", help="run the paper's experiments and write a report", description=__doc__)
+    p = subparsers.add_parser("reproduce", help="run the paper's experiments and write a report", description=describe(__doc__, "reproduce"))
     p.add_argument("--out", type=Path, default=Path("out/reproduce"), help="output folder (default: out/reproduce)")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
     p.add_argument("--calibration", type=Path, default=None, help="calibration file (default: the shipped bench calibration)")

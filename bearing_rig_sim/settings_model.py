@@ -146,7 +146,7 @@ def rig_file_value(rig_file: Path, key: str) -> float:
         ConfigError: naming the rig file and the key (missing, not a number).
     """
     *sections, last = key.split(".")
-    here = read_mapping(rig_file)
+    here: Any = read_mapping(rig_file)
     for depth, section in enumerate(sections):
         here = here.get(section)
         if not isinstance(here, Mapping):

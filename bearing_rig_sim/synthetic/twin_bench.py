@@ -102,7 +102,8 @@ def twin_bench_run(
     from bearing_rig_sim.config import shipped_calibration_file
 
     cal = calibration_file if calibration_file is not None else shipped_calibration_file()
-    twin = RigTwin.from_files(bearing_file, cal, None, **({"initial_axial_load": holds[0].axial_load_n} if holds else {}))
+    start: dict[str, Any] = {"initial_axial_load": holds[0].axial_load_n} if holds else {}
+    twin = RigTwin.from_files(bearing_file, cal, None, **start)
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
     coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=lubricant_feedback) if thermal else None

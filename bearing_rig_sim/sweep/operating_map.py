@@ -1,7 +1,7 @@
 """The operating map of a steady sweep: slip over inner-ring speed x axial load.
 
-The map is the (load, speed) plane coloured by the slip from the rolling start (a colour bar, log
-scale), with the skid boundary of each branch (:func:`skid_boundary`) and the SKF minimum axial
+The map is the (load, speed) plane coloured by the slip from the rolling start (a colour bar,
+logarithmic in both signs: :data:`SLIP_LINEAR_PCT`), with the skid boundary of each branch (:func:`skid_boundary`) and the SKF minimum axial
 load rule (:func:`skf_minimum_axial_load`) drawn over it. With a handful of speeds
 (:data:`HANDFUL_OF_SPEEDS`) a second panel beside it shows slip against load, one line per speed
 and branch; beyond that the lines would be a tangle and their legend a list, so the continued
@@ -66,9 +66,10 @@ def boundaries(table: Any, threshold_pct: float) -> dict[str, dict[float, float 
 HANDFUL_OF_SPEEDS = 6
 """Most speeds drawn as lines of slip against load (each with a legend entry); more are a map only."""
 
-SLIP_FLOOR_PCT = 0.01
-"""Lowest slip the colour scale shows, %: smaller (or negative: a cage ahead of pure rolling)
-slips take its colour (the colour bar's lower extension)."""
+SLIP_LINEAR_PCT = 0.1
+"""Slip below which (in magnitude) the colour scale is linear, %: above it logarithmic, so that
+20 % and 0.2 % differ as much as 2 % and 0.02 % would not; a negative slip (a cage ahead of its
+speed at the nominal contact angle, under large loads) keeps its sign."""
 
 
 def _columns(table: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -105,8 +106,7 @@ def _medians(i: np.ndarray, j: np.ndarray, values: np.ndarray) -> dict[tuple[int
 
 def _map_panel(ax: Any, speeds: np.ndarray, loads: np.ndarray, grid: np.ndarray, norm: Any) -> Any:
     """The slip map of one branch (NaN cells left blank); returns the mesh for the colour bar."""
-    shown = np.ma.masked_invalid(np.where(np.isfinite(grid), np.maximum(grid, SLIP_FLOOR_PCT), np.nan))
-    mesh = ax.pcolormesh(loads, speeds, shown, shading="nearest", cmap="viridis", norm=norm)
+    mesh = ax.pcolormesh(loads, speeds, np.ma.masked_invalid(grid), shading="nearest", cmap="viridis", norm=norm)
     ax.set_xlabel("axial load F_a (N)")
     ax.set_ylabel("inner-ring speed n_i (rpm)")
     return mesh
@@ -130,7 +130,7 @@ def _boundaries_over(ax: Any, found: dict[str, dict[float, float | None]], branc
         n = np.linspace(min(speeds), max(speeds), 100)
         ax.plot(skf_minimum_axial_load(n, factor_kn), n, "k:", lw=1.4, label=f"SKF minimum axial load, A = {factor_kn:g} kN")
     ax.set_xlim(xlim)
-    ax.legend(fontsize=7, loc="upper left", framealpha=0.8)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
 
 
 def _lines_panel(ax: Any, branch: np.ndarray, rpm: np.ndarray, load: np.ndarray, slip: np.ndarray, speeds: Sequence[float], threshold_pct: float) -> None:
@@ -165,7 +165,7 @@ def operating_map_figure(table: Any, threshold_pct: float, factor_kn: float, tit
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
+    from matplotlib.colors import SymLogNorm
 
     branch, rpm, load, slip = _columns(table)
     speeds = sorted(set(rpm[np.isfinite(rpm)].tolist()))
@@ -175,8 +175,9 @@ def operating_map_figure(table: Any, threshold_pct: float, factor_kn: float, tit
     fig, axes = plt.subplots(1, len(maps) + int(lines), figsize=(6.5 * (len(maps) + int(lines)), 4.8), squeeze=False, layout="constrained")
     if lines:
         _lines_panel(axes[0, 0], branch, rpm, load, slip, speeds, threshold_pct)
-    positive = slip[np.isfinite(slip) & (slip > SLIP_FLOOR_PCT)]
-    norm = LogNorm(vmin=max(SLIP_FLOOR_PCT, float(positive.min())) if positive.size else SLIP_FLOOR_PCT, vmax=float(positive.max()) if positive.size else 1.0)
+    finite = slip[np.isfinite(slip)]
+    low, high = (float(finite.min()), float(finite.max())) if finite.size else (0.0, 1.0)
+    norm = SymLogNorm(linthresh=SLIP_LINEAR_PCT, linscale=0.5, vmin=low, vmax=max(high, low + SLIP_LINEAR_PCT), base=10)
     found = boundaries(table, threshold_pct)
     mesh = None
     for k, (ax, which) in enumerate(zip(axes[0, int(lines) :], maps)):
@@ -189,7 +190,7 @@ def operating_map_figure(table: Any, threshold_pct: float, factor_kn: float, tit
         name = "from the rolling start" if which == KIND_ROLLING_START else "continued from lower loads"
         ax.set_title(f"slip {name}; skid boundary: slip < {threshold_pct:g} % above it", fontsize=9)
     if mesh is not None:
-        fig.colorbar(mesh, ax=list(axes[0, int(lines) :]), label="cage slip S_c (%)", extend="min")
+        fig.colorbar(mesh, ax=list(axes[0, int(lines) :]), label="cage slip S_c (%)")
     if title:
         fig.suptitle(title)
     return fig

@@ -14,6 +14,7 @@ import argparse
 import importlib
 import sys
 from bearing_rig_sim import __version__
+from bearing_rig_sim.commands import CommandParser
 from bearing_rig_sim.errors import RigError
 
 PROG = "bearing-rig"
@@ -24,7 +25,7 @@ COMMANDS: tuple[str, ...] = ("bench", "calibrate", "predict", "reproduce", "swee
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command of :data:`COMMANDS` registered."""
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog=PROG,
         description="Digital twin of the H7006C bearing cage-slip test rig.",
     )

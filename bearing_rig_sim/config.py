@@ -71,6 +71,33 @@ def config_path(*parts: str) -> Path:
     return local
 
 
+SHIPPED_BEARING_FILE: str = "bearings/h7006c.yaml"
+"""The shipped bearing file, relative to ``config/``: the bearing a command, a core or a node
+uses when none is named (the node parameter files name it too, as their defaults)."""
+
+SHIPPED_CALIBRATION_FILE: str = "calibration/h7006c_table3.yaml"
+"""The shipped calibration of :data:`SHIPPED_BEARING_FILE` (the bench's Table 3 fit), relative to
+``config/``."""
+
+SHIPPED_RIG_FILE: str = "rig.yaml"
+"""The shipped rig file, relative to ``config/``."""
+
+
+def shipped_bearing_file() -> Path:
+    """Path of the shipped bearing file (:data:`SHIPPED_BEARING_FILE`)."""
+    return config_path(*SHIPPED_BEARING_FILE.split("/"))
+
+
+def shipped_calibration_file() -> Path:
+    """Path of the shipped calibration (:data:`SHIPPED_CALIBRATION_FILE`)."""
+    return config_path(*SHIPPED_CALIBRATION_FILE.split("/"))
+
+
+def shipped_rig_file() -> Path:
+    """Path of the shipped rig file (:data:`SHIPPED_RIG_FILE`)."""
+    return config_path(SHIPPED_RIG_FILE)
+
+
 MAX_YAML_BYTES: int = 4 * 1024 * 1024
 """Largest YAML document read, bytes (the shipped files are a few kB; a bag's metadata a few
 tens of kB)."""

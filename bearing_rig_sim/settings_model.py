@@ -15,8 +15,10 @@ A settings class derives from :class:`NodeSettings` and declares each parameter 
   and never a boolean; YAML 1.1's unsigned exponents such as ``2.0e9``, which PyYAML reads as
   strings, are numbers); :data:`ConfigFile` and :data:`OptionalConfigFile` are files that must
   exist (absolute, or relative to ``config/``); :func:`one_of` restricts a text to a few words;
-* :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``) and
-  whether the parameter may change while the node runs;
+* :func:`param` gives the description, the unit, the range (``gt``, ``ge``, ``lt``, ``le``),
+  whether the parameter may change while the node runs, and where a limit of the rig lives
+  (``rig_limit``: a dotted key of the node's rig file, such as ``loading_chain.max_setpoint_n``,
+  which is then the upper bound the checks apply and the descriptor shows);
 * :meth:`NodeSettings.from_mapping` (and ``from_values``, ``from_yaml``) validates a mapping and
   raises :class:`~bearing_rig_sim.config.ConfigError` for the first problem in field order, in
   the project's words (``load_controller.yaml: state_rate_hz: must be > 0.0, got 0``);
@@ -48,10 +50,21 @@ import annotated_types
 from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, TypeAdapter, ValidationError, ValidationInfo, field_validator, model_validator
 from pydantic_core import ErrorDetails
 
-from bearing_rig_sim.config import ConfigError, check_number, config_path, flag_value, integer_value, number_value, read_mapping, ros_parameters
+from bearing_rig_sim.config import (
+    ConfigError,
+    check_number,
+    config_path,
+    flag_value,
+    integer_value,
+    number_value,
+    read_mapping,
+    ros_parameters,
+    shipped_rig_file,
+)
 
 __all__ = [
     "ConfigFile",
+    "check_within_rig",
     "FileSection",
     "Flag",
     "Integer",
@@ -69,6 +82,8 @@ __all__ = [
     "quantity",
     "read_file",
     "resolve_config_file",
+    "resolve_rig_file",
+    "rig_file_value",
     "validate_mapping",
     "without_nulls",
 ]
@@ -113,6 +128,58 @@ def existing_config_file(raw: object, *, empty_ok: bool = False) -> Path | None:
     return path
 
 
+def resolve_rig_file(raw: object) -> Path:
+    """A rig-file parameter as an existing path: ``""`` is the shipped ``config/rig.yaml``, a
+    relative name is under ``config/``. Raises ValueError with the problem."""
+    if raw == "":
+        return shipped_rig_file()
+    path = existing_config_file(raw)
+    assert path is not None  # "" handled above
+    return path
+
+
+def rig_file_value(rig_file: Path, key: str) -> float:
+    """The number at dotted ``key`` of a rig file (a limit of the rig, such as
+    ``loading_chain.max_setpoint_n``): the one place that limit is written.
+
+    Raises:
+        ConfigError: naming the rig file and the key (missing, not a number).
+    """
+    *sections, last = key.split(".")
+    here: Any = read_mapping(rig_file)
+    for depth, section in enumerate(sections):
+        here = here.get(section)
+        if not isinstance(here, Mapping):
+            raise ConfigError(str(rig_file), ".".join(sections[: depth + 1]), "missing (required: a mapping)")
+    if last not in here:
+        raise ConfigError(str(rig_file), key, "missing (required)")
+    return check_number(here[last], str(rig_file), key)
+
+
+def check_within_rig(
+    value: float,
+    source: str,
+    key: str,
+    rig_key: str,
+    *,
+    rig_file: Path | None = None,
+    unit_in_si: float = 1.0,
+    unit: str = "",
+) -> float:
+    """Check that ``value`` (at ``key`` of ``source``) is at most the rig's limit at dotted
+    ``rig_key`` of ``rig_file`` (default: the shipped ``config/rig.yaml``); ``unit_in_si`` is
+    the value's unit in SI (``RPM_TO_RAD_S`` for a speed in rpm), ``unit`` its name in the error.
+
+    Raises:
+        ConfigError: naming ``source``, ``key``, the limit and where it is written.
+    """
+    rig = rig_file if rig_file is not None else shipped_rig_file()
+    limit = rig_file_value(rig, rig_key) / unit_in_si
+    if not value <= limit * (1.0 + 1e-12):  # a limit written in SI for a round number of rpm
+        raise ConfigError(source, key, f"must be <= {limit:.10g}{unit}, the rig's limit ({rig_key} in {rig}), got {value!r}")
+    return value
+
+
 def _required_file(raw: object) -> Path | None:
     return existing_config_file(raw)
 
@@ -150,11 +217,14 @@ def param(
     lt: float | None = None,
     le: float | None = None,
     live: bool = False,
+    rig_limit: str = "",
 ) -> Any:
     """One parameter of a settings class: what it is, its SI unit (``"1"`` for a pure number,
-    ``""`` for text, files and flags), its allowed range, and whether it may be set while the
-    node runs (``live``; otherwise it is read at configure and read-only to ROS)."""
-    return Field(description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "live": live})
+    ``""`` for text, files and flags), its allowed range, whether it may be set while the node
+    runs (``live``; otherwise it is read at configure and read-only to ROS), and the dotted key
+    of the node's rig file holding its upper bound (``rig_limit``; ``le`` is then the plausible
+    bound of any bench, the rig file's value the one in force)."""
+    return Field(description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "live": live, "rig_limit": rig_limit})
 
 
 def quantity(
@@ -187,6 +257,9 @@ class ParameterField:
         low_exclusive, high_exclusive: the bound itself is refused.
         integer: an integer parameter.
         live: may be set while the node runs.
+        rig_limit: the dotted key of the rig file holding the upper bound ("" for none).
+        limit_source: where ``high`` was read ("" for the settings class itself), e.g.
+            ``loading_chain.max_setpoint_n in rig.yaml``.
     """
 
     name: str
@@ -198,6 +271,8 @@ class ParameterField:
     high_exclusive: bool
     integer: bool
     live: bool
+    rig_limit: str = ""
+    limit_source: str = ""
 
     @property
     def numeric(self) -> bool:
@@ -219,7 +294,7 @@ class ParameterField:
         if self.low is not None and self.high is not None:
             low = ">" if self.low_exclusive else ">="
             high = "<" if self.high_exclusive else "<="
-            parts.append(f"range: {low} {self.low:g} and {high} {self.high:g}")
+            parts.append(f"range: {low} {self.low:g} and {high} {self.high:g}" + (f" ({self.limit_source})" if self.limit_source else ""))
         parts.append("may be set live" if self.live else "read-only: set at start (parameter file or -p), read at configure")
         return "; ".join(parts)
 
@@ -381,6 +456,25 @@ class NodeSettings(BaseModel):
     NODE_NAME: ClassVar[str]
     SHIPPED_FILE: ClassVar[str]
     OTHER_KEYS: ClassVar[tuple[str, ...]] = ("use_sim_time",)
+    RIG_FILE_PARAMETER: ClassVar[str] = "rig_file"
+    """The parameter naming the rig file whose limits bound the ``rig_limit`` parameters."""
+
+    @model_validator(mode="after")
+    def _within_the_rig(self) -> Self:
+        """A parameter with a ``rig_limit`` is at most the rig file's value."""
+        for name, key in self.rig_limits().items():
+            check_within_rig(getattr(self, name), "", name, key, rig_file=getattr(self, self.RIG_FILE_PARAMETER))
+        return self
+
+    @classmethod
+    def rig_limits(cls) -> dict[str, str]:
+        """Parameter -> the dotted key of the rig file holding its upper bound."""
+        out = {}
+        for name, info in cls.model_fields.items():
+            extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
+            if extra.get("rig_limit"):
+                out[name] = str(extra["rig_limit"])
+        return out
 
     @classmethod
     def check_other_keys(cls, values: Mapping[str, Any]) -> None:
@@ -465,8 +559,18 @@ class NodeSettings(BaseModel):
         return ""
 
     @classmethod
-    def parameter_fields(cls) -> list[ParameterField]:
-        """Every parameter as the node declares it to ROS, in field order."""
+    def parameter_fields(cls, values: Mapping[str, Any] | None = None) -> list[ParameterField]:
+        """Every parameter as the node declares it to ROS, in field order. With the ``values``
+        in force (the rig file's parameter among them), a parameter with a ``rig_limit`` has that
+        rig file's value as its upper bound; without, or where the rig file cannot be read (the
+        node reports that at configure), the settings class's plausible bound."""
+        limits: dict[str, tuple[float, str]] = {}
+        if values is not None and cls.RIG_FILE_PARAMETER in values:
+            try:
+                rig = resolve_rig_file(values[cls.RIG_FILE_PARAMETER])
+                limits = {name: (rig_file_value(rig, key), f"{key} in {rig.name}") for name, key in cls.rig_limits().items()}
+            except (ConfigError, ValueError):
+                limits = {}
         out = []
         for name, info in cls.model_fields.items():
             bounds: dict[str, float] = {}
@@ -477,6 +581,12 @@ class NodeSettings(BaseModel):
             extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
             low = bounds.get("gt", bounds.get("ge"))
             high = bounds.get("lt", bounds.get("le"))
+            limit, limit_source = limits.get(name, (None, ""))
+            if limit is not None and (high is None or limit <= high):
+                high = limit
+                bounds.pop("lt", None)
+            else:
+                limit_source = ""
             out.append(
                 ParameterField(
                     name=name,
@@ -488,6 +598,8 @@ class NodeSettings(BaseModel):
                     high_exclusive="lt" in bounds,
                     integer=info.annotation is int,
                     live=bool(extra.get("live", False)),
+                    rig_limit=str(extra.get("rig_limit", "")),
+                    limit_source=limit_source,
                 )
             )
         return out

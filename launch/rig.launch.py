@@ -9,7 +9,8 @@ started again. Then, with a ``program``, runs it with ``python -m bearing_rig_si
 --attach --no-record`` (the program runner, live progress and summary, on these nodes; the
 interpreter running the launch, so no ``bearing-rig`` on PATH is needed); when it ends the launch
 shuts down, with exit status 0 when the program passed and 1 otherwise. With ``record:=true`` it
-records the rig's topics with ``ros2 bag record`` (MCAP storage) into ``bag_dir``.
+records the rig's topics with ``ros2 bag record`` (MCAP storage) into ``bag_dir``: every topic of
+the interface contract (``bearing_rig_sim.interfaces.TOPICS``), as a session records them.
 
 Arguments:
   program:=FILE       test program (YAML); empty (default): the nodes only
@@ -42,14 +43,13 @@ from launch_ros.event_handlers import OnStateTransition
 from launch_ros.events.lifecycle import ChangeState
 from lifecycle_msgs.msg import Transition
 
+from bearing_rig_sim.interfaces import TOPICS
+
 NODES = ("simulator", "load_controller", "monitor")
 """Bring-up order: the source of /clock first."""
 
-RECORDED = (
-    "/clock /rig/spindle/command /rig/spindle/pulses /rig/cage/pulses /rig/speeds /rig/truth "
-    "/rig/axial_load/setpoint /rig/axial_load/state /rig/axial_load/force /rig/bearing/axial_force "
-    "/rig/slip_status /diagnostics"
-)
+RECORDED: tuple[str, ...] = tuple(topic.name for topic in TOPICS)
+"""What ``record:=true`` records: the interface contract's topics, as a session records them."""
 
 
 def _change(node: LifecycleNode, transition: int) -> EmitEvent:
@@ -95,7 +95,7 @@ def generate_launch_description() -> LaunchDescription:
         condition=IfCondition(PythonExpression(["'", program, "' != ''"])),
     )
     recorder = ExecuteProcess(
-        cmd=["ros2", "bag", "record", "-s", "mcap", "-o", LaunchConfiguration("bag_dir"), *RECORDED.split()],
+        cmd=["ros2", "bag", "record", "-s", "mcap", "-o", LaunchConfiguration("bag_dir"), *RECORDED],
         output="screen",
         condition=IfCondition(record),
     )

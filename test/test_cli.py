@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import re
 import subprocess
 import sys
 import types
@@ -268,3 +269,107 @@ def test_run_refuses_a_program_beyond_the_shipped_rig_naming_the_segment(tmp_pat
     err = one_line_error(["run", str(program), "--bag-dir", str(tmp_path / "bags")], capsys)
     assert "segments[1].speed_rpm: segment 'n12000': 12000 rpm is above the rig's limit of 10000 rpm" in err
     assert not (tmp_path / "bags").exists()  # nothing started, nothing recorded
+
+
+def _rig_limits() -> tuple[float, float]:
+    """The shipped rig's spindle speed limit (rpm) and set-point limit (N), read with PyYAML."""
+    import yaml
+
+    from bearing_rig_sim.config import config_path
+
+    rig = yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))
+    return rig["spindle"]["max_speed_rad_s"] * 30.0 / np.pi, rig["loading_chain"]["max_setpoint_n"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "key", "limit"),
+    [
+        (["predict", "--rpm", "900", "--load", "5000"], "loading_chain.max_setpoint_n", "1000 N"),
+        (["predict", "--rpm", "12000", "--load", "100"], "spindle.max_speed_rad_s", "10000 rpm"),
+    ],
+)
+def test_predict_refuses_what_the_rig_file_does_not_allow(argv: list[str], key: str, limit: str, capsys: pytest.CaptureFixture[str]) -> None:
+    """One line naming the option, the rig file's limit and where it is written (config/rig.yaml:
+    10 000 rpm, 1000 N); the limits themselves are accepted."""
+    speed, load = _rig_limits()
+    assert f"{speed:.6g} rpm" == "10000 rpm" and f"{load:g} N" == "1000 N"
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("bearing-rig: error: command line: --") and f"must be <= {limit}, the rig's limit ({key} in " in err, err
+    assert cli.main(["predict", "--rpm", f"{speed:.6g}", "--load", f"{load:g}", "--json"]) == 0
+
+
+@pytest.mark.parametrize(
+    ("axis", "value", "key"), [("axial_load_n", 5000, "loading_chain.max_setpoint_n"), ("inner_ring_speed_rpm", 12000, "spindle.max_speed_rad_s")]
+)
+def test_a_sweep_axis_beyond_the_rig_is_refused_before_any_point_runs(
+    axis: str, value: float, key: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    grid = {"inner_ring_speed_rpm": [1000], "axial_load_n": [100]} | {axis: [value]}
+    spec = tmp_path / "beyond.yaml"
+    spec.write_text(json.dumps({"sweep": {"name": "beyond"}, "grid": grid}), encoding="utf-8")
+    assert cli.main(["sweep", str(spec), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"grid.{axis}[0]: must be <= " in err and f"the rig's limit ({key} in " in err, err
+    assert not (tmp_path / "out" / "results.parquet").exists()
+
+
+HELP_HEADINGS = ("options:", "positional arguments:")
+
+
+def help_description(text: str) -> list[str]:
+    """The lines of a ``--help`` between its usage (up to the first blank line) and its first
+    list of arguments, blank lines left out."""
+    lines = text.splitlines()
+    start = lines.index("") if "" in lines else len(lines)
+    end = next((i for i, line in enumerate(lines) if line in HELP_HEADINGS), len(lines))
+    return [line for line in lines[start:end] if line.strip()]
+
+
+def guide_anchors() -> set[str]:
+    """The anchors of docs/guide.md's headings, as GitHub makes them (lower case, punctuation but
+    hyphens dropped, spaces as hyphens)."""
+    text = (Path(__file__).resolve().parent.parent / "docs" / "guide.md").read_text(encoding="utf-8")
+    headings = [line.lstrip("#").strip() for line in text.splitlines() if line.startswith("#")]
+    return {re.sub(r"[^\w\- ]", "", h.lower()).replace(" ", "-") for h in headings}
+
+
+SUB_COMMANDS = [[name] for name in cli.COMMANDS] + [["bag", "info"], ["bag", "repair"]]
+
+
+@pytest.mark.parametrize("command", SUB_COMMANDS, ids=" ".join)
+def test_help_is_a_line_or_two_then_the_options(command: list[str], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """At most 5 lines between the usage and the options (on an 80-column terminal), ending with
+    the section of docs/guide.md that explains the command in full."""
+    monkeypatch.setenv("COLUMNS", "80")
+    with pytest.raises(SystemExit) as exit_info:
+        cli.main([*command, "--help"])
+    assert exit_info.value.code == 0
+    text = capsys.readouterr().out
+    assert text.startswith(f"usage: bearing-rig {' '.join(command)}")
+    description = help_description(text)
+    assert len(description) <= 5, "\n".join(description)
+    assert any(line in text.splitlines() for line in HELP_HEADINGS)
+    if len(command) == 1:  # a sub-command names its section of the guide, and the section exists
+        links = re.findall(r"docs/guide\.md#([\w-]+)", " ".join(description))
+        assert links == [f"bearing-rig-{command[0]}"], description
+        assert links[0] in guide_anchors()
+
+
+def test_the_help_description_counts_what_lies_between_usage_and_options() -> None:
+    """The measure above can fail: a long paragraph counts in full."""
+    text = "usage: bearing-rig x [-h]\n\n" + "word " * 200 + "\n\noptions:\n  -h, --help  show this help\n"
+    assert len(help_description(text)) == 1
+    wrapped = "usage: bearing-rig x [-h]\n\n" + "\n".join(["a line of text"] * 50) + "\n\noptions:\n"
+    assert len(help_description(wrapped)) == 50
+
+
+def test_predict_help_shows_the_rig_files_limits(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """The bound --help states is the one the check applies: the rig file's (read with PyYAML)."""
+    speed, load = _rig_limits()
+    monkeypatch.setenv("COLUMNS", "200")
+    with pytest.raises(SystemExit):
+        cli.main(["predict", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert f"at most {speed:.6g} rpm (spindle.max_speed_rad_s in rig.yaml)" in text
+    assert f"at most {load:g} N (loading_chain.max_setpoint_n in rig.yaml)" in text

@@ -27,7 +27,7 @@ from bearing_rig_sim.rig.fibre_optic import FibreOpticConfig
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth, stopped_reason
-from bearing_rig_sim.simulation.twin import RigTwin
+from bearing_rig_sim.simulation.twin import RigTwin, twin_options
 
 RPM = math.pi / 30.0
 
@@ -195,7 +195,12 @@ def test_a_forced_divergence_is_detected_not_published(params: BearingParameters
     publishes nothing of it), and the simulator's health turns it into an ERROR naming it, with
     the reason in the diagnostics' ``simulation_stopped`` value on which a session ends."""
     engine = _DivergingEngine(params)
-    twin = RigTwin(engine, FibreOpticConfig.from_yaml(None), BearingKinematics.from_config(config_path("bearings", "h7006c.yaml")), initial_axial_load=100.0)
+    twin = RigTwin(
+        engine,
+        FibreOpticConfig.from_yaml(None),
+        BearingKinematics.from_config(config_path("bearings", "h7006c.yaml")),
+        **(twin_options() | {"initial_axial_load": 100.0}),
+    )
     twin.command_spindle(SpindleCommand(target_speed=900 * RPM, profile=SpeedProfileKind.CONSTANT_ACCELERATION, acceleration=80.0))
     returned = []
     with pytest.raises(

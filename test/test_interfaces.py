@@ -3,7 +3,11 @@ the recorder records it, replay offers its QoS, and every type exists as a messa
 
 from __future__ import annotations
 
+import importlib.util
+import re
+import sys
 from pathlib import Path
+from unittest.mock import MagicMock
 
 import pytest
 
@@ -95,3 +99,71 @@ def test_every_topic_type_resolves_to_its_generated_class() -> None:
         assert cls.__name__ == name and cls.__module__.startswith(f"{package}.msg"), t.name
     with pytest.raises(AttributeError):
         message_class("std_msgs/msg/NoSuchMessage")
+
+
+LAUNCH_MODULES = (
+    "launch",
+    "launch.actions",
+    "launch.conditions",
+    "launch.event_handlers",
+    "launch.events",
+    "launch.events.process",
+    "launch.launch_context",
+    "launch.substitutions",
+    "launch_ros",
+    "launch_ros.actions",
+    "launch_ros.event_handlers",
+    "launch_ros.events",
+    "launch_ros.events.lifecycle",
+)
+"""What launch/rig.launch.py imports from ROS 2's launch packages (not on PyPI): stood in for by
+mocks that record each action the file makes."""
+
+
+def launch_processes(monkeypatch: pytest.MonkeyPatch) -> list[list[object]]:
+    """The command lines of the processes ``generate_launch_description`` makes, from the launch
+    file itself run against recording stand-ins of the launch packages."""
+    for name in LAUNCH_MODULES:
+        monkeypatch.setitem(sys.modules, name, MagicMock(name=name))
+    spec = importlib.util.spec_from_file_location("rig_launch", ROOT / "launch" / "rig.launch.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.generate_launch_description()
+    execute = sys.modules["launch.actions"].ExecuteProcess
+    return [list(call.kwargs["cmd"]) for call in execute.call_args_list]
+
+
+def test_the_launch_file_records_every_contract_topic(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``rig.launch.py record:=true`` runs ``ros2 bag record`` on the contract's topics, all of
+    them and nothing else (a session records the same: test_recorder_records_every_contract_topic)."""
+    (record,) = [cmd for cmd in launch_processes(monkeypatch) if cmd[:3] == ["ros2", "bag", "record"]]
+    recorded = [arg for arg in record if isinstance(arg, str) and arg.startswith("/")]
+    assert recorded == [t.name for t in interfaces.TOPICS]
+
+
+TOPIC_NAME = re.compile(r"(?<![\w./-])(/(?:rig|twin)(?:/[a-z][a-z_]*)+|/clock\b|/diagnostics\b)")
+"""A topic or service name of the rig written in text: ``/rig/...``, ``/twin/...``, ``/clock``,
+``/diagnostics`` (a bare namespace such as ``/twin/*`` is not a name)."""
+
+WRITTEN_IN = ("README.md", "docs/*.md", "config/**/*.yaml", "config/**/*.json", "launch/*.py", "bearing_rig_sim/**/*.py")
+"""Where the rig's topics are documented or named (the tests are not: they name wrong ones on purpose)."""
+
+
+def test_every_topic_the_docs_config_and_code_name_is_in_the_contract() -> None:
+    """A topic a document, a configuration comment or the code names exists: a contract topic or
+    service (config/shadow.yaml once documented a /twin/status that nothing published)."""
+    known = {t.name for t in interfaces.TOPICS} | {s.name for s in interfaces.SERVICES}
+    unknown = set()
+    for pattern in WRITTEN_IN:
+        for path in sorted(ROOT.glob(pattern)):
+            for match in TOPIC_NAME.finditer(path.read_text(encoding="utf-8")):
+                if match.group(1) not in known:
+                    unknown.add(f"{path.relative_to(ROOT)}: {match.group(1)}")
+    assert not unknown, sorted(unknown)
+
+
+def test_the_topic_name_pattern_finds_a_stale_name() -> None:
+    """The scan above can fail: it finds a topic name in a YAML comment, and not a namespace."""
+    found = TOPIC_NAME.findall("    status_rate_hz: 10.0   # /twin/status, wall clock; the /twin/* topics; a/rig/x path\n")
+    assert found == ["/twin/status"]

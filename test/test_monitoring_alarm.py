@@ -22,7 +22,7 @@ DOF = 20
 
 def first_state(slope: float, se: float, dof: int = DOF) -> SlipState:
     """The state after one slip point whose slope (phase estimate) is ``slope`` +- ``se``."""
-    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0, stable_confidence=0.95)
+    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, change_threshold=4.0, max_span=8.0, stable_confidence=0.95)
     trailing.add(0.0, 2.0, (slope, se, dof))
     return trailing.state
 
@@ -54,7 +54,7 @@ def test_a_first_verdict_may_come_between_slip_points_and_is_then_held() -> None
     """``refresh`` with a newer phase estimate between two windows decides a first verdict
     (0.01 - 1.72 * 0.01 >= k: STABLE) and, once one is held, leaves it to the next point's
     overturn rules (a refresh at -1.0 +- 0.01 changes nothing)."""
-    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0, stable_confidence=0.95)
+    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, change_threshold=4.0, max_span=8.0, stable_confidence=0.95)
     trailing.refresh((0.0, 0.01, DOF))  # before any point: nothing
     assert trailing.state is SlipState.UNKNOWN
     trailing.add(0.0, 2.0, (0.0, 0.05, DOF))  # 0 - 1.72 * 0.05 < k: undecided
@@ -69,7 +69,7 @@ def held_then_falling_windows(trailing: tuple[float, float, int]) -> list[SlipSt
     """States of a series held STABLE on 3 s of flat slip points (scattering +-0.01 %, 0.159 s
     apart, the phase's trailing slope 0 +- 0.005), whose points then fall at -0.1 %/s for 2 s
     while the phase's trailing slope is ``trailing``."""
-    series = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0, stable_confidence=0.95)
+    series = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, change_threshold=4.0, max_span=8.0, stable_confidence=0.95)
     states = []
     for i in range(32):
         x = 0.159 * i

@@ -34,7 +34,7 @@ TAIL = 1e-6  # binomial quantile of the bounds, each side
 
 def stable_after_one_estimate(slope: float, se: float, dof: int, confidence: float) -> bool:
     """Whether one phase estimate ``slope`` +- ``se`` on ``dof`` makes a fresh series STABLE."""
-    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, max_span=8.0, stable_confidence=confidence)
+    trailing = TrailingSlope(K2, span=1.0, min_points=5, resolution=0.002, change_threshold=4.0, max_span=8.0, stable_confidence=confidence)
     trailing.add(0.0, 2.0, (slope, se, dof))
     return trailing.state is SlipState.STABLE
 

@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 
 rclpy = pytest.importorskip("rclpy")
 
@@ -171,6 +172,8 @@ def test_load_step_settles_within_the_stated_time(ros_graph: Any) -> None:
 
 
 BAD_VALUES = [(math.nan, "finite"), (-5.0, ">= 0"), (5000.0, "<= 1000"), (20_000.0, "<= 1000")]
+CHAIN_LIMIT_N = float(yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))["loading_chain"]["max_setpoint_n"])
+"""The set-point parameter's declared upper bound: the loading chain's limit in config/rig.yaml."""
 
 
 def test_bad_setpoints_are_refused_by_every_route_and_the_node_answers(ros_graph: Any) -> None:
@@ -195,11 +198,11 @@ def test_bad_setpoints_are_refused_by_every_route_and_the_node_answers(ros_graph
         mark = rig.mark()
         result = rig.set_by_parameter(value)
         assert not result.successful
-        if 0.0 <= value <= 10_000.0:  # inside the parameter's declared range: the chain refuses it
+        if 0.0 <= value <= CHAIN_LIMIT_N:  # inside the parameter's declared range: the chain refuses it
             assert reason in result.reason
             rig.wait_diagnostic(mark, DiagnosticStatus.WARN, "by parameter refused", reason)
-        else:  # outside the declared range (config/load_controller's descriptor): ROS refuses it
-            assert "out of range" in result.reason and "Max: 10000.0" in result.reason, result.reason
+        else:  # outside the declared range (the descriptor's bound is the chain's limit): ROS refuses it
+            assert "out of range" in result.reason and f"Max: {CHAIN_LIMIT_N}" in result.reason, result.reason
         assert rig.set_by_service(100.0).accepted
     result = rig.set_by_parameter("a lot")
     assert not result.successful and "must be a number" in result.reason

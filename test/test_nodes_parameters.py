@@ -9,17 +9,19 @@ does) and asked through rclpy's own parameter API, which the ``describe_paramete
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any
 from collections.abc import Callable
 
 import pytest
+import yaml
 
 rclpy = pytest.importorskip("rclpy")
 
 from rcl_interfaces.msg import ParameterType  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 
-from bearing_rig_sim.config import ConfigError  # noqa: E402
+from bearing_rig_sim.config import ConfigError, config_path  # noqa: E402
 from bearing_rig_sim.errors import RigError  # noqa: E402
 from bearing_rig_sim.load_control.settings import LoadControllerSettings  # noqa: E402
 from bearing_rig_sim.load_control.settings import shipped_parameters as load_controller_parameters  # noqa: E402
@@ -75,11 +77,16 @@ def test_every_parameter_has_a_descriptor_with_unit_and_range(ros_graph: Any, na
         node.destroy_node()
 
 
+def chain_limit(rig: Path) -> float:
+    """The loading chain's set-point limit as the rig file writes it (read here with PyYAML)."""
+    return float(yaml.safe_load(rig.read_text(encoding="utf-8"))["loading_chain"]["max_setpoint_n"])
+
+
 def test_sets_are_refused_with_the_reason(ros_graph: Any) -> None:
     node = LoadControllerNode(context=ros_graph.context())
     try:
-        (result,) = node.set_parameters([Parameter("axial_load_setpoint_n", value=20_000.0)])
-        assert not result.successful and "out of range" in result.reason and "10000" in result.reason
+        (result,) = node.set_parameters([Parameter("axial_load_setpoint_n", value=chain_limit(config_path("rig.yaml")) + 1.0)])
+        assert not result.successful and "out of range" in result.reason and f"{chain_limit(config_path('rig.yaml'))}" in result.reason, result.reason
         (result,) = node.set_parameters([Parameter("axial_load_setpoint_n", value=math.nan)])
         assert not result.successful and result.reason
         (result,) = node.set_parameters([Parameter("state_rate_hz", value=50.0)])
@@ -89,6 +96,30 @@ def test_sets_are_refused_with_the_reason(ros_graph: Any) -> None:
         assert node.get_parameter("axial_load_setpoint_n").value == 250.0
     finally:
         node.destroy_node()
+
+
+def test_the_set_points_upper_bound_is_the_rig_files_chain_limit(ros_graph: Any, tmp_path: Path) -> None:
+    """``ros2 param describe`` shows the loading chain's limit (config/rig.yaml: 1000 N), not a
+    bound of its own; a node given another rig file shows that file's limit and refuses a set
+    above it."""
+    shipped = chain_limit(config_path("rig.yaml"))
+    doc = yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))
+    doc["loading_chain"]["max_setpoint_n"] = 600.0
+    small = tmp_path / "small_rig.yaml"
+    small.write_text(yaml.safe_dump(doc), encoding="utf-8")
+    for overrides, limit in (([], shipped), ([Parameter("rig_file", value=str(small))], 600.0)):
+        node = LoadControllerNode(context=ros_graph.context(), parameter_overrides=overrides)
+        try:
+            (descriptor,) = node.describe_parameters(["axial_load_setpoint_n"])
+            (bound,) = descriptor.floating_point_range
+            assert (bound.from_value, bound.to_value) == (0.0, limit)
+            assert f"<= {limit:g} (loading_chain.max_setpoint_n in " in descriptor.additional_constraints, descriptor.additional_constraints
+            (result,) = node.set_parameters([Parameter("axial_load_setpoint_n", value=limit + 1.0)])
+            assert not result.successful
+            (result,) = node.set_parameters([Parameter("axial_load_setpoint_n", value=limit)])
+            assert result.successful
+        finally:
+            node.destroy_node()
 
 
 def test_a_start_value_out_of_range_is_one_line_naming_the_parameter(ros_graph: Any) -> None:

@@ -37,10 +37,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+import yaml
 
 pytest.importorskip("rclpy")
 
 from conftest import _prepare_child, skip_missing, time_left
+
+from bearing_rig_sim.config import config_path
 
 TIMEOUT_S = 600
 """Each test's limit, s: the stock tools' set-up when a test other than the first is run alone,
@@ -326,13 +329,16 @@ def test_params_topics_and_services_with_the_stock_tools(ros2_readme: Ros2, tmp_
         ros2.wait_state(node, "active")
 
     described = ros2.run("param", "describe", "/load_controller", "axial_load_setpoint_n", "--no-daemon")
-    assert "axial-load set-point" in described.stdout and "Min value: 0.0" in described.stdout and "Max value: 10000.0" in described.stdout, described.stdout
+    chain_limit = yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))["loading_chain"]["max_setpoint_n"]  # the chain's limit, 1000 N
+    assert "axial-load set-point" in described.stdout and "Min value: 0.0" in described.stdout and f"Max value: {float(chain_limit)}" in described.stdout, (
+        described.stdout
+    )
     assert "Read only: true" not in described.stdout, described.stdout  # the one live parameter
     read_only = ros2.run("param", "describe", "/simulator", "chunk_s", "--no-daemon")
     assert "Read only: true" in read_only.stdout and "unit: s" in read_only.stdout, read_only.stdout
 
     assert "Set parameter successful" in ros2.run("param", "set", "/load_controller", "axial_load_setpoint_n", "250.0", "--no-daemon").stdout
-    refused = ros2.run("param", "set", "/load_controller", "axial_load_setpoint_n", "20000.0", "--no-daemon")
+    refused = ros2.run("param", "set", "/load_controller", "axial_load_setpoint_n", f"{chain_limit + 1.0}", "--no-daemon")
     assert "Setting parameter failed" in refused.stderr, refused.stdout + refused.stderr
     refused = ros2.run("param", "set", "/simulator", "chunk_s", "0.002", "--no-daemon")
     assert "Setting parameter failed" in refused.stderr and "read-only" in refused.stderr, refused.stdout + refused.stderr

@@ -7,6 +7,7 @@ from pathlib import Path
 from typing import Annotated, ClassVar
 
 import pytest
+import yaml
 
 from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.load_control.settings import LoadControllerSettings
@@ -96,6 +97,7 @@ NODE_SETTINGS: tuple[type[NodeSettings], ...] = (LoadControllerSettings, Monitor
 
 DEPENDENT = {
     ("simulator", "initial_speed_rad_s"): "at most the rig file's spindle speed limit",
+    ("load_controller", "axial_load_setpoint_n"): "at most the rig file's loading_chain.max_setpoint_n",
     ("shadow", "warn_after_s"): "below error_after_s",
     ("shadow", "error_after_s"): "above warn_after_s",
 }
@@ -142,6 +144,34 @@ def test_file_checks_are_the_declared_ranges(settings: type[NodeSettings], field
     else:
         settings.from_values({**shipped, field.name: cast(field.low)})
         assert settings.check_value(field.name, cast(field.low)) == ""
+
+
+RIG_LIMITED = [
+    (LoadControllerSettings, "axial_load_setpoint_n", ("loading_chain", "max_setpoint_n")),
+    (SimulatorSettings, "initial_speed_rad_s", ("spindle", "max_speed_rad_s")),
+]
+"""Parameters whose upper bound is a limit written in the rig file: settings, parameter, rig key."""
+
+
+@pytest.mark.parametrize(("settings", "name", "rig_key"), RIG_LIMITED, ids=lambda x: x if isinstance(x, str) else "")
+def test_a_limit_of_the_rig_file_is_the_bound_checked_and_declared(settings: type[NodeSettings], name: str, rig_key: tuple[str, str], tmp_path: Path) -> None:
+    """The bound the node declares to ROS and the one its values are checked against are the rig
+    file's value (read here with PyYAML), for the shipped rig file and for another one."""
+    doc = yaml.safe_load(config_path("rig.yaml").read_text(encoding="utf-8"))
+    shipped_limit = float(doc[rig_key[0]][rig_key[1]])
+    doc[rig_key[0]][rig_key[1]] = shipped_limit / 2.0
+    other = tmp_path / "other_rig.yaml"
+    other.write_text(yaml.safe_dump(doc), encoding="utf-8")
+    for rig_file, limit in ((settings.shipped_parameters()["rig_file"], shipped_limit), (str(other), shipped_limit / 2.0)):
+        values = {**settings.shipped_parameters(), "rig_file": rig_file}
+        field = {f.name: f for f in settings.parameter_fields(values)}[name]
+        assert (field.high, field.high_exclusive) == (limit, False)
+        assert f"({'.'.join(rig_key)} in " in field.constraints()
+        assert getattr(settings.from_values(values | {name: limit}), name) == limit
+        with pytest.raises(ConfigError, match=rf"{name}: must be <= .*the rig's limit \({'.'.join(rig_key)} in .*, got {limit * 1.01!r}"):
+            settings.from_values(values | {name: limit * 1.01})
+    plausible = {f.name: f for f in settings.parameter_fields()}[name]
+    assert plausible.high is not None and plausible.high > shipped_limit and plausible.limit_source == ""  # without the values in force: any bench's bound
 
 
 def test_load_controller_reads_the_shipped_file_and_refuses_sim_time_off(tmp_path: Path) -> None:

@@ -17,6 +17,8 @@ from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleCommandError, SpindleDrive, profile_from_code
 
 STEP, ACCEL = SpeedProfileKind.STEP, SpeedProfileKind.CONSTANT_ACCELERATION
+UNLIMITED = {"max_speed": math.inf, "max_acceleration": math.inf, "max_lead": math.inf}
+"""A drive without limits: the profiles' arithmetic alone (the rig's limits are tested below)."""
 
 
 def cubic(t: float, t0: float, w0: float, t1: float, w1: float) -> float:
@@ -41,7 +43,7 @@ def run(drive: SpindleDrive, speed: float, t: float, h: float, n: int, feedback:
 
 
 def test_step_ramp_followed_at_every_chunk_boundary_and_ends_exactly():
-    drive = SpindleDrive(0.0)
+    drive = SpindleDrive(0.0, **UNLIMITED)
     drive.submit(SpindleCommand(100.0, STEP, ramp_time=1.0), now=0.0, current_speed=0.0)
     trace = run(drive, 0.0, 0.0, 1e-3, 1500)
     for t, w, _ in trace[::37]:
@@ -56,7 +58,7 @@ def test_step_ramp_followed_at_every_chunk_boundary_and_ends_exactly():
 
 
 def test_step_ramp_zero_duration_is_a_one_chunk_jump():
-    drive = SpindleDrive(10.0)
+    drive = SpindleDrive(10.0, **UNLIMITED)
     drive.submit(SpindleCommand(50.0, STEP, ramp_time=0.0), now=2.0, current_speed=10.0)
     assert drive.chunk_acceleration(2.0, 1e-3, 10.0) == pytest.approx(40.0 / 1e-3)
     assert drive.chunk_acceleration(2.001, 1e-3, 50.0) == 0.0
@@ -64,7 +66,7 @@ def test_step_ramp_zero_duration_is_a_one_chunk_jump():
 
 @pytest.mark.parametrize("h", [1e-3, 3e-3])
 def test_constant_acceleration_reaches_target_at_delta_w_over_alpha(h):
-    drive = SpindleDrive(50.0)
+    drive = SpindleDrive(50.0, **UNLIMITED)
     drive.submit(SpindleCommand(150.0, ACCEL, acceleration=40.0), now=0.0, current_speed=50.0)
     trace = run(drive, 50.0, 0.0, h, int(round(3.0 / h)))
     reach = 100.0 / 40.0  # 2.5 s
@@ -82,7 +84,7 @@ def test_constant_acceleration_reaches_target_at_delta_w_over_alpha(h):
 
 
 def test_constant_deceleration_goes_down_to_the_target():
-    drive = SpindleDrive(150.0)
+    drive = SpindleDrive(150.0, **UNLIMITED)
     drive.submit(SpindleCommand(30.0, ACCEL, acceleration=60.0), now=1.0, current_speed=150.0)
     trace = run(drive, 150.0, 1.0, 1e-3, 2500)
     assert trace[0][2] == pytest.approx(-60.0)
@@ -92,7 +94,7 @@ def test_constant_deceleration_goes_down_to_the_target():
 
 
 def test_command_starts_from_the_current_speed_not_the_old_profile():
-    drive = SpindleDrive(0.0)
+    drive = SpindleDrive(0.0, **UNLIMITED)
     drive.submit(SpindleCommand(100.0, STEP, ramp_time=1.0), now=0.0, current_speed=0.0)
     # the spindle is actually at 37 rad/s when the next command arrives at t = 0.4 s
     drive.submit(SpindleCommand(80.0, STEP, ramp_time=2.0), now=0.4, current_speed=37.0)
@@ -104,14 +106,14 @@ def test_command_starts_from_the_current_speed_not_the_old_profile():
 
 
 def test_speed_drift_is_corrected_in_the_next_chunk():
-    drive = SpindleDrive(100.0)
+    drive = SpindleDrive(100.0, **UNLIMITED)
     # the spindle is 0.5 rad/s off the profile: the next chunk brings it back
     a = drive.chunk_acceleration(3.0, 1e-3, 99.5)
     assert 99.5 + a * 1e-3 == pytest.approx(100.0, abs=1e-12)
 
 
 def test_future_command_waits_for_its_time():
-    drive = SpindleDrive(20.0)
+    drive = SpindleDrive(20.0, **UNLIMITED)
     drive.submit(SpindleCommand(60.0, STEP, ramp_time=0.5, time=0.2005), now=0.1, current_speed=20.0)
     assert len(drive.pending) == 1
     assert drive.chunk_acceleration(0.200, 1e-3, 20.0) == 0.0  # not yet: 0.2005 is inside this chunk
@@ -159,12 +161,12 @@ def test_profile_codes_of_the_message():
 
 
 def test_bad_chunk_and_bad_limits_are_refused():
-    drive = SpindleDrive(0.0)
+    drive = SpindleDrive(0.0, **UNLIMITED)
     with pytest.raises(SpindleCommandError, match="h"):
         drive.chunk_acceleration(0.0, 0.0)
     with pytest.raises(SpindleCommandError, match="current_speed"):
         drive.chunk_acceleration(0.0, 1e-3, math.nan)
     with pytest.raises(SpindleCommandError, match="max_speed"):
-        SpindleDrive(0.0, max_speed=0.0)
+        SpindleDrive(0.0, **(UNLIMITED | {"max_speed": 0.0}))
     with pytest.raises(SpindleCommandError, match="initial_speed"):
-        SpindleDrive(-3.0)
+        SpindleDrive(-3.0, **UNLIMITED)

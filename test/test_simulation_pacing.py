@@ -20,10 +20,12 @@ class FakeClock:
         return self.now
 
 
+OPTIONS: dict[str, object] = {"loop_period": 1e-3, "realtime": True, "rate": 1.0, "overrun_margin": 5e-3, "rtf_window": 1.0, "max_batch": 50, "resync_lag": 0.5}
+"""The test's own pacer: 1 ms loop, 5 ms margin, batches of 50 (the arithmetic below is worked for these)."""
+
+
 def pacer(clock: FakeClock, **options: object) -> RealTimePacer:
-    defaults: dict[str, object] = {"loop_period": 1e-3, "overrun_margin": 5e-3, "max_batch": 50, "resync_lag": 0.5}
-    defaults.update(options)
-    return RealTimePacer(1e-3, clock=clock, **defaults)  # type: ignore[arg-type]
+    return RealTimePacer(1e-3, clock=clock, **(OPTIONS | options))  # type: ignore[arg-type]
 
 
 def test_due_chunks_follow_the_wall_clock():
@@ -121,6 +123,6 @@ def test_bad_options_and_calls_before_start_are_refused():
         with pytest.raises(PacerError):
             pacer(clock, **bad)
     with pytest.raises(PacerError, match="chunk"):
-        RealTimePacer(0.0, clock=clock)
+        RealTimePacer(0.0, clock=clock, **OPTIONS)  # type: ignore[arg-type]
     with pytest.raises(PacerError, match="start"):
         pacer(clock).due_chunks(0.0)

@@ -23,7 +23,7 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
-from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RadialLoadError, RigTwin, TwinError
+from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RadialLoadError, RigTwin, TwinError, twin_options
 from conftest import bearing_section
 
 RPM = math.pi / 30.0
@@ -51,9 +51,14 @@ def params() -> BearingParameters:
     return BearingParameters.calibrated()
 
 
+UNLIMITED_LOADERS = {"max_radial_load": math.inf, "max_moment": math.inf}
+"""A bench with radial and moment loaders of any size (the shipped rig loads only axially)."""
+
+
 def make_twin(params: BearingParameters, config: FibreOpticConfig | None = None, **options: float) -> RigTwin:
+    """The simulator's twin (its shipped settings and rig limits) with unlimited loaders."""
     engine = BearingDynamics(params)
-    return RigTwin(engine, config or sensors(), BearingKinematics.from_config(BEARING), **options)
+    return RigTwin(engine, config or sensors(), BearingKinematics.from_config(BEARING), **(twin_options() | UNLIMITED_LOADERS | options))
 
 
 def test_counted_speeds_equal_the_true_speeds_at_constant_speed_without_jitter(params):
@@ -146,7 +151,7 @@ def test_truth_carries_the_cage_whirl_radius(params):
 def test_sensor_slip_agrees_with_ground_truth_over_whole_revolution_windows(params):
     """Issue 5: within 0.1 percentage points, through a STEP ramp, a hold, a constant
     acceleration and a hold, with the shipped sensors (config/rig.yaml: 4 strips, 1 us jitter)."""
-    twin = RigTwin(BearingDynamics(params), FibreOpticConfig.from_yaml(), BearingKinematics.from_config(BEARING))
+    twin = RigTwin(BearingDynamics(params), FibreOpticConfig.from_yaml(), BearingKinematics.from_config(BEARING), **twin_options())
     twin.command_spindle(SpindleCommand(1500 * RPM, SpeedProfileKind.STEP, ramp_time=1.0))
     times, inner, cage, spindle_t, cage_t = [0.0], [0.0], [0.0], [], []
     for i in range(2700):
@@ -211,7 +216,12 @@ def test_radial_load_is_the_magnitude_of_its_components_and_reaches_the_engine(p
     assert twin.set_loads(163.0) == (163.0, 0.0)
     twin.tick()
     assert twin.engine.radial_load == 0.0
-    stiff = RigTwin(BearingDynamics(params, model="stiff"), sensors(), BearingKinematics.from_config(BEARING), initial_axial_load=163.0)
+    stiff = RigTwin(
+        BearingDynamics(params, model="stiff"),
+        sensors(),
+        BearingKinematics.from_config(BEARING),
+        **(twin_options() | UNLIMITED_LOADERS | {"initial_axial_load": 163.0}),
+    )
     with pytest.raises(RadialLoadError, match="reduced model"):
         stiff.set_loads(163.0, 1.0, 0.0)
     assert stiff.set_loads(170.0, 0.0, 0.0) == (170.0, 0.0)

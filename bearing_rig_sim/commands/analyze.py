@@ -1,11 +1,7 @@
-"""``bearing-rig analyze BAG [--out DIR]``: the slip and stability report of a recorded bag.
+"""``bearing-rig analyze BAG``: the slip and stability report of a recorded bag (markdown, PNG
+plots, CSV series), from the monitor run offline over its pulses.
 
-Runs the monitor offline over the bag's fibre-optic pulses (deterministic: the same bag gives the
-same report), then writes ``report.md``, PNG plots of speeds, slip, axial load and state against
-time, and the derived series as CSV into DIR (default ``out/analyze/<bag name>``). Bags of the
-physical bench on the same topics are analysed alike (docs/guide.md, "Replay and offline analysis").
-A damaged bag is analysed as far as it reads, with a warning; a bag without the pulse topics is
-an error.
+What is written and which bags: docs/guide.md, section ``bearing-rig analyze``.
 """
 
 from __future__ import annotations
@@ -14,12 +10,12 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.commands import output_folder
+from bearing_rig_sim.commands import describe, output_folder
 
 
 def register(subparsers: Any) -> None:
     """Add ``analyze`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("analyze", help="slip and stability report of a bag (markdown, PNG, CSV)", description=__doc__)
+    p = subparsers.add_parser("analyze", help="slip and stability report of a bag (markdown, PNG, CSV)", description=describe(__doc__, "analyze"))
     p.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder (default: out/analyze/<bag name>)")
     p.add_argument(

@@ -11,6 +11,8 @@ from pathlib import Path
 from typing import Any, TextIO
 from collections.abc import Iterator
 
+from bearing_rig_sim.commands import describe
+
 PROG = "bearing-rig"
 
 
@@ -44,7 +46,7 @@ def bag_warnings_as_lines(out: TextIO | None = None) -> Iterator[list[str]]:
 
 def register(subparsers: Any) -> None:
     """Add ``bag`` (``info``, ``repair``) to the ``bearing-rig`` parser."""
-    parser = subparsers.add_parser("bag", help="inspect or repair a recorded bag", description=__doc__)
+    parser = subparsers.add_parser("bag", help="inspect or repair a recorded bag", description=describe(__doc__, "bag"))
     actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
     info = actions.add_parser("info", help="topics, counts, duration, run context and problems of a bag")
     info.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")

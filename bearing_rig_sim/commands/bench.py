@@ -21,6 +21,7 @@ from types import ModuleType
 from typing import Any, TextIO
 from collections.abc import Iterable
 
+from bearing_rig_sim.commands import CommandParser, describe
 from bearing_rig_sim.errors import RigError
 
 BENCHMARKS: dict[str, str] = {
@@ -40,7 +41,7 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "bench",
         help="run a benchmark (JSON lines with --json)",
-        description=__doc__.split("\n\n")[0] if __doc__ else None,
+        description=describe(__doc__, "bench"),
         epilog=f"benchmarks: {known_names()}. `bearing-rig bench NAME --help` lists NAME's options.",
     )
     parser.add_argument("--json", action="store_true", help="print one JSON object per line")
@@ -72,7 +73,7 @@ def load_benchmark(name: str) -> ModuleType:
 def run(args: argparse.Namespace) -> int:
     """Parse the benchmark's own options, run it and print its rows; return the exit status."""
     module = load_benchmark(args.name)
-    parser = argparse.ArgumentParser(prog=f"bearing-rig bench {args.name}", description=module.__doc__)
+    parser = CommandParser(prog=f"bearing-rig bench {args.name}", description=describe(module.__doc__, "bench"))
     parser.add_argument("--json", action="store_true", help="print one JSON object per line")
     module.add_arguments(parser)
     options = parser.parse_args(args.options)

@@ -1,13 +1,6 @@
 """``bearing-rig calibrate DATA.csv``: fit the engine's uncertain resistances to bench slip data.
 
-With ``--thermal`` every row is the coupled thermal steady state (the bearing file's
-``thermal:`` section): the bench's slips are steady, warm values, and the fitted values are the
-grease's at the bearing file's lubricant temperature (the reference of its temperature laws).
-The shipped coupled calibration is made so (docs/thermal.md, "Named calibrations"), with
-``--fix consistency_temperature_exponent=0``. A bench run (a CSV adding ``hold_s``,
-``outer_ring_temperature_c``, ``friction_torque_n_mm``: :mod:`bearing_rig_sim.studies.bench_run`)
-is fitted with ``--thermal`` through every measured quantity at once (docs/thermal.md, "The bench
-run that settles the priors")."""
+The thermal fit and where the result goes: docs/guide.md, section ``bearing-rig calibrate``."""
 
 from __future__ import annotations
 
@@ -31,7 +24,7 @@ from bearing_rig_sim.studies.calibration import (
     write_calibration,
 )
 from bearing_rig_sim.studies.uncertainty import LOAD_SIGMA_N, check_identifiable, fit_uncertainty
-from bearing_rig_sim.commands import output_file
+from bearing_rig_sim.commands import describe, output_file
 from bearing_rig_sim.config import ConfigError, check_number, rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.calibrations import NAMED, calibration_file
@@ -42,13 +35,13 @@ from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 def register(subparsers: Any) -> None:
     """Add ``calibrate`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=__doc__)
+    p = subparsers.add_parser("calibrate", help="fit uncertain resistances to bench slip data", description=describe(__doc__, "calibrate"))
     p.add_argument(
         "data",
         type=Path,
         help="CSV with columns inner_ring_rpm, axial_load_n, slip_pct; or a bench run adding hold_s, outer_ring_temperature_c, friction_torque_n_mm (with --thermal)",
     )
-    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
+    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
     p.add_argument("--model", choices=MODELS, default=None, help="start from a named model's files, uncalibrated (instead of --bearing)")
     p.add_argument("--fit", nargs="+", default=list(DEFAULT_FITTED), choices=sorted(CALIBRATABLE), help="parameters to fit")
     p.add_argument(

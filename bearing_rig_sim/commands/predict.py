@@ -1,47 +1,8 @@
-"""``bearing-rig predict --rpm R [R ...] --load N``: steady cage speed and slip from the calibrated
-engine (one JSON object per line with ``--json``).
+"""``bearing-rig predict --rpm R [R ...] --load N``: steady cage speed and slip of the calibrated
+twin at given speeds and axial loads; on request the thermal steady state, combined loads and
+the mounting.
 
-With ``--thermal`` each point is the coupled thermal steady state (bearing_rig_sim/thermal,
-docs/thermal.md): slip, ``friction_torque_nm`` and ``power_loss_w`` at the lubricant's steady
-temperature, with ``outer_ring_temperature_c``, ``lubricant_temperature_c`` and the values at the
-bearing file's temperature under ``isothermal``. ``--transient S`` prints the warm-up from
-ambient over S seconds instead (one row per ``--transient-step``). ``--lubricant FILE`` replaces
-the bearing file's lubricant (the calibration's lubricant values are laid over it only when
-``--calibration`` is given); the shipped calibration belongs to the shipped bearing, so another
-``--bearing`` gets a calibration only when one is named. ``--running-hours H`` takes the grease
-to its state after H hours of running by its file's ``running_in:`` law
-(:mod:`bearing_rig_sim.dynamics.running_in`; 0: the calibrated, freshly packed state). When the calibration file has an
-``uncertainty:`` block (``bearing-rig calibrate`` writes it), each point gets ``slip_pct_low`` and
-``slip_pct_high``, its 95 % interval from the parameter and load uncertainty
-(:mod:`bearing_rig_sim.studies.uncertainty`).
-
-With ``--radial-load`` (and ``--moment``) each point also gets the quasi-static load
-distribution under the combined load (dynamics/quasi_static.py): ``ball_load_max_n``,
-``ball_load_min_n``, ``loaded_balls``, ``contact_angle_max_load_deg`` and, with the tilt held
-(no ``--moment``), ``reaction_moment_n_m`` [M_x, M_y]. Such a point's slip, torque and power are
-the engine's under the combined load, averaged over whole ball-pass periods (the steady state is
-periodic there: :meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`), with
-``cage_whirl_radius_um`` the cage centre's distance from the axis at the window's end,
-``cage_whirl_frequency_hz`` the centre's orbital frequency about the axis over the window (signed:
-> 0 in the cage's direction of rotation) and ``cage_whirl_ratio`` that over the cage's rotation
-frequency, both null with ``cage_whirl_reason`` when the centre does not orbit
-(:func:`~bearing_rig_sim.dynamics.steady.cage_whirl`), and no uncertainty interval (the
-calibration's is an axial-load one). With ``--thermal`` such a
-point is the coupled thermal steady state of that periodic state (its heat, term by term, each
-term's energy over whole ball-pass periods over their length; the network's conductances those
-of the axial load), its ``isothermal`` values the periodic state at the bearing file's
-temperature, and ``--transient`` warms up under the combined load.
-
-The mounting (non-thermal path; docs/model.md, "Mounting"): ``--clearance M`` an extra diametral
-clearance (m, negative: interference), ``--misalignment RAD RAD`` the tilts held, ``--preload-n N``
-a spring preload added to each point's axial load and ``--preload-displacement M`` the rigid
-preload of a back-to-back pair, within the ranges of the rig file's ``mounting`` section
-(:mod:`bearing_rig_sim.rig.mounting`). Each row then states them (``clearance_um``,
-``misalignment_mrad``, ``preload_n``, ``preload_displacement_um``; ``axial_load_n`` stays the
-external load) and has no uncertainty interval (the calibration's is the nominal mounting's). A
-misalignment breaks the axial symmetry: its points are periodic steady states as under a radial
-load. The load distribution's row (``--radial-load``) takes the clearance, misalignment and
-spring preload; the rigid preload's partner is the engine's only.
+What each row holds and every option: docs/guide.md, section ``bearing-rig predict``.
 """
 
 from __future__ import annotations
@@ -52,8 +13,9 @@ import math
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
-from bearing_rig_sim.dynamics import BearingParameters, Mounting
+from bearing_rig_sim.commands import describe, rig_limit_text
+from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
+from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.calibrations import DEFAULT_CALIBRATION, calibration_file
 from bearing_rig_sim.dynamics.parameters import overlay_calibration
@@ -63,21 +25,33 @@ from bearing_rig_sim.dynamics.models import BENCH, DEFAULT_MODEL, MODELS, model_
 from bearing_rig_sim.dynamics.steady import SKID_SLIP_PCT, CageWhirl, SteadySolver, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.mounting import MountingConfig
-from bearing_rig_sim.settings_model import read_file, validate_mapping
+from bearing_rig_sim.settings_model import check_within_rig, read_file, validate_mapping
 from bearing_rig_sim.studies.calibration import SteadyState, steady_states
 
 
 def register(subparsers: Any) -> None:
     """Add ``predict`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("predict", help="steady slip of the calibrated twin", description=__doc__)
-    p.add_argument("--rpm", type=float, nargs="+", required=True, help="inner-ring speeds, rpm")
-    p.add_argument("--load", type=float, nargs="+", required=True, help="axial loads, N (one, or one per speed, or several at one speed)")
+    p = subparsers.add_parser("predict", help="steady slip of the calibrated twin", description=describe(__doc__, "predict"))
+    p.add_argument(
+        "--rpm",
+        type=float,
+        nargs="+",
+        required=True,
+        help=f"inner-ring speeds, rpm, {rig_limit_text('spindle.max_speed_rad_s', unit_in_si=RPM_TO_RAD_S, unit=' rpm')}",
+    )
+    p.add_argument(
+        "--load",
+        type=float,
+        nargs="+",
+        required=True,
+        help=f"axial loads, N (one, one per speed, or several at one speed), {rig_limit_text('loading_chain.max_setpoint_n', unit=' N')}",
+    )
     p.add_argument("--radial-load", type=float, nargs="+", default=None, help="radial loads, N (one, or one per speed): adds the load distribution")
     p.add_argument(
         "--moment", type=float, nargs=2, default=None, metavar=("M_X", "M_Y"), help="moment on the inner ring, N m (default: tilt held, reaction reported)"
     )
     p.add_argument("--model", choices=MODELS, default=None, help="named model: bench (the bench twin, default) or paper (the paper's own model; docs/paper.md)")
-    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: config/bearings/h7006c.yaml)")
+    p.add_argument("--bearing", type=Path, default=None, help="bearing file (default: the shipped H7006C)")
     p.add_argument(
         "--calibration",
         type=str,
@@ -110,6 +84,13 @@ def mounting_of(args: argparse.Namespace) -> Mounting | None:
     }
     mounting = Mounting.of(validate_mapping(MountingConfig, stated, "command line (--clearance, --misalignment, --preload-n, --preload-displacement)"))
     return None if mounting == Mounting() else mounting
+
+
+RIG_FREE_MAX_RPM = 100_000.0
+"""Highest speed for a bearing that is not the rig's (``--bearing``), rpm: spindle bearings of
+35 mm bore run to about 100 000 rpm (NASA TP-2275 to 72 000 rpm)."""
+RIG_FREE_MAX_LOAD_N = 20_000.0
+"""Largest axial load for a bearing that is not the rig's, N."""
 
 
 def parameters_of(args: argparse.Namespace) -> BearingParameters:
@@ -173,10 +154,17 @@ def run(args: argparse.Namespace) -> int:
     if len(args.load) not in (1, len(args.rpm)):
         raise RigError(f"--load takes one value, one per speed ({len(args.rpm)}) or several at one speed, got {len(args.load)}")
     loads = args.load * len(args.rpm) if len(args.load) == 1 else args.load
+    # the rig file's limits bound the rig's bearing; another bearing (--bearing, e.g. NASA TP-2275
+    # at 72 000 rpm) is not on this rig and is held to its plausible ranges only
+    on_rig = args.bearing is None
     for n in args.rpm:
-        check_number(n, "command line", "--rpm", gt=0.0, le=100000.0)
+        check_number(n, "command line", "--rpm", gt=0.0, le=RIG_FREE_MAX_RPM)
+        if on_rig:
+            check_within_rig(n, "command line", "--rpm", "spindle.max_speed_rad_s", unit_in_si=RPM_TO_RAD_S, unit=" rpm")
     for f in loads:
-        check_number(f, "command line", "--load", ge=1.0, le=20000.0)
+        check_number(f, "command line", "--load", ge=MIN_AXIAL_LOAD, le=RIG_FREE_MAX_LOAD_N)
+        if on_rig:
+            check_within_rig(f, "command line", "--load", "loading_chain.max_setpoint_n", unit=" N")
     if args.transient is not None:
         check_number(args.transient, "command line", "--transient", gt=0.0, le=36000.0)
         check_number(args.transient_step, "command line", "--transient-step", gt=0.0, le=3600.0)

@@ -1,9 +1,7 @@
-"""``bearing-rig replay BAG [--rate R] [--loop] [--topics T ...] [--start S] [--duration D] [--foxglove [PORT]]``:
-republish a recorded bag into the ROS 2 graph with its original timing, and ``/clock``.
+"""``bearing-rig replay BAG``: republish a recorded bag into the ROS 2 graph with its original
+timing, and ``/clock``.
 
-Nodes on ``use_sim_time`` (the monitor's default) follow the bag's clock. Replay only the sensor
-topics (``--topics /rig/spindle/pulses /rig/cage/pulses``) to run a monitor on them without the
-recorded ``/rig/slip_status`` beside its own. Ctrl-C stops the replay cleanly (exit status 130).
+Replaying some topics only, stopping: docs/guide.md, section ``bearing-rig replay``.
 """
 
 from __future__ import annotations
@@ -14,6 +12,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import describe
 from bearing_rig_sim.commands.run import add_foxglove_argument
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import CLOCK
@@ -21,7 +20,7 @@ from bearing_rig_sim.interfaces import CLOCK
 
 def register(subparsers: Any) -> None:
     """Add ``replay`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("replay", help=f"republish a bag into ROS 2 with its timing and {CLOCK.name}", description=__doc__)
+    p = subparsers.add_parser("replay", help=f"republish a bag into ROS 2 with its timing and {CLOCK.name}", description=describe(__doc__, "replay"))
     p.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")
     p.add_argument("--rate", type=float, default=1.0, help="bag seconds per wall second (default 1)")
     p.add_argument("--loop", action="store_true", help="start again at the end (the clock jumps back), until Ctrl-C")

@@ -9,6 +9,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import describe
 from bearing_rig_sim.config import BEARING_MODELS
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.studies.reproduction_report import Outputs
@@ -16,7 +17,7 @@ from bearing_rig_sim.studies.reproduction_report import Outputs
 
 def register(subparsers: Any) -> None:
     """Add ``reproduce`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("reproduce", help="run the paper's experiments and write a report", description=__doc__)
+    p = subparsers.add_parser("reproduce", help="run the paper's experiments and write a report", description=describe(__doc__, "reproduce"))
     p.add_argument("--out", type=Path, default=Path("out/reproduce"), help="output folder (default: out/reproduce)")
     p.add_argument("--model", choices=BEARING_MODELS, default=None, help="one named model only (default: both, side by side)")
     p.add_argument("--bearing", type=Path, default=None, help="bearing file: one custom model instead (with --calibration)")
@@ -30,7 +31,7 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run or reuse the experiments and write the outputs."""
     from bearing_rig_sim.commands import output_folder
-    from bearing_rig_sim.config import config_path
+    from bearing_rig_sim.config import shipped_calibration_file
     from bearing_rig_sim.errors import RigError
     from bearing_rig_sim.studies.reproduction import reproduce, reproduce_models
 
@@ -40,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     if args.bearing is not None or args.calibration is not None:
         if args.model is not None:
             raise RigError("--model names the bearing and calibration: give --bearing and --calibration without it")
-        params = BearingParameters.from_yaml(args.bearing, args.calibration or config_path("calibration", "h7006c_table3.yaml"))
+        params = BearingParameters.from_yaml(args.bearing, args.calibration or shipped_calibration_file())
         _print_outputs(reproduce(args.out, params, workers=args.workers, use_cache=not args.no_cache, progress=not args.quiet))
         return 0
     models = (args.model,) if args.model is not None else BEARING_MODELS

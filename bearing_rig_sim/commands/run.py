@@ -1,10 +1,7 @@
-"""``bearing-rig run [PROGRAM] [--no-realtime] [--bag-dir DIR] [--quiet] [--params-file FILE] [--foxglove [PORT]]``.
+"""``bearing-rig run [PROGRAM]``: a rig session: the three nodes, a test program on the
+simulation clock, every rig topic recorded, live progress and a summary per segment.
 
-Starts the simulator, load controller and monitor as separate processes on a private ROS domain,
-runs the test program on the simulation clock, records every rig topic to
-``<bag dir>/<run id>/`` (rosbag2, MCAP storage), prints live progress and a summary table per
-segment. Ctrl-C stops it with the bag finalised and the summary so far (exit status 130); a node
-that fails to come up or dies is named with the end of its output (exit status 1).
+Processes, bag, exit statuses: docs/guide.md, section ``bearing-rig run``.
 """
 
 from __future__ import annotations
@@ -14,6 +11,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.commands import describe
 from bearing_rig_sim.config import BEARING_MODELS, check_number, config_path
 from bearing_rig_sim.errors import RigError
 
@@ -47,7 +45,7 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run",
         help="run a test program on the rig's nodes, recorded (default: the validation program)",
-        description=__doc__.split("\n\n")[1] if __doc__ else None,
+        description=describe(__doc__, "run"),
     )
     parser.add_argument(
         "program",

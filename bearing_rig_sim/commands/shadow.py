@@ -1,15 +1,7 @@
-"""``bearing-rig shadow``: the twin beside the bench, live or over a recorded bag.
+"""``bearing-rig shadow``: the twin beside the bench on its measured inputs (predicted slip,
+residual, anomalies), live or over a recorded bag.
 
-* ``bearing-rig shadow`` runs the shadow node on the live topics (the bench's pulse counter and
-  load cell, or the twin's): predictions and residuals on ``/twin/...``, anomalies on
-  ``/diagnostics``; ROS arguments after ``--``: ``bearing-rig shadow -- --ros-args -p
-  warn_after_s:=2.0``.
-* ``bearing-rig shadow --bag BAG --out DIR`` runs the same core over a bag, without ROS and
-  deterministically: ``DIR/residuals.csv`` (one row per slip window), ``DIR/report.md`` and
-  ``DIR/shadow.png``. The bag needs ``/rig/spindle/pulses``, ``/rig/cage/pulses`` and
-  ``/rig/axial_load/force``, from the twin or the physical bench.
-
-The exit status is 0 when no window was flagged, 1 when some were (offline), 2 on an error.
+Both modes, their outputs and exit statuses: docs/guide.md, section ``bearing-rig shadow``.
 """
 
 from __future__ import annotations
@@ -19,9 +11,14 @@ from pathlib import Path
 from typing import Any
 
 
+from bearing_rig_sim.commands import describe
+
+
 def register(subparsers: Any) -> None:
     """Add ``shadow`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("shadow", help="the twin beside the bench: predicted slip, residual, anomalies (live or --bag)", description=__doc__)
+    p = subparsers.add_parser(
+        "shadow", help="the twin beside the bench: predicted slip, residual, anomalies (live or --bag)", description=describe(__doc__, "shadow")
+    )
     p.add_argument("--bag", type=Path, default=None, metavar="BAG", help="run over this bag instead of the live topics")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder with --bag (default: out/shadow/<bag name>)")
     p.add_argument("--params", type=Path, default=None, metavar="FILE", help="shadow parameter file (default: config/shadow.yaml)")

@@ -1,10 +1,7 @@
-"""``bearing-rig sweep SPEC.yaml [--out DIR] [--scheduler ADDRESS | --workers N]``: run a sweep.
+"""``bearing-rig sweep SPEC.yaml``: run a sweep of operating points on Dask, writing a Parquet
+table and, for a steady sweep, the operating map.
 
-Without ``--scheduler`` the points run on a Dask ``LocalCluster`` of ``--workers`` processes
-(default: one per core); with ``--scheduler tcp://HOST:8786`` on an existing cluster started
-with ``dask scheduler`` and ``dask worker``. Results go to ``DIR/results.parquet`` (one row per
-point; a second run computes only the missing points) and, for a steady sweep, the operating
-map ``DIR/operating_map.png``.
+Where the points run and what is written: docs/guide.md, section ``bearing-rig sweep``.
 """
 
 from __future__ import annotations
@@ -15,9 +12,12 @@ from pathlib import Path
 from typing import Any
 
 
+from bearing_rig_sim.commands import describe
+
+
 def register(subparsers: Any) -> None:
     """Add ``sweep`` to the ``bearing-rig`` parser."""
-    p = subparsers.add_parser("sweep", help="run a sweep of operating points on Dask (Parquet results, operating map)", description=__doc__)
+    p = subparsers.add_parser("sweep", help="run a sweep of operating points on Dask (Parquet results, operating map)", description=describe(__doc__, "sweep"))
     p.add_argument("spec", type=Path, help="sweep spec (YAML), e.g. config/sweeps/paper_load_grid.yaml")
     p.add_argument("--out", type=Path, default=None, help="result folder (default: sweeps/<spec name>)")
     where = p.add_mutually_exclusive_group()

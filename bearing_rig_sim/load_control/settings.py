@@ -16,9 +16,8 @@ from typing import Any, ClassVar
 
 from pydantic import field_validator
 
-from bearing_rig_sim.config import config_path
 from bearing_rig_sim.interfaces import AXIAL_LOAD_STATE, CLOCK, DIAGNOSTICS
-from bearing_rig_sim.settings_model import Flag, NodeSettings, Number, field_error, param
+from bearing_rig_sim.settings_model import Flag, NodeSettings, Number, field_error, param, resolve_rig_file
 
 __all__ = ["NODE_NAME", "SHIPPED_FILE", "LoadControllerSettings", "shipped_parameters"]
 
@@ -36,7 +35,8 @@ class LoadControllerSettings(NodeSettings):
 
     ``use_sim_time`` may be in the file and must be true: the chain is stepped on the
     simulation clock. ``rig_file`` is resolved to an existing file ('' = the shipped
-    ``config/rig.yaml``; a relative name is under ``config/``).
+    ``config/rig.yaml``; a relative name is under ``config/``). The set-point's upper bound is
+    that file's ``loading_chain.max_setpoint_n``, in the checks and in the ROS descriptor.
     """
 
     NODE_NAME: ClassVar[str] = NODE_NAME
@@ -44,7 +44,12 @@ class LoadControllerSettings(NodeSettings):
 
     rig_file: Path = param("rig data file with the loading chain ('' = the shipped config/rig.yaml)")
     axial_load_setpoint_n: Number = param(
-        "axial-load set-point; also settable by topic and service; mirrors the one in force", unit="N", ge=0.0, le=10_000.0, live=True
+        "axial-load set-point; also settable by topic and service; mirrors the one in force",
+        unit="N",
+        ge=0.0,
+        le=10_000.0,
+        live=True,
+        rig_limit="loading_chain.max_setpoint_n",
     )
     engage_clutch_on_start: Flag = param("close the magnet clutch when the node is configured")
     state_rate_hz: Number = param(f"rate of {AXIAL_LOAD_STATE.name} in simulated time", unit="Hz", gt=0.0, le=1000.0)
@@ -61,12 +66,7 @@ class LoadControllerSettings(NodeSettings):
     @field_validator("rig_file", mode="before")
     @classmethod
     def _existing_rig_file(cls, raw: object) -> Path:
-        if not isinstance(raw, str):
-            raise ValueError(f"must be a file name ('' = the shipped rig.yaml), got {raw!r}")
-        rig = Path(raw) if raw and Path(raw).is_absolute() else config_path(*(Path(raw).parts if raw else ("rig.yaml",)))
-        if not rig.is_file():
-            raise ValueError(f"file not found: {raw!r} (looked for {rig})")
-        return rig
+        return resolve_rig_file(raw)
 
 
 def shipped_parameters() -> dict[str, Any]:

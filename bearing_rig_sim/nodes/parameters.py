@@ -29,6 +29,7 @@ __all__ = [
     "STANDARD_PARAMETERS",
     "STANDARD_PREFIXES",
     "NODES",
+    "in_force",
     "ParameterSpec",
     "is_standard",
     "settings_of",
@@ -118,6 +119,12 @@ NODE_SETTINGS: Mapping[str, type[NodeSettings]] = _SettingsByNode()
 
 NODE_PARAMETERS: Mapping[str, dict[str, ParameterSpec]] = _ByNode()
 """Every parameter of every node (besides rclpy's own ``use_sim_time``), by node name."""
+
+
+def in_force(node: str, values: Mapping[str, object]) -> dict[str, ParameterSpec]:
+    """``node``'s parameters with the bounds that the ``values`` in force give them (a limit of
+    the rig file they name: :meth:`~bearing_rig_sim.settings_model.NodeSettings.parameter_fields`)."""
+    return {f.name: f for f in settings_of(node).parameter_fields(values)}
 
 
 def spec_for(node: str, name: str) -> ParameterSpec:

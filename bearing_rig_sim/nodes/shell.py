@@ -53,7 +53,7 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.nodes.parameters import ParameterSpec, is_standard, spec_for
+from bearing_rig_sim.nodes.parameters import ParameterSpec, in_force, is_standard, spec_for
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -79,16 +79,21 @@ def descriptor_of(spec: ParameterSpec) -> ParameterDescriptor:
 
 def declare_described(node: Node, node_name: str, defaults: Mapping[str, Any]) -> None:
     """Declare each parameter of ``defaults`` (except those every node declares by itself,
-    :func:`~bearing_rig_sim.nodes.parameters.is_standard`) with its descriptor.
+    :func:`~bearing_rig_sim.nodes.parameters.is_standard`) with its descriptor. A parameter
+    bounded by a limit of the rig file (``rig_limit``) is declared last, with the rig file in
+    force (declared before it) giving its upper bound.
 
     Raises:
         RigError: a value given at start (``-p``, parameter file) is out of the parameter's
             range (one line naming the parameter and the range); a parameter has no spec.
     """
-    for name, default in defaults.items():
-        if is_standard(name):
-            continue
+    names = [name for name in defaults if not is_standard(name)]
+    bounded = [name for name in names if spec_for(node_name, name).rig_limit]
+    for name in [*(n for n in names if n not in bounded), *bounded]:
+        default = defaults[name]
         spec = spec_for(node_name, name)
+        if spec.rig_limit:
+            spec = in_force(node_name, parameter_values(node, defaults))[name]
         try:
             node.declare_parameter(name, default, descriptor_of(spec))
         except InvalidParameterValueException as exc:

@@ -186,30 +186,8 @@ class SimulatorNode(ManagedNode):
         """Validate the parameters; build the twin, the pacer, publishers, subscriptions, timers."""
         s = SimulatorSettings.from_values(parameter_values(self, self._defaults), f"{NODE_NAME} parameters")
         self.settings = s
-        self.twin = RigTwin.from_files(
-            s.bearing_file,
-            s.calibration_file,
-            s.rig_file,
-            model=s.model,
-            bearing_model=s.bearing_model,
-            chunk=s.chunk_s,
-            initial_speed=s.initial_speed_rad_s,
-            initial_axial_load=s.initial_axial_load_n,
-            counter_timeout=s.counter_timeout_s,
-            max_speed=s.max_spindle_speed_rad_s,
-            max_acceleration=s.max_spindle_acceleration_rad_s2,
-            max_command_lead=s.max_command_lead_s,
-        )
-        self.pacer = RealTimePacer(
-            s.chunk_s,
-            loop_period=s.loop_period_s,
-            realtime=s.realtime,
-            rate=s.rate,
-            overrun_margin=s.overrun_margin_s,
-            rtf_window=s.rtf_window_s,
-            max_batch=s.max_batch_chunks,
-            resync_lag=s.resync_lag_s,
-        )
+        self.twin = RigTwin.from_files(s.bearing_file, s.calibration_file, s.rig_file, model=s.model, bearing_model=s.bearing_model, settings=s)
+        self.pacer = RealTimePacer.from_settings(s)
         self.health = SimulatorHealth(s.fault_hold_s)
         self._speeds_every = max(1, round(1.0 / (s.speeds_rate_hz * s.chunk_s)))
         self._truth_every = max(1, round(1.0 / (s.truth_rate_hz * s.chunk_s)))

@@ -26,12 +26,12 @@ from typing import Any, ClassVar, TypeVar
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from bearing_rig_sim.config import ConfigError, config_path, mapping_at, read_mapping
+from bearing_rig_sim.config import SHIPPED_RIG_FILE, ConfigError, config_path, mapping_at, read_mapping
 from bearing_rig_sim.settings_model import Flag, Integer, Number, first_error, validate_mapping
 
 R = TypeVar("R", bound="ParameterRecord")
 
-RIG_FILE = "rig.yaml"
+RIG_FILE = SHIPPED_RIG_FILE
 """Name of the rig data file under ``config/``."""
 
 

@@ -22,6 +22,7 @@ from bearing_rig_sim.simulation.twin import (
     TickOutput,
     TruthSummary,
     TwinError,
+    twin_options,
 )
 
 __all__ = [
@@ -40,4 +41,5 @@ __all__ = [
     "TickOutput",
     "TruthSummary",
     "TwinError",
+    "twin_options",
 ]

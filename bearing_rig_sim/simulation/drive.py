@@ -101,12 +101,12 @@ class SpindleDrive:
 
     def __init__(
         self,
-        initial_speed: float = 0.0,
+        initial_speed: float,
         start_time: float = 0.0,
         *,
-        max_speed: float = math.inf,
-        max_acceleration: float = math.inf,
-        max_lead: float = math.inf,
+        max_speed: float,
+        max_acceleration: float,
+        max_lead: float,
     ) -> None:
         for name, value in (("max_speed", max_speed), ("max_acceleration", max_acceleration)):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or math.isnan(value) or not value > 0.0:

@@ -20,7 +20,8 @@ The achieved real-time factor is simulated seconds per wall second over a slidin
 ``rtf_window`` wall seconds, from the (wall, sim) pairs given to :meth:`RealTimePacer.record`.
 
 The wall clock is injected (``clock``, default :func:`time.monotonic`), so the arithmetic is
-tested with a fake clock.
+tested with a fake clock. The options have no defaults here: the simulator's are in
+``config/simulator.yaml`` (:meth:`RealTimePacer.from_settings`).
 """
 
 from __future__ import annotations
@@ -29,8 +30,12 @@ import math
 import time
 from collections import deque
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from bearing_rig_sim.errors import RigError
+
+if TYPE_CHECKING:
+    from bearing_rig_sim.simulation.settings import SimulatorSettings
 
 CHUNK_EPSILON = 1e-9
 """Tolerance, in chunks, when counting due chunks (float round-off of sums of chunk lengths)."""
@@ -53,7 +58,7 @@ class RealTimePacer:
 
     Args:
         chunk: simulated length of one chunk, s (> 0).
-        loop_period: wall period of the loop's timer, s (> 0; default: one chunk).
+        loop_period: wall period of the loop's timer, s (> 0; None: one chunk at ``rate``).
         realtime: lock to the wall clock (True) or run as fast as possible (False).
         rate: simulated seconds per wall second in real time (1 = real time; > 0).
         overrun_margin: lateness beyond one loop period, wall s, that counts as an overrun (> 0).
@@ -70,13 +75,13 @@ class RealTimePacer:
         self,
         chunk: float,
         *,
-        loop_period: float | None = None,
-        realtime: bool = True,
-        rate: float = 1.0,
-        overrun_margin: float = 0.005,
-        rtf_window: float = 1.0,
-        max_batch: int = 50,
-        resync_lag: float = 0.5,
+        loop_period: float | None,
+        realtime: bool,
+        rate: float,
+        overrun_margin: float,
+        rtf_window: float,
+        max_batch: int,
+        resync_lag: float,
         clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.chunk = _positive("chunk", chunk)
@@ -101,6 +106,21 @@ class RealTimePacer:
         """Times the debt was dropped because the lag exceeded ``resync_lag`` (1)."""
         self.behind = False
         """Whether the latest call found the simulation late by more than the margin."""
+
+    @classmethod
+    def from_settings(cls, settings: SimulatorSettings, clock: Callable[[], float] = time.monotonic) -> RealTimePacer:
+        """The simulator's pacer, every option from its settings (``config/simulator.yaml``)."""
+        return cls(
+            settings.chunk_s,
+            loop_period=settings.loop_period_s,
+            realtime=settings.realtime,
+            rate=settings.rate,
+            overrun_margin=settings.overrun_margin_s,
+            rtf_window=settings.rtf_window_s,
+            max_batch=settings.max_batch_chunks,
+            resync_lag=settings.resync_lag_s,
+            clock=clock,
+        )
 
     @property
     def started(self) -> bool:

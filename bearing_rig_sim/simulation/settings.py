@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, ClassVar
 
-from pydantic import PrivateAttr, ValidationInfo, field_validator
+from pydantic import field_validator, PrivateAttr
 
 from bearing_rig_sim.config import BEARING_MODELS
 from bearing_rig_sim.dynamics.engine import MODELS
@@ -77,7 +77,13 @@ class SimulatorSettings(NodeSettings):
     overrun_margin_s: Number = param("lag behind the wall clock counted as an overrun", unit="s", gt=0.0, le=10.0)
     resync_lag_s: Number = param("lag behind the wall clock beyond which the debt is dropped", unit="s", gt=0.0, le=60.0)
     rtf_window_s: Number = param("sliding window of the reported real-time factor (wall clock)", unit="s", gt=0.0, le=600.0)
-    initial_speed_rad_s: Number = param("spindle speed at start (at most the rig file's spindle limit)", unit="rad/s", ge=0.0, le=PLAUSIBLE_SPINDLE_SPEED_RAD_S)
+    initial_speed_rad_s: Number = param(
+        "spindle speed at start (at most the rig file's spindle limit)",
+        unit="rad/s",
+        ge=0.0,
+        le=PLAUSIBLE_SPINDLE_SPEED_RAD_S,
+        rig_limit="spindle.max_speed_rad_s",
+    )
     initial_axial_load_n: Number = param("axial load until the loading chain's first force message", unit="N", ge=0.0, le=10_000.0)
     initial_temperature_rise_k: Number = param(
         "start temperature of the bearing's thermal network above the bearing file's ambient (0: a cold start)", unit="K", ge=0.0, le=150.0
@@ -101,16 +107,6 @@ class SimulatorSettings(NodeSettings):
         from bearing_rig_sim.dynamics.calibrations import NAMED
 
         return f"calibration/{NAMED[value]}" if isinstance(value, str) and value in NAMED else value
-
-    @field_validator("initial_speed_rad_s")
-    @classmethod
-    def _within_the_spindle(cls, value: float, info: ValidationInfo) -> float:
-        rig = info.data.get("rig_file")
-        if rig is not None:
-            limit = SpindleConfig.from_yaml(rig).max_speed_rad_s
-            if not value <= limit:
-                raise ValueError(f"must be <= {limit}, got {value!r}")
-        return value
 
     def model_post_init(self, context: Any, /) -> None:
         self._spindle = SpindleConfig.from_yaml(self.rig_file)

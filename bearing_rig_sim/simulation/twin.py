@@ -1,6 +1,6 @@
 """The rig's digital twin, one chunk at a time: engine, spindle drive, axial load, speed sensors.
 
-:class:`RigTwin` advances the dynamics engine by one chunk (1 ms by default) at the current axial
+:class:`RigTwin` advances the dynamics engine by one chunk (``chunk_s`` of ``config/simulator.yaml``) at the current axial
 load, with the inner-ring acceleration the :class:`~bearing_rig_sim.simulation.drive.SpindleDrive`
 asks for, then shows the motion to the two fibre-optic sensors of the bench (docs/paper.md section 8):
 
@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.config import shipped_bearing_file
 from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Mounting, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
@@ -42,6 +42,7 @@ from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOptic
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.rig.program import RigLimits
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
+from bearing_rig_sim.simulation.settings import SimulatorSettings
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling
 
@@ -189,8 +190,37 @@ def _mean_where_loaded(values: np.ndarray, loads: np.ndarray) -> float:
     return float(np.mean(values[mask])) if np.any(mask) else math.nan
 
 
+def twin_options(settings: SimulatorSettings | None = None, rig_file: str | Path | None = None) -> dict[str, Any]:
+    """The keyword options of :class:`RigTwin` as the simulator runs it: chunk, start, counter
+    timeout and command lead from its ``settings`` (default: the shipped
+    ``config/simulator.yaml``), the spindle's and the loaders' limits from ``rig_file`` (default:
+    the shipped ``config/rig.yaml``; absent ``combined_loading``: 0 N and 0 N m).
+
+    Raises:
+        ConfigError: a file is missing or malformed (naming the file and key).
+    """
+    s = settings if settings is not None else SimulatorSettings.from_yaml()
+    limits = RigLimits.from_rig_file(rig_file)
+    return {
+        "chunk": s.chunk_s,
+        "initial_speed": s.initial_speed_rad_s,
+        "initial_axial_load": s.initial_axial_load_n,
+        "counter_timeout": s.counter_timeout_s,
+        "max_command_lead": s.max_command_lead_s,
+        "max_speed": limits.max_speed_rad_s,
+        "max_acceleration": limits.max_acceleration_rad_s2,
+        "max_radial_load": limits.max_radial_load_n,
+        "radial_limit_source": f"combined_loading.max_radial_setpoint_n in {limits.source}",
+        "max_moment": limits.max_moment_n_m,
+        "moment_limit_source": f"combined_loading.max_moment_setpoint_n_m in {limits.source}",
+    }
+
+
 class RigTwin:
     """The engine, the spindle drive, the axial load and the two fibre-optic sensors.
+
+    The options have no defaults here: :func:`twin_options` gives the simulator's (its settings
+    and its rig file's limits), which :meth:`from_files` uses.
 
     Args:
         engine: the dynamics engine; initialised here at ``initial_speed`` and
@@ -208,10 +238,10 @@ class RigTwin:
         max_command_lead: how far ahead a command's time may lie, s.
         max_radial_load: largest radial force accepted, N (>= 0; :meth:`from_files` takes it
             from the rig file's ``combined_loading.max_radial_setpoint_n``: 0 for a loading
-            chain that loads only axially). Default: no limit.
+            chain that loads only axially).
         radial_limit_source: where ``max_radial_load`` comes from, named in a refusal.
         max_moment: largest moment accepted, N m (>= 0; :meth:`from_files`: the rig file's
-            ``combined_loading.max_moment_setpoint_n_m``). Default: no limit.
+            ``combined_loading.max_moment_setpoint_n_m``).
         moment_limit_source: where ``max_moment`` comes from, named in a refusal.
 
     Raises:
@@ -226,16 +256,16 @@ class RigTwin:
         sensors: FibreOpticConfig,
         kinematics: BearingKinematics,
         *,
-        chunk: float = 1e-3,
-        initial_speed: float = 0.0,
-        initial_axial_load: float = 100.0,
-        counter_timeout: float = 1.0,
-        max_speed: float = math.inf,
-        max_acceleration: float = math.inf,
-        max_command_lead: float = math.inf,
-        max_radial_load: float = math.inf,
+        chunk: float,
+        initial_speed: float,
+        initial_axial_load: float,
+        counter_timeout: float,
+        max_speed: float,
+        max_acceleration: float,
+        max_command_lead: float,
+        max_radial_load: float,
+        max_moment: float,
         radial_limit_source: str = "max_radial_load",
-        max_moment: float = math.inf,
         moment_limit_source: str = "max_moment",
     ) -> None:
         self.engine = engine
@@ -300,12 +330,13 @@ class RigTwin:
         *,
         model: str = "reduced",
         bearing_model: str = "bench",
+        settings: SimulatorSettings | None = None,
         **options: Any,
     ) -> RigTwin:
         """A twin from a bearing file, an optional calibration overlay and a rig file.
 
         Args:
-            bearing_file: bearing data (default: the shipped ``config/bearings/h7006c.yaml``).
+            bearing_file: bearing data (default: the shipped one, :data:`~bearing_rig_sim.config.SHIPPED_BEARING_FILE`).
             calibration_file: calibration laid over it (None: none).
             rig_file: rig data with the ``sensors`` section and the test bearing's ``mounting``
                 (clearance, misalignment, preload; default: ``config/rig.yaml``).
@@ -313,9 +344,9 @@ class RigTwin:
             bearing_model: the bearing's physics (:data:`~bearing_rig_sim.config.BEARING_MODELS`):
                 ``"bench"`` the bearing file with the calibration; ``"paper"`` the paper's own
                 model (:mod:`bearing_rig_sim.dynamics.models`; the two files are not used).
-            options: the keyword options of :class:`RigTwin`; ``max_radial_load`` and
-                ``max_moment`` default to the rig file's ``combined_loading`` limits (absent:
-                0 N and 0 N m).
+            settings: the simulator's settings giving the options (default: the shipped
+                ``config/simulator.yaml``); see :func:`twin_options`.
+            options: keyword options of :class:`RigTwin` that replace those.
 
         Raises:
             ConfigError: a file is missing or malformed (naming the file and key).
@@ -323,21 +354,15 @@ class RigTwin:
                 the rig file's envelope (top spindle speed, largest axial load).
         """
         if bearing_model == "bench":
-            bearing = Path(bearing_file) if bearing_file is not None else config_path("bearings", "h7006c.yaml")
+            bearing = Path(bearing_file) if bearing_file is not None else shipped_bearing_file()
             params = BearingParameters.from_yaml(bearing, calibration_file)
         else:
             params = model_parameters(bearing_model)
         mounting = Mounting.of(MountingConfig.from_rig_file(rig_file))
         engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file), mounting=mounting)
         sensors = FibreOpticConfig.from_yaml(rig_file)
-        limits = RigLimits.from_rig_file(rig_file)
-        if "max_radial_load" not in options:
-            options["max_radial_load"] = limits.max_radial_load_n
-            options.setdefault("radial_limit_source", f"combined_loading.max_radial_setpoint_n in {limits.source}")
-        if "max_moment" not in options:
-            options["max_moment"] = limits.max_moment_n_m
-            options.setdefault("moment_limit_source", f"combined_loading.max_moment_setpoint_n_m in {limits.source}")
-        return cls(engine, sensors, BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle), **options)
+        kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
+        return cls(engine, sensors, kinematics, **(twin_options(settings, rig_file) | options))
 
     def _check_chunk(self, chunk: float) -> float:
         if isinstance(chunk, bool) or not isinstance(chunk, (int, float)) or not math.isfinite(chunk) or not chunk > 0.0:

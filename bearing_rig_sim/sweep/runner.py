@@ -21,7 +21,7 @@ from typing import Any
 from collections.abc import Callable
 
 from bearing_rig_sim import __version__
-from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.config import ConfigError, shipped_calibration_file
 from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.calibrations import NAMED, calibration_file
@@ -85,7 +85,7 @@ def base_parameters(spec: SweepSpec) -> BearingParameters:
     if spec.calibration == "none":
         calibration: str | Path | None = None
     elif spec.calibration == "shipped":
-        calibration = config_path("calibration", "h7006c_table3.yaml")
+        calibration = shipped_calibration_file()
     elif spec.calibration in NAMED:
         calibration = calibration_file(spec.calibration)
     else:

@@ -24,8 +24,10 @@ dynamics/quasi_static.py counts it; with this axis the inner ring's tilts are fr
 they are held). A steady point's steady state is then periodic at the ball-pass frequency and is
 averaged over whole periods (:meth:`~bearing_rig_sim.dynamics.steady.SteadySolver.periodic`);
 a transient point runs up from rest under the combined load.
-Any other axis of :data:`AXES` changes one bearing parameter. Errors name the file and the key
-(``grid.axial_load_n[0]: must be >= 1.0, got -5``).
+Any other axis of :data:`AXES` changes one bearing parameter. The speed, the acceleration and the
+axial load are at most the shipped rig file's limits (``spindle.max_speed_rad_s``,
+``spindle.max_acceleration_rad_s2``, ``loading_chain.max_setpoint_n``). Errors name the file and
+the key (``grid.axial_load_n[0]: must be >= 1.0, got -5``).
 """
 
 from __future__ import annotations
@@ -42,9 +44,9 @@ from typing import Annotated, Any, Self
 import numpy as np
 from pydantic import BeforeValidator, ConfigDict, Field, model_validator
 
-from bearing_rig_sim.config import BEARING_MODELS, check_number, read_mapping
+from bearing_rig_sim.config import BEARING_MODELS, RPM_TO_RAD_S, check_number, read_mapping
 from bearing_rig_sim.dynamics.engine import MIN_AXIAL_LOAD
-from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, field_error, one_of, quantity, validate_mapping
+from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, check_within_rig, field_error, one_of, quantity, validate_mapping
 
 
 @dataclass(frozen=True)
@@ -58,6 +60,9 @@ class AxisDefinition:
             (``None`` for the operating conditions: speed, acceleration, load).
         low / high: the allowed range (inclusive), in the axis's unit.
         description: what it is, with its unit.
+        rig_limit: the dotted key of the rig file holding a tighter upper bound (an operating
+            condition the bench sets: speed, acceleration, axial load), or None.
+        unit_in_si: the axis's unit in SI (for comparing with ``rig_limit``).
     """
 
     name: str
@@ -65,6 +70,16 @@ class AxisDefinition:
     low: float
     high: float
     description: str
+    rig_limit: str | None = None
+    unit_in_si: float = 1.0
+
+    def check(self, value: float, key: str) -> float:
+        """``value`` at ``key`` (relative to the spec's mapping) within the axis's range and the
+        rig's limit. Raises ConfigError naming ``key``, the bound and where it is written."""
+        check_number(value, "", key, ge=self.low, le=self.high)
+        if self.rig_limit is not None:
+            check_within_rig(value, "", key, self.rig_limit, unit_in_si=self.unit_in_si)
+        return value
 
 
 SPEED_AXIS = "inner_ring_speed_rpm"
@@ -76,9 +91,11 @@ MOMENT_AXIS = "moment_n_m"
 AXES: dict[str, AxisDefinition] = {
     a.name: a
     for a in (
-        AxisDefinition(SPEED_AXIS, None, 1.0, 60000.0, "inner-ring speed, rpm (steady points)"),
-        AxisDefinition(LOAD_AXIS, None, MIN_AXIAL_LOAD, 20000.0, "axial load on the inner ring, N"),
-        AxisDefinition(ACCELERATION_AXIS, None, 0.1, 10000.0, "inner-ring acceleration from rest, rad/s^2 (transient points)"),
+        AxisDefinition(SPEED_AXIS, None, 1.0, 60000.0, "inner-ring speed, rpm (steady points)", "spindle.max_speed_rad_s", RPM_TO_RAD_S),
+        AxisDefinition(LOAD_AXIS, None, MIN_AXIAL_LOAD, 20000.0, "axial load on the inner ring, N", "loading_chain.max_setpoint_n"),
+        AxisDefinition(
+            ACCELERATION_AXIS, None, 0.1, 10000.0, "inner-ring acceleration from rest, rad/s^2 (transient points)", "spindle.max_acceleration_rad_s2"
+        ),
         AxisDefinition(RADIAL_AXIS, None, 0.0, 20000.0, "radial load on the inner ring along x, N (steady and transient)"),
         AxisDefinition(MOMENT_AXIS, None, -1000.0, 1000.0, "moment M_x on the inner ring in the radial load's plane, N m; tilts free (steady and transient)"),
         # lubricant
@@ -223,7 +240,7 @@ def axis_values(name: str, raw: object) -> tuple[float, ...]:
     else:
         raise field_error(name, f"must be a list of values or a mapping {{from, to, step}}, got {raw!r}")
     for i, v in enumerate(values):
-        check_number(v, "", f"{name}[{i}]", ge=definition.low, le=definition.high)
+        definition.check(v, f"{name}[{i}]")
     if len(set(values)) != len(values):
         raise field_error(name, "has repeated values")
     return tuple(values)
@@ -247,7 +264,7 @@ def _ranges(raw: object) -> dict[str, tuple[float, float]]:
         definition = _definition(str(name))
         if not isinstance(lo_hi, list) or len(lo_hi) != 2:
             raise field_error(str(name), f"must be [low, high], got {lo_hi!r}")
-        lo, hi = (check_number(v, "", f"{name}[{i}]", ge=definition.low, le=definition.high) for i, v in enumerate(lo_hi))
+        lo, hi = (definition.check(check_number(v, "", f"{name}[{i}]"), f"{name}[{i}]") for i, v in enumerate(lo_hi))
         if not hi > lo:
             raise field_error(str(name), f"high must be > low, got [{lo}, {hi}]: the range is empty")
         bounds[str(name)] = (lo, hi)

@@ -101,10 +101,11 @@ def twin_bench_run(
         lubricant_feedback: the engine's lubricant follows the network's temperature (the
             simulator's parameter of that name; default as shipped, off).
     """
-    from bearing_rig_sim.config import config_path
+    from bearing_rig_sim.config import shipped_calibration_file
 
-    cal = calibration_file if calibration_file is not None else config_path("calibration", "h7006c_table3.yaml")
-    twin = RigTwin.from_files(bearing_file, cal, None, initial_axial_load=holds[0].axial_load_n if holds else 100.0)
+    cal = calibration_file if calibration_file is not None else shipped_calibration_file()
+    start: dict[str, Any] = {"initial_axial_load": holds[0].axial_load_n} if holds else {}
+    twin = RigTwin.from_files(bearing_file, cal, None, **start)
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
     coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=lubricant_feedback) if thermal else None

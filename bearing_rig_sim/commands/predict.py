@@ -309,7 +309,7 @@ def _add_interval(
     at the point with ``reference``, the calibration's parameters, and the thermal data
     ``thermal``; the gradients are then ``params``' at the steady temperature;
     ``slip_pct_parametric_low`` / ``_high`` and ``model_form_pp`` state the parts)."""
-    from bearing_rig_sim.studies.priors import point_effects, spread, widen
+    from bearing_rig_sim.studies.priors import ThermalRunawayError, point_effects, spread, widen
     from bearing_rig_sim.studies.uncertainty import Z95, parametric_sd, slip_gradients
 
     g_theta, g_load = slip_gradients(params, unc, omega, load, slip, thermal if form is None else None)
@@ -318,7 +318,14 @@ def _add_interval(
         row["slip_pct_low"] = round(slip - Z95 * sd, 4)
         row["slip_pct_high"] = round(slip + Z95 * sd, 4)
         return
-    effects = point_effects(reference, thermal, omega, load)
+    try:
+        effects = point_effects(reference, thermal, omega, load)
+    except ThermalRunawayError as exc:  # a draw of the priors has no steady state here: no model-form spread to state
+        row["slip_pct_low"] = round(slip - Z95 * sd, 4)
+        row["slip_pct_high"] = round(slip + Z95 * sd, 4)
+        row["model_form_pp"] = None
+        row["model_form_reason"] = str(exc)
+        return
     lo_shift, hi_shift, kept = spread(effects.effects, form, g_theta)
     low, high = widen(slip, sd, lo_shift, hi_shift)
     row["slip_pct_low"] = round(low, 4)

@@ -35,6 +35,8 @@ each side (:func:`widen`).
 
 from __future__ import annotations
 
+from bearing_rig_sim.errors import RigError
+
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -173,6 +175,15 @@ def point_effects(params: BearingParameters, cfg: ThermalConfig, inner_ring_spee
     return PointEffects(s0, t_ss, effects, t_short)
 
 
+MAX_STEADY_LUBRICANT_C = 400.0
+"""Highest lubricant temperature searched for a steady state, degC: above the flash points of
+spindle greases' base oils (about 200-250 degC), so a point beyond it has no useful steady state."""
+
+
+class ThermalRunawayError(RigError):
+    """No steady lubricant temperature below :data:`MAX_STEADY_LUBRICANT_C` for a prior's draw."""
+
+
 def _prior(name: str) -> Prior:
     return next(p for p in PRIORS if p.name == name)
 
@@ -193,7 +204,13 @@ def _steady_temperature(heat: Any, params: BearingParameters, cfg: ThermalConfig
         w = (t - a) / (b - a) if b != a else 0.0
         return float(net.steady(np.maximum(q[a] + w * (q[b] - q[a]), 0.0))[lub]) - t
 
-    return float(brentq(g, cfg.ambient, 200.0, xtol=0.01))
+    hot = MAX_STEADY_LUBRICANT_C
+    if g(hot) > 0.0:
+        raise ThermalRunawayError(
+            f"no steady lubricant temperature below {hot:g} degC at {rad_s_to_rpm(inner_ring_speed):.0f} rpm / {axial_load:g} N "
+            f"with the frame conductance {cfg.frame_conductance:g} W/K: the bearing's heat outgrows what the housing carries"
+        )
+    return float(brentq(g, cfg.ambient, hot, xtol=0.01))
 
 
 def draws(count: int = DRAWS, seed: int = DRAW_SEED) -> list[dict[str, float]]:

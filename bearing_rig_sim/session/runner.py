@@ -404,7 +404,8 @@ class ProgramRunner:
             verdict = _DWELL_VERDICTS[last.state] if last is not None else Verdict.UNKNOWN
         if verdict is None:
             return []
-        if verdict is not Verdict.STABLE and self.monitor_guard_s is not None and self.status_through < plan.deadline - STAMP_RESOLUTION_S:
+        at_deadline = plan.segment.dwell is not None or verdict is Verdict.TIMEOUT
+        if at_deadline and self.monitor_guard_s is not None and self.status_through < plan.deadline - STAMP_RESOLUTION_S:
             wall = self._wall_clock()
             self._waiting_since = wall if self._waiting_since is None else self._waiting_since
             if wall - self._waiting_since < self.monitor_guard_s:

@@ -247,7 +247,8 @@ class ManagedNode(LifecycleNode):
     def publisher(self, msg_type: Any, topic: str, qos: Any, **kwargs: Any) -> LifecyclePublisher:
         """A lifecycle publisher (publishes only while active), destroyed at cleanup."""
         pub = Node.create_publisher(self, msg_type, topic, qos, **kwargs, publisher_class=CountedPublisher)
-        self._managed_entities.add(pub)
+        assert isinstance(pub, CountedPublisher)
+        self._managed_entities.add(pub)  # as create_lifecycle_publisher, with the counting class
         self._publishers_made.append(pub)
         return pub
 

@@ -136,10 +136,11 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
         assert context["ros_domain_id"] == str(ros_graph.domain_id) and context["realtime"] == "false"
     assert (bag / "logs" / "simulator.log").is_file()
 
-    # the session managed the nodes' lifecycles: bring-up in order, deactivation in order (the clock stops first), clean-up in reverse order
+    # the session managed the nodes' lifecycles: configure in order, activate in reverse order (the clock
+    # starts last), deactivate in order (the clock stops first), clean up in reverse order
     nodes = ("simulator", "load_controller", "monitor")
     expected = [f"lifecycle: {n} configure: unconfigured -> inactive" for n in nodes]
-    expected += [f"lifecycle: {n} activate: inactive -> active" for n in nodes]
+    expected += [f"lifecycle: {n} activate: inactive -> active" for n in reversed(nodes)]
     expected += [f"lifecycle: {n} deactivate: active -> inactive" for n in nodes]
     expected += [f"lifecycle: {n} cleanup: inactive -> unconfigured" for n in reversed(nodes)]
     assert [line for line in out.splitlines() if line.startswith("lifecycle: ")] == expected

@@ -67,8 +67,10 @@ class TransitionRecord:
 
 
 def bring_up(nodes: Sequence[str]) -> list[Step]:
-    """Configure all of ``nodes`` in order, then activate all in order."""
-    return [Step(n, "configure") for n in nodes] + [Step(n, "activate") for n in nodes]
+    """Configure all of ``nodes`` in order, then activate all in reverse order (the simulator
+    last: the load controller and the monitor take the clock from its first message, so the
+    force and the statuses start with it, not some 0.3 s of sim time later)."""
+    return [Step(n, "configure") for n in nodes] + [Step(n, "activate") for n in reversed(nodes)]
 
 
 def shut_down(nodes: Sequence[str], states: Mapping[str, str], gone: Sequence[str] = ()) -> list[Step]:

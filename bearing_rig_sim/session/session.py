@@ -11,7 +11,8 @@
    comes first), their output in ``<bag dir>/<run id>/logs/<node>.log``;
 3. is their lifecycle manager (:mod:`.lifecycle`, :mod:`.manager`): once every node's
    ``change_state`` service is up, configures all of them in order, waits until the recorder has
-   matched the streams they will publish (at most ``MATCH_WAIT_S``), then activates all in order;
+   matched the streams they will publish (at most ``MATCH_WAIT_S``), then activates all in reverse
+   order (the simulator last: the others take its clock from the first message);
    each transition is an event line (also in ``logs/session.log``) and a ``/diagnostics`` status
    (``lifecycle_manager: <node>``, recorded). A node that fails a transition is named with its
    reason (its ``configure failed: ...`` line) and the session ends (exit status 1);
@@ -24,7 +25,9 @@
 5. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
    clock while recording every rig topic and printing progress;
 6. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node fails or dies: stops the runner,
-   deactivates the active nodes and cleans up the configured ones (reverse order, the nodes
+   deactivates the active nodes in order (the simulator first; at the end of a program run
+   through, the monitor once its last status is in) and cleans up the configured ones in
+   reverse order once the recorder holds every message they report having published (the nodes
    still running), stops the processes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag,
    prints the summary so far.
 

@@ -713,7 +713,9 @@ class _Session:
             + f"); node logs in {self.writer.path / 'logs'}\n"
         )
         if self.node is not None:
-            unreported = [name for name in NODES if self.manager is not None and name not in self.node.reports]
+            # a node that was never active published nothing; one that was reports when deactivated
+            activated = {r.step.node for r in self.manager.records if r.success and r.step.transition == "activate"} if self.manager is not None else set()
+            unreported = [name for name in NODES if name in activated and name not in self.node.reports]
             published = self.node.published(self._own_published())
             delivery = format_delivery(published, self.recorder.counts, unreported)
             self.out.write(f"\ndelivery (messages per topic):\n{delivery}\n")

@@ -184,3 +184,10 @@ def test_a_node_without_a_delivery_report_is_named() -> None:
     text = format_delivery({"/clock": 3}, {"/clock": 3, "/rig/slip_status": 7}, unreported=["monitor"])
     assert ["/rig/slip_status", "?", "7"] in [line.split() for line in text.splitlines()]
     assert "NO DELIVERY REPORT from monitor" in text and "every published message recorded" not in text
+
+
+def test_topics_without_a_published_count_are_not_called_complete() -> None:
+    from bearing_rig_sim.session.progress import format_delivery
+
+    text = format_delivery({"/rig/spindle/command": 3}, {"/rig/spindle/command": 3, "/clock": 900})  # attached: nodes managed elsewhere
+    assert "every published message recorded" not in text and "published counts unknown for 1 topic(s)" in text

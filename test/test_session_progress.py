@@ -162,3 +162,32 @@ def test_printer_lines_refresh_and_quiet() -> None:
     quiet = io.StringIO()
     ProgressPrinter(quiet, quiet=True).show("a")
     assert quiet.getvalue() == ""
+
+
+def test_the_delivery_table_names_every_shortfall_loudly() -> None:
+    from bearing_rig_sim.session.progress import format_delivery
+
+    published = {"/clock": 1000, "/rig/axial_load/force": 1000, "/rig/slip_status": 50}
+    recorded = {"/clock": 1000, "/rig/axial_load/force": 930, "/rig/slip_status": 50, "/rig/spindle/pulses": 0}
+    text = format_delivery(published, recorded)
+    rows = {line.split()[0]: line.split()[1:] for line in text.splitlines()[1:4]}
+    assert rows == {"/clock": ["1000", "1000"], "/rig/axial_load/force": ["1000", "930"], "/rig/slip_status": ["50", "50"]}
+    assert "NOT ALL RECORDED: /rig/axial_load/force: 70 of 1000 published messages missing from the bag" in text
+    assert "every published message recorded" not in text
+    whole = format_delivery({"/clock": 3}, {"/clock": 3})
+    assert whole.endswith("every published message recorded") and "NOT" not in whole
+
+
+def test_a_node_without_a_delivery_report_is_named() -> None:
+    from bearing_rig_sim.session.progress import format_delivery
+
+    text = format_delivery({"/clock": 3}, {"/clock": 3, "/rig/slip_status": 7}, unreported=["monitor"])
+    assert ["/rig/slip_status", "?", "7"] in [line.split() for line in text.splitlines()]
+    assert "NO DELIVERY REPORT from monitor" in text and "every published message recorded" not in text
+
+
+def test_topics_without_a_published_count_are_not_called_complete() -> None:
+    from bearing_rig_sim.session.progress import format_delivery
+
+    text = format_delivery({"/rig/spindle/command": 3}, {"/rig/spindle/command": 3, "/clock": 900})  # attached: nodes managed elsewhere
+    assert "every published message recorded" not in text and "published counts unknown for 1 topic(s)" in text

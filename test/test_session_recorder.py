@@ -51,7 +51,8 @@ def test_every_topic_of_the_interface_table_is_declared_with_its_qos(fake: tuple
     writer, _ = fake
     assert set(writer.topics) == {t.name for t in RECORDED_TOPICS}
     assert writer.topics["/rig/speeds"] == ("sensor_msgs/msg/JointState", "reliable_stream")
-    assert writer.topics["/rig/axial_load/force"][1] == "sensor_data"
+    assert writer.topics["/rig/axial_load/force"][1] == "reliable_stream"
+    assert writer.topics["/rig/load/setpoint"][1] == "transient_stream"
     assert writer.topics["/rig/slip_status"][1] == "transient_local"
     assert writer.topics["/clock"][1] == "reliable_stream"
 

@@ -550,3 +550,51 @@ def test_set_points_of_every_fixed_start_go_at_once_and_stop_at_an_until_stable_
     led.start(0.0)
     assert [p.segment.name for p in led.setpoints_due(0.4)] == ["load_up"]
     assert [p.segment.name for p in led.setpoints_due(0.5)] == ["n0900"]
+
+
+class WallClock:
+    """A wall clock the test moves by hand (s)."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def test_a_segment_ending_at_its_deadline_waits_for_the_monitors_statuses_through_it(program: TestProgram) -> None:
+    """With a monitor guard (a session's runner), a dwell segment whose deadline the clock has
+    passed ends only once a status stamped at or after that deadline has come: the statuses of
+    its last stretch, which a monitor lagging the clock delivers late, decide its verdict."""
+    wall = WallClock()
+    runner = ProgramRunner(program, monitor_guard_s=30.0, wall_clock=wall)
+    runner.start(0.0)
+    runner.observe_status(status(0.5, StatusState.SLIPPING))
+    assert runner.update(1.2) == [] and not runner.outcomes  # the clock is past 1.0, the statuses are not
+    runner.observe_status(status(0.9, StatusState.STABLE))  # late, from the segment's last stretch
+    assert runner.update(1.3) == [] and not runner.outcomes
+    runner.observe_status(status(1.0, StatusState.STABLE))  # at the deadline: every status of the segment is in
+    (second,) = runner.update(1.3)
+    assert second.segment.name == "n0900" and second.start_time == 1.0  # the plan's start, not the late end
+    assert runner.outcomes[0].verdict is Verdict.STABLE and runner.unconfirmed == []
+
+
+def test_a_segment_waits_for_the_monitor_no_longer_than_its_guard(program: TestProgram) -> None:
+    wall = WallClock()
+    runner = ProgramRunner(program, monitor_guard_s=30.0, wall_clock=wall)
+    runner.start(0.0)
+    runner.observe_status(status(0.5, StatusState.SLIPPING))
+    assert runner.update(1.0) == []
+    wall.now = 29.9
+    assert runner.update(1.0) == []
+    wall.now = 30.1
+    (second,) = runner.update(1.0)
+    assert second.segment.name == "n0900" and runner.outcomes[0].verdict is Verdict.SLIPPING
+    assert runner.unconfirmed == ["load_up: the monitor's statuses end at 0.500 s, the segment at 1.000 s"]
+
+
+def test_without_a_monitor_guard_a_segment_ends_at_its_deadline(program: TestProgram) -> None:
+    runner = ProgramRunner(program)  # offline replays and the tests above: no monitor to wait for
+    runner.start(0.0)
+    (second,) = runner.update(1.0)
+    assert second.segment.name == "n0900" and runner.outcomes[0].verdict is Verdict.UNKNOWN

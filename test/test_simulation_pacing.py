@@ -126,3 +126,52 @@ def test_bad_options_and_calls_before_start_are_refused():
         RealTimePacer(0.0, clock=clock, **OPTIONS)  # type: ignore[arg-type]
     with pytest.raises(PacerError, match="start"):
         pacer(clock).due_chunks(0.0)
+
+
+# -- StreamLead: the simulation kept within a lead of a stream that follows its clock -------------
+from bearing_rig_sim.simulation.pacing import StreamLead  # noqa: E402
+
+
+def test_a_stream_that_follows_the_clock_bounds_the_simulation_by_its_lead():
+    lead = StreamLead("monitor status", 0.5)
+    assert lead.room(10.0, 1e-3, 0.0) is None and "no monitor status" in lead.off  # nothing seen yet
+    lead.observe(9.9, 10.0, 0.0)
+    assert lead.room(10.0, 1e-3, 0.0) is None  # one stamp: not yet advancing
+    lead.observe(10.0, 10.2, 0.1)
+    # at most 10.0 + 0.5 s: from 10.2 s, 300 chunks of 1 ms and not one more
+    assert lead.room(10.2, 1e-3, 0.1) == 300 and lead.off == ""
+    assert lead.room(10.5, 1e-3, 0.1) == 0
+    assert lead.room(10.6, 1e-3, 0.1) == 0  # never negative
+
+
+def test_stamps_far_from_the_simulated_time_do_not_pace():
+    lead = StreamLead("force on the bearing", 0.1, follow_s=1.0)
+    lead.observe(1.0, 1.0, 0.0)
+    lead.observe(1.001, 5.0, 0.0)  # 4 s behind when taken: not a stream that follows the clock
+    assert lead.room(5.0, 1e-3, 0.0) is None
+    lead.observe(5.0, 5.0, 0.0)
+    lead.observe(5.0, 5.0, 0.0)  # not advancing
+    assert lead.room(5.0, 1e-3, 0.0) is None
+
+
+def test_a_paused_or_silent_stream_stops_pacing_until_it_advances_again():
+    lead = StreamLead("monitor status", 0.5, silent_s=10.0)
+    lead.observe(1.0, 1.0, 0.0)
+    lead.observe(1.1, 1.1, 0.0)
+    assert lead.room(1.1, 1e-3, 5.0) == 500
+    assert lead.room(1.1, 1e-3, 10.5) is None and "10 s of wall time" in lead.off  # silent
+    lead.observe(1.2, 1.2, 11.0)
+    lead.observe(1.3, 1.3, 11.0)
+    assert lead.room(1.3, 1e-3, 11.0) == 500
+    lead.stop("/monitor left the active state (inactive)", paused=True)
+    lead.observe(1.4, 1.4, 11.0)
+    lead.observe(1.5, 1.5, 11.0)  # queued before the deactivation
+    assert lead.room(1.5, 1e-3, 11.0) is None and "left the active state" in lead.off
+    lead.paused = False  # active again
+    lead.observe(1.6, 1.6, 11.0)
+    assert lead.room(1.6, 1e-3, 11.0) == 500
+
+
+def test_a_stream_lead_refuses_a_lead_that_is_not_positive():
+    with pytest.raises(PacerError, match="lead_s"):
+        StreamLead("x", 0.0)

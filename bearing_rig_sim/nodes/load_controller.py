@@ -40,7 +40,8 @@ Interfaces (README, interface table):
   ``/rig/bearing/axial_force`` (geometry_msgs/WrenchStamped, force.z = the force that reaches the
   bearing, N, force.x/y and torque.x/y the radial set-point in force (all 0.0 without one), reliable,
   ``force_rate_hz`` of sim time: the simulator's input),
-  ``/rig/axial_load/force`` (WrenchStamped, the load cell's reading, N, sensor data, the same),
+  ``/rig/axial_load/force`` (WrenchStamped, the load cell's reading, N, reliable stream: recorded
+  whole, read best effort by the monitor; the same rate),
   ``/rig/axial_load/state`` (bearing_rig_msgs/AxialLoadState, reliable, ``state_rate_hz`` of sim
   time) and ``/diagnostics`` (every ``diagnostics_period_s`` of sim time and at once on a change:
   OK; WARN after a refused set-point, until the next accepted one; ERROR with the interlock's
@@ -109,7 +110,6 @@ from bearing_rig_sim.nodes.common import (
     ERROR,
     OK,
     RELIABLE_QOS,
-    SENSOR_QOS,
     WARN,
     diagnostic_array,
     diagnostic_status,
@@ -174,7 +174,7 @@ class LoadControllerNode(ManagedNode):
         # walks on every wake-up; an incompatible QoS goes unlogged.
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
         self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, qos_profile(BEARING_AXIAL_FORCE), event_callbacks=quiet)
-        self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, SENSOR_QOS, event_callbacks=quiet)
+        self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, qos_profile(AXIAL_LOAD_FORCE), event_callbacks=quiet)
         self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
         self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
         self._rig_services = [
@@ -220,6 +220,10 @@ class LoadControllerNode(ManagedNode):
         effect at a later activation."""
         if self.operation is not None and self.operation.pending:
             self.get_logger().info(f"deactivated: {self.operation.drop_pending()} set-point(s) stamped ahead dropped")
+
+    def delivery_stamp(self) -> Any:
+        """The chain's time (its last /clock), s; 0 before any."""
+        return to_stamp((self.operation.time if self.operation is not None else None) or 0.0)
 
     def cleanup(self) -> None:
         """Drop the chain, the services and the clock reader."""

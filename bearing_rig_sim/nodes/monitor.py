@@ -2,9 +2,10 @@
 around :class:`~bearing_rig_sim.monitoring.SlipMonitor` and the
 :class:`~bearing_rig_sim.monitoring.StatusSchedule` that offline analysis runs too).
 
-Subscribes ``/rig/spindle/pulses`` and ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse,
-sensor data) and ``/rig/axial_load/force`` (the load cell: the load sweep's abscissa and the
-loaded contact angle of the kinematic slip), so it runs unchanged on the bench's topics. Publishes:
+Subscribes ``/rig/spindle/pulses`` and ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse)
+and ``/rig/axial_load/force`` (the load cell: the load sweep's abscissa and the loaded contact
+angle of the kinematic slip), all best effort with a deep queue (``pulse_reader``), so it runs
+unchanged on the bench's topics. Publishes:
 
 * ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): when the
   schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes);
@@ -13,8 +14,14 @@ loaded contact angle of the kinematic slip), so it runs unchanged on the bench's
   on every change of level: OK stable, WARN slipping, unknown or pulses lost lately (with the
   counts), ERROR sustained sensor loss or invalid data.
 
-The rig time is the pulses' stamps, extrapolated by the steady clock while none arrive; with
-``use_sim_time`` a /clock going back resets the monitor.
+The rig time is the latest stamp of the pulses and the load cell. On a bench without a load cell
+it is the pulses' stamps extrapolated by the steady clock while none arrive; the load cell's
+stamps (in a session: the simulation clock's, as the load controller steps on ``/clock``) carry it
+on through a stop, and no status is then stamped past them. Before any of them has come a status
+or a diagnostic is stamped 0 (the simulation clock's origin) while a ``/clock`` is published, the
+wall clock only on a bench without one; so in a session on ``/clock`` no message of the monitor
+carries the wall clock. With ``use_sim_time`` the node's clock counts as well, and a /clock going
+back resets the monitor.
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the slip monitor,
 publishers, subscriptions and timers are made at configure; pulses are taken and statuses
@@ -36,7 +43,7 @@ from geometry_msgs.msg import WrenchStamped
 from rclpy.clock import Clock, ClockType
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
-from bearing_rig_sim.interfaces import DIAGNOSTICS, SLIP_STATUS
+from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SLIP_STATUS
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS
 from bearing_rig_sim.monitoring import (
@@ -92,6 +99,8 @@ class MonitorNode(ManagedNode):
         self.merger = PulseMerger()
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
+        self._last_load_stamp: float | None = None
+        """Stamp of the latest load-cell sample, s (None before the first)."""
         self._last_state: SlipState | None = None
         self._last_level: bytes | None = None
         self._received = {"spindle": 0, "cage": 0}
@@ -104,7 +113,7 @@ class MonitorNode(ManagedNode):
         for shaft, topic in PULSE_TOPICS.items():
             self.subscription(FibreOpticPulse, topic.name, functools.partial(self._on_pulse, shaft), PULSE_READER_QOS)
         # the load cell: the load sweep's abscissa and the loaded contact angle of the kinematic slip
-        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, qos_profile(AXIAL_LOAD_FORCE))
+        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_load, PULSE_READER_QOS)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer(1.0 / self.settings.status_rate_hz, self._on_status_timer, clock=steady)
         self.timer(1.0 / self.settings.diagnostics_rate_hz, self._on_diagnostics_timer, clock=steady)
@@ -118,6 +127,10 @@ class MonitorNode(ManagedNode):
         """Report the state at once on activation (the first status, then the timers)."""
         self._last_state = None
         self._last_level = None
+
+    def delivery_stamp(self) -> Any:
+        """The rig time (see the module docstring)."""
+        return to_stamp(max(self._stamp_now(), 0.0))
 
     # -- inputs --------------------------------------------------------------------------------
     @survives_shutdown
@@ -154,19 +167,38 @@ class MonitorNode(ManagedNode):
 
     @survives_shutdown
     def _on_load(self, msg: WrenchStamped) -> None:
-        self.monitor.add_load(from_stamp(msg.header.stamp), float(msg.wrench.force.z))
+        stamp = from_stamp(msg.header.stamp)
+        if stamp > 0.0:
+            self._last_load_stamp = max(stamp, self._last_load_stamp or 0.0)
+        self.monitor.add_load(stamp, float(msg.wrench.force.z))
 
     def _clock_now(self) -> float:
         return self.get_clock().now().nanoseconds * 1e-9
 
     def _rig_now(self, clock_now: float) -> float | None:
-        """Rig time now: the latest pulse extrapolated by the steady clock; with use_sim_time,
-        the later of that and the node's clock. None before any pulse without sim time."""
-        last = self.monitor.last_pulse_time()
-        if last is None or self._last_pulse_wall is None:
-            return clock_now if self._sim_time else None
-        extrapolated = last + (time.monotonic() - self._last_pulse_wall)
-        return max(clock_now, extrapolated) if self._sim_time else extrapolated
+        """Rig time now (see the module docstring): the latest stamp of the pulses and the load
+        cell; without a load cell the latest pulse extrapolated by the steady clock; with
+        use_sim_time, the later of that and the node's clock. None before any stamp without sim
+        time."""
+        last = self.monitor.last_pulse_time() if self._last_pulse_wall is not None else None
+        stamps = [t for t in (last, self._last_load_stamp) if t is not None]
+        if self._sim_time:
+            return max([clock_now, *stamps])
+        if not stamps:
+            return None
+        if self._last_load_stamp is None and last is not None and self._last_pulse_wall is not None:
+            return last + (time.monotonic() - self._last_pulse_wall)
+        return max(stamps)
+
+    def _stamp_now(self) -> float:
+        """The stamp of a message that has no rig time of its own, s: the rig time when known;
+        before it, 0 while a ``/clock`` is published (a session on simulation time), else the
+        node's clock (the wall clock on a bench)."""
+        clock_now = self._clock_now()
+        now = self._rig_now(clock_now)
+        if now is not None:
+            return now
+        return 0.0 if self.count_publishers(CLOCK.name) > 0 else clock_now
 
     # -- periodic ------------------------------------------------------------------------------
     @survives_shutdown
@@ -199,7 +231,7 @@ class MonitorNode(ManagedNode):
 
     def _status_message(self, status: MonitorStatus) -> SlipStatus:
         msg = SlipStatus(**status.message_fields())
-        stamp = status.time if status.time is not None else self._clock_now()
+        stamp = status.time if status.time is not None else self._stamp_now()
         msg.header.stamp = to_stamp(max(stamp, 0.0))
         msg.header.frame_id = "bearing"
         return msg
@@ -228,7 +260,7 @@ class MonitorNode(ManagedNode):
             **self.settings.published_parameters(),  # what judging these statuses takes: the running values
         }
         message = f"{status.state.label}: {status.detail}"
-        array = diagnostic_array(to_stamp(max(self._clock_now(), 0.0)), [diagnostic_status(DIAGNOSTIC_NAME, level, message, values)])
+        array = diagnostic_array(to_stamp(max(self._stamp_now(), 0.0)), [diagnostic_status(DIAGNOSTIC_NAME, level, message, values)])
         self._diag_pub.publish(array)
 
 

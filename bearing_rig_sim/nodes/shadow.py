@@ -125,7 +125,7 @@ class ShadowNode(ManagedNode):
         sensor = PULSE_READER_QOS  # best effort: matches a bench counter publishing sensor data, and the twin's reliable streams
         self.subscription(FibreOpticPulse, SPINDLE_PULSES.name, lambda m: self._on_pulse("spindle", m), sensor)
         self.subscription(FibreOpticPulse, CAGE_PULSES.name, lambda m: self._on_pulse("cage", m), sensor)
-        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, qos_profile(AXIAL_LOAD_FORCE))
+        self.subscription(WrenchStamped, AXIAL_LOAD_FORCE.name, self._on_force, sensor)  # the load cell: best effort, as the pulses
         self.subscription(Temperature, OUTER_RING_TEMPERATURE.name, self._on_temperature, qos_profile(OUTER_RING_TEMPERATURE))
         self.subscription(WrenchStamped, HOUSING_TORQUE.name, self._on_torque, qos_profile(HOUSING_TORQUE))
         steady = Clock(clock_type=ClockType.STEADY_TIME)

@@ -11,7 +11,10 @@
     again;
   - **activate**: the timers start and inputs are taken: the streams flow;
   - **deactivate**: timers stopped, inputs ignored, publishers disabled: an inactive node
-    publishes nothing (``/diagnostics`` included);
+    publishes nothing (``/diagnostics`` included) after its delivery report: one ``/diagnostics``
+    status named ``<node>: published`` (:data:`PUBLISHED_SUFFIX`) whose values are the messages
+    each of its topics published so far (the report itself counted), so that a recorder can tell
+    when it holds a node's last message and what it missed (``bearing-rig run`` does);
   - **cleanup** / **shutdown**: the core and every entity made at configure are destroyed.
 
   Faults of the rig (an interlock, a sensor loss, a halted engine, an overrun storm) do not
@@ -53,9 +56,28 @@ from rclpy.subscription import Subscription
 from rclpy.timer import Timer
 
 from bearing_rig_sim.errors import RigError
+from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.nodes.parameters import ParameterSpec, in_force, is_standard, spec_for
 
 F = TypeVar("F", bound=Callable[..., Any])
+
+PUBLISHED_SUFFIX = ": published"
+"""A node's delivery report is the ``/diagnostics`` status named ``<node name>`` + this."""
+
+
+class CountedPublisher(LifecyclePublisher):
+    """A lifecycle publisher that counts the messages it published (:attr:`published`)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.published = 0
+        """Messages published while enabled."""
+
+    def publish(self, msg: Any) -> None:
+        """Publish (when enabled, as :class:`LifecyclePublisher`) and count it."""
+        if self.is_activated:
+            self.published += 1
+        super().publish(msg)
 
 
 def descriptor_of(spec: ParameterSpec) -> ParameterDescriptor:
@@ -219,12 +241,51 @@ class ManagedNode(LifecycleNode):
     def cleanup(self) -> None:
         """Drop the core (the entities made at configure are destroyed by the base)."""
 
+    def delivery_stamp(self) -> Any:
+        """The stamp (``builtin_interfaces/Time``) of the delivery report: the node's own rig
+        time, as its other messages are stamped (the base: 0, the simulation clock's origin)."""
+        from builtin_interfaces.msg import Time
+
+        return Time()
+
     # -- entities made at configure ----------------------------------------------------------------
     def publisher(self, msg_type: Any, topic: str, qos: Any, **kwargs: Any) -> LifecyclePublisher:
         """A lifecycle publisher (publishes only while active), destroyed at cleanup."""
-        pub: LifecyclePublisher = self.create_lifecycle_publisher(msg_type, topic, qos, **kwargs)
+        pub = Node.create_publisher(self, msg_type, topic, qos, **kwargs, publisher_class=CountedPublisher)
+        assert isinstance(pub, CountedPublisher)
+        self._managed_entities.add(pub)  # as create_lifecycle_publisher, with the counting class
         self._publishers_made.append(pub)
         return pub
+
+    def published(self) -> dict[str, int]:
+        """Messages published so far per topic by the publishers made at configure."""
+        counts: dict[str, int] = {}
+        for pub in self._publishers_made:
+            if isinstance(pub, CountedPublisher):
+                counts[pub.topic_name] = counts.get(pub.topic_name, 0) + pub.published
+        return counts
+
+    def _report_published(self) -> None:
+        """The delivery report (see the module docstring), on this node's ``/diagnostics``
+        publisher, stamped with the stamp of its last diagnostics (the node's own time)."""
+        from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+
+        pub = next((p for p in self._publishers_made if p.topic_name == DIAGNOSTICS.name and isinstance(p, CountedPublisher)), None)
+        if pub is None or not pub.is_activated:
+            return
+        counts = self.published()
+        counts[DIAGNOSTICS.name] = counts.get(DIAGNOSTICS.name, 0) + 1  # this report
+        name = self.get_name()
+        status = DiagnosticStatus(
+            level=DiagnosticStatus.OK,
+            name=name + PUBLISHED_SUFFIX,
+            message=f"{sum(counts.values())} messages published",
+            hardware_id=name,
+            values=[KeyValue(key=topic, value=str(n)) for topic, n in sorted(counts.items())],
+        )
+        array = DiagnosticArray(status=[status])
+        array.header.stamp = self.delivery_stamp()
+        pub.publish(array)
 
     def subscription(self, msg_type: Any, topic: str, callback: Callable[[Any], None], qos: Any, **kwargs: Any) -> Subscription:
         """A subscription whose callback runs only while active, destroyed at cleanup."""
@@ -292,6 +353,10 @@ class ManagedNode(LifecycleNode):
             self.deactivate()
         except Exception as exc:
             self.get_logger().error(f"deactivate: {one_line(exc)}")
+        try:
+            self._report_published()
+        except Exception as exc:
+            self.get_logger().error(f"delivery report: {one_line(exc)}")
         self.get_logger().info("inactive")
         return super().on_deactivate(state)
 

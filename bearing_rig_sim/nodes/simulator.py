@@ -4,7 +4,9 @@
 Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, history 5000):
 
 * ``/clock`` (rosgraph_msgs/Clock, reliable stream): the simulated time, once per chunk
-  (1 kHz simulated with 1 ms chunks), so the other nodes can run on ``use_sim_time``;
+  (1 kHz simulated with 1 ms chunks), so the other nodes can run on ``use_sim_time``; the first
+  one, at the first activation, is the time the simulation starts at (0), so that what the other
+  nodes stamp before the first chunk (0) lies on the clock's timeline;
 * ``/rig/spindle/pulses``, ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse, reliable
   stream): one per strip passage, stamped with the pulse time on the simulated clock;
 * ``/rig/speeds`` (sensor_msgs/JointState, reliable stream, ``speeds_rate_hz`` simulated): names
@@ -27,8 +29,8 @@ atan2(force.y, force.x), where the engine centres its load zone, and refused (ER
 accepted loads kept) above the rig file's ``combined_loading.max_radial_setpoint_n`` (0 for the
 paper's axially loaded bench); torque.x and torque.y a moment across the axis, N m, which
 frees the inner ring's tilts (both 0: the tilts held, the reaction reported), refused above
-``combined_loading.max_moment_setpoint_n_m``; read best effort from its reliable publisher;
-1 kHz, so its queue is taken by the loop, not dispatched message by message: the latest force
+``combined_loading.max_moment_setpoint_n_m``; read reliably (``force_reader``): the loop paces on
+its stamps, and a lost last sample would hold it; 1 kHz, so its queue is taken by the loop, not dispatched message by message: the latest force
 queued is the one applied). Bad input is refused with a
 logged reason and an ERROR on /diagnostics; the node goes on.
 
@@ -37,9 +39,16 @@ when due: in real time it runs the chunks the wall clock asks for (:class:`~bear
 batch of ``max_batch_chunks`` per call, as fast as its reliable readers take the streams: every
 :data:`ACK_WINDOW_CHUNKS` chunks the loop waits until each reliable reader (the session's
 recorder) has acknowledged all it was sent, so no sample leaves the writers' history unread and a
-recording holds every message, and no further than :data:`FORCE_LEAD_S` past the latest force on
+recording holds every message, no further than :data:`FORCE_LEAD_S` past the latest force on
 the bearing while the load controller's force stream follows the clock (so a starved load
-controller's force is never applied late; a deactivated or exited one holds nothing up).
+controller's force is never applied late; a deactivated or exited one holds nothing up), and no
+further than :data:`MONITOR_LEAD_S` past the monitor's latest ``/rig/slip_status`` (read reliably,
+transient local) while its statuses follow the clock (so the monitor's verdicts keep up with the
+program under any load). The three bounds, without real time: the recorder's middleware has
+acknowledged every sample but the last :data:`ACK_WINDOW_CHUNKS` chunks' (2 s of simulated time;
+its reader queues, 50000 deep, hold them until the session takes them), the force on the bearing
+lags the clock by at most 0.1 s and the monitor by at most 0.5 s; the force and the monitor's
+statuses are reliable streams, so none of the three waits on a message that can be lost.
 ``simulator --no-realtime`` sets the parameter ``realtime`` to false.
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
@@ -74,9 +83,9 @@ from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState, Temperature
 
-from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SpindleCommand as SpindleCommandMsg
+from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand as SpindleCommandMsg
 from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SPEEDS, SPINDLE_COMMAND, SPINDLE_PULSES, TRUTH
-from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE
+from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SLIP_STATUS
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.thermal import sensors as bench_sensors
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
@@ -98,7 +107,7 @@ from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth
-from bearing_rig_sim.simulation.pacing import RealTimePacer
+from bearing_rig_sim.simulation.pacing import RealTimePacer, StreamLead
 from bearing_rig_sim.simulation.settings import NODE_NAME, SimulatorSettings, shipped_parameters
 from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RigTwin, TickOutput
 
@@ -141,6 +150,21 @@ publishes nothing, and holds nothing up) or when no publisher is left (one that 
 resumes when the stream advances again (after an activation); a stream silent for
 :data:`FORCE_SILENT_S` of wall time otherwise (a process killed before the middleware noticed)
 stops it too."""
+
+MONITOR_LEAD_S = 0.5
+"""Without real time, how far the simulation may run ahead of the monitor, s of simulated time:
+past the stamp of its latest status (one per ``status_rate_hz`` of pulse time, 10 Hz, and per
+closed slip window; while no pulse comes, one per 0.1 s of wall time stamped with the load cell's
+latest sample, the clock's). So the monitor's pulse queue never holds more than some 0.6 s of
+pulses (its depth, 10000, is 20 s at 9000 rpm), its verdicts keep up with the program on any
+host, and its last status at the end of a session lies within this of the clock's end. Paced as
+the force stream (:data:`FORCE_LEAD_S`): only while the statuses follow the clock, not while the
+monitor is inactive, gone, or silent for :data:`FORCE_SILENT_S` of wall time; while the spindle
+stands still the simulation then runs at most 5 s of simulated time per wall second."""
+
+MONITOR_FOLLOW_S = 2.0
+"""A status stamp this close (s of simulated time) to the simulation when it arrives is taken as
+a monitor that follows the clock."""
 
 FORCE_FOLLOW_S = 1.0
 """A force stamp this close (s of simulated time) to the simulation when it arrives is taken as
@@ -199,25 +223,22 @@ class SimulatorNode(ManagedNode):
         self._gave_up = False
         """A reader stayed unacknowledging past :data:`ACK_GIVE_UP_S`; not waited for again until
         every reader has acknowledged all."""
-        self._force_pace: float | None = None
-        """Without real time: the latest stamp (s) of a force stream that follows the clock."""
-        self._force_seen = 0.0
-        """Wall time (monotonic) the latest force sample was taken."""
-        self._force_stamp = -math.inf
-        """Stamp (s) of the latest force sample taken."""
-        self._force_publishers = -1
-        """Publishers of the force stream whose node is known (-1: not looked up yet)."""
-        self._graph_checked = -math.inf
-        """Wall time (monotonic) of the last look-up of the force stream's publishers."""
-        self._lifecycle_events: dict[str, Subscription] = {}
-        """The ``transition_event`` reader of each node that published the force stream, by topic."""
-        self._force_paused = False
-        """A publisher of the force stream left the active state (until it is active again)."""
-        self._pacing_off = "no force stream following the clock yet"
-        """Why the loop does not pace on the force stream (empty while it does); on /diagnostics."""
+        self._leads = {
+            BEARING_AXIAL_FORCE.name: StreamLead("force on the bearing", FORCE_LEAD_S, follow_s=FORCE_FOLLOW_S, silent_s=FORCE_SILENT_S),
+            SLIP_STATUS.name: StreamLead("monitor status", MONITOR_LEAD_S, follow_s=MONITOR_FOLLOW_S, silent_s=FORCE_SILENT_S),
+        }
+        """Without real time, the streams the loop keeps within a lead of (see the module docstring)."""
+        self._stream_publishers = {name: -1 for name in self._leads}
+        """Publishers of each paced stream whose node is known (-1: not looked up yet)."""
+        self._graph_checked = {name: -math.inf for name in self._leads}
+        """Wall time (monotonic) of the last look-up of each paced stream's publishers."""
+        self._lifecycle_events: dict[str, tuple[Subscription, set[str]]] = {}
+        """The ``transition_event`` reader of each node publishing a paced stream, and those streams."""
         self._pulses = {"spindle": 0, "cage": 0}
         self._last_level: HealthLevel | None = None
         self._anchor = True
+        self._clock_started = False
+        """The clock's first message (the time the simulation starts at) was published."""
 
         self._clock_pub = self.publisher(ClockMsg, CLOCK.name, qos_profile(CLOCK))
         self._pulse_pubs = {
@@ -250,6 +271,14 @@ class SimulatorNode(ManagedNode):
             event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
         )
 
+        self._status_sub = self._force_tap.create_subscription(
+            SlipStatus,
+            SLIP_STATUS.name,
+            _unused,
+            STATUS_QOS,
+            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
+        )
+
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
         self.timer(period, self._on_loop, clock=steady)
@@ -277,6 +306,10 @@ class SimulatorNode(ManagedNode):
         (the latest is the load in force)."""
         self._take_forces()
 
+    def delivery_stamp(self) -> Any:
+        """The simulated time the simulation stands at."""
+        return to_stamp(max(self.twin.time, 0.0))
+
     def cleanup(self) -> None:
         """Destroy the force reader's node (and the lifecycle readers on it)."""
         tap = getattr(self, "_force_tap", None)
@@ -300,6 +333,10 @@ class SimulatorNode(ManagedNode):
         if self._anchor:
             self.pacer.start(self.twin.time)
             self._anchor = False
+            if not self._clock_started:  # the clock's origin: what is stamped before the first chunk lies on it
+                self._clock_started = True
+                self._clock_msg.clock = to_stamp(max(self.twin.time, 0.0))
+                self._clock_pub.publish(self._clock_msg)
         self._take_forces()
         for _ in range(self._force_paced(self.pacer.due_chunks(self.twin.time), now)):
             try:
@@ -314,54 +351,63 @@ class SimulatorNode(ManagedNode):
 
     def _force_paced(self, chunks: int, now: float) -> int:
         """Without real time, at most the chunks that keep the simulation within
-        :data:`FORCE_LEAD_S` of the force stream that follows the clock (see there)."""
+        :data:`FORCE_LEAD_S` of the force stream and :data:`MONITOR_LEAD_S` of the monitor's
+        statuses, each while it follows the clock (see there)."""
         if self.pacer.realtime:
             return chunks
-        self._follow_force_publishers()
-        pace = self._force_pace
-        if pace is None or self._force_paused:
-            self._pacing_off = self._pacing_off or "no force stream following the clock"
+        self._take_statuses()
+        for name in self._leads:
+            self._follow_publishers(name)
+        rooms = [r for lead in self._leads.values() if (r := lead.room(self.twin.time, self.settings.chunk_s, now)) is not None]
+        if not rooms:
             return chunks
-        if now - self._force_seen > FORCE_SILENT_S:
-            self._force_pace = None
-            self._pacing_off = f"no force on the bearing for {FORCE_SILENT_S:g} s of wall time"
-            return chunks
-        self._pacing_off = ""
-        room = int((pace + FORCE_LEAD_S - self.twin.time) / self.settings.chunk_s + 1e-9)
+        room = min(rooms)
         if room <= 0:
-            time.sleep(ACK_POLL_S)  # yield the core to the load controller rather than spin
+            time.sleep(ACK_POLL_S)  # yield the core to the load controller and the monitor rather than spin
         return max(0, min(chunks, room))
 
-    def _follow_force_publishers(self) -> None:
-        """Count the force stream's publishers (none: pacing stops), read each one's lifecycle
-        transitions (one leaving the active state pauses pacing until it is active again)."""
+    def _take_statuses(self) -> None:
+        """Follow the monitor's progress: the stamp of its latest status (only the last queued
+        is decoded)."""
+        queued = drain(self._status_sub, SlipStatus)
+        if queued:
+            message = deserialize_message(queued[-1][0], SlipStatus)
+            self._leads[SLIP_STATUS.name].observe(from_stamp(message.header.stamp), self.twin.time, time.monotonic())
+
+    def _follow_publishers(self, name: str) -> None:
+        """Count a paced stream's publishers (none: pacing on it stops), read each one's
+        lifecycle transitions (one leaving the active state pauses it until it is active again)."""
         tap = self._force_tap
         if tap is None:
             return
-        count = self._force_sub.get_publisher_count()
+        lead = self._leads[name]
+        count = tap.count_publishers(name)
         now = time.monotonic()
-        if count != self._force_publishers and now >= self._graph_checked + GRAPH_RECHECK_S:
-            self._graph_checked = now
+        if count != self._stream_publishers[name] and now >= self._graph_checked[name] + GRAPH_RECHECK_S:
+            self._graph_checked[name] = now
             if count == 0:
-                self._force_pace, self._force_stamp, self._force_paused = None, -math.inf, False
-                self._pacing_off = f"no publisher of {BEARING_AXIAL_FORCE.name}"
+                lead.stop(f"no publisher of {name}")
             # the graph may name a matched publisher's node later than the match (meanwhile
             # "_NODE_NAME_UNKNOWN_"): counted as known only once it does, so the lookup is
             # repeated until then
-            infos = [i for i in tap.get_publishers_info_by_topic(BEARING_AXIAL_FORCE.name) if i.node_name != UNKNOWN_NODE_NAME]
-            self._force_publishers = count if len(infos) >= count else len(infos)
+            infos = [i for i in tap.get_publishers_info_by_topic(name) if i.node_name != UNKNOWN_NODE_NAME]
+            self._stream_publishers[name] = count if len(infos) >= count else len(infos)
             for info in infos:
                 topic = f"{info.node_namespace.rstrip('/')}/{info.node_name}/transition_event"
                 if topic not in self._lifecycle_events:
-                    self._lifecycle_events[topic] = tap.create_subscription(
+                    reader = tap.create_subscription(
                         TransitionEvent, topic, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
                     )
-        for reader in self._lifecycle_events.values():
+                    self._lifecycle_events[topic] = (reader, set())
+                self._lifecycle_events[topic][1].add(name)
+        for reader, streams in self._lifecycle_events.values():
             for event, _info in drain(reader, TransitionEvent, serialized=False):
-                self._force_paused = event.goal_state.id != LifecycleState.PRIMARY_STATE_ACTIVE
-                if self._force_paused:
-                    self._force_pace, self._force_stamp = None, -math.inf
-                    self._pacing_off = f"{reader.topic_name.rsplit('/', 1)[0]} left the active state ({event.goal_state.label})"
+                for stream in streams:
+                    if event.goal_state.id != LifecycleState.PRIMARY_STATE_ACTIVE:
+                        node = reader.topic_name.rsplit("/", 1)[0]
+                        self._leads[stream].stop(f"{node} left the active state ({event.goal_state.label})", paused=True)
+                    else:
+                        self._leads[stream].paused = False
 
     def _readers_caught_up(self, now: float) -> bool:
         """Without real time: has every reliable reader acknowledged all the streams sent it?
@@ -512,11 +558,7 @@ class SimulatorNode(ManagedNode):
         if not queued:
             return
         message = deserialize_message(queued[-1][0], WrenchStamped)
-        stamp = from_stamp(message.header.stamp)
-        self._force_seen = time.monotonic()
-        advancing = stamp > self._force_stamp and abs(stamp - self.twin.time) <= FORCE_FOLLOW_S
-        self._force_pace = stamp if advancing and self._force_stamp > -math.inf else None
-        self._force_stamp = stamp
+        self._leads[BEARING_AXIAL_FORCE.name].observe(from_stamp(message.header.stamp), self.twin.time, time.monotonic())
         wrench = message.wrench
         force = wrench.force
         try:
@@ -572,7 +614,10 @@ class SimulatorNode(ManagedNode):
             "cage_pulses": self._pulses["cage"],
             "refused_inputs": self.health.refused,
             "reader_stalls": self.health.reader_stalls,
-            "force_pacing": "off" if pacer.realtime else (f"off: {self._pacing_off}" if self._pacing_off else "on"),
+            **{
+                f"{key}_pacing": "off" if pacer.realtime else (f"off: {lead.off}" if lead.off else "on")
+                for key, lead in zip(("force", "monitor"), self._leads.values())
+            },
             STOPPED_KEY: self.health.halted,
         }
         status = diagnostic_status(f"{NODE_NAME}: rig twin", int(health.level), health.message, values)

@@ -67,14 +67,18 @@ class TransitionRecord:
 
 
 def bring_up(nodes: Sequence[str]) -> list[Step]:
-    """Configure all of ``nodes`` in order, then activate all in order."""
-    return [Step(n, "configure") for n in nodes] + [Step(n, "activate") for n in nodes]
+    """Configure all of ``nodes`` in order, then activate all in reverse order (the simulator
+    last: the load controller and the monitor take the clock from its first message, so the
+    force and the statuses start with it, not some 0.3 s of sim time later)."""
+    return [Step(n, "configure") for n in nodes] + [Step(n, "activate") for n in reversed(nodes)]
 
 
 def shut_down(nodes: Sequence[str], states: Mapping[str, str], gone: Sequence[str] = ()) -> list[Step]:
-    """Deactivate the active nodes, then clean up the configured ones, both in reverse order of
-    ``nodes``; nodes in ``gone`` (their process ended) and unknown states are skipped."""
-    alive = [n for n in reversed(nodes) if n not in gone]
+    """Deactivate the active nodes in the order of ``nodes`` (the simulator first: the clock
+    stops, and the nodes after it take its last messages while still active), then clean up the
+    configured ones in reverse order; nodes in ``gone`` (their process ended) and unknown states
+    are skipped."""
+    alive = [n for n in nodes if n not in gone]
     steps = [Step(n, "deactivate") for n in alive if states.get(n) == "active"]
-    steps += [Step(n, "cleanup") for n in alive if states.get(n) in ("active", "inactive")]
+    steps += [Step(n, "cleanup") for n in reversed(alive) if states.get(n) in ("active", "inactive")]
     return steps

@@ -3,22 +3,24 @@ and a ``/diagnostics`` status per transition (a thin shell around :mod:`.lifecyc
 
 Nothing here blocks: :meth:`LifecycleManager.poll` is called from the session's timer, sends the
 next transition when the previous one has answered, and reports each answer. A transition not
-answered within its time limit fails (the node is named, with "no answer within N s").
+answered is asked again every second (:class:`~bearing_rig_sim.nodes.service_call.RetriedCall`:
+an answer lost right after discovery), and fails when none came within its time limit (the node
+is named, with "no answer within N s"). A repeat refused (the first request was made, its answer
+lost) is settled by the node's ``get_state``: done when the node is in the transition's goal state.
 """
 
 from __future__ import annotations
 
-import time
-from typing import Any
 from collections.abc import Callable, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from lifecycle_msgs.msg import Transition
-from lifecycle_msgs.srv import ChangeState
+from lifecycle_msgs.srv import ChangeState, GetState
 from rclpy.node import Node
 
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.nodes.common import OK, ERROR, RELIABLE_QOS, diagnostic_array, diagnostic_status, to_stamp
+from bearing_rig_sim.nodes.service_call import RetriedCall
 from bearing_rig_sim.session.lifecycle import GOAL, Step, TransitionRecord
 
 __all__ = ["DIAGNOSTIC_PREFIX", "LifecycleManager"]
@@ -59,11 +61,14 @@ class LifecycleManager:
         self.failed: TransitionRecord | None = None
         """The transition that failed (the queue is dropped then), else None."""
         self._clients = {name: node.create_client(ChangeState, f"/{name}/change_state") for name in names}
+        self._state_clients = {name: node.create_client(GetState, f"/{name}/get_state") for name in names}
+        self.published = 0
+        """Lifecycle statuses published on ``/diagnostics``."""
         self._diagnostics = node.create_publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
         self._on_record = on_record
         self._sim_time = sim_time
         self._queue: list[Step] = []
-        self._pending: tuple[Step, Any, float] | None = None
+        self._pending: tuple[Step, RetriedCall, RetriedCall | None] | None = None
         self._limit = 10.0
 
     def services_missing(self) -> list[str]:
@@ -84,19 +89,25 @@ class LifecycleManager:
     def poll(self) -> None:
         """Take the pending answer (if any) and send the next transition."""
         if self._pending is not None:
-            step, future, deadline = self._pending
-            if future.done():
-                self._pending = None
-                result = future.result()
-                success = bool(result is not None and result.success)
-                self._record(TransitionRecord(step, success, "" if success else "the node refused the transition"))
-            elif time.monotonic() > deadline:
-                self._pending = None
-                self._record(TransitionRecord(step, False, f"no answer within {self._limit:g} s"))
+            step, call, state_call = self._pending
+            if state_call is not None:
+                if state_call.poll():
+                    self._pending = None
+                    state = state_call.response.current_state.label if state_call.answered else ""
+                    done = state == GOAL[step.transition]
+                    self._record(TransitionRecord(step, done, "" if done else f"the node refused the transition (it is {state or 'not answering'})"))
+            elif call.poll():
+                success = bool(call.answered and call.response.success)
+                if call.answered and not success and call.attempts > 1:  # perhaps the first request's answer was lost
+                    self._pending = (step, call, RetriedCall(self._state_clients[step.node], GetState.Request(), self._limit))
+                else:
+                    self._pending = None
+                    detail = "" if success else "the node refused the transition" if call.answered else f"no answer within {self._limit:g} s"
+                    self._record(TransitionRecord(step, success, detail))
         if self._pending is None and self._queue:
             step = self._queue.pop(0)
             request = ChangeState.Request(transition=Transition(id=TRANSITION_IDS[step.transition], label=""))
-            self._pending = (step, self._clients[step.node].call_async(request), time.monotonic() + self._limit)
+            self._pending = (step, RetriedCall(self._clients[step.node], request, self._limit), None)
 
     def drop(self, name: str) -> None:
         """Forget a node whose process ended: no more transitions for it."""
@@ -118,4 +129,5 @@ class LifecycleManager:
             DIAGNOSTIC_PREFIX + step.node, level, message, {"state": record.state, "transition": step.transition}, hardware_id="bearing_rig_session"
         )
         self._diagnostics.publish(diagnostic_array(to_stamp(max(self._sim_time(), 0.0)), [status]))
+        self.published += 1
         self._on_record(record)

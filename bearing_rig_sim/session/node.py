@@ -17,7 +17,7 @@ import dataclasses
 import importlib
 import math
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -49,6 +49,7 @@ from bearing_rig_sim.interfaces import (
 )
 from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
 from bearing_rig_sim.monitoring.settings import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
+from bearing_rig_sim.nodes.shell import PUBLISHED_SUFFIX
 from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
@@ -188,6 +189,11 @@ class SessionNode(Node):
         """Validates each ``/clock`` stamp before the runner follows it (negative, far jumps)."""
         self.taken = 0
         """Messages taken from the recorder's queues so far."""
+        self.sent: Counter[str] = Counter()
+        """Messages this session published per topic (commands and set-points)."""
+        self.reports: dict[str, dict[str, int]] = {}
+        """Each node's delivery report (``<node>: published`` on ``/diagnostics``): messages
+        published per topic, by node."""
         self._own: dict[str, Counter[str]] = {SPINDLE_COMMAND.name: Counter(), AXIAL_LOAD_SETPOINT.name: Counter(), LOAD_SETPOINT.name: Counter()}
         """Serialized commands and set-points this session published, not yet seen by its recorder:
         any other on those topics came from outside and marks the running segment."""
@@ -209,6 +215,7 @@ class SessionNode(Node):
         command.acceleration = plan.segment.acceleration
         self._own[SPINDLE_COMMAND.name][repr(command)] += 1
         self._spindle.publish(command)
+        self.sent[SPINDLE_COMMAND.name] += 1
 
     def send_setpoint(self, plan: SegmentPlan) -> None:
         """The segment's load set-point on ``/rig/load/setpoint``, stamped with the segment's start
@@ -225,6 +232,7 @@ class SessionNode(Node):
         setpoint.wrench.torque.y = segment.moment
         self._own[LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._setpoint.publish(setpoint)
+        self.sent[LOAD_SETPOINT.name] += 1
 
     # -- readiness --------------------------------------------------------------------------------
     def unmatched_streams(self, *, published_only: bool = False) -> list[str]:
@@ -312,6 +320,21 @@ class SessionNode(Node):
         if "load_controller" not in missing and self._setpoint.get_subscription_count() < self.count_subscribers(LOAD_SETPOINT.name):
             missing["load_controller"] = f"{LOAD_SETPOINT.name}: the session's publisher has not matched every subscription yet"
         return missing
+
+    def published(self, own: Mapping[str, int]) -> dict[str, int]:
+        """Messages published per topic by the nodes that sent their delivery report and by this
+        session (:attr:`sent`, and ``own``: e.g. its lifecycle statuses)."""
+        total: Counter[str] = Counter(self.sent)
+        total.update(own)
+        for counts in self.reports.values():
+            total.update(counts)
+        return dict(total)
+
+    def undelivered(self, own: Mapping[str, int]) -> dict[str, tuple[int, int]]:
+        """The topics the recorder holds fewer messages of than were published (:meth:`published`),
+        with (published, recorded)."""
+        counts = self.recorder.counts
+        return {topic: (n, counts.get(topic, 0)) for topic, n in self.published(own).items() if counts.get(topic, 0) < n}
 
     # -- recording --------------------------------------------------------------------------------
     def take(self) -> int:
@@ -403,6 +426,9 @@ class SessionNode(Node):
         for status in msg.status:
             level = status.level[0] if isinstance(status.level, (bytes, bytearray)) else int(status.level)
             self.simulator_stopped = self.simulator_stopped or stopped_reason((kv.key, kv.value) for kv in status.values)
+            if status.name.endswith(PUBLISHED_SUFFIX):
+                self.reports[status.name[: -len(PUBLISHED_SUFFIX)]] = {kv.key: int(kv.value) for kv in status.values if kv.value.isdigit()}
+                continue
             if status.name == MONITOR_DIAGNOSTIC_NAME:  # the running monitor's parameters: the time to stable's
                 problem = self.runner.observe_monitor_parameters({kv.key: kv.value for kv in status.values})
                 if problem and problem != self._monitor_parameter_problem:

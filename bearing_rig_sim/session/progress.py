@@ -29,6 +29,7 @@ __all__ = [
     "ProgressPrinter",
     "ProgressSnapshot",
     "RealTimeFactor",
+    "format_delivery",
     "format_progress",
     "format_summary",
 ]
@@ -218,3 +219,28 @@ class ProgressPrinter:
             self.out.write("\n")
             self.out.flush()
             self._open = False
+
+
+def format_delivery(published: Mapping[str, int], recorded: Mapping[str, int], unreported: Sequence[str] = ()) -> str:
+    """The delivery table of the summary: per topic, the messages published (the nodes' own
+    counts, from their delivery reports, and the session's) and those recorded; every topic
+    recorded short of what was published is named again under the table in capitals, and so is
+    each node that sent no delivery report (``unreported``: its topics' counts are unknown)."""
+    topics = sorted(set(published) | {t for t, n in recorded.items() if n})
+    name_width = max([len("topic"), *(len(t) for t in topics)])
+    lines = [f"{'topic'.ljust(name_width)}  {'published':>10}  {'recorded':>10}"]
+    short = []
+    for topic in topics:
+        sent = published.get(topic)
+        got = recorded.get(topic, 0)
+        lines.append(f"{topic.ljust(name_width)}  {'?' if sent is None else sent:>10}  {got:>10}")
+        if sent is not None and got < sent:
+            short.append(f"NOT ALL RECORDED: {topic}: {sent - got} of {sent} published messages missing from the bag")
+    lines.extend(short)
+    lines.extend(f"NO DELIVERY REPORT from {name}: what it published is unknown" for name in unreported)
+    unknown = [t for t in topics if t not in published]
+    if unknown and not unreported:
+        lines.append(f"published counts unknown for {len(unknown)} topic(s): their publishers sent no delivery report (nodes managed elsewhere)")
+    elif not short and not unreported:
+        lines.append("every published message recorded")
+    return "\n".join(lines)

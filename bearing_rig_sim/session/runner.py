@@ -42,6 +42,11 @@ Rules (simulation time throughout, s):
   (a run-up is judged stable during its acceleration). A window closes only at a spindle pulse
   at or after its end, so a stop that stopped has none after its ramp (its last window closes
   during the ramp, and is not judged), and a stop whose spindle still turns is measured turning.
+* **Statuses through the end** (with ``monitor_guard_s``, as a session runs it): a segment that
+  ends at its deadline (a dwell's end, an ``until_stable`` timeout) ends only once a status
+  stamped at or after that deadline has come, so its verdict and slip rest on every status of
+  the segment however far the monitor lags the clock; after ``monitor_guard_s`` of wall time
+  without one it ends anyway, named in :attr:`ProgramRunner.unconfirmed`.
 * Observations stamped at or after the end of a dwell segment belong to the next segment (the
   simulator may be there already, its command having been sent ahead): they are kept until the
   runner starts it.
@@ -75,6 +80,7 @@ Rules (simulation time throughout, s):
 from __future__ import annotations
 
 import math
+from time import monotonic
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -289,8 +295,20 @@ class ProgramRunner:
         monitor_settings: MonitorSettings | None = None,
         command_lead_s: float = COMMAND_LEAD_S,
         setpoint_lead_s: float = math.inf,
+        monitor_guard_s: float | None = None,
+        wall_clock: Callable[[], float] = monotonic,
     ) -> None:
         self.program = program
+        self.monitor_guard_s = monitor_guard_s
+        """A segment that ends at its deadline waits for a status stamped at or after it (every
+        status of the segment taken: the monitor publishes in order) up to this much wall time, s;
+        None: it does not wait (the module documentation, "Statuses through the end")."""
+        self._wall_clock = wall_clock
+        self.status_through = -math.inf
+        """The latest stamp of a status taken, s of sim time."""
+        self.unconfirmed: list[str] = []
+        """Segments ended without the monitor's statuses through their end (the guard ran out)."""
+        self._waiting_since: float | None = None
         self.command_lead_s = command_lead_s
         """How long before a segment's fixed start its command is sent, s (:meth:`commands_due`)."""
         self.setpoint_lead_s = setpoint_lead_s
@@ -388,6 +406,14 @@ class ProgramRunner:
             verdict = _DWELL_VERDICTS[last.state] if last is not None else Verdict.UNKNOWN
         if verdict is None:
             return []
+        at_deadline = plan.segment.dwell is not None or verdict is Verdict.TIMEOUT
+        if at_deadline and self.monitor_guard_s is not None and self.status_through < plan.deadline - STAMP_RESOLUTION_S:
+            wall = self._wall_clock()
+            self._waiting_since = wall if self._waiting_since is None else self._waiting_since
+            if wall - self._waiting_since < self.monitor_guard_s:
+                return []
+            self.unconfirmed.append(f"{plan.segment.name}: the monitor's statuses end at {self.status_through:.3f} s, the segment at {plan.deadline:.3f} s")
+        self._waiting_since = None
         self._end(verdict, now)
         if plan.index + 1 < self.segment_count:
             # after a dwell segment the next one starts at its end, where its command is stamped
@@ -491,6 +517,7 @@ class ProgramRunner:
     def observe_status(self, status: SlipObservation) -> None:
         """A slip status of the monitor (any order relative to :meth:`update`)."""
         self.latest_status = status
+        self.status_through = max(self.status_through, status.time)
         if status.sweep_verdict and math.isfinite(status.sweep_speed):
             self.sweeps[sweep_key(status.sweep_speed)] = status.sweep_verdict
         data = self._data

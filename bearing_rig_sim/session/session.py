@@ -11,7 +11,8 @@
    comes first), their output in ``<bag dir>/<run id>/logs/<node>.log``;
 3. is their lifecycle manager (:mod:`.lifecycle`, :mod:`.manager`): once every node's
    ``change_state`` service is up, configures all of them in order, waits until the recorder has
-   matched the streams they will publish (at most ``MATCH_WAIT_S``), then activates all in order;
+   matched the streams they will publish (at most ``MATCH_WAIT_S``), then activates all in reverse
+   order (the simulator last: the others take its clock from the first message);
    each transition is an event line (also in ``logs/session.log``) and a ``/diagnostics`` status
    (``lifecycle_manager: <node>``, recorded). A node that fails a transition is named with its
    reason (its ``configure failed: ...`` line) and the session ends (exit status 1);
@@ -24,7 +25,9 @@
 5. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
    clock while recording every rig topic and printing progress;
 6. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node fails or dies: stops the runner,
-   deactivates the active nodes and cleans up the configured ones (reverse order, the nodes
+   deactivates the active nodes in order (the simulator first; at the end of a program run
+   through, the monitor once its last status is in) and cleans up the configured ones in
+   reverse order once the recorder holds every message they report having published (the nodes
    still running), stops the processes (SIGINT, then SIGTERM, then SIGKILL), finalises the bag,
    prints the summary so far.
 
@@ -46,12 +49,12 @@ from enum import Enum
 from pathlib import Path
 from types import FrameType
 from typing import Any, TextIO
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from bearing_rig_sim.dds_profile import apply_rig_profile
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.interfaces import CLOCK, SLIP_STATUS, SPEEDS
+from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.rig.program import TestProgram, load_program
 from bearing_rig_sim.session.context import check_bearing_file, check_parameter_file, make_run_id, node_parameters, parameter_arguments, run_context
@@ -65,7 +68,7 @@ from bearing_rig_sim.session.processes import (
     session_environment,
     stop_all,
 )
-from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, RealTimeFactor, format_progress, format_summary
+from bearing_rig_sim.session.progress import ProgressPrinter, ProgressSnapshot, RealTimeFactor, format_delivery, format_progress, format_summary
 from bearing_rig_sim.session.recorder import SessionRecorder
 from bearing_rig_sim.simulation.settings import shipped_parameters as simulator_shipped_parameters
 from bearing_rig_sim.session.runner import COMMAND_LEAD_S, REALTIME_COMMAND_LEAD_S, ProgramRunner, SegmentOutcome, SegmentPlan
@@ -90,6 +93,21 @@ MATCH_WAIT_S = 10.0
 they are activated; attached (``--attach``), before the program starts (wall s). Only a bound
 against a stream that never matches: the wait ends when the recorder has matched."""
 
+
+MONITOR_GUARD_S = 30.0
+"""Longest wait, wall s, for the monitor's statuses to reach a segment's end before it is judged
+without them (:attr:`ProgramRunner.monitor_guard_s`), and at the end for its last status: a guard
+against a monitor that stopped, the wait ends when the status comes."""
+
+MONITOR_END_MARGIN_S = 0.2
+"""At the end the monitor is deactivated once it has published a status stamped within this of
+the clock's last time, s of sim time: two of its status periods (10 Hz of pulse time; its
+statuses once the pulses stop carry the load cell's last stamp, the clock's)."""
+
+DELIVERY_GUARD_S = 30.0
+"""Longest wait, wall s, at the end for the recorder to hold every message the nodes report
+having published (their delivery reports, :data:`bearing_rig_sim.nodes.shell.PUBLISHED_SUFFIX`):
+a guard only, the wait ends when it does; what is still missing then is named in the summary."""
 
 OWN_STATUS_GUARD_S = 30.0
 """Longest wait at the end for the recorder to take the session's own last lifecycle status
@@ -263,7 +281,9 @@ class _Session:
         lead = REALTIME_COMMAND_LEAD_S if options.realtime else COMMAND_LEAD_S  # without real time the simulator runs ahead
         # set-points: in real time as the commands (a queue outliving an interrupted session holds
         # at most a second); without real time every fixed start's at once (see the runner)
-        self.runner = ProgramRunner(program, command_lead_s=lead, setpoint_lead_s=lead if options.realtime else math.inf)
+        self.runner = ProgramRunner(
+            program, command_lead_s=lead, setpoint_lead_s=lead if options.realtime else math.inf, monitor_guard_s=MONITOR_GUARD_S
+        )
         self.view = view
         if view is not None:
             from bearing_rig_sim.live.foxglove import TeeWriter
@@ -488,7 +508,10 @@ class _Session:
         self._event(record.line())
 
     def _deactivate_nodes(self, executor: Any) -> None:
-        """Deactivate and clean up the nodes still running (see the module documentation)."""
+        """Deactivate and clean up the nodes still running (see the module documentation): the
+        simulator first (the clock stops), the monitor once its last status is in (at the end of
+        a program run through), and the cleanups once the recorder holds every message the
+        deactivated nodes report having published (or the guards ran out)."""
         manager, node = self.manager, self.node
         if manager is None or node is None or executor is None:
             return
@@ -498,13 +521,50 @@ class _Session:
         steps = shut_down(list(NODES), manager.states, gone)
         if not steps:
             return
-        manager.run(steps, self.options.transition_timeout_s)
-        manager.poll()
-        deadline = time.monotonic() + self.options.transition_timeout_s * (len(steps) + 1)
-        while manager.busy and time.monotonic() < deadline:
+        ran_through = self.status in (EXIT_OK, EXIT_CONDITIONS)
+        for step in steps:
+            if step.transition == "cleanup" and step == next(s for s in steps if s.transition == "cleanup"):
+                self._await(executor, self._undelivered, DELIVERY_GUARD_S, "the recorder still misses")
+            elif step.transition == "deactivate" and step.node == "monitor" and ran_through:
+                self._await(executor, self._monitor_behind, MONITOR_GUARD_S, "the monitor's last status")
+            manager.run([step], self.options.transition_timeout_s)
+            self._await(executor, lambda: "busy" if manager.busy else "", self.options.transition_timeout_s * 2, "")
+
+    def _await(self, executor: Any, pending: Callable[[], str], guard_s: float, what: str) -> None:
+        """Spin, taking what the recorder receives, until ``pending()`` says nothing is (an empty
+        string), at most ``guard_s`` of wall time; then an event line says what still is."""
+        node, manager = self.node, self.manager
+        assert node is not None
+        deadline = time.monotonic() + guard_s
+        while (left := pending()) and time.monotonic() < deadline:
             executor.spin_once(timeout_sec=0.02)
-            manager.poll()
+            if manager is not None:
+                manager.poll()
             node.drain()
+        if left and what:
+            self._event(f"end: not waiting longer than {guard_s:g} s for {what}: {left}")
+
+    def _own_published(self) -> dict[str, int]:
+        """What the session published itself besides commands and set-points: its lifecycle statuses."""
+        return {DIAGNOSTICS.name: self.manager.published} if self.manager is not None else {}
+
+    def _undelivered(self) -> str:
+        """The topics the recorder holds fewer messages of than were published, in words ("" when none)."""
+        assert self.node is not None
+        return ", ".join(f"{topic} ({got} of {sent})" for topic, (sent, got) in self.node.undelivered(self._own_published()).items())
+
+    def _monitor_behind(self) -> str:
+        """Why the monitor's last status is not in yet ("" once it is): every message of the
+        simulator recorded (its clock's last time known), and a status stamped within
+        :data:`MONITOR_END_MARGIN_S` of it."""
+        node = self.node
+        assert node is not None
+        if "simulator" in node.reports and self._undelivered():
+            return f"the simulator's last messages: {self._undelivered()}"
+        through = self.runner.status_through
+        if through < node.sim_time - MONITOR_END_MARGIN_S:
+            return f"its statuses reach {through:.3f} s, the clock {node.sim_time:.3f} s"
+        return ""
 
     def _send_commands(self, now: float) -> None:
         """Send the spindle commands and load set-points due (the running segment's and those of
@@ -656,6 +716,16 @@ class _Session:
             + ", ".join(f"{t.name} {counts.get(t.name, 0)}" for t in (CLOCK, SPEEDS, SLIP_STATUS))
             + f"); node logs in {self.writer.path / 'logs'}\n"
         )
+        if self.node is not None:
+            # a node that was never active published nothing; one that was reports when deactivated
+            activated = {r.step.node for r in self.manager.records if r.success and r.step.transition == "activate"} if self.manager is not None else set()
+            unreported = [name for name in NODES if name in activated and name not in self.node.reports]
+            published = self.node.published(self._own_published())
+            delivery = format_delivery(published, self.recorder.counts, unreported)
+            self.out.write(f"\ndelivery (messages per topic):\n{delivery}\n")
+            short = [line for line in delivery.splitlines() if line.startswith(("NOT ALL RECORDED", "NO DELIVERY REPORT"))]
+            for line in short:
+                self.err.write(f"bearing-rig run: {line}\n")
         rule = self.recorder.rule
         if rule.clock_guard.refused or rule.clock_guard.jumps:
             first = f"; first: {rule.clock_notes[0]}" if rule.clock_notes else ""

@@ -196,3 +196,67 @@ class RealTimePacer:
         if not w1 > w0:
             return math.nan
         return (s1 - s0) / (w1 - w0)
+
+
+class StreamLead:
+    """Without real time: how far the simulation may run ahead of a stream that follows its clock.
+
+    A stream *follows the clock* when its stamps advance and each lies within ``follow_s`` of the
+    simulated time when it is taken. While one does, :meth:`room` allows the chunks that keep the
+    simulated time at most ``lead_s`` past its latest stamp: the bound is enforced by the loop
+    running no chunk beyond it. Pacing stops (:meth:`room` is None, with :attr:`off` saying why)
+    before the stream follows, when :meth:`stop` is called (its publisher left the active state
+    or exited) and after ``silent_s`` of wall time without a new stamp (a publisher gone without
+    a word); it resumes when the stream advances again.
+
+    Args:
+        name: what the stream is, for :attr:`off` (e.g. the topic).
+        lead_s: most simulated time past the stream's latest stamp, s (> 0).
+        follow_s: stamps this close to the simulated time follow the clock, s (> 0).
+        silent_s: wall time without a new stamp after which pacing stops, s (> 0).
+
+    Raises:
+        PacerError: an option out of range.
+    """
+
+    def __init__(self, name: str, lead_s: float, *, follow_s: float = 1.0, silent_s: float = 10.0) -> None:
+        self.name = name
+        self.lead_s = _positive("lead_s", lead_s)
+        self.follow_s = _positive("follow_s", follow_s)
+        self.silent_s = _positive("silent_s", silent_s)
+        self.pace: float | None = None
+        """The latest stamp of the stream while it follows the clock, s; None otherwise."""
+        self.stamp = -math.inf
+        """The latest stamp taken, s."""
+        self.seen = -math.inf
+        """Wall time (monotonic) the latest stamp was taken, s."""
+        self.off = f"no {name} following the clock yet"
+        """Why the stream does not pace the loop (empty while it does)."""
+        self.paused = False
+        """Its publisher left the active state: no pacing until it is active again."""
+
+    def observe(self, stamp: float, sim_time: float, wall: float) -> None:
+        """A message stamped ``stamp`` (s) taken at the simulated time ``sim_time`` (s), wall
+        time ``wall`` (s)."""
+        advancing = stamp > self.stamp and abs(stamp - sim_time) <= self.follow_s
+        self.pace = stamp if advancing and self.stamp > -math.inf else None
+        self.stamp = stamp
+        self.seen = wall
+
+    def stop(self, reason: str, *, paused: bool = False) -> None:
+        """Stop pacing on the stream until it advances again (``paused``: and :attr:`paused` is
+        cleared); ``reason`` goes to :attr:`off`."""
+        self.pace, self.stamp, self.off = None, -math.inf, reason
+        self.paused = paused
+
+    def room(self, sim_time: float, chunk: float, wall: float) -> int | None:
+        """Chunks of ``chunk`` s the simulation at ``sim_time`` (s) may still run, wall time
+        ``wall`` (s); None while the stream does not pace (see the class docstring)."""
+        if self.pace is None or self.paused:
+            self.off = self.off or f"no {self.name} following the clock"
+            return None
+        if wall - self.seen > self.silent_s:
+            self.stop(f"no {self.name} for {self.silent_s:g} s of wall time")
+            return None
+        self.off = ""
+        return max(0, int((self.pace + self.lead_s - sim_time) / chunk + CHUNK_EPSILON))

@@ -1,0 +1,84 @@
+"""Without real time the simulator keeps within ``MONITOR_LEAD_S`` (0.5 s of sim time) of the
+monitor's latest ``/rig/slip_status``: a monitor that falls silent holds the simulation there,
+and its next status lets it go on.
+
+The simulator (``--no-realtime``) runs as a process on the test's isolated domain; the test's
+node plays the monitor, publishing statuses stamped with the latest ``/clock`` it took, as the
+monitor stamps with its rig time. Every wait is for a message (a ``/clock`` stamp, a periodic
+diagnostics report of the simulator), bounded by a guard against a hang. The bound is the
+contract's (the lead), not a figure measured from a run."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import pytest
+
+pytestmark = pytest.mark.ros
+rclpy = pytest.importorskip("rclpy")
+
+from bearing_rig_msgs.msg import SlipStatus  # noqa: E402
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from rosgraph_msgs.msg import Clock  # noqa: E402
+
+from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SLIP_STATUS  # noqa: E402
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, qos_profile, to_stamp  # noqa: E402
+from bearing_rig_sim.nodes.simulator import MONITOR_LEAD_S  # noqa: E402
+
+WAIT = 120.0
+"""Guard on any one wait, wall s."""
+
+CHUNK_S = 0.001
+"""The simulator's chunk (config/simulator.yaml), s."""
+
+HELD_REPORTS = 3
+"""Periodic diagnostics reports (1 Hz of wall time) the simulation must stay held for: well
+beyond the time a loop not held would take to run 0.5 s of sim time (a few hundred ms)."""
+
+
+def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_status(ros_graph: Any) -> None:
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+    node = ros_graph.node("monitor")  # plays the monitor
+    executor = ros_graph.executor([node])
+    seen = {"clock": -math.inf, "pacing": "", "reports": 0, "sim_time": -math.inf}
+
+    def on_clock(msg: Clock) -> None:
+        seen["clock"] = max(seen["clock"], from_stamp(msg.clock))
+
+    def on_diagnostics(msg: DiagnosticArray) -> None:
+        for status in msg.status:
+            values = {kv.key: kv.value for kv in status.values}
+            if "monitor_pacing" in values:
+                seen["pacing"] = values["monitor_pacing"]
+                seen["reports"] += 1
+                seen["sim_time"] = float(values["sim_time_s"])
+
+    node.create_subscription(Clock, CLOCK.name, on_clock, qos_profile("clock_reader"))
+    node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, RELIABLE_QOS)
+    statuses = node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+
+    def publish(stamp: float) -> None:
+        msg = SlipStatus()
+        msg.header.stamp = to_stamp(stamp)
+        statuses.publish(msg)
+
+    # follow the clock, as the monitor does, up to 2 s of sim time
+    def following() -> bool:
+        if seen["clock"] > 0.0:
+            publish(seen["clock"])
+        return seen["clock"] >= 2.0 and seen["pacing"] == "on"
+
+    assert ros_graph.spin_until(following, WAIT, executor=executor), f"the simulator never paced on the statuses: {seen}"
+    last = seen["clock"]
+    publish(last)
+    bound = last + MONITOR_LEAD_S + CHUNK_S  # a status stamped from a clock the test had not yet taken in full
+    # silent monitor: the simulation reaches its lead and stays there
+    assert ros_graph.spin_until(lambda: seen["clock"] >= last + MONITOR_LEAD_S - 0.1, WAIT, executor=executor), seen
+    reports = seen["reports"]
+    assert ros_graph.spin_until(lambda: seen["reports"] >= reports + HELD_REPORTS, WAIT, executor=executor), seen
+    assert seen["clock"] <= bound, f"the clock ran to {seen['clock']:.3f} s, the last status was {last:.3f} s"
+    assert seen["sim_time"] <= bound and seen["pacing"] == "on", seen
+    # the monitor's next status lets it go on
+    publish(last + 1.0)
+    assert ros_graph.spin_until(lambda: seen["clock"] > bound + 0.5, WAIT, executor=executor), seen

@@ -109,6 +109,30 @@ def test_topic_and_time_selection_and_raw_bytes(traffic_bag: tuple[Path, int]) -
             bag.messages(["/rig/nothing"])
 
 
+def test_batches_hold_each_topics_messages_as_the_mcap_library_reads_them(traffic_bag: tuple[Path, int]) -> None:
+    """:meth:`BagReader.batches` (chunks located through their message indexes, arrays) against the
+    mcap library's own reader with a topic filter: the same log times and bytes per topic, in
+    log-time order, batches in time order; an unknown topic refused."""
+    path, _count = traffic_bag
+    topics = [SPEEDS_TOPIC, TRUTH_TOPIC]
+    expected: dict[str, list[tuple[int, bytes]]] = {t: [] for t in topics}
+    with open(next(path.glob("*.mcap")), "rb") as stream:
+        for _schema, channel, message in make_reader(stream).iter_messages(topics=topics, log_time_order=True):
+            expected[channel.topic].append((message.log_time, bytes(message.data)))
+    got: dict[str, list[tuple[int, bytes]]] = {t: [] for t in topics}
+    batches = 0
+    with open_bag(path) as bag:
+        for batch in bag.batches(topics):
+            batches += 1
+            for topic, part in batch.items():
+                got[topic] += [(t, part.data[a:b]) for t, a, b in zip(part.log_times.tolist(), part.starts.tolist(), part.ends.tolist())]
+        with pytest.raises(BagError, match="no topic /rig/nothing"):
+            next(bag.batches(["/rig/nothing"]))
+    assert batches > 1  # 4 kB chunks
+    for topic in topics:
+        assert got[topic] == expected[topic] and len(got[topic]) > 10
+
+
 def test_a_single_mcap_file_opens_as_a_bag(traffic_bag: tuple[Path, int]) -> None:
     path, count = traffic_bag
     with open_bag(path / "traffic_0.mcap") as bag:

@@ -23,7 +23,7 @@ def test_predict_gives_the_load_distribution_of_a_combined_load(capsys: pytest.C
     assert main(["predict", "--rpm", "900", "--load", "163", "--radial-load", "500", "--calibration", "isothermal", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)
     assert row["ball_load_max_n"] == pytest.approx(4.37 * 500 / (16 * math.cos(math.radians(15.0))), rel=0.03)
-    assert row["ball_load_min_n"] == 0.0
+    assert row["ball_load_min_n"] < 0.03  # behind the load zone a ball is wedged by F_c alone
     assert 7 <= row["loaded_balls"] <= 9
     assert 10.0 < row["contact_angle_max_load_deg"] < 20.0
     mx, my = row["reaction_moment_n_m"]

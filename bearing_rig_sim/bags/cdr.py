@@ -128,11 +128,16 @@ def make_normaliser(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], 
 
 def make_decoder(typestore: Typestore, msgtype: str) -> Callable[[CdrBytes], object]:
     """A function decoding messages of ``msgtype`` with rosbags' ``deserialize_cdr``, ignoring
-    bytes after the message (padding); BagError for a malformed or cut message."""
+    bytes after the message (padding: the bytes are trimmed to the message's length when they do
+    not decode as they are); BagError for a malformed or cut message."""
     length = length_function(typestore, msgtype)
     deserialize = typestore.deserialize_cdr
 
     def decode(data: CdrBytes) -> object:
+        try:  # as the recorder stores them: the exact bytes (a walk to the end costs as much again)
+            return deserialize(data, msgtype)
+        except _MALFORMED:
+            pass  # padded by Fast-CDR, or malformed: trimmed to the message's own length, or refused
         end = length(data) if length is not None else len(data)
         try:
             return deserialize(data[:end] if end < len(data) else data, msgtype)

@@ -9,8 +9,10 @@ import struct
 from dataclasses import dataclass, field
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
-from typing import BinaryIO, TypeVar
+from typing import BinaryIO, NamedTuple, TypeVar
 
+import numpy as np
+import numpy.typing as npt
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import EndOfFile, McapError
 from mcap.opcode import Opcode
@@ -40,6 +42,11 @@ class ChunkRef:
     start_ns: int
     end_ns: int
     channel_ids: frozenset[int] | None = None
+    message_indexes: tuple[tuple[int, int], ...] = ()
+    """(channel id, file offset) of the chunk's message index records (from the summary; empty
+    when not known: the chunk is then read record by record)."""
+    index_stop: int = 0
+    """File offset after the chunk's message index records."""
 
 
 @dataclass
@@ -110,6 +117,101 @@ def _messages_in(data: bytes, keep: Callable[[int, int], bool]) -> list[MessageT
     return out
 
 
+class ChunkBatch(NamedTuple):
+    """The wanted messages of one chunk as arrays, in log-time order (file order at equal times):
+    ``log_times`` and ``publish_times`` (ns), ``channel_ids``, and each payload's ``starts`` and
+    ``ends`` in ``data`` (the decompressed chunk)."""
+
+    log_times: npt.NDArray[np.int64]
+    channel_ids: npt.NDArray[np.int64]
+    publish_times: npt.NDArray[np.int64]
+    starts: npt.NDArray[np.int64]
+    ends: npt.NDArray[np.int64]
+    data: bytes
+
+    @classmethod
+    def of(cls, messages: list[MessageTuple]) -> ChunkBatch:
+        """The batch of messages already read one by one (in log-time order)."""
+        lengths = np.array([len(m[3]) for m in messages], dtype=np.int64)
+        ends = np.cumsum(lengths, dtype=np.int64)
+        log_times, channel_ids, publish_times = (np.array([m[k] for m in messages], dtype=np.int64) for k in (0, 1, 2))
+        return cls(log_times, channel_ids, publish_times, ends - lengths, ends, b"".join(m[3] for m in messages))
+
+    def of_channels(self, channel_ids: list[int]) -> ChunkBatch:
+        """The messages of these channels (the same ``data``)."""
+        keep = np.isin(self.channel_ids, channel_ids)
+        if keep.all():
+            return self
+        return ChunkBatch(self.log_times[keep], self.channel_ids[keep], self.publish_times[keep], self.starts[keep], self.ends[keep], self.data)
+
+    def tuples(self) -> list[MessageTuple]:
+        """The messages as :data:`.storage.MessageTuple`."""
+        data = self.data
+        return [
+            (t, c, p, data[a:b])
+            for t, c, p, a, b in zip(self.log_times.tolist(), self.channel_ids.tolist(), self.publish_times.tolist(), self.starts.tolist(), self.ends.tolist())
+        ]
+
+
+_INDEX_HEAD = struct.Struct("<BQHI")  # opcode, length, channel id, byte length of the (time, offset) pairs ("Message Index")
+_U64 = np.dtype("<u8")
+
+
+def _indexed_batch(stream: BinaryIO, ref: ChunkRef, wanted: frozenset[int] | None, low: int, high: int) -> ChunkBatch | None:
+    """The chunk's wanted messages located through its message index records, without walking
+    its other records; None when the chunk has no usable index (DamagedRecord when the chunk
+    itself is damaged)."""
+    entries = [(c, offset) for c, offset in ref.message_indexes if wanted is None or c in wanted]
+    if not ref.message_indexes:
+        return None
+    try:
+        chunk = _one_record(stream, ref.offset, Chunk)
+        with _opening_chunk():
+            stream_of_data, size = get_chunk_data_stream(chunk, validate_crc=True)
+            data = stream_of_data.read(size)
+        first = min((offset for _c, offset in entries), default=ref.index_stop)
+        stream.seek(first)
+        block = stream.read(ref.index_stop - first)
+    except _UNREADABLE as exc:
+        raise DamagedRecord(f"unreadable at offset {ref.offset} ({exc or type(exc).__name__})") from None
+    times, channels, offsets = [], [], []
+    for channel, offset in entries:
+        if offset - first + _INDEX_HEAD.size > len(block):
+            return None
+        opcode, _length, found, size = _INDEX_HEAD.unpack_from(block, offset - first)
+        if opcode != Opcode.MESSAGE_INDEX or found != channel or offset - first + _INDEX_HEAD.size + size > len(block) or size % 16:
+            return None
+        pairs = np.frombuffer(block, dtype=_U64, count=size // 8, offset=offset - first + _INDEX_HEAD.size).reshape(-1, 2).astype(np.int64)
+        times.append(pairs[:, 0])
+        offsets.append(pairs[:, 1])
+        channels.append(np.full(len(pairs), channel, dtype=np.int64))
+    log_times = np.concatenate(times) if times else np.zeros(0, np.int64)
+    where = np.concatenate(offsets) if offsets else np.zeros(0, np.int64)
+    channel_ids = np.concatenate(channels) if channels else np.zeros(0, np.int64)
+    raw = np.frombuffer(data, dtype=np.uint8)
+    if where.size and (where.min() < 0 or where.max() + 31 > raw.size):
+        return None
+    heads = raw[where[:, None] + np.arange(31)]  # opcode, length, channel, sequence, log time, publish time
+    lengths = heads[:, 1:9].copy().view(_U64).ravel().astype(np.int64)
+    ends = where + 9 + lengths
+    if np.any(heads[:, 0] != Opcode.MESSAGE) or np.any(ends > raw.size) or np.any(lengths < 22):
+        return None
+    publish = heads[:, 23:31].copy().view(_U64).ravel().astype(np.int64)
+    keep = (log_times >= low) & (log_times < high)
+    order = np.lexsort((where[keep], log_times[keep]))  # time, then file order
+    return ChunkBatch(log_times[keep][order], channel_ids[keep][order], publish[keep][order], where[keep][order] + 31, ends[keep][order], data)
+
+
+def read_chunk_batch(stream: BinaryIO, ref: ChunkRef, wanted: frozenset[int] | None = None, low: int = -1, high: int = 2**64) -> ChunkBatch:
+    """The messages of one chunk on ``wanted`` channels (None: all) with ``low <= log_time < high``
+    as arrays (:class:`ChunkBatch`): through the chunk's message indexes when the summary lists
+    them, else record by record; DamagedRecord for a chunk truncated, corrupt or not decompressing."""
+    batch = _indexed_batch(stream, ref, wanted, low, high)
+    if batch is not None:
+        return batch
+    return ChunkBatch.of(read_chunk_messages(stream, ref, lambda c, t: (wanted is None or c in wanted) and low <= t < high))
+
+
 def read_chunk_messages(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool] = lambda _c, _t: True) -> list[MessageTuple]:
     """Messages of one chunk that ``keep(channel_id, log_time)`` accepts, stably sorted by log time;
     DamagedRecord for a chunk truncated, corrupt or not decompressing."""
@@ -146,7 +248,11 @@ def _index_from_summary(stream: BinaryIO, index: McapIndex) -> bool:
         index.add_channel(channel, summary.schemas)
     for c in sorted(summary.chunk_indexes, key=lambda c: c.chunk_start_offset):
         channels = frozenset(c.message_index_offsets) if c.message_index_offsets else None
-        index.chunks.append(ChunkRef(c.chunk_start_offset, c.chunk_start_offset + c.chunk_length, c.message_start_time, c.message_end_time, channels))
+        stop = c.chunk_start_offset + c.chunk_length
+        offsets = tuple(sorted(c.message_index_offsets.items()))
+        if any(not stop <= offset < stop + c.message_index_length for _channel, offset in offsets):
+            offsets = ()  # an index pointing elsewhere: read the chunk record by record
+        index.chunks.append(ChunkRef(c.chunk_start_offset, stop, c.message_start_time, c.message_end_time, channels, offsets, stop + c.message_index_length))
     index.compression = summary.chunk_indexes[0].compression if summary.chunk_indexes else ""
     index.unchunked = bool(stats.message_count and not summary.chunk_indexes)
     index.message_count, index.channel_counts = stats.message_count, dict(stats.channel_message_counts)
@@ -271,14 +377,23 @@ def damaged_chunk_bytes(index: McapIndex) -> int:
     return damaged
 
 
-def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, keep: Callable[[int, int], bool], report: ProblemSink, label: str) -> Iterator[MessageTuple]:
+def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, wanted: frozenset[int] | None, low: int, high: int, report: ProblemSink, label: str) -> Iterator[MessageTuple]:
     """A chunk's wanted messages after a marker (channel -1) at its start time, so that a merge
     holds many chunks without reading them."""
     yield (ref.start_ns, -1, 0, b"")
     try:
-        yield from read_chunk_messages(stream, ref, keep)
+        yield from read_chunk_batch(stream, ref, wanted, low, high).tuples()
     except DamagedRecord as exc:
         report(f"{label}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
+
+
+def _open(index: FileIndex, report: ProblemSink) -> BinaryIO | None:
+    """The file of ``index`` opened for reading; None (reported) when it cannot be."""
+    try:
+        return open(index.path, "rb")
+    except OSError as exc:
+        report(f"{index.path}: cannot open ({exc.strerror or exc})")
+        return None
 
 
 class McapFormat:
@@ -307,10 +422,8 @@ class McapFormat:
 
         refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
         refs.sort(key=lambda r: (r.start_ns, r.offset))
-        try:
-            stream = open(index.path, "rb")  # closed by the with below
-        except OSError as exc:
-            report(f"{index.path}: cannot open ({exc.strerror or exc})")
+        stream = _open(index, report)
+        if stream is None:
             return
         with stream:
             if index.unchunked:
@@ -321,5 +434,29 @@ class McapFormat:
                             found.append((m.log_time, m.channel_id, m.publish_time, m.data))
                 yield from sorted(found, key=lambda m: m[0])
                 return
-            chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, keep, report, index.path.name)) for r in refs]
+            chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, wanted, low, high, report, index.path.name)) for r in refs]
             yield from (m for m in merge_in_time(chunks) if m[1] >= 0)
+
+    def batches(self, index: FileIndex, report: ProblemSink, channel_ids: Iterable[int]) -> Iterator[ChunkBatch]:
+        """The messages of one file on ``channel_ids`` chunk by chunk (:class:`ChunkBatch`), the
+        chunks in the order of their start times: for a topic sampled rather than read message by
+        message (a chunk's messages located through its message indexes, no record walked).
+        Damaged chunks are reported through ``report`` and skipped; an unchunked file is one batch."""
+        assert isinstance(index, McapIndex)
+        wanted = frozenset(channel_ids)
+        if index.unchunked:
+            yield ChunkBatch.of(list(self.messages(index, report, wanted)))
+            return
+        refs = sorted((r for r in index.chunks if r.channel_ids is None or r.channel_ids & wanted), key=lambda r: (r.start_ns, r.offset))
+        stream = _open(index, report)
+        if stream is None:
+            return
+        with stream:
+            for ref in refs:
+                try:
+                    batch = read_chunk_batch(stream, ref, wanted)
+                except DamagedRecord as exc:
+                    report(f"{index.path.name}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
+                    continue
+                if batch.log_times.size:
+                    yield batch

@@ -10,6 +10,7 @@ problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:clas
 
 from __future__ import annotations
 
+import itertools
 import warnings
 from dataclasses import dataclass
 from collections.abc import Callable, Iterable, Iterator
@@ -24,7 +25,7 @@ from rosbags.typesys.store import Typestore
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import BagLayout, layout_from_indexes, read_layout
-from bearing_rig_sim.bags.mcapfile import McapFormat
+from bearing_rig_sim.bags.mcapfile import ChunkBatch, McapFormat
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
@@ -41,7 +42,9 @@ def storage_format(identifier: str, source: str = "") -> StorageFormat:
     try:
         return STORAGE_FORMATS[identifier]
     except KeyError:
-        raise BagError(f"{source}{': ' if source else ''}storage {identifier!r} is not supported (this project reads: {', '.join(sorted(STORAGE_FORMATS))})") from None
+        raise BagError(
+            f"{source}{': ' if source else ''}storage {identifier!r} is not supported (this project reads: {', '.join(sorted(STORAGE_FORMATS))})"
+        ) from None
 
 
 class BagMessage(NamedTuple):
@@ -159,6 +162,33 @@ class BagReader:
                 selected = {name for name in selected if self.topics[name].decodable}
         return self._iterate(selected, start_ns, stop_ns, raw)
 
+    def batches(self, topics: Iterable[str], *, size: int = 4096) -> Iterator[dict[str, ChunkBatch]]:
+        """The raw messages of ``topics`` in batches of arrays (:class:`.mcapfile.ChunkBatch`), by
+        topic, each in log-time order and the batches in the order of their first times: one per
+        MCAP chunk, located through the chunk's message indexes, no message handled one by one
+        (for topics sampled now and then rather than read whole); other storage in batches of
+        ``size`` messages. Files of a split bag follow each other in time; overlapping chunks or
+        files give batches whose time ranges overlap. BagError for a topic not in the bag."""
+        if self._closed:
+            raise BagError(f"{self.path}: the bag is closed")
+        selected = set(topics)
+        unknown = sorted(selected - self.topics.keys())
+        if unknown:
+            raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self.topics)) or 'none'})")
+        for k in sorted(range(len(self._indexes)), key=lambda k: self._indexes[k].start_ns):
+            index = self._indexes[k]
+            wanted = {cid: name for cid, name in self._channel_topics[k].items() if name in selected}
+            if not wanted or not index.message_count:
+                continue
+            found = (
+                self._format.batches(index, self._report, wanted)
+                if isinstance(self._format, McapFormat)
+                else _blocks(self._format.messages(index, self._report, wanted), size)
+            )
+            for batch in found:
+                split = {name: batch.of_channels([c for c, n in wanted.items() if n == name]) for name in set(wanted.values())}
+                yield {name: part for name, part in split.items() if part.log_times.size}
+
     def close(self) -> None:
         """Mark the reader closed (files are opened only while messages are read)."""
         self._closed = True
@@ -248,6 +278,12 @@ class BagReader:
         for name, count in failed.items():
             if count > 1:
                 self._report(f"{self.path.name}: topic {name}: {count} messages could not be decoded in all")
+
+
+def _blocks(messages: Iterator[MessageTuple], size: int) -> Iterator[ChunkBatch]:
+    """Messages read one by one, in batches of ``size``."""
+    while block := list(itertools.islice(messages, size)):
+        yield ChunkBatch.of(block)
 
 
 TIMELINE_GAP_NS = DEFAULT_MAX_STEP_NS

@@ -14,15 +14,17 @@ prints one JSON object per line:
   memory of that process) and ``baseline_rss_mb`` (after imports and opening the bag, before
   reading). The long bag is one hour (``--quick``: 4 minutes); the short one a quarter of it:
   equal peaks show that memory does not grow with the bag's length.
-* ``case: "analyse"``, one per bag length: a bag at the rig's rates (speeds 1 kHz, truth 100 Hz
+* ``case: "analyse"``, one per bag length (each analysis ``--repeats`` times, medians): a bag at the rig's rates (speeds 1 kHz, truth 100 Hz
   (:func:`rig_traffic`, steady content), fibre-optic pulses of 4 strips per shaft with 1 us
   jitter and slip status at 10 Hz (:func:`program_traffic`: the validation program's speeds,
   900-2700 rpm, held ``HOLD_S`` each with 1 s STEP ramps and a decaying slip transient after
   each step, over and over) is analysed offline as ``bearing-rig analyze`` does, in a fresh
   process: ``analyse_s`` (the monitor run over every pulse, the series and CSV files), of it
   ``monitor_s`` (inside the monitor's own ``add_pulse``, ``check`` and ``status``: its slip
-  windows, trailing slopes and verdicts), ``report_s`` (plots and markdown), ``target_s`` (30 for an hour, pro rata), ``peak_rss_mb``,
-  ``baseline_rss_mb``, and the counts (pulses, windows, status rows).
+  windows, trailing slopes and verdicts), ``report_s`` (plots and markdown), ``cpu_s`` (the
+  process's CPU time over both: the figure to trust on a busy machine), ``target_s`` (10 for an
+  hour, pro rata), ``peak_rss_mb`` (target 200), ``baseline_rss_mb``, and the counts (pulses,
+  windows, status rows).
 """
 
 from __future__ import annotations
@@ -58,8 +60,10 @@ from bearing_rig_sim.synthetic.traffic import (
 TARGET_MSGS_PER_S = 20_000
 """Recorder throughput required by issue 6 (messages/s)."""
 
-TARGET_ANALYSE_S_PER_HOUR = 30.0
-"""Offline analysis of a one-hour bag required by issue 12 (s; issue 6 asked for 60)."""
+TARGET_ANALYSE_S_PER_HOUR = 10.0
+"""Offline analysis of a one-hour bag required by issue 36 (s; issue 12 asked for 30, issue 6 for 60)."""
+TARGET_ANALYSE_PEAK_MB = 200.0
+"""Peak resident memory of the analysis of a one-hour bag, report included, required by issue 36 (MB)."""
 
 PROGRAM_RPM = (900.0, 1200.0, 1500.0, 1800.0, 2100.0, 2400.0, 2700.0)
 """Inner-ring speeds of :func:`program_traffic`: the validation program's (rpm)."""
@@ -76,7 +80,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--quick", action="store_true", help="read-back bags of 4 and 1 minutes instead of 60 and 15")
     parser.add_argument("--minutes", type=float, default=None, help="length of the long read-back bag (simulated minutes)")
     parser.add_argument("--messages", type=int, default=200_000, help="messages per recorder throughput run")
-    parser.add_argument("--repeats", type=int, default=3, help="recorder throughput runs; the median is reported")
+    parser.add_argument("--repeats", type=int, default=3, help="recorder throughput runs and analyses of each bag; medians are reported")
     parser.add_argument("--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed)")
     parser.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES), help="cases to run (default: all)")
 
@@ -225,13 +229,16 @@ def measure_analysis(path: str, out: str) -> dict:
         setattr(SlipMonitor, name, timed(getattr(SlipMonitor, name)))
     baseline = _current_rss_mb()
     start = time.perf_counter()
+    cpu = time.process_time()
     result = analyse_bag(path, csv_dir=out)
     analysed = time.perf_counter()
     write_report(result, out)
     done = time.perf_counter()
+    cpu = time.process_time() - cpu
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     return {
         "analyse_s": analysed - start,
+        "cpu_s": cpu,
         "monitor_s": spent[0],
         "report_s": done - analysed,
         "pulses": sum(result.pulses.values()),
@@ -307,8 +314,15 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
         for minutes in (long_minutes / 4, long_minutes) if "analyse" in args.cases else ():
             folder = workdir / f"rig-{minutes:g}min"
             write_s, count, size = _record_rig_bag(folder, minutes)
-            with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
-                analysis = pool.submit(measure_analysis, str(folder), str(workdir / f"report-{minutes:g}min")).result()
+            analyses: list[dict[str, Any]] = []
+            for _ in range(max(1, args.repeats)):  # each in a fresh process; medians of time, the largest peak
+                with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
+                    analyses.append(pool.submit(measure_analysis, str(folder), str(workdir / f"report-{minutes:g}min")).result())
+            analysis = {
+                **analyses[0],
+                **{key: statistics.median(r[key] for r in analyses) for key in ("analyse_s", "monitor_s", "report_s", "cpu_s", "baseline_rss_mb")},
+                "peak_rss_mb": max(r["peak_rss_mb"] for r in analyses),
+            }
             target = TARGET_ANALYSE_S_PER_HOUR * minutes / 60.0
             yield {
                 "bench": "bags",
@@ -320,8 +334,9 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "analyse_s": round(analysis["analyse_s"], 2),
                 "monitor_s": round(analysis["monitor_s"], 2),
                 "report_s": round(analysis["report_s"], 2),
+                "cpu_s": round(analysis["cpu_s"], 2),
                 "target_s": round(target, 2),
-                "meets_target": analysis["analyse_s"] + analysis["report_s"] <= target,
+                "meets_target": analysis["analyse_s"] + analysis["report_s"] <= target and analysis["peak_rss_mb"] <= TARGET_ANALYSE_PEAK_MB,
                 "pulses": analysis["pulses"],
                 "windows": analysis["windows"],
                 "status_rows": analysis["status_rows"],

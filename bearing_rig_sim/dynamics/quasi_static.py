@@ -48,7 +48,8 @@ balances nested, each a 2x2 Newton problem).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import root
@@ -60,6 +61,32 @@ from bearing_rig_sim.thermal.materials import BEARING_STEEL
 
 class LoadDistributionError(RigError):
     """The quasi-static equilibrium could not be found (or a bad input)."""
+
+
+GYROSCOPIC_FRICTION = 0.1
+"""Friction coefficient, 1, bounding the gyroscopic moment a ball's contacts can hold:
+M <= mu Q_i Dw / 2 (the couple of two opposed tangential forces at the raceways, the inner
+contact the weaker; the usual estimate of Harris and Kotzalas, high-speed operation: about
+7 mN m at 100 N here against M_g of 1.25 mN m at 9000 rpm). Above it the ball pivots and the
+contacts hold only that much; a ball that barely touches the inner raceway holds next to none,
+so the load passes continuously from the loaded balls to those resting on the outer raceway.
+Range 0.05-0.15 (lubricated to boundary)."""
+METHOD_NEWTON = "newton"
+"""Newton (Powell's hybrid method) from the thrust-only start converged."""
+METHOD_SPEED_CONTINUATION = "speed continuation"
+"""Found by continuation in speed from rest (Newton from the start and continuation in load failed)."""
+METHOD_LOAD_CONTINUATION = "load continuation"
+"""Found by continuation in the radial load and moment from the axial load alone."""
+_CONTINUATION_STEPS = 8
+"""First step of a continuation path: this fraction of the way (in load; in the square of speed)."""
+_MIN_STEP = 1.0 / 1024.0
+"""Smallest step of a continuation path, fraction of the way."""
+_RING_TOL = 1e-8
+"""The ring's balance: largest unbalanced load relative to the largest applied one."""
+_ANGLE_ITERATIONS = 12
+"""Fixed-point passes of a ball's speeds on its contact angles (they settle to 1e-12 rad in 3-5)."""
+_ANGLE_TOL = 1e-12
+"""rad: the contact angles' change below which a ball's speeds are taken as settled."""
 
 
 def thermal_clearance_change(
@@ -131,6 +158,10 @@ class LoadDistribution:
         reaction_moment: (M_x, M_y) the balls exert on the inner ring, N m (equal and opposite
             to what holds the tilt when ``moment`` was None).
         orbit_speeds: ball orbit speeds used for the body forces, rad/s.
+        load_zone: per ball, whether the ring presses it (its curvature centres farther apart
+            than A); at rest exactly the balls with a load.
+        method: how it was found: :data:`METHOD_NEWTON` from the thrust start, or after
+            :data:`METHOD_SPEED_CONTINUATION` or :data:`METHOD_LOAD_CONTINUATION`.
     """
 
     azimuths: np.ndarray
@@ -142,6 +173,8 @@ class LoadDistribution:
     tilt: tuple[float, float]
     reaction_moment: tuple[float, float]
     orbit_speeds: np.ndarray
+    load_zone: np.ndarray
+    method: str = METHOD_NEWTON
 
     @property
     def ball_load_max(self) -> float:
@@ -150,13 +183,15 @@ class LoadDistribution:
 
     @property
     def ball_load_min(self) -> float:
-        """Smallest inner contact load of any ball, N (0 outside the load zone)."""
+        """Smallest inner contact load of any ball, N (0 outside the load zone at rest; at speed
+        a ball there is wedged by its centrifugal force, with loads of the order of F_c)."""
         return float(self.inner_loads.min())
 
     @property
     def loaded_balls(self) -> int:
-        """Balls with an inner contact load, 1."""
-        return int(np.count_nonzero(self.inner_loads > 0.0))
+        """Balls in the load zone (the ring presses them: their curvature centres farther apart
+        than A), 1."""
+        return int(np.count_nonzero(self.load_zone))
 
     @property
     def contact_angle_at_max_load(self) -> float:
@@ -206,34 +241,75 @@ class QuasiStaticBearing:
             a = math.atan2(a1, a2)
             x = np.array([self.go * math.sin(a), self.go * math.cos(a)])
             return q, q, a, a, 0.0, x
+        # Resting on the outer raceway under F_c alone (a_o = 0), its speeds at its own angles.
+        ai_rest = math.atan2(a1, a2 - self.go)
+        for _ in range(_ANGLE_ITERATIONS):
+            orbit, _, _ = self._speeds(omega, ai_rest, 0.0)
+            fc = 0.5 * self.mass * self.dm * orbit * orbit
+            rest = self.go + (fc / self.ko) ** (2.0 / 3.0)
+            previous, ai_rest = ai_rest, math.atan2(a1, a2 - rest)
+            if abs(ai_rest - previous) < _ANGLE_TOL:
+                break
+        if math.hypot(a1, a2 - rest) <= self.gi:  # the inner raceway out of reach
+            return 0.0, fc, ai_rest, 0.0, orbit, np.array([0.0, rest])
+        # Both contacts: wedged between the raceways (the curvature centres closer than A, the
+        # loads of the order of F_c) or loaded by the ring.
         d = math.hypot(a1, a2)
-        ai = ao = math.atan2(a1, a2)
-        if x0 is None:  # the static position: on the centre line, the approach split by Hertz
-            q = self.kn * max(d - self.big_a, 0.0) ** 1.5
-            reach = self.go + (q / self.ko) ** (2.0 / 3.0)
-            x0 = np.array([reach * math.sin(ai), reach * math.cos(ai)])
-        x = x0.copy()
-        for _ in range(3):  # speeds depend on the angles
+        # starts: the last solution, on the centre line with the approach split by Hertz, and on
+        # the outer raceway where it meets the inner one nearest a_o = 0 (where F_c pushes it)
+        reach = self.go + ((self.kn * max(d - self.big_a, 0.0) ** 1.5) / self.ko) ** (2.0 / 3.0)
+        starts = [np.array([reach * a1 / d, reach * a2 / d]), self._wedge(a1, a2, rest)]
+        if d <= self.big_a:
+            starts.reverse()
+        if x0 is not None:
+            starts.insert(0, x0)
+        x = starts[0]
+        ai, ao = math.atan2(a1 - x[0], a2 - x[1]), math.atan2(x[0], x[1])
+        for _ in range(_ANGLE_ITERATIONS):  # the speeds depend on the angles
             orbit, roll, beta = self._speeds(omega, ai, ao)
             fc = 0.5 * self.mass * self.dm * orbit * orbit
-            # Outside the load zone: the ball rests on the outer raceway under F_c alone (at
-            # a_o = 0; no inner contact to carry a gyroscopic moment by friction).
-            rest = self.go + (fc / self.ko) ** (2.0 / 3.0)
-            if d <= self.big_a or math.hypot(a1, a2 - rest) <= self.gi:
-                return 0.0, fc, math.atan2(a1, a2 - rest), 0.0, orbit, np.array([0.0, rest])
             mg = self.inertia * roll * orbit * math.sin(beta) if gyro else 0.0
 
             def residual(v: np.ndarray, fc: float = fc, mg: float = mg) -> np.ndarray:
                 qi, qo, si, ci, so, co = self._contacts(a1, a2, v)
-                return np.array([qi * si - qo * so + 2.0 * mg * co / self.dw, qi * ci - qo * co - 2.0 * mg * so / self.dw + fc])
+                held = math.copysign(min(abs(mg), GYROSCOPIC_FRICTION * qi * 0.5 * self.dw), mg)
+                return np.array([qi * si - qo * so + 2.0 * held * co / self.dw, qi * ci - qo * co - 2.0 * held * so / self.dw + fc])
 
-            sol = root(residual, x, method="hybr", options={"xtol": 1e-13})
-            if not sol.success and np.max(np.abs(residual(sol.x))) > 1e-6 * max(fc, 1.0):
-                raise LoadDistributionError(f"ball equilibrium not found at offsets ({a1:.4g}, {a2:.4g}) m: {sol.message}")
-            x = sol.x
+            x = self._ball_root(residual, [x, *starts[1:]], fc, a1, a2)
             qi, qo, si, ci, so, co = self._contacts(a1, a2, x)
+            change = max(abs(math.atan2(si, ci) - ai), abs(math.atan2(so, co) - ao))
             ai, ao = math.atan2(si, ci), math.atan2(so, co)
+            if change < _ANGLE_TOL:
+                break
         return qi, qo, ai, ao, orbit, x
+
+    def _ball_root(self, residual: Callable[[np.ndarray], np.ndarray], starts: list[np.ndarray], fc: float, a1: float, a2: float) -> np.ndarray:
+        """The ball centre where ``residual`` (N) vanishes, from the first start that converges
+        (to 1e-9 of the largest of F_c, the contact loads and 1 N; Powell's hybrid method, then
+        Levenberg-Marquardt)."""
+        message = ""
+        for method in ("hybr", "lm"):
+            for start in starts:
+                sol = root(residual, start, method=method, options={"xtol": 1e-13})
+                if not np.all(np.isfinite(sol.x)):
+                    continue
+                qi, qo, *_ = self._contacts(a1, a2, sol.x)
+                if np.max(np.abs(residual(sol.x))) <= 1e-9 * max(fc, qi, qo, 1.0):
+                    return np.asarray(sol.x, dtype=float)
+                message = str(sol.message)
+        raise LoadDistributionError(f"ball equilibrium not found at curvature-centre offsets ({a1:.4g}, {a2:.4g}) m: {message}")
+
+    def _wedge(self, a1: float, a2: float, reach: float) -> np.ndarray:
+        """Where the circle of radius ``reach`` about the outer curvature centre meets the
+        circle of radius (f_i - 1/2) Dw about the inner one (a1, a2), on the side of the smaller
+        outer contact angle in magnitude, further out radially where F_c pushes the ball (m)."""
+        d = math.hypot(a1, a2)
+        along = (d * d + reach * reach - self.gi * self.gi) / (2.0 * d)
+        across = math.sqrt(max(reach * reach - along * along, 0.0))
+        ux, uy = a1 / d, a2 / d
+        # of the two points along * u +- across * (-uy, ux), the one further out radially
+        side = 1.0 if ux >= 0.0 else -1.0
+        return np.array([along * ux - side * across * uy, along * uy + side * across * ux])
 
     def _contacts(self, a1: float, a2: float, x: np.ndarray) -> tuple[float, float, float, float, float, float]:
         """Q_i, Q_o and the sines/cosines of a_i, a_o for the ball centre x = (X1, X2)."""
@@ -244,16 +320,24 @@ class QuasiStaticBearing:
         return qi, qo, (a1 - x[0]) / di, (a2 - x[1]) / di, x[0] / do, x[1] / do
 
     # -- the ring ----------------------------------------------------------------------------
+    def _offsets(self, u: np.ndarray, case: LoadCase) -> tuple[np.ndarray, np.ndarray]:
+        """Each ball's curvature-centre offsets (A1_j, A2_j), m, under the ring's displacements ``u``."""
+        c, s = np.cos(self.psi), np.sin(self.psi)
+        a1 = self.big_a * math.sin(self.a0) + u[0] + case.axial_preload + self.ri * (u[3] * c + u[4] * s)
+        a2 = self.big_a * math.cos(self.a0) + u[1] * c + u[2] * s - 0.5 * case.clearance
+        return a1, a2
+
     def _balls(self, u: np.ndarray, case: LoadCase, centres: list[np.ndarray | None]) -> tuple[np.ndarray, ...]:
-        da, dx, dy, tx, ty = u
-        z = self.z
-        qi, qo, ai, ao, wm = (np.zeros(z) for _ in range(5))
-        for j in range(z):
-            c, s = math.cos(self.psi[j]), math.sin(self.psi[j])
-            a1 = self.big_a * math.sin(self.a0) + da + case.axial_preload + self.ri * (tx * c + ty * s)
-            a2 = self.big_a * math.cos(self.a0) + dx * c + dy * s - 0.5 * case.clearance
-            qi[j], qo[j], ai[j], ao[j], wm[j], centres[j] = self._ball(a1, a2, case.inner_ring_speed, case.gyroscopic, centres[j])
+        qi, qo, ai, ao, wm = (np.zeros(self.z) for _ in range(5))
+        a1, a2 = self._offsets(u, case)
+        for j in range(self.z):
+            qi[j], qo[j], ai[j], ao[j], wm[j], centres[j] = self._ball(float(a1[j]), float(a2[j]), case.inner_ring_speed, case.gyroscopic, centres[j])
         return qi, qo, ai, ao, wm
+
+    def _load_zone(self, u: np.ndarray, case: LoadCase) -> np.ndarray:
+        """Per ball: its curvature centres farther apart than A under the ring's displacements ``u``."""
+        a1, a2 = self._offsets(u, case)
+        return np.asarray(np.hypot(a1, a2) > self.big_a)
 
     def _ring_forces(self, qi: np.ndarray, ai: np.ndarray) -> np.ndarray:
         c, s = np.cos(self.psi), np.sin(self.psi)
@@ -274,31 +358,20 @@ class QuasiStaticBearing:
             raise LoadDistributionError(f"axial_load must be > 0 N for a single angular contact bearing, got {case.axial_load!r}")
         if case.inner_ring_speed < 0.0:
             raise LoadDistributionError(f"inner_ring_speed must be >= 0 rad/s, got {case.inner_ring_speed!r}")
-        held = case.moment is None
-        target = np.array([case.axial_load, case.radial_load, 0.0, *(case.moment or (0.0, 0.0))])
-        free = [0, 1, 2] if held else [0, 1, 2, 3, 4]
-        u = np.array([0.0, 0.0, 0.0, *case.misalignment])
-        # Start: the thrust-only approach for F_a/(Z sin a0) at each ball, plus the radial share.
-        q0 = max(case.axial_load, 1.0) / (self.z * math.sin(self.a0))
-        u[0] = (q0 / self.kn) ** (2.0 / 3.0) / math.sin(self.a0)
-        u[1] = 2.0 * (max(abs(case.radial_load), 1.0) / (self.z * self.kn)) ** (2.0 / 3.0) * math.copysign(1.0, case.radial_load)
-        scale_x = 1e-6  # unknowns in micrometres / microradians x R_i
-        scale_f = max(abs(case.axial_load), abs(case.radial_load), 1.0)
+        for name in ("moment", "misalignment"):
+            value = getattr(case, name)
+            if value is not None and not all(math.isfinite(v) for v in value):
+                raise LoadDistributionError(f"{name} must be finite, got {value!r}")
         centres: list[np.ndarray | None] = [None] * self.z
-        lengths = np.array([1.0, 1.0, 1.0, 1.0 / self.ri, 1.0 / self.ri])
-
-        def residual(v: np.ndarray) -> np.ndarray:
-            w = u.copy()
-            w[free] = v * scale_x * lengths[free]
-            qi, _, ai, _, _ = self._balls(w, case, centres)
-            f = self._ring_forces(qi, ai) - target
-            f[3:] /= self.ri
-            return f[free] / scale_f
-
-        sol = root(residual, u[free] / (scale_x * lengths[free]), method="hybr", options={"xtol": 1e-12})
-        if np.max(np.abs(residual(sol.x))) > 1e-8:
-            raise LoadDistributionError(f"no quasi-static equilibrium found for {case}: {sol.message}")
-        u[free] = sol.x * scale_x * lengths[free]
+        u, unbalanced, message = self._equilibrium(case, self._start(case), centres)
+        method = METHOD_NEWTON
+        if unbalanced > _RING_TOL:
+            u, unbalanced, method, message = self._continuation(case, centres)
+        if unbalanced > _RING_TOL:
+            raise LoadDistributionError(
+                f"no quasi-static equilibrium found for {case}: the closest state leaves {unbalanced:.3g} of the largest applied load "
+                f"unbalanced after Newton, continuation in speed and continuation in load ({message})"
+            )
         qi, qo, ai, ao, wm = self._balls(u, case, centres)
         forces = self._ring_forces(qi, ai)
         return LoadDistribution(
@@ -311,7 +384,110 @@ class QuasiStaticBearing:
             tilt=(float(u[3]), float(u[4])),
             reaction_moment=(float(forces[3]), float(forces[4])),
             orbit_speeds=wm,
+            load_zone=self._load_zone(u, case),
+            method=method,
         )
+
+    def _start(self, case: LoadCase) -> np.ndarray:
+        """Newton's start: the thrust-only approach for F_a/(Z sin a0) at each ball, plus the
+        radial share (m, m, m, rad, rad)."""
+        u = np.array([0.0, 0.0, 0.0, *case.misalignment])
+        q0 = max(case.axial_load, 1.0) / (self.z * math.sin(self.a0))
+        u[0] = (q0 / self.kn) ** (2.0 / 3.0) / math.sin(self.a0)
+        u[1] = 2.0 * (max(abs(case.radial_load), 1.0) / (self.z * self.kn)) ** (2.0 / 3.0) * math.copysign(1.0, case.radial_load)
+        return u
+
+    def _equilibrium(self, case: LoadCase, start: np.ndarray, centres: list[np.ndarray | None]) -> tuple[np.ndarray, float, str]:
+        """Powell's hybrid method on the ring's free displacements from ``start``: the
+        displacements, the largest unbalanced load relative to the largest applied one (forces
+        in N, moments over R_i), and the solver's message. A ball whose balance fails counts as
+        unbalanced (inf)."""
+        held = case.moment is None
+        target = np.array([case.axial_load, case.radial_load, 0.0, *(case.moment or (0.0, 0.0))])
+        free = [0, 1, 2] if held else [0, 1, 2, 3, 4]
+        u = start.copy()
+        scale_x = 1e-6  # unknowns in micrometres / microradians x R_i
+        scale_f = max(abs(case.axial_load), abs(case.radial_load), *(abs(m) / self.ri for m in case.moment or ()), 1.0)
+        lengths = np.array([1.0, 1.0, 1.0, 1.0 / self.ri, 1.0 / self.ri])
+
+        def residual(v: np.ndarray) -> np.ndarray:
+            w = u.copy()
+            w[free] = v * scale_x * lengths[free]
+            qi, _, ai, _, _ = self._balls(w, case, centres)
+            f = self._ring_forces(qi, ai) - target
+            f[3:] /= self.ri
+            return np.asarray(f[free] / scale_f)
+
+        def jacobian(v: np.ndarray) -> np.ndarray:
+            # forward differences with a step of 1e-6 um (or of 1e-6 relative): MINPACK's own
+            # step is relative to the unknown, next to nothing for a displacement that a
+            # symmetric load leaves at 1e-20 m, where its Jacobian column vanishes
+            f0 = residual(v)
+            jac = np.empty((f0.size, v.size))
+            for k in range(v.size):
+                w = v.copy()
+                w[k] += 1e-6 * max(1.0, abs(v[k]))
+                jac[:, k] = (residual(w) - f0) / (w[k] - v[k])
+            return jac
+
+        try:
+            sol = root(residual, u[free] / (scale_x * lengths[free]), jac=jacobian, method="hybr", options={"xtol": 1e-12})
+            unbalanced = float(np.max(np.abs(residual(sol.x))))
+        except LoadDistributionError as exc:
+            return start, math.inf, str(exc)
+        u[free] = sol.x * scale_x * lengths[free]
+        return u, unbalanced, str(sol.message)
+
+    def _continuation(self, case: LoadCase, centres: list[np.ndarray | None]) -> tuple[np.ndarray, float, str, str]:
+        """The fallbacks where Newton fails from its start, each step started from the last
+        one's solution: continuation in load (from the axial load alone, the radial load and
+        moment growing to the case's) at the case's speed; then continuation in speed from
+        rest (no body force; the rest point itself found directly or by continuation in load)
+        up to the case's speed. Returns (displacements, unbalance, method, message)."""
+        u, unbalanced, message = self._load_path(case, centres)
+        if unbalanced <= _RING_TOL:
+            return u, unbalanced, METHOD_LOAD_CONTINUATION, message
+        if case.inner_ring_speed > 0.0:
+            rest = replace(case, inner_ring_speed=0.0)
+            u, unbalanced, message = self._equilibrium(rest, self._start(rest), centres)
+            if unbalanced > _RING_TOL:
+                u, unbalanced, message = self._load_path(rest, centres)
+            if unbalanced <= _RING_TOL:  # F_c grows as the square of the speed: steps in its square
+                u, unbalanced, message = self._path(lambda f: replace(case, inner_ring_speed=case.inner_ring_speed * math.sqrt(f)), u, centres)
+                if unbalanced <= _RING_TOL:
+                    return u, unbalanced, METHOD_SPEED_CONTINUATION, message
+        return u, unbalanced, "", message
+
+    def _load_path(self, case: LoadCase, centres: list[np.ndarray | None]) -> tuple[np.ndarray, float, str]:
+        """Continuation from the axial load alone to ``case``'s radial load and moment:
+        (displacements, unbalance, message) of the last step reached."""
+        if case.radial_load == 0.0 and case.moment is None:
+            return self._start(case), math.inf, "no radial load or moment to continue in"
+
+        def scaled(f: float) -> LoadCase:
+            moment = None if case.moment is None else (case.moment[0] * f, case.moment[1] * f)
+            return replace(case, radial_load=case.radial_load * f, moment=moment)
+
+        u, unbalanced, message = self._equilibrium(scaled(0.0), self._start(case), centres)
+        if unbalanced > _RING_TOL:
+            return u, unbalanced, message
+        return self._path(scaled, u, centres)
+
+    def _path(self, case_at: Callable[[float], LoadCase], u: np.ndarray, centres: list[np.ndarray | None]) -> tuple[np.ndarray, float, str]:
+        """Continuation along ``case_at(f)`` from f = 0 (solved: ``u``) to f = 1, the step
+        halved where Newton fails from the last solution (down to :data:`_MIN_STEP`) and
+        doubled after a success: (displacements, unbalance, message) of the last step reached."""
+        f, step, unbalanced, message = 0.0, 1.0 / _CONTINUATION_STEPS, 0.0, ""
+        while f < 1.0:
+            trial = min(f + step, 1.0)
+            w, unbalanced, message = self._equilibrium(case_at(trial), u, centres)
+            if unbalanced <= _RING_TOL:
+                f, u, step = trial, w, 2.0 * step
+            elif step > _MIN_STEP:
+                step *= 0.5
+            else:
+                return u, unbalanced, f"continuation stopped at {f:.4g} of the way: {message}"
+        return u, unbalanced, message
 
 
 def solve(params: BearingParameters, case: LoadCase) -> LoadDistribution:

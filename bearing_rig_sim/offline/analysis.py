@@ -53,6 +53,8 @@ from pathlib import Path
 from typing import Any, cast
 from collections.abc import Callable
 
+import numpy as np
+
 
 from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
@@ -62,6 +64,7 @@ from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorS
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
+from bearing_rig_sim.bags.mcapfile import ChunkBatch
 from bearing_rig_sim.bags.reader import BagReader, open_bag
 from bearing_rig_sim.offline.segments import (
     SEGMENTS_CSV,
@@ -110,6 +113,10 @@ CONTEXT_TOPICS: dict[str, str] = {
     )
 }
 """Topics read when present, with the type they must carry."""
+SAMPLED_TOPICS = frozenset((SPEEDS, TRUTH, LOAD_STATE, LOAD_SETPOINT, BEARING_FORCE, OUTER_RING_TEMPERATURE, HOUSING_TORQUE))
+"""Context topics only sampled by the status rows (their latest value): read a chunk at a time
+as arrays beside the pulses, never message by message (the 1 kHz speeds would be most of the
+messages of the bag)."""
 
 MONITOR_PARAMETERS_KEY = f"parameters/{NODE_NAME}"
 """Run-context key holding the monitor's parameter file of the run."""
@@ -202,7 +209,33 @@ class OfflineResult:
 # ---------------------------------------------------------------------------------------------
 # Helpers
 # ---------------------------------------------------------------------------------------------
-class _Latest:
+class _Decoding:
+    """Decodes the message a row asks for once (a message that does not decode is counted in
+    :attr:`failed` and leaves the value unknown)."""
+
+    def __init__(self, decode: Callable[[bytes], Any]) -> None:
+        self._decode = decode
+        self._decoded: tuple[int, bytes, Any] | None = None
+        self._bad: set[int] = set()  # keys of messages that did not decode
+        self.failed = 0
+
+    def _value(self, entry: tuple[int, bytes] | None) -> Any:
+        """The decoded message of ``entry`` = (key, raw bytes); None for no entry or a bad one."""
+        if entry is None or entry[0] in self._bad:
+            return None
+        if self._decoded is not None and self._decoded[:2] == entry:
+            return self._decoded[2]
+        try:
+            value = self._decode(entry[1])
+        except BagError:
+            self.failed += 1
+            self._bad.add(entry[0])
+            return None
+        self._decoded = (*entry, value)
+        return value
+
+
+class _Latest(_Decoding):
     """The latest message of a topic, decoded only when asked for (a message that does not
     decode is counted in :attr:`failed` and leaves the value unknown); :meth:`get` ``before`` a
     message's place in the bag gives the latest read before it (a status is computed on pulses
@@ -212,11 +245,8 @@ class _Latest:
     """Messages kept for :meth:`get` before an earlier place (1)."""
 
     def __init__(self, decode: Callable[[bytes], Any]) -> None:
-        self._decode = decode
+        super().__init__(decode)
         self._kept: deque[tuple[int, bytes]] = deque(maxlen=self.KEPT)  # (place read, raw)
-        self._decoded: tuple[int, bytes, Any] | None = None
-        self._bad: set[int] = set()  # places of messages that did not decode
-        self.failed = 0
 
     def put(self, place: int, raw: bytes) -> None:
         """The message read ``place``-th in the bag."""
@@ -230,18 +260,62 @@ class _Latest:
             if before is None or kept[0] < before:
                 entry = kept
                 break
-        if entry is None or entry[0] in self._bad:
-            return None
-        if self._decoded is not None and self._decoded[:2] == entry:
-            return self._decoded[2]
-        try:
-            value = self._decode(entry[1])
-        except BagError:
-            self.failed += 1
-            self._bad.add(entry[0])
-            return None
-        self._decoded = (*entry, value)
-        return value
+        return self._value(entry)
+
+
+class _Sampled(_Decoding):
+    """A context topic read only where a status row samples it: its messages arrive a chunk at a
+    time as arrays (:meth:`.BagReader.batches`: no message handled one by one) and only the one a
+    row asks for is decoded (a message that does not decode is counted in :attr:`failed` and
+    leaves the value unknown)."""
+
+    def __init__(self, decode: Callable[[bytes], Any]) -> None:
+        super().__init__(decode)
+        self._current: ChunkBatch | None = None
+        self._before: tuple[int, bytes] | None = None  # the last message of the batches left behind
+
+    def take(self, batch: ChunkBatch) -> None:
+        """The topic's next batch (later than the ones before)."""
+        current = self._current
+        if current is not None:
+            self._before = (int(current.log_times[-1]), current.data[int(current.starts[-1]) : int(current.ends[-1])])
+        self._current = batch
+
+    def get(self, at_ns: int) -> Any:
+        """The latest message taken logged at or before ``at_ns`` (ns), decoded; None if none
+        (or it does not decode)."""
+        entry = self._before
+        current = self._current
+        if current is not None:
+            k = int(np.searchsorted(current.log_times, at_ns, side="right")) - 1
+            if k >= 0:
+                entry = (int(current.log_times[k]), current.data[int(current.starts[k]) : int(current.ends[k])])
+        return self._value(entry)
+
+
+class _SampledTopics:
+    """The sampled context topics (:data:`SAMPLED_TOPICS`) of a bag, read a chunk ahead of the
+    time asked for: times asked for may go back a little (pulses released in stamp order), not
+    before the chunk the latest time reached."""
+
+    def __init__(self, bag: BagReader, names: list[str]) -> None:
+        self.topics = {name: _Sampled(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in names}
+        self._batches = bag.batches(names) if names else iter(())
+        self._next = next(self._batches, None)
+
+    def get(self, at_ns: int) -> dict[str, Any]:
+        """Each topic's latest message logged at or before ``at_ns`` (ns), decoded (None if none)."""
+        while self._next is not None and min(int(b.log_times[0]) for b in self._next.values()) <= at_ns:
+            for name, batch in self._next.items():
+                self.topics[name].take(batch)
+            self._next = next(self._batches, None)
+        return {name: topic.get(at_ns) for name, topic in self.topics.items()}
+
+    def close(self) -> None:
+        """Release the bag's file."""
+        close = getattr(self._batches, "close", None)
+        if close is not None:
+            close()
 
 
 def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> MonitorSettings | None:
@@ -324,7 +398,8 @@ class OfflineAnalysis:
         )
         self._rows = RowDecimator(max_points)
         self._on_row, self._on_window = on_row, on_window
-        self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context}
+        self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context if name not in SAMPLED_TOPICS}
+        self._sampled = _SampledTopics(bag, [name for name in self._context if name in SAMPLED_TOPICS])
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0
         self._unstamped = 0
@@ -336,10 +411,14 @@ class OfflineAnalysis:
         """The pulses in stamp order, not the log's reception order (a held-up recorder)."""
         self._read = 0
         """Messages read from the bag so far."""
-        self._read_at: dict[int, int] = {}
-        """Place in the bag of each pulse held in :attr:`_order`, by id."""
+        self._read_at: dict[int, tuple[int, int]] = {}
+        """Place in the bag and log time (ns) of each pulse held in :attr:`_order`, by id."""
         self._context_before: int | None = None
         """Statuses take the context read before this place (the pulse computing them); None: all."""
+        self._context_time = 0
+        """... and the sampled topics' messages logged at or before this time, ns."""
+        self._log_ns = 0
+        """Log time of the last message read, ns."""
         self._commands_ahead: list[tuple[float, Any]] = []
         """Spindle commands read before their stamp: (stamp s, message), in order."""
         self._sinks: list[CsvWriter] = []
@@ -402,7 +481,7 @@ class OfflineAnalysis:
     def run(self) -> OfflineResult:
         """Read the bag once and return the result; CSV files are closed whatever happens."""
         handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
-        for name in self._context:
+        for name in self._latest:
             handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, functools.partial(self._on_context, name))
             if name == LOAD_CELL:  # the load sweep's abscissa and the kinematic slip's contact angle
                 handlers[name] = self._on_load_cell
@@ -416,17 +495,20 @@ class OfflineAnalysis:
                         self._emit(scheduled.time, scheduled.reason, scheduled.status)
                     self._start_segment(start, command)
                 self._read += 1
+                self._log_ns = log_time_ns
                 handlers[topic](log_time_ns, cast(bytes, data))  # raw=True: the CDR bytes
             self._finish()
         finally:
+            self._sampled.close()
             for sink in self._sinks:
                 sink.close()
         result = self.result
         if self._bad_pulses > 1:
             self._report(f"{self.bag.path.name}: {self._bad_pulses} pulses could not be decoded in all")
-        for name, latest in self._latest.items():
-            if latest.failed:
-                self._report(f"{self.bag.path.name}: topic {name}: {latest.failed} message(s) could not be decoded; not used")
+        failures = {name: latest.failed for name, latest in self._latest.items()} | {name: topic.failed for name, topic in self._sampled.topics.items()}
+        for name, failed in failures.items():
+            if failed:
+                self._report(f"{self.bag.path.name}: topic {name}: {failed} message(s) could not be decoded; not used")
         result.complete = self.bag.complete and not self._problems
         result.problems = list(dict.fromkeys(self.bag.problems + self._problems))
         result.rows = self._rows.result()
@@ -452,18 +534,18 @@ class OfflineAnalysis:
             pulse = dataclasses.replace(pulse, time=log_time_ns * 1e-9)
         shaft = self._shaft_of[topic]
         self.result.pulses[shaft] += 1
-        self._read_at[id(pulse)] = self._read
+        self._read_at[id(pulse)] = (self._read, log_time_ns)
         for ordered in self._order.push(shaft, pulse):
             self._feed(*ordered)
 
     def _feed(self, shaft: str, pulse: Pulse) -> None:
         """One pulse, in stamp order, through the schedule; its statuses take the context read
         before it."""
-        self._context_before = self._read_at.pop(id(pulse), None)
+        self._context_before, self._context_time = self._read_at.pop(id(pulse), (None, self._log_ns))
         try:
             self._schedule_pulse(shaft, pulse)
         finally:
-            self._context_before = None
+            self._context_before, self._context_time = None, self._log_ns
 
     def _schedule_pulse(self, shaft: str, pulse: Pulse) -> None:
         for scheduled in self.schedule.on_pulse(shaft, pulse):
@@ -573,6 +655,7 @@ class OfflineAnalysis:
         values: dict[str, Any] = {}
         before = self._context_before
         get = {name: latest.get(before) for name, latest in self._latest.items() if name not in (STATUS, COMMAND)}
+        get.update(self._sampled.get(self._context_time if before is not None else self._log_ns))
         speeds = get.get(SPEEDS)
         if speeds is not None:
             velocity = dict(zip(speeds.name, speeds.velocity))

@@ -40,7 +40,9 @@ from hypothesis import strategies as st
 from scipy.optimize import brentq
 
 from bearing_rig_sim.dynamics import BearingParameters
+from bearing_rig_sim.dynamics.engine import DynamicsInputError
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, LoadDistribution, QuasiStaticBearing
+from bearing_rig_sim.dynamics.steady import METHOD_INTEGRATION, SteadySolver
 
 RPM = math.pi / 30.0
 MAX_SPEED = 10_000 * RPM
@@ -153,3 +155,52 @@ def test_the_points_where_newton_lost_the_balls_at_the_load_zone_edge_solve(bear
     sol = bearing.solve(case)
     assert_ring_balance(sol, case, bearing.ri)
     assert_balls(sol, case)
+
+
+SPEED_TOLERANCE = 0.2
+"""rad/s: the engine's absolute speed tolerance (engine.SPEED_TOLERANCE)."""
+
+
+@pytest.fixture(scope="module")
+def steady() -> SteadySolver:
+    return SteadySolver(BearingParameters.calibrated())
+
+
+@settings(max_examples=300, derandomize=True, database=None, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(
+    speed=st.one_of(st.just(MAX_SPEED), st.floats(0.1 * RPM, 100.0 * RPM), st.floats(0.1 * RPM, MAX_SPEED)),
+    axial=axials,
+)
+def test_every_speed_and_axial_load_of_the_envelope_has_a_steady_state(steady: SteadySolver, speed: float, axial: float) -> None:
+    """The engine's steady state (Newton on its own step, the integration its fallback): finite;
+    the cage and the balls' orbit turning forwards and no faster than pure rolling at any contact
+    angle, omega_i (1 - Dw cos a / d_m) / 2 <= omega_i / 2 (the inner ring is the only driven
+    body), within the engine's speed tolerance; the friction torque and power dissipated, not
+    gained (>= 0); a state Newton found says it is stable, an average says it is not."""
+    point = steady.solve(speed, axial)
+    values = [point.cage_speed, point.ball_orbit_speed, point.ball_spin_speed, point.slip_pct, point.power, point.torque]
+    assert all(math.isfinite(v) for v in values), point
+    for rate in (point.cage_speed, point.ball_orbit_speed):
+        assert -SPEED_TOLERANCE <= rate <= 0.5 * speed + SPEED_TOLERANCE, point
+    assert point.power >= 0.0 and point.torque >= 0.0, point
+    assert point.stable == (point.method != METHOD_INTEGRATION)
+
+
+def test_at_rest_there_is_no_steady_state_and_the_solver_says_why(steady: SteadySolver) -> None:
+    with pytest.raises(DynamicsInputError, match="at rest there is no rolling steady state"):
+        steady.solve(0.0, 100.0)
+
+
+@pytest.mark.slow
+@settings(max_examples=40, derandomize=True, database=None, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(speed=st.one_of(st.just(MAX_SPEED), st.floats(10.0 * RPM, MAX_SPEED)), axial=axials, radial=radials, moment=moments)
+def test_every_combined_load_of_the_envelope_has_a_periodic_steady_state(
+    steady: SteadySolver, speed: float, axial: float, radial: float, moment: tuple[float, float] | None
+) -> None:
+    """The periodic steady state under a combined load (integrated and averaged over whole
+    ball-pass periods): the same bounds as the axial one's (forty cases: each integrates 0.35 s)."""
+    point = steady.periodic(speed, axial, radial, moment=moment)
+    assert all(math.isfinite(v) for v in (point.cage_speed, point.ball_orbit_speed, point.power)), point
+    for rate in (point.cage_speed, point.ball_orbit_speed):
+        assert -SPEED_TOLERANCE <= rate <= 0.5 * speed + SPEED_TOLERANCE, point
+    assert point.power >= 0.0, point

@@ -492,7 +492,9 @@ class SteadySolver:
     def _inputs(inner_ring_speed: float, axial_load: float) -> tuple[float, float]:
         omega = float(inner_ring_speed)
         if not math.isfinite(omega) or omega <= 0.0:
-            raise DynamicsInputError(f"inner_ring_speed must be finite and > 0, got {inner_ring_speed!r}")
+            raise DynamicsInputError(
+                f"inner_ring_speed must be finite and > 0 (at rest there is no rolling steady state: the slip is undefined), got {inner_ring_speed!r}"
+            )
         return omega, float(axial_load)
 
     def sweep_load(self, inner_ring_speed: float, loads: list[float]) -> list[SteadyPoint]:

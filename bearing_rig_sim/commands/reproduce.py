@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.commands import describe
+from bearing_rig_sim.analysis.stability import K1_AXIAL_LOAD
 from bearing_rig_sim.config import BEARING_MODELS
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.studies.reproduction_report import Outputs
@@ -60,7 +61,7 @@ def _print_outputs(out: Outputs) -> None:
     print(f"validation RMS (twin - bench, 4 rows): {out.validation_rms_pct:.3f} pp")
     for rpm, f in out.load_onsets_n.items():
         why = out.reasons.get(f"{rpm:.0f} rpm", "not reached in 50-700 N")
-        print(f"  {rpm:6.0f} rpm: {f'stable from {f:.0f} N' if f is not None else why} (k1 = -5e-6 %/N)")
+        print(f"  {rpm:6.0f} rpm: {f'stable from {f:.0f} N' if f is not None else why} (k1 = {K1_AXIAL_LOAD:g} %/N, the shipped reading)")
     for a, t in out.acceleration_onsets_s.items():
         why = out.reasons.get(f"{a:.0f} rad/s^2", "not reached")
         print(f"  {a:4.0f} rad/s^2: {f'stable from {t:.2f} s' if t is not None else why} (k2 = -3e-2 %/s)")

@@ -73,12 +73,22 @@ def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_stat
     last = seen["clock"]
     publish(last)
     bound = last + MONITOR_LEAD_S + CHUNK_S  # a status stamped from a clock the test had not yet taken in full
-    # silent monitor: the simulation reaches its lead and stays there
+    # silent monitor: the simulation reaches its lead and stays there while the simulator paces on
+    # the statuses (it lets go by design after FORCE_SILENT_S of wall silence, which its report
+    # then states: on a loaded host the held reports may take that long, so each report is
+    # judged by what it says)
     assert ros_graph.spin_until(lambda: seen["clock"] >= last + MONITOR_LEAD_S - 0.1, WAIT, executor=executor), seen
     reports = seen["reports"]
-    assert ros_graph.spin_until(lambda: seen["reports"] >= reports + HELD_REPORTS, WAIT, executor=executor), seen
-    assert seen["clock"] <= bound, f"the clock ran to {seen['clock']:.3f} s, the last status was {last:.3f} s"
-    assert seen["sim_time"] <= bound and seen["pacing"] == "on", seen
-    # the monitor's next status lets it go on
+    held: list[float] = []
+
+    def judged() -> bool:
+        if seen["reports"] > reports + len(held) and seen["pacing"] == "on":
+            held.append(seen["sim_time"])
+        return len(held) >= HELD_REPORTS or seen["pacing"] != "on"
+
+    assert ros_graph.spin_until(judged, WAIT, executor=executor), seen
+    assert held, f"no report while held: the simulator stopped pacing at once ({seen})"
+    assert max(held) <= bound, f"held, the simulation ran to {max(held):.3f} s, the last status was {last:.3f} s"
+    # the monitor's next status lets it go on (and sets the pacing on again if it had let go)
     publish(last + 1.0)
     assert ros_graph.spin_until(lambda: seen["clock"] > bound + 0.5, WAIT, executor=executor), seen

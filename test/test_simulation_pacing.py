@@ -149,9 +149,9 @@ def test_stamps_far_from_the_simulated_time_do_not_pace():
     lead.observe(1.0, 1.0, 0.0)
     lead.observe(1.001, 5.0, 0.0)  # 4 s behind when taken: not a stream that follows the clock
     assert lead.room(5.0, 1e-3, 0.0) is None
-    lead.observe(5.0, 5.0, 0.0)
-    lead.observe(5.0, 5.0, 0.0)  # not advancing
-    assert lead.room(5.0, 1e-3, 0.0) is None
+    lead.observe(5.0, 5.0, 0.0)  # advancing and near the simulated time: paces from here
+    lead.observe(5.0, 5.05, 0.0)  # the same stamp again: nothing new, the hold stays where it was
+    assert lead.room(5.05, 1e-3, 0.0) == 50  # (5.0 + 0.1 - 5.05) / 1e-3: a repeated stamp releases nothing
 
 
 def test_a_paused_or_silent_stream_stops_pacing_until_it_advances_again():

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.config import SHIPPED_CALIBRATION_FILE, ConfigError, config_path
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.settings_model import read_file
 
 COUPLED = "coupled"
 ISOTHERMAL = "isothermal"
-NAMED: dict[str, str] = {COUPLED: "h7006c_coupled.yaml", ISOTHERMAL: "h7006c_table3.yaml"}
+NAMED: dict[str, str] = {COUPLED: "h7006c_coupled.yaml", ISOTHERMAL: Path(SHIPPED_CALIBRATION_FILE).name}
 """Named calibration -> its file under ``config/calibration/``."""
 DEFAULT_CALIBRATION = COUPLED
 """The bench twin's default calibration."""

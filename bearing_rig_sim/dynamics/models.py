@@ -17,7 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.config import BEARING_MODELS, ConfigError, config_path, read_mapping
+from bearing_rig_sim.config import BEARING_MODELS, ConfigError, config_path, read_mapping, shipped_bearing_file, shipped_calibration_file
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.parameters import BearingParameters, overlay_calibration
 from bearing_rig_sim.settings_model import read_file
@@ -27,10 +27,12 @@ MODELS: tuple[str, ...] = BEARING_MODELS
 BENCH, PAPER = MODELS
 DEFAULT_MODEL = BENCH
 
-DEFAULT_BEARING = config_path("bearings", "h7006c.yaml")
+DEFAULT_BEARING = shipped_bearing_file()
 """The shipped bearing file."""
-BENCH_CALIBRATION = config_path("calibration", "h7006c_table3.yaml")
-"""The bench twin's calibration (paper Table 3, bench column)."""
+BENCH_CALIBRATION = shipped_calibration_file()
+"""The bench twin's isothermal calibration (paper Table 3, bench column): the engine's parameters
+without the thermal network (the coupled one is for a twin whose lubricant follows it:
+:mod:`.calibrations`)."""
 
 
 def model_file(name: str) -> Path:

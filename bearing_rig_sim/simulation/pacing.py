@@ -237,7 +237,11 @@ class StreamLead:
 
     def observe(self, stamp: float, sim_time: float, wall: float) -> None:
         """A message stamped ``stamp`` (s) taken at the simulated time ``sim_time`` (s), wall
-        time ``wall`` (s)."""
+        time ``wall`` (s). The same stamp again (a status with no newer rig time behind it)
+        changes nothing: the pacing stays where the last advance put it, and the silence guard
+        counts from that advance."""
+        if stamp == self.stamp:
+            return
         advancing = stamp > self.stamp and abs(stamp - sim_time) <= self.follow_s
         self.pace = stamp if advancing and self.stamp > -math.inf else None
         self.stamp = stamp

@@ -40,7 +40,7 @@ from scipy.optimize import least_squares
 
 from bearing_rig_sim.config import check_number, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters
-from bearing_rig_sim.studies.calibration import CalibrationError, check_in_range, current_value, with_values
+from bearing_rig_sim.studies.calibration import CalibrationError, check_in_range, current_value, data_lines, with_values
 from bearing_rig_sim.thermal.bearing import ThermalConfig, build_network, node_heat
 
 COLUMNS: dict[str, str] = {
@@ -119,13 +119,7 @@ def read_bench_run(path: str | Path) -> list[RunRow]:
             unknown column, or a file with nothing measured.
     """
     path = Path(path)
-    try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    except OSError as exc:
-        raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
-    except UnicodeDecodeError as exc:
-        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    reader = csv.DictReader(lines)
+    reader = csv.DictReader(data_lines(path))
     names = [n.strip() for n in reader.fieldnames or ()]
     unknown = [n for n in names if n not in COLUMNS]
     if unknown:

@@ -143,6 +143,20 @@ class CalibrationResult:
     """Whether the rows were the coupled thermal steady states."""
 
 
+def data_lines(path: Path) -> list[str]:
+    """The lines of a CSV data file without blank and comment (``#``) lines.
+
+    Raises:
+        CalibrationError: the file cannot be read or is not UTF-8 text.
+    """
+    try:
+        return [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    except OSError as exc:
+        raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
+
+
 def read_bench_csv(path: str | Path) -> list[BenchPoint]:
     """Read ``inner_ring_rpm,axial_load_n,slip_pct`` rows (``#`` starts a comment line).
 
@@ -150,13 +164,7 @@ def read_bench_csv(path: str | Path) -> list[BenchPoint]:
         CalibrationError: naming file, line and column of the first bad value.
     """
     path = Path(path)
-    try:
-        lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
-    except OSError as exc:
-        raise CalibrationError(f"{path}: cannot read ({exc.strerror or exc})") from exc
-    except UnicodeDecodeError as exc:
-        raise CalibrationError(f"{path}: not UTF-8 text (byte {exc.start})") from None
-    reader = csv.DictReader(lines)
+    reader = csv.DictReader(data_lines(path))
     need = ("inner_ring_rpm", "axial_load_n", "slip_pct")
     if reader.fieldnames is None or any(k not in reader.fieldnames for k in need):
         raise CalibrationError(f"{path}: header must name the columns {', '.join(need)}, got {reader.fieldnames}")

@@ -10,7 +10,7 @@ import pytest
 
 from bearing_rig_sim.bags import BagWriter
 from bearing_rig_sim.cli import main
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.shadow import ShadowSettings
 from bearing_rig_sim.interfaces import CAGE_PULSES, SPINDLE_PULSES
 from bearing_rig_sim.shadow.offline import COLUMNS, PLOT_PNG, REPORT_MD, RESIDUALS_CSV
 from bearing_rig_sim.synthetic.twin_bench import Hold, scaled_calibration, twin_bench_run, write_bench_bag
@@ -67,7 +67,8 @@ def test_shadow_flags_a_bench_with_other_drag_and_recalibrates(bench_bag: Path, 
 
     # the twin assumes a grease 30 % less consistent than the bench's: less drag, slip higher than predicted
     key = "lubricant.consistency_pa_sn"
-    shipped = config_path("calibration", "h7006c_table3.yaml")
+    shipped = ShadowSettings.from_yaml().calibration_file  # the twin playing the bench runs it too
+    assert shipped is not None
     bench_value = yaml.safe_load(shipped.read_text())["parameters"][key]["value"]
     cal = scaled_calibration(shipped, key, 1.0 / 1.3, tmp_path / "low.yaml")
     out = tmp_path / "out"

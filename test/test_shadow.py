@@ -13,7 +13,6 @@ from pathlib import Path
 
 import pytest
 
-from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -68,14 +67,23 @@ def same_bench() -> BenchRun:
     return twin_bench_run(HOLDS, clock_offset_s=BENCH_CLOCK, initial_rise_k=WARM_K)
 
 
+def shadow_calibration() -> Path:
+    """The shadow twin's shipped calibration (config/shadow.yaml: the coupled one), which the
+    twin playing the bench runs too (synthetic.twin_bench's default)."""
+    cal = ShadowSettings.from_yaml().calibration_file
+    assert cal is not None
+    return cal
+
+
 def changed_bench(key: str, directory: Path) -> BenchRun:
     """The twin as a bench with 30 % more drag (the grease's consistency x 1.3) or 30 % less
-    traction (the Eyring stress x 0.7, which the calibration leaves at the lubricant file's)."""
-    source = config_path("calibration", "h7006c_table3.yaml")
+    traction (the Eyring stress x 0.7, which the calibration leaves at the lubricant file's);
+    the scaled file stays a coupled one, so the bench's lubricant follows its temperature."""
+    source = shadow_calibration()
     if key == DRAG_KEY:
         cal = scaled_calibration(source, key, 1.3, directory / "changed.yaml")
     else:
-        lubricant = BearingParameters.calibrated().lubricant
+        lubricant = BearingParameters.from_yaml(None, source).lubricant
         assert lubricant is not None
         cal = scaled_calibration(source, key, 0.7, directory / "changed.yaml", base=lubricant.eyring_stress)
     return twin_bench_run(HOLDS[:2], calibration_file=cal, clock_offset_s=BENCH_CLOCK, initial_rise_k=WARM_K)
@@ -161,6 +169,22 @@ def test_shipped_settings_read_the_calibration_rms() -> None:
     assert 0.0 < shipped < 1.0 and st.calibration_rms_slip_pct == shipped
 
 
+def test_shadow_twin_runs_the_sessions_coupled_calibration() -> None:
+    """config/shadow.yaml names the calibration the session runs (config/simulator.yaml), by
+    name, with the lubricant following its temperature as that calibration was fitted."""
+    from bearing_rig_sim.dynamics.calibrations import COUPLED, ISOTHERMAL, calibration_file, is_coupled
+    from bearing_rig_sim.shadow import shipped_parameters
+    from bearing_rig_sim.simulation.settings import SimulatorSettings
+
+    st = ShadowSettings.from_yaml()
+    assert shipped_parameters()["calibration_file"] == COUPLED
+    assert st.calibration_file is not None and st.calibration_file.resolve() == calibration_file(COUPLED).resolve()
+    assert st.calibration_file.resolve() == SimulatorSettings.from_yaml().calibration_file.resolve()  # type: ignore[union-attr]
+    assert is_coupled(st.calibration_file) and st.lubricant_feedback and st.thermal
+    other = ShadowSettings.from_values({**shipped_parameters(), "calibration_file": ISOTHERMAL})
+    assert other.calibration_file is not None and other.calibration_file.resolve() == calibration_file(ISOTHERMAL).resolve()
+
+
 def test_rule_warns_then_errors_and_names_the_class() -> None:
     rule = AnomalyRule(1.0, 3.0)
     levels = [rule.add(0.2 * k, 0.2 * (k + 1), 0.5, 0.2).level for k in range(20)]
@@ -224,8 +248,10 @@ def test_a_bench_whose_outer_ring_runs_hotter_or_whose_torque_is_higher_is_flagg
     """The same bench whose outer ring runs 5 K hotter than the twin from 2 s on, or whose friction
     torque is 30 % higher (synthetic.twin_bench.departed): that rule flags it within the stated
     time and stays flagged, with the residual's sign; the slip's rule and the other sensor's do not.
-    The bands are config/shadow.yaml's: about 1.8 K here, and 2 x 3.1 % of the torque (the
-    calibration's propagated uncertainty), so 5 K and 30 % lie well outside them."""
+    The bands are config/shadow.yaml's: about 1.8 K here, and 2 x 3.4 % of the torque (the
+    calibration's propagated uncertainty and the network's through the lubricant's temperature),
+    so 5 K and 30 % lie well outside them. Bench and shadow run the coupled calibration with the
+    lubricant following its temperature."""
     start = same_bench.events()[0][0]
     bench = departed(same_bench, from_s=start + DEPART_AFTER_S, outer_ring_hotter_k=hotter_k, torque_factor=torque_factor)
     twin = ShadowTwin(ShadowSettings.from_yaml())
@@ -284,9 +310,9 @@ def test_online_recalibration_converges_to_the_changed_drag(dragged_bench: Bench
     # stated tolerance: within 2 % of the bench's value (1.3 x calibrated)
     assert estimate.ratio == pytest.approx(1.3, rel=0.02)
     assert estimate.std < 0.05 * estimate.value
-    assert estimate.in_range  # 66 Pa s^n lies in the calibration's stated 1-100
+    assert estimate.in_range  # 1.3 x 68.2 = 88.6 Pa s^n lies in the calibration's stated 1-100
     # never written: the calibration file still holds the calibrated value
-    shipped = yaml.safe_load(Path(config_path("calibration", "h7006c_table3.yaml")).read_text(encoding="utf-8"))
+    shipped = yaml.safe_load(shadow_calibration().read_text(encoding="utf-8"))
     assert shipped["parameters"][DRAG_KEY]["value"] == estimate.calibrated
 
 
@@ -364,3 +390,17 @@ def test_recalibrating_an_unknown_parameter_is_refused() -> None:
 
     with pytest.raises(RecalibrationError, match="no_such_parameter"):
         ShadowTwin(ShadowSettings.from_yaml().replace(recalibrate=True, recalibrate_parameter="no_such_parameter"))
+
+
+def test_recalibration_tracks_the_first_fitted_parameter_by_default() -> None:
+    """"" names the calibration's first fitted parameter (calibration.fitted), not a fixed input
+    the file also sets (the coupled file's grease-law exponent, 0: nothing to scale)."""
+    import yaml
+
+    from bearing_rig_sim.shadow.recalibration import CalibrationParameter
+
+    st = ShadowSettings.from_yaml()
+    assert st.calibration_file is not None
+    fitted = yaml.safe_load(st.calibration_file.read_text(encoding="utf-8"))["calibration"]["fitted"]
+    tracked = CalibrationParameter(st.bearing_file, st.calibration_file, "")
+    assert tracked.name == fitted[0] and tracked.calibrated > 0.0

@@ -22,7 +22,13 @@ def register(subparsers: Any) -> None:
     p.add_argument("--bag", type=Path, default=None, metavar="BAG", help="run over this bag instead of the live topics")
     p.add_argument("--out", type=Path, default=None, metavar="DIR", help="output folder with --bag (default: out/shadow/<bag name>)")
     p.add_argument("--params", type=Path, default=None, metavar="FILE", help="shadow parameter file (default: config/shadow.yaml)")
-    p.add_argument("--calibration", type=Path, default=None, metavar="FILE", help="calibration file of the twin (default: the parameter file's)")
+    p.add_argument(
+        "--calibration",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="calibration of the twin: a named one (coupled, isothermal) or a file (default: the parameter file's); the lubricant follows the temperature with a coupled one",
+    )
     p.add_argument(
         "--recalibrate",
         nargs="?",
@@ -45,16 +51,21 @@ def register(subparsers: Any) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run shadow mode live or over a bag."""
     from bearing_rig_sim.config import ConfigError
+    from bearing_rig_sim.dynamics.calibrations import NAMED, calibration_file, is_coupled
     from bearing_rig_sim.shadow import ShadowSettings
     from bearing_rig_sim.shadow.settings import calibration_rms
 
     settings = ShadowSettings.from_yaml(args.params)
     if args.calibration is not None:
+        if str(args.calibration) in NAMED:
+            args.calibration = calibration_file(str(args.calibration))
         if not args.calibration.is_file():
             raise ConfigError(str(args.calibration), "calibration", "file not found")
         rms = calibration_rms(args.calibration)
         settings = settings.replace(
-            calibration_file=args.calibration.resolve(), calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct
+            calibration_file=args.calibration.resolve(),
+            calibration_rms_slip_pct=rms if rms is not None else settings.calibration_rms_slip_pct,
+            lubricant_feedback=is_coupled(args.calibration),  # run as it was fitted
         )
     if args.recalibrate is not None:
         settings = settings.replace(recalibrate=True, recalibrate_parameter=args.recalibrate or settings.recalibrate_parameter)
@@ -93,6 +104,7 @@ def _live(args: argparse.Namespace, settings: Any) -> int:
         extra += ["--params-file", str(args.params)]
     if args.calibration is not None:
         extra += ["-p", f"calibration_file:={settings.calibration_file}", "-p", f"calibration_rms_slip_pct:={settings.calibration_rms_slip_pct}"]
+        extra += ["-p", f"lubricant_feedback:={str(settings.lubricant_feedback).lower()}"]
     if args.recalibrate is not None:
         extra += ["-p", "recalibrate:=true", "-p", f"recalibrate_parameter:={settings.recalibrate_parameter}"]
     if extra:

@@ -42,6 +42,12 @@ def calibration_file(name_or_path: str | Path) -> Path:
     return path
 
 
+def named_as_config_path(value: object) -> object:
+    """A calibration's name (:data:`NAMED`) as its file relative to ``config/``; any other value
+    as given (a settings file's ``calibration_file``, validated as a file afterwards)."""
+    return f"calibration/{NAMED[value]}" if isinstance(value, str) and value in NAMED else value
+
+
 def is_coupled(path: str | Path) -> bool:
     """Whether a calibration file was fitted through the coupled thermal steady states (its
     ``calibration.thermal``): the twin then runs with the lubricant following its temperature."""

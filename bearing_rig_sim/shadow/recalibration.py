@@ -62,7 +62,8 @@ class CalibrationParameter:
     Args:
         bearing_file: the bearing data.
         calibration_file: the calibration laid over it.
-        name: a key of the calibration's ``parameters:``; "" for the first one.
+        name: a key of the calibration's ``parameters:``; "" for the first one it fitted (its
+            ``calibration.fitted``; a file that names none: its first parameter).
 
     Raises:
         RecalibrationError: no such parameter, or its value is not a non-zero number.
@@ -72,8 +73,10 @@ class CalibrationParameter:
     def __init__(self, bearing_file: Path, calibration_file: Path, name: str) -> None:
         self._bearing, self._bearing_source = read_mapping(bearing_file), str(bearing_file)
         calibration = read_file(CalibrationFile, calibration_file)
-        entries = read_mapping(calibration_file)["parameters"]  # as written: a number or a quantity with unit and range
-        key = name or next(iter(entries), "")
+        raw = read_mapping(calibration_file)
+        entries = raw["parameters"]  # as written: a number or a quantity with unit and range
+        fitted = [k for k in (raw.get("calibration") or {}).get("fitted") or [] if k in entries]
+        key = name or next(iter(fitted or entries), "")
         if key not in entries:
             raise RecalibrationError(f"recalibrate_parameter: {name!r} is not a parameter of {calibration_file} (it has {', '.join(entries) or 'none'})")
         entry = entries[key]

@@ -8,6 +8,7 @@ from typing import Annotated, ClassVar
 from pydantic import ValidationInfo, field_validator
 
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
+from bearing_rig_sim.dynamics.calibrations import named_as_config_path
 from bearing_rig_sim.interfaces import DIAGNOSTICS
 from bearing_rig_sim.dynamics.engine import MODELS
 from bearing_rig_sim.settings_model import ConfigFile, Flag, Integer, NodeSettings, Number, OptionalConfigFile, one_of, param, read_file
@@ -21,7 +22,8 @@ SHIPPED_FILE = "shadow.yaml"
 
 class ShadowSettings(NodeSettings):
     """The shadow twin's parameters (see ``config/shadow.yaml`` for each one's reason), declared
-    once (:mod:`bearing_rig_sim.settings_model`). ``calibration_rms_slip_pct`` below zero is
+    once (:mod:`bearing_rig_sim.settings_model`). ``calibration_file`` may name a calibration
+    (``coupled``, ``isothermal``). ``calibration_rms_slip_pct`` below zero is
     replaced by the calibration file's ``calibration.rms_slip_pct``; ``error_after_s`` must
     exceed ``warn_after_s``."""
 
@@ -29,7 +31,9 @@ class ShadowSettings(NodeSettings):
     SHIPPED_FILE: ClassVar[str] = SHIPPED_FILE
 
     bearing_file: ConfigFile = param("bearing data file (absolute, or relative to config/)")
-    calibration_file: OptionalConfigFile = param("calibration laid over the bearing data ('' = the uncalibrated bearing file)")
+    calibration_file: OptionalConfigFile = param(
+        "calibration laid over the bearing data: a named one ('coupled', 'isothermal') or a file ('' = the uncalibrated bearing file)"
+    )
     rig_file: ConfigFile = param("rig data file: the test bearing's mounting (clearance, misalignment, preload) the twin's engine is built with, as the simulator's")
     model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
     chunk_s: Number = param("engine advance per call (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
@@ -51,12 +55,18 @@ class ShadowSettings(NodeSettings):
     load_average_s: Number = param("averaging time of the load-cell force", unit="s", gt=0.0, le=10.0)
     load_timeout_s: Number = param("no load-cell sample for this long is a dropout", unit="s", gt=0.0, le=60.0)
     recalibrate: Flag = param("track a calibration parameter online (recursive least squares)")
-    recalibrate_parameter: str = param("the calibration file's parameter tracked ('section.key'; '' = its first one)")
+    recalibrate_parameter: str = param("the calibration file's parameter tracked ('section.key'; '' = the first one it fitted)")
     forgetting_factor: Number = param("forgetting factor of the recursive least squares, per compared steady window", unit="1", gt=0.5, le=1.0)
     probe_step_fraction: Number = param("initial offset of the probe engine from the calibrated value", unit="1", gt=0.0, le=0.5)
     steady_speed_fraction: Number = param("windows within this fraction of the previous one's spindle speed are steady", unit="1", ge=0.0, le=0.5)
     status_rate_hz: Number = param("checks of the twin per second (wall clock), plus each change of level", unit="Hz", gt=0.0, le=1000.0)
     diagnostics_rate_hz: Number = param(f"rate of {DIAGNOSTICS.name} besides every change (wall clock)", unit="Hz", gt=0.0, le=100.0)
+
+    @field_validator("calibration_file", mode="before")
+    @classmethod
+    def _named_calibration(cls, value: object) -> object:
+        """A calibration's name (:data:`~bearing_rig_sim.dynamics.calibrations.NAMED`) as its file."""
+        return named_as_config_path(value)
 
     @field_validator("recalibrate_parameter", mode="before")
     @classmethod

@@ -104,9 +104,9 @@ class SimulatorSettings(NodeSettings):
     @classmethod
     def _named_calibration(cls, value: object) -> object:
         """A calibration's name (:data:`~bearing_rig_sim.dynamics.calibrations.NAMED`) as its file."""
-        from bearing_rig_sim.dynamics.calibrations import NAMED
+        from bearing_rig_sim.dynamics.calibrations import named_as_config_path
 
-        return f"calibration/{NAMED[value]}" if isinstance(value, str) and value in NAMED else value
+        return named_as_config_path(value)
 
     def model_post_init(self, context: Any, /) -> None:
         self._spindle = SpindleConfig.from_yaml(self.rig_file)

@@ -6,9 +6,10 @@ fibre-optic sensors with their timing jitter) through :class:`Hold` segments, ea
 paper's STEP ramp, and returns what the bench's topics would carry: both pulse streams and the
 load cell's force at 1 kHz with its noise (``config/rig.yaml``: 1 N standard deviation). Stamps
 may be put on a bench system clock (``clock_offset_s``). With the bearing's thermal network
-(``thermal=True``, the default, coupled both ways as in the rig session) it also records the
-outer-ring thermocouple (10 Hz) and the housing torque meter (100 Hz) as the simulator node
-emits them. :func:`departed` makes of a run a bench whose outer ring runs hotter or whose
+(``thermal=True``, the default, coupled both ways as in the rig session: with the default
+``coupled`` calibration the lubricant follows the network's temperature, as in the session and the
+shadow twin, ``config/shadow.yaml``) it also records the outer-ring thermocouple (10 Hz) and the
+housing torque meter (100 Hz) as the simulator node emits them. :func:`departed` makes of a run a bench whose outer ring runs hotter or whose
 torque is higher than the twin's from a given time. :func:`write_bench_bag` writes them as a bag with the topics shadow mode reads.
 
 Units: s, rpm and N at this edge (the programme), SI in the events.
@@ -23,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.config import read_mapping, rpm_to_rad_s
+from bearing_rig_sim.dynamics import calibrations
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.rig.fibre_optic import Pulse
@@ -84,13 +86,14 @@ def twin_bench_run(
     seed: int = 7,
     thermal: bool = True,
     initial_rise_k: float = 0.0,
-    lubricant_feedback: bool = False,
+    lubricant_feedback: bool | None = None,
 ) -> BenchRun:
     """Run the twin through ``holds`` (from rest at 0 s) and record its bench topics.
 
     Args:
         holds: the programme.
-        calibration_file: the calibration of the twin playing the bench (default: the shipped).
+        calibration_file: the calibration of the twin playing the bench (default: the named
+            default, ``coupled``: :data:`~bearing_rig_sim.dynamics.calibrations.DEFAULT_CALIBRATION`).
         bearing_file: bearing data (default: the shipped H7006C).
         load_noise_std_n: load-cell noise, N (standard deviation of each 1 kHz sample).
         clock_offset_s: added to every stamp (a bench system clock), s.
@@ -99,16 +102,16 @@ def twin_bench_run(
             meter (the bearing file's ``thermal:`` section).
         initial_rise_k: the network's start above the bearing file's ambient, K.
         lubricant_feedback: the engine's lubricant follows the network's temperature (the
-            simulator's parameter of that name; default as shipped, off).
+            simulator's parameter of that name; None: as the calibration was fitted, on for a
+            coupled one (:func:`~bearing_rig_sim.dynamics.calibrations.is_coupled`)).
     """
-    from bearing_rig_sim.config import shipped_calibration_file
-
-    cal = calibration_file if calibration_file is not None else shipped_calibration_file()
+    cal = calibrations.calibration_file(calibration_file if calibration_file is not None else calibrations.DEFAULT_CALIBRATION)
+    feedback = calibrations.is_coupled(cal) if lubricant_feedback is None else lubricant_feedback
     start: dict[str, Any] = {"initial_axial_load": holds[0].axial_load_n} if holds else {}
     twin = RigTwin.from_files(bearing_file, cal, None, **start)
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
-    coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=lubricant_feedback) if thermal else None
+    coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=feedback) if thermal else None
     thermocouple, torque_meter = bench_sensors.Thermocouple(), bench_sensors.TorqueMeter()
     chunk = twin.chunk
     temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))

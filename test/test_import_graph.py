@@ -22,7 +22,7 @@ FLOORS: tuple[tuple[str, frozenset[str]], ...] = (
         "foundation: the contract, configuration, errors and plumbing",
         frozenset({"", "errors", "config", "interfaces", "health", "clock_guard", "dds_profile", "executors", "settings_model", "numba_cache"}),
     ),
-    ("models: the bearing's dynamics, the rig's models, analysis, bag files", frozenset({"dynamics", "thermal", "rig", "analysis", "bags"})),
+    ("models: the bearing's dynamics, the rig's models, analysis, bag files", frozenset({"dynamics", "thermal", "rig", "instruments", "analysis", "bags"})),
     (
         "cores: what the nodes and commands run, without ROS shells",
         frozenset({"simulation", "monitoring", "load_control", "shadow", "offline", "replay", "live", "synthetic", "studies", "sweep"}),

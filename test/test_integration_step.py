@@ -23,7 +23,7 @@ from bearing_rig_sim.dynamics import (
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.nodes.common import diagnostic_status
-from bearing_rig_sim.rig.fibre_optic import FibreOpticConfig
+from bearing_rig_sim.instruments.registry import InstrumentSet
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth, stopped_reason
@@ -197,7 +197,7 @@ def test_a_forced_divergence_is_detected_not_published(params: BearingParameters
     engine = _DivergingEngine(params)
     twin = RigTwin(
         engine,
-        FibreOpticConfig.from_yaml(None),
+        InstrumentSet.from_rig_file(None),
         BearingKinematics.from_config(config_path("bearings", "h7006c.yaml")),
         **(twin_options() | {"initial_axial_load": 100.0}),
     )

@@ -18,7 +18,7 @@ import yaml
 
 from bearing_rig_sim.config import ConfigError, config_path
 from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonitor
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from conftest import bearing_section
 
 TWO_PI = 2.0 * math.pi

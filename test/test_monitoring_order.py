@@ -20,7 +20,7 @@ from bearing_rig_sim.monitoring.monitor import SlipMonitor
 from bearing_rig_sim.monitoring.schedule import StampOrder, StatusSchedule
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.offline.analysis import analyse_bag
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.synthetic.bench import bench_pulses, table7_run_up, write_bench_bag
 
 SETTINGS = MonitorSettings.from_yaml()

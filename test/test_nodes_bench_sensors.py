@@ -20,13 +20,16 @@ from sensor_msgs.msg import Temperature  # noqa: E402
 
 from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE, TRUTH  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, from_stamp  # noqa: E402
-from bearing_rig_sim.thermal.sensors import THERMOCOUPLE_NOISE_K  # noqa: E402
+from bearing_rig_sim.instruments.first_order import ThermocoupleSettings  # noqa: E402
+from bearing_rig_sim.instruments.registry import InstrumentSet  # noqa: E402
 
 CONFIG = Path(__file__).resolve().parents[1] / "config"
 AMBIENT_C = 22.0
 """Ambient temperature, degC (config/bearings/h7006c.yaml, thermal section)."""
 WAIT = 120.0
 """Longest wait, wall s."""
+THERMOCOUPLE_NOISE_K = InstrumentSet.from_rig_file().on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings).noise_std_k
+"""The thermocouple's RMS noise, K (config/rig.yaml, sensors.outer_ring_thermocouple)."""
 
 
 def test_thermocouple_warms_and_torque_meter_reads_the_friction_torque(ros_graph: Any) -> None:

@@ -24,7 +24,7 @@ from bearing_rig_sim.offline.segments import PROFILE_CONSTANT_ACCELERATION, SEGM
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, RowDecimator, SlipWindowRow, StatusRow
 from bearing_rig_sim.synthetic.traffic import NO_BALLS, RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
 from bearing_rig_sim.bags.typestore import msg_folder
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.simulation import RigTwin, SpindleCommand
 from conftest import write_foreign_metadata
 

@@ -8,15 +8,12 @@ never taken from the model's own output.
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from bearing_rig_sim.config import ConfigError
-from bearing_rig_sim.rig.fibre_optic import (
+from bearing_rig_sim.instruments.fibre_optic import (
     JITTER_CLIP,
-    FibreOpticConfig,
     FibreOpticSensor,
     Pulse,
     PulseCounter,
@@ -217,39 +214,3 @@ def test_counter_refuses_inconsistent_pulses() -> None:
         counter.is_stale(1.0, 0.0)
     with pytest.raises(SensorError):
         PulseCounter(4, revolutions_per_window=0)
-
-
-def test_shipped_sensor_config_builds_matching_sensor_and_counter() -> None:
-    config = FibreOpticConfig.from_yaml()
-    sensor, counter = config.sensor("cage"), config.counter("cage")
-    assert sensor.strip_count == counter.strip_count == config.cage.strip_count
-    assert sensor.jitter_std == config.timing_jitter_std_s
-    with pytest.raises(SensorError, match="shaft"):
-        config.sensor("outer_ring")  # type: ignore[arg-type]
-
-
-def test_sensor_config_errors_name_file_and_key(tmp_path: Path) -> None:
-    good = """
-simulator: {anything: [owned, by, another, part]}
-sensors:
-  spindle: {strip_count: 4, phase_rad: 0.0, seed: 1}
-  cage: {strip_count: 2, phase_rad: 0.5, seed: 2}
-  timing_jitter_std_s: 1.0e-6
-  pulse_drop_probability: 0.0
-  counter_revolutions_per_window: 2
-"""
-    path = tmp_path / "rig.yaml"
-    path.write_text(good)
-    config = FibreOpticConfig.from_yaml(path)  # other top-level sections are ignored
-    assert config.cage.strip_count == 2 and config.counter_revolutions_per_window == 2
-    for bad, key in [
-        (good.replace("strip_count: 4", "strip_count: 0"), "sensors.spindle.strip_count"),
-        (good.replace("timing_jitter_std_s: 1.0e-6", "timing_jitter_std_s: .nan"), "sensors.timing_jitter_std_s"),
-        (good.replace("pulse_drop_probability: 0.0", "pulse_drop_probability: 1.5"), "sensors.pulse_drop_probability"),
-        (good.replace("  counter_revolutions_per_window: 2\n", ""), "sensors.counter_revolutions_per_window"),
-        (good.replace("seed: 2}", "seed: 2, strips: 3}"), "sensors.cage.strips"),
-    ]:
-        path.write_text(bad)
-        with pytest.raises(ConfigError) as info:
-            FibreOpticConfig.from_yaml(path)
-        assert info.value.source == str(path) and info.value.key == key

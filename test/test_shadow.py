@@ -15,7 +15,7 @@ import pytest
 
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import HealthLevel
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.shadow import AnomalyRule, ResidualWindow, ShadowSettings, ShadowTwin, band_pct, likely_cause
 from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.synthetic.twin_bench import BenchRun, Hold, departed, scaled_calibration, twin_bench_run

@@ -20,7 +20,8 @@ from bearing_rig_sim.analysis.slip import BearingKinematics, whole_revolution_sl
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.rig.fibre_optic import JITTER_CLIP, FibreOpticConfig, ShaftSensorParams
+from bearing_rig_sim.instruments.fibre_optic import JITTER_CLIP, FibreOpticSettings
+from bearing_rig_sim.instruments.registry import InstrumentSet
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import AxialLoadError, MomentError, RadialLoadError, RigTwin, TwinError, twin_options
@@ -36,14 +37,22 @@ def epicyclic_ratio() -> float:
     return 0.5 * (1.0 - g["ball_diameter_m"] * math.cos(math.radians(g["contact_angle_deg"])) / g["pitch_diameter_m"])
 
 
-def sensors(jitter: float = 0.0, spindle_strips: int = 4, cage_strips: int = 3, window: int = 1) -> FibreOpticConfig:
-    return FibreOpticConfig(
-        spindle=ShaftSensorParams(strip_count=spindle_strips, phase_rad=0.0, seed=1),
-        cage=ShaftSensorParams(strip_count=cage_strips, phase_rad=0.5, seed=2),
-        timing_jitter_std_s=jitter,
-        pulse_drop_probability=0.0,
-        counter_revolutions_per_window=window,
-    )
+def sensors(jitter: float = 0.0, spindle_strips: int = 4, cage_strips: int = 3, window: int = 1) -> InstrumentSet:
+    def shaft(sensor_id: str, measures: str, strips: int, phase: float, seed: int) -> FibreOpticSettings:
+        return FibreOpticSettings(
+            kind="fibre_optic",
+            topic=f"/rig/{sensor_id}/pulses",
+            measures=measures,
+            sensor_id=sensor_id,
+            strip_count=strips,
+            phase_rad=phase,
+            timing_jitter_std_s=jitter,
+            pulse_drop_probability=0.0,
+            counter_revolutions_per_window=window,
+            seed=seed,
+        )
+
+    return InstrumentSet({"spindle": shaft("spindle", "inner_ring_angle", spindle_strips, 0.0, 1), "cage": shaft("cage", "cage_angle", cage_strips, 0.5, 2)})
 
 
 @pytest.fixture(scope="module")
@@ -55,7 +64,7 @@ UNLIMITED_LOADERS = {"max_radial_load": math.inf, "max_moment": math.inf}
 """A bench with radial and moment loaders of any size (the shipped rig loads only axially)."""
 
 
-def make_twin(params: BearingParameters, config: FibreOpticConfig | None = None, **options: float) -> RigTwin:
+def make_twin(params: BearingParameters, config: InstrumentSet | None = None, **options: float) -> RigTwin:
     """The simulator's twin (its shipped settings and rig limits) with unlimited loaders."""
     engine = BearingDynamics(params)
     return RigTwin(engine, config or sensors(), BearingKinematics.from_config(BEARING), **(twin_options() | UNLIMITED_LOADERS | options))
@@ -151,7 +160,7 @@ def test_truth_carries_the_cage_whirl_radius(params):
 def test_sensor_slip_agrees_with_ground_truth_over_whole_revolution_windows(params):
     """Issue 5: within 0.1 percentage points, through a STEP ramp, a hold, a constant
     acceleration and a hold, with the shipped sensors (config/rig.yaml: 4 strips, 1 us jitter)."""
-    twin = RigTwin(BearingDynamics(params), FibreOpticConfig.from_yaml(), BearingKinematics.from_config(BEARING), **twin_options())
+    twin = RigTwin(BearingDynamics(params), InstrumentSet.from_rig_file(), BearingKinematics.from_config(BEARING), **twin_options())
     twin.command_spindle(SpindleCommand(1500 * RPM, SpeedProfileKind.STEP, ramp_time=1.0))
     times, inner, cage, spindle_t, cage_t = [0.0], [0.0], [0.0], [], []
     for i in range(2700):

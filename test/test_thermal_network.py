@@ -157,19 +157,3 @@ def test_twin_with_the_network_warms_up_chunk_by_chunk() -> None:
     assert coupling.network.time == pytest.approx(1.0, abs=1e-9)
     assert coupling.temperature("outer_ring") > start
     assert coupling.network.heat_in > 0.0
-
-
-def test_thermocouple_and_torque_meter_lag_by_their_time_constants() -> None:
-    """Noise-free: a step from 20 to 30 degC read after one time constant shows
-    20 + 10 (1 - 1/e); the noisy reading scatters with the stated RMS."""
-    from bearing_rig_sim.thermal.sensors import Thermocouple, TorqueMeter
-
-    tc = Thermocouple(time_constant=2.0, noise=0.0)
-    assert tc.update(20.0, 0.1) == 20.0
-    assert tc.update(30.0, 2.0) == pytest.approx(20.0 + 10.0 * (1.0 - math.exp(-1.0)), rel=1e-12)
-    tm = TorqueMeter(time_constant=0.01, noise=2e-4, seed=3)
-    readings = np.array([tm.update(0.1, 0.01) for _ in range(4000)])
-    assert np.mean(readings[100:]) == pytest.approx(0.1, abs=3e-5)
-    assert np.std(readings[100:]) == pytest.approx(2e-4, rel=0.1)
-    with pytest.raises(ValueError, match="time constant"):
-        Thermocouple(time_constant=0.0)

@@ -45,7 +45,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.shadow import ResidualWindow, ShadowSettings, ShadowTwin
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.synthetic.twin_bench import BenchRun, Hold, twin_bench_run, write_bench_bag

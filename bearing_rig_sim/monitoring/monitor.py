@@ -43,7 +43,7 @@ from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED
 from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 MonitorState = SlipState
 """The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorStatus, SlipMonitor
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 
 @dataclass(frozen=True)

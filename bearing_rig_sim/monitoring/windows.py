@@ -63,7 +63,7 @@ import math
 from collections import deque
 from dataclasses import dataclass, field
 
-from bearing_rig_sim.rig.fibre_optic import TWO_PI, Pulse
+from bearing_rig_sim.instruments.fibre_optic import TWO_PI, Pulse
 
 SHAFTS = ("spindle", "cage")
 OTHER = {"spindle": "cage", "cage": "spindle"}

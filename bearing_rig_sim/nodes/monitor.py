@@ -72,7 +72,7 @@ from bearing_rig_sim.nodes.common import (
 )
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WARN, SlipState.FAULT: ERROR}
 """Diagnostics level of each monitor state (recent lost pulses raise OK to WARN)."""

@@ -45,7 +45,7 @@ from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, DIAGNOSTIC
 from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE, TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL
 from bearing_rig_sim.nodes.common import PULSE_READER_QOS, diagnostic_array, diagnostic_status, from_stamp, qos_profile, run_node, to_stamp
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.shadow import NODE_NAME, ResidualWindow, ShadowSettings, ShadowTwin, shipped_parameters
 
 

@@ -7,18 +7,19 @@ Publishes (interface table, docs/interfaces.md; "reliable stream": reliable, his
   (1 kHz simulated with 1 ms chunks), so the other nodes can run on ``use_sim_time``; the first
   one, at the first activation, is the time the simulation starts at (0), so that what the other
   nodes stamp before the first chunk (0) lies on the clock's timeline;
-* ``/rig/spindle/pulses``, ``/rig/cage/pulses`` (bearing_rig_msgs/FibreOpticPulse, reliable
-  stream): one per strip passage, stamped with the pulse time on the simulated clock;
+* every instrument of the rig file's ``sensors`` section on its contract topic
+  (:mod:`bearing_rig_sim.instruments`; the twin samples them, this node only publishes their
+  readings): as shipped, ``/rig/spindle/pulses``, ``/rig/cage/pulses``
+  (bearing_rig_msgs/FibreOpticPulse, reliable stream): one per strip passage, stamped with the
+  pulse time on the simulated clock; ``/rig/outer_ring/temperature`` (sensor_msgs/Temperature,
+  reliable, 10 Hz simulated, degC; once the bearing file's ``thermal:`` section gives the
+  network, docs/thermal.md) and ``/rig/housing/torque`` (geometry_msgs/WrenchStamped, torque.z
+  in N m, reliable, 100 Hz simulated): the outer-ring thermocouple and the housing torque meter;
 * ``/rig/speeds`` (sensor_msgs/JointState, reliable stream, ``speeds_rate_hz`` simulated): names
   ``inner_ring`` and ``cage``, velocity from the pulse counters (rad/s), position the
   pulse-counted angle (rad), effort empty;
 * ``/rig/truth`` (bearing_rig_msgs/SimulatorTruth, reliable stream, ``truth_rate_hz`` simulated):
   the engine's ground truth with the achieved real-time factor and the overrun count;
-* ``/rig/outer_ring/temperature`` (sensor_msgs/Temperature, reliable, 10 Hz simulated, degC) and
-  ``/rig/housing/torque`` (geometry_msgs/WrenchStamped, torque.z in N m, reliable, 100 Hz
-  simulated): the bench's outer-ring thermocouple and housing torque meter
-  (:mod:`bearing_rig_sim.thermal.sensors`) on the bearing's thermal network, when the bearing
-  file has a ``thermal:`` section (docs/thermal.md);
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` wall and
   on every change of level (see :mod:`bearing_rig_sim.health`).
 
@@ -61,6 +62,7 @@ configures and activates at once.
 
 from __future__ import annotations
 
+import importlib
 import math
 import sys
 import time
@@ -81,13 +83,12 @@ from rclpy.node import Node
 from rclpy.serialization import deserialize_message
 from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock as ClockMsg
-from sensor_msgs.msg import JointState, Temperature
+from sensor_msgs.msg import JointState
 
-from bearing_rig_msgs.msg import FibreOpticPulse, SimulatorTruth, SlipStatus, SpindleCommand as SpindleCommandMsg
-from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CAGE_PULSES, CLOCK, DIAGNOSTICS, SPEEDS, SPINDLE_COMMAND, SPINDLE_PULSES, TRUTH
-from bearing_rig_sim.interfaces import HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SLIP_STATUS
+from bearing_rig_msgs.msg import SimulatorTruth, SlipStatus, SpindleCommand as SpindleCommandMsg
+from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
+from bearing_rig_sim.interfaces import topic as contract_topic
 from bearing_rig_sim.config import ConfigError
-from bearing_rig_sim.thermal import sensors as bench_sensors
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.nodes.common import (
@@ -103,7 +104,7 @@ from bearing_rig_sim.nodes.common import (
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.base import Reading
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
 from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth
@@ -241,23 +242,24 @@ class SimulatorNode(ManagedNode):
         """The clock's first message (the time the simulation starts at) was published."""
 
         self._clock_pub = self.publisher(ClockMsg, CLOCK.name, qos_profile(CLOCK))
-        self._pulse_pubs = {
-            "spindle": self.publisher(FibreOpticPulse, SPINDLE_PULSES.name, qos_profile(SPINDLE_PULSES)),
-            "cage": self.publisher(FibreOpticPulse, CAGE_PULSES.name, qos_profile(CAGE_PULSES)),
-        }
+        self._instrument_pubs: dict[str, tuple[Any, Any]] = {}
+        """Contract topic -> its publisher and message class, one per instrument of the rig file."""
+        for name in self.twin.instruments.set.topics():
+            topic, kind = contract_topic(name), message_class(contract_topic(name).msgtype)
+            self._instrument_pubs[name] = (self.publisher(kind, name, qos_profile(topic)), kind)
         self._speeds_pub = self.publisher(JointState, SPEEDS.name, qos_profile(SPEEDS))
         self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, qos_profile(TRUTH))
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
-        self._configure_bench_sensors(s.bearing_file)
+        self._attach_thermal(s.bearing_file)
         self._stream_pubs = {
             topic.name: pub
             for topic, pub in (
                 (CLOCK, self._clock_pub),
-                (SPINDLE_PULSES, self._pulse_pubs["spindle"]),
-                (CAGE_PULSES, self._pulse_pubs["cage"]),
+                *((contract_topic(name), pub) for name, (pub, _kind) in self._instrument_pubs.items()),
                 (SPEEDS, self._speeds_pub),
                 (TRUTH, self._truth_pub),
             )
+            if topic.qos == "reliable_stream"
         }
         self.subscription(SpindleCommandMsg, SPINDLE_COMMAND.name, self._on_command, STATUS_QOS)
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
@@ -434,10 +436,12 @@ class SimulatorNode(ManagedNode):
         stamp = to_stamp(out.time)
         self._clock_msg.clock = stamp
         self._clock_pub.publish(self._clock_msg)
-        for shaft, pulses in (("spindle", out.spindle_pulses), ("cage", out.cage_pulses)):
-            for pulse in pulses:
-                self._pulse_pubs[shaft].publish(pulse_message(pulse))
-            self._pulses[shaft] += len(pulses)
+        for name, readings in out.readings.items():
+            pub, kind = self._instrument_pubs[name]
+            for reading in readings:
+                pub.publish(instrument_message(kind, reading))
+        self._pulses["spindle"] += len(out.spindle_pulses)
+        self._pulses["cage"] += len(out.cage_pulses)
         if self._chunks % self._speeds_every == 0:
             m = out.measured
             msg = self._speeds_msg
@@ -447,46 +451,18 @@ class SimulatorNode(ManagedNode):
             self._speeds_pub.publish(msg)
         if out.truth is not None:
             self._truth_pub.publish(self._truth_message(out))
-        if self.twin.thermal is not None:
-            self._publish_bench_sensors(stamp)
 
-    # -- the thermocouple and the torque meter -------------------------------------------------
-    def _configure_bench_sensors(self, bearing_file: Any) -> None:
+    # -- the bench's instruments -----------------------------------------------------------------
+    def _attach_thermal(self, bearing_file: Any) -> None:
         """Couple the bearing's thermal network to the engine (its heat, term by term; with
         ``lubricant_feedback`` also back: the engine's lubricant follows the lubricant node every
-        network step, 0.1 s; :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`) and publish
-        the outer-ring thermocouple and the housing torque meter; a bearing file without a
-        ``thermal:`` section has neither."""
+        network step, 0.1 s; :class:`~bearing_rig_sim.thermal.coupling.ThermalCoupling`), whose
+        temperatures the thermocouples read; a bearing file without a ``thermal:`` section has
+        none, and its thermocouples publish nothing."""
         try:
             self.twin.attach_thermal(bearing_file, initial_rise_k=self.settings.initial_temperature_rise_k, feedback=self.settings.lubricant_feedback)
         except ConfigError as exc:
-            self.get_logger().info(f"no thermocouple or torque meter: {exc}")
-            return
-        chunk = self.settings.chunk_s
-        self._temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))
-        self._torque_every = max(1, round(1.0 / (bench_sensors.TORQUE_METER_RATE_HZ * chunk)))
-        self._thermocouple = bench_sensors.Thermocouple()
-        self._torque_meter = bench_sensors.TorqueMeter()
-        self._temperature_pub = self.publisher(Temperature, OUTER_RING_TEMPERATURE.name, qos_profile(OUTER_RING_TEMPERATURE))
-        self._torque_pub = self.publisher(WrenchStamped, HOUSING_TORQUE.name, qos_profile(HOUSING_TORQUE))
-
-    def _publish_bench_sensors(self, stamp: Any) -> None:
-        thermal = self.twin.thermal
-        assert thermal is not None
-        chunk = self.settings.chunk_s
-        if self._chunks % self._temperature_every == 0:
-            reading = self._thermocouple.update(thermal.temperature("outer_ring"), self._temperature_every * chunk)
-            msg = Temperature(temperature=reading, variance=bench_sensors.THERMOCOUPLE_NOISE_K**2)
-            msg.header.stamp = stamp
-            msg.header.frame_id = "outer_ring"
-            self._temperature_pub.publish(msg)
-        if self._chunks % self._torque_every == 0:
-            torque = self._torque_meter.update(self.twin.engine.friction_torque(), self._torque_every * chunk)
-            wrench = WrenchStamped()
-            wrench.header.stamp = stamp
-            wrench.header.frame_id = "housing"
-            wrench.wrench.torque.z = torque
-            self._torque_pub.publish(wrench)
+            self.get_logger().info(f"no thermal network, so no temperature readings: {exc}")
 
     def _truth_message(self, out: TickOutput) -> SimulatorTruth:
         t = out.truth
@@ -628,17 +604,23 @@ def _unused(_msg: object) -> None:  # pragma: no cover - the force reader's node
     """Callback of the force reader; its queue is taken by the loop."""
 
 
-def pulse_message(pulse: Pulse) -> FibreOpticPulse:
-    """A FibreOpticPulse for a sensor pulse, stamped with the pulse time (s)."""
-    msg = FibreOpticPulse(
-        sensor_id=pulse.sensor_id,
-        strip_id=pulse.strip_id,
-        strip_count=pulse.strip_count,
-        revolution=pulse.revolution,
-        pulse_index=pulse.pulse_index,
-    )
-    msg.header.stamp = to_stamp(pulse.time)
-    msg.header.frame_id = f"{pulse.sensor_id}_sensor"
+def message_class(msgtype: str) -> Any:
+    """The rclpy message class of a contract type ``pkg/msg/Name``."""
+    package, _, name = msgtype.split("/")
+    return getattr(importlib.import_module(f"{package}.msg"), name)
+
+
+def instrument_message(kind: Any, reading: Reading) -> Any:
+    """A message of class ``kind`` holding an instrument's reading: stamped with its time (s),
+    each of its fields set by dotted path."""
+    msg = kind()
+    msg.header.stamp = to_stamp(reading.time)
+    for path, value in reading.message_fields().items():
+        *parents, leaf = path.split(".")
+        target = msg
+        for part in parents:
+            target = getattr(target, part)
+        setattr(target, leaf, value)
     return msg
 
 

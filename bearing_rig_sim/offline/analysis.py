@@ -83,7 +83,7 @@ from bearing_rig_sim.offline.series import (
     StatusRow,
     csv_columns,
 )
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype

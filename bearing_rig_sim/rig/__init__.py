@@ -1,6 +1,6 @@
-"""Models of the bench around the bearing, without ROS (docs/paper.md section 8).
+"""Models of the bench around the bearing, without ROS (docs/paper.md section 8); its instruments
+are in :mod:`bearing_rig_sim.instruments`.
 
-* :mod:`.fibre_optic`: fibre-optic reflective speed sensors and the pulse counter.
 * :mod:`.loading`: the axial loading chain put together, with its interlocks;
   :mod:`.loading_elements` (linear brake, wire rope, lever, magnet clutch, housing) and
   :mod:`.force_control` (load cell, PI(D) force controller) are its parts.

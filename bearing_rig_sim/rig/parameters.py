@@ -2,7 +2,8 @@
 
 A parameter record is a frozen dataclass whose field names are the YAML keys (units in the
 name: ``resistance_ohm``, ``stiffness_n_per_m``) and whose fields carry their allowed range
-(:func:`bounded`). The checks are those of the declarative parameter model
+(:func:`bounded`); a number declared with its unit may be written ``{value, unit, range,
+source}`` as in the bearing files. The checks are those of the declarative parameter model
 (:mod:`bearing_rig_sim.settings_model`): each record class gives a pydantic model of its
 fields (:meth:`ParameterRecord.model`), with the same value kinds (a number is finite and never
 a boolean, an integer is no float, a flag is a YAML boolean) and the same one-line errors. They
@@ -24,10 +25,10 @@ import typing
 from pathlib import Path
 from typing import Any, ClassVar, TypeVar
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
+from pydantic import BaseModel, Field, ValidationError, create_model
 
 from bearing_rig_sim.config import SHIPPED_RIG_FILE, ConfigError, config_path, mapping_at, read_mapping
-from bearing_rig_sim.settings_model import Flag, Integer, Number, first_error, validate_mapping
+from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, Text, first_error, validate_mapping
 
 R = TypeVar("R", bound="ParameterRecord")
 
@@ -42,14 +43,18 @@ def bounded(
     lt: float | None = None,
     le: float | None = None,
     default: Any = dataclasses.MISSING,
+    unit: str = "",
 ) -> Any:
     """A dataclass field of a :class:`ParameterRecord` with its allowed range.
 
-    Integer and boolean fields are recognised by their annotation; the bounds apply to numbers
-    and integers alike. ``default`` makes the key optional in the YAML file.
+    Integer, boolean and text fields are recognised by their annotation; the bounds apply to
+    numbers and integers alike. ``default`` makes the key optional in the YAML file. A number
+    with a ``unit`` (SI, ``"1"`` for a pure number) may be written in the file as
+    ``{value, unit, range, source}`` (:class:`~bearing_rig_sim.settings_model.StatedQuantity`):
+    its unit must be this one and its value lie in the range it states.
     """
     bounds = {"gt": gt, "ge": ge, "lt": lt, "le": le}
-    return dataclasses.field(default=default, metadata={"bounds": bounds})
+    return dataclasses.field(default=default, metadata={"bounds": bounds, "unit": unit})
 
 
 def _is_record(kind: object) -> bool:
@@ -86,10 +91,12 @@ class ParameterRecord:
         for field in dataclasses.fields(cls):  # type: ignore[arg-type]  # every ParameterRecord subclass is a dataclass
             kind = hints[field.name]
             bounds = {k: v for k, v in field.metadata.get("bounds", {}).items() if v is not None}
-            annotation: Any = kind.model() if _is_record(kind) else Flag if kind is bool else Integer if kind is int else Number
+            annotation: Any = kind.model() if _is_record(kind) else Flag if kind is bool else Integer if kind is int else Text if kind is str else Number
             default = ... if field.default is dataclasses.MISSING else field.default
-            fields[field.name] = (annotation, Field(default, **bounds))
-        model: type[BaseModel] = create_model(cls.__name__, __config__=ConfigDict(extra="forbid", frozen=True), **fields)
+            unit = field.metadata.get("unit", "")
+            stated: dict[str, Any] | None = {"unit": unit, "source": "the rig file"} if unit else None  # may be written {value, unit, range, source}
+            fields[field.name] = (annotation, Field(default, json_schema_extra=stated, **bounds))
+        model: type[BaseModel] = create_model(cls.__name__, __base__=FileSection, **fields)
         return model
 
     def __post_init__(self) -> None:

@@ -22,7 +22,7 @@ import math
 from collections import deque
 from typing import NamedTuple
 
-from bearing_rig_sim.rig.fibre_optic import TWO_PI, Pulse
+from bearing_rig_sim.instruments.fibre_optic import TWO_PI, Pulse
 
 
 class SpeedPoint(NamedTuple):

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 
 from bearing_rig_sim.monitoring import MonitorSettings, SlipWindow, SlipWindows
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 
 MeasuredWindow = SlipWindow

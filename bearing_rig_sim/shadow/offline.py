@@ -36,7 +36,7 @@ from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.health import HealthLevel
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.offline.analysis import decode_pulse
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.shadow.recalibration import ParameterEstimate
 from bearing_rig_sim.shadow.settings import ShadowSettings
 from bearing_rig_sim.shadow.twin import ResidualWindow, ShadowTwin

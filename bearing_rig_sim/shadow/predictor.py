@@ -40,7 +40,9 @@ from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingPar
 from bearing_rig_sim.shadow.inputs import SpeedPoint
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling, TractionTableGrid
-from bearing_rig_sim.thermal.sensors import Thermocouple
+from bearing_rig_sim.instruments.first_order import FirstOrderLag, ThermocoupleSettings
+from bearing_rig_sim.instruments.registry import InstrumentSet
+from bearing_rig_sim.interfaces import OUTER_RING_TEMPERATURE
 
 
 TORQUE_PERIOD_S = 0.01
@@ -86,6 +88,8 @@ class MeasuredDrive:
             lubricant temperature (False: held at the bearing file's, the calibration's).
         mounting: the test bearing's clearance, misalignment and preload (the rig file's
             ``mounting`` section; default none).
+        thermocouple: the bench's outer-ring thermocouple, whose lag the predicted reading goes
+            through (noise-free); default the shipped rig file's (used with ``thermal`` only).
     """
 
     def __init__(
@@ -99,6 +103,7 @@ class MeasuredDrive:
         thermal: ThermalConfig | None = None,
         lubricant_feedback: bool = False,
         mounting: Mounting | None = None,
+        thermocouple: ThermocoupleSettings | None = None,
     ) -> None:
         self.engine = BearingDynamics(params, model=model, mounting=mounting)
         self.thermal_config = thermal
@@ -117,7 +122,9 @@ class MeasuredDrive:
         if thermal is not None:
             # built now (the node's configure), not in the first pulse's callback
             self.coupling = ThermalCoupling(self.engine, thermal, feedback=lubricant_feedback, grid=self._grid)
-        self._thermocouple = Thermocouple(noise=0.0)
+        if thermocouple is None and thermal is not None:
+            thermocouple = InstrumentSet.from_rig_file().on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings)
+        self._thermocouple = FirstOrderLag(thermocouple.time_constant_s, 0.0, None) if thermocouple is not None else None
         self._torque_now = 0.0
         self._torque_age = math.inf
         self.chunk = chunk
@@ -193,7 +200,7 @@ class MeasuredDrive:
         return self._torque_now
 
     def _thermocouple_reading(self, h: float) -> float:
-        if self.coupling is None:
+        if self.coupling is None or self._thermocouple is None:
             return math.nan
         return self._thermocouple.update(self.coupling.temperature("outer_ring"), h)
 

@@ -50,7 +50,10 @@ from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.health import Health, HealthLevel
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
+from bearing_rig_sim.instruments.first_order import ThermocoupleSettings
+from bearing_rig_sim.instruments.registry import InstrumentSet
+from bearing_rig_sim.interfaces import OUTER_RING_TEMPERATURE
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.shadow.measured import MeasuredWindow, MeasuredWindows
@@ -157,6 +160,8 @@ class ShadowTwin:
             except ConfigError:
                 self.thermal_config = None  # a bearing file without a thermal: section
         self.mounting = Mounting.of(MountingConfig.from_rig_file(settings.rig_file))
+        self.thermocouple = InstrumentSet.from_rig_file(settings.rig_file).on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings)
+        """The rig file's outer-ring thermocouple, whose lag the predicted reading follows."""
         """The test bearing's mounting, from the rig file (as the simulator's engine has it)."""
         self.drive = self._make_drive(self.params)
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
@@ -195,6 +200,7 @@ class ShadowTwin:
             thermal=self.thermal_config,
             lubricant_feedback=st.lubricant_feedback,
             mounting=self.mounting,
+            thermocouple=self.thermocouple,
         )
 
     # -- input ---------------------------------------------------------------------------------

@@ -1,17 +1,19 @@
-"""The rig's digital twin, one chunk at a time: engine, spindle drive, axial load, speed sensors.
+"""The rig's digital twin, one chunk at a time: engine, spindle drive, axial load, instruments.
 
 :class:`RigTwin` advances the dynamics engine by one chunk (``chunk_s`` of ``config/simulator.yaml``) at the current axial
 load, with the inner-ring acceleration the :class:`~bearing_rig_sim.simulation.drive.SpindleDrive`
-asks for, then shows the motion to the two fibre-optic sensors of the bench (docs/paper.md section 8):
+asks for, then shows the motion to the bench's instruments (the rig file's ``sensors`` section,
+:class:`~bearing_rig_sim.simulation.instruments.TwinInstruments`), among them the two
+fibre-optic sensors of the bench (docs/paper.md section 8):
 
 * spindle sensor: the inner-ring angle (the spindle carries the inner ring);
 * cage sensor: the angle of the cage segment carrying the reflective strip
   (``Observation.cage_angle``).
 
 Each sensor emits one pulse per strip passage, its time interpolated inside the chunk, with its
-timing jitter (:class:`~bearing_rig_sim.rig.fibre_optic.FibreOpticSensor`). The measured speeds
+timing jitter (:class:`~bearing_rig_sim.instruments.fibre_optic.FibreOpticSensor`). The measured speeds
 come from the pulses alone, through the bench's counter
-(:class:`~bearing_rig_sim.rig.fibre_optic.PulseCounter`): never from the engine's true speed.
+(:class:`~bearing_rig_sim.instruments.fibre_optic.PulseCounter`): never from the engine's true speed.
 The ground truth (true speeds, slip, contact loads) is reported beside them, for the truth topic.
 
 A counter's estimate is the mean speed over its last window of whole revolutions, so it lags a
@@ -27,6 +29,7 @@ Units: s, rad, rad/s, rad/s^2, N, m; slip in percent.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,10 +41,13 @@ from bearing_rig_sim.config import shipped_bearing_file
 from bearing_rig_sim.dynamics.models import model_parameters
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingDynamics, BearingParameters, Mounting, Observation, OperatingEnvelope
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.rig.fibre_optic import TWO_PI, FibreOpticConfig, FibreOpticSensor, Pulse, PulseCounter
+from bearing_rig_sim.instruments.base import Reading
+from bearing_rig_sim.instruments.fibre_optic import TWO_PI, FibreOpticSensor, Pulse, PulseCounter
+from bearing_rig_sim.instruments.registry import InstrumentSet
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.rig.program import RigLimits
 from bearing_rig_sim.simulation.drive import SpindleCommand, SpindleDrive
+from bearing_rig_sim.simulation.instruments import TwinInstruments
 from bearing_rig_sim.simulation.settings import SimulatorSettings
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling
@@ -156,6 +162,8 @@ class TickOutput:
         cage_pulses: pulses of the cage sensor inside the chunk, in time order.
         measured: the counters' speeds and pulse-counted angles at the chunk's end.
         truth: the engine's ground truth at the chunk's end (None if not asked for).
+        readings: every instrument's readings inside the chunk by contract topic, in time order
+            (the pulses included).
     """
 
     start_time: float
@@ -164,6 +172,7 @@ class TickOutput:
     cage_pulses: list[Pulse]
     measured: MeasuredSpeeds
     truth: TruthSummary | None
+    readings: dict[str, Sequence[Reading]]
 
 
 def counted_speed(counter: PulseCounter, strip_count: int, now: float, timeout: float) -> float:
@@ -217,7 +226,7 @@ def twin_options(settings: SimulatorSettings | None = None, rig_file: str | Path
 
 
 class RigTwin:
-    """The engine, the spindle drive, the axial load and the two fibre-optic sensors.
+    """The engine, the spindle drive, the axial load and the bench's instruments.
 
     The options have no defaults here: :func:`twin_options` gives the simulator's (its settings
     and its rig file's limits), which :meth:`from_files` uses.
@@ -225,7 +234,8 @@ class RigTwin:
     Args:
         engine: the dynamics engine; initialised here at ``initial_speed`` and
             ``initial_axial_load``.
-        sensors: both sensors and the counter (``sensors`` section of ``config/rig.yaml``).
+        instruments: the bench's instruments (``sensors`` section of ``config/rig.yaml``), among
+            them a fibre-optic sensor on the inner ring and one on the cage.
         kinematics: the bearing's geometry for the truth's theoretical cage speed and slip
             (nominal contact angle).
         chunk: default chunk length, s; a whole number of engine time steps.
@@ -253,7 +263,7 @@ class RigTwin:
     def __init__(
         self,
         engine: BearingDynamics,
-        sensors: FibreOpticConfig,
+        instruments: InstrumentSet,
         kinematics: BearingKinematics,
         *,
         chunk: float,
@@ -295,10 +305,12 @@ class RigTwin:
         self._radial_angle = 0.0
         self._moment = (0.0, 0.0)
         engine.initialise(self.drive.speed_at(0.0), self._load, time=0.0)
-        self.spindle_sensor: FibreOpticSensor = sensors.sensor("spindle")
-        self.cage_sensor: FibreOpticSensor = sensors.sensor("cage")
-        self.spindle_counter: PulseCounter = sensors.counter("spindle")
-        self.cage_counter: PulseCounter = sensors.counter("cage")
+        self.instruments = TwinInstruments(instruments)
+        """The bench's instruments, shown the motion after each chunk."""
+        self.spindle_sensor: FibreOpticSensor = self.instruments.spindle_sensor
+        self.cage_sensor: FibreOpticSensor = self.instruments.cage_sensor
+        self.spindle_counter: PulseCounter = self.instruments.spindle_counter
+        self.cage_counter: PulseCounter = self.instruments.cage_counter
         self._last_index: dict[str, int | None] = {"spindle": None, "cage": None}
         self.step_count = 0
         """Engine integration steps since the start (1)."""
@@ -318,8 +330,10 @@ class RigTwin:
             raise TwinError(f"initial_rise_k: must be a finite number >= 0 K, got {initial_rise_k!r}")
         config = ThermalConfig.from_yaml(bearing_file)
         options.setdefault("initial", config.ambient + initial_rise_k)
-        self.thermal = ThermalCoupling(self.engine, config, **options)
-        return self.thermal
+        coupling = ThermalCoupling(self.engine, config, **options)
+        self.instruments.check_thermal(coupling)
+        self.thermal = coupling
+        return coupling
 
     @classmethod
     def from_files(
@@ -338,7 +352,7 @@ class RigTwin:
         Args:
             bearing_file: bearing data (default: the shipped one, :data:`~bearing_rig_sim.config.SHIPPED_BEARING_FILE`).
             calibration_file: calibration laid over it (None: none).
-            rig_file: rig data with the ``sensors`` section and the test bearing's ``mounting``
+            rig_file: rig data with the ``sensors`` section (the instruments) and the test bearing's ``mounting``
                 (clearance, misalignment, preload; default: ``config/rig.yaml``).
             model: the engine's model, ``"reduced"`` (real time) or ``"stiff"``.
             bearing_model: the bearing's physics (:data:`~bearing_rig_sim.config.BEARING_MODELS`):
@@ -360,9 +374,9 @@ class RigTwin:
             params = model_parameters(bearing_model)
         mounting = Mounting.of(MountingConfig.from_rig_file(rig_file))
         engine = BearingDynamics(params, model=model, envelope=OperatingEnvelope.from_rig_file(rig_file), mounting=mounting)
-        sensors = FibreOpticConfig.from_yaml(rig_file)
+        instruments = InstrumentSet.from_rig_file(rig_file)
         kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
-        return cls(engine, sensors, kinematics, **(twin_options(settings, rig_file) | options))
+        return cls(engine, instruments, kinematics, **(twin_options(settings, rig_file) | options))
 
     def _check_chunk(self, chunk: float) -> float:
         if isinstance(chunk, bool) or not isinstance(chunk, (int, float)) or not math.isfinite(chunk) or not chunk > 0.0:
@@ -504,7 +518,8 @@ class RigTwin:
                 Python; the node asks for it only when it publishes the truth).
 
         Returns:
-            The pulses of the chunk, the counters' speeds and the ground truth at its end.
+            The pulses of the chunk, every instrument's readings, the counters' speeds and the
+            ground truth at its end.
 
         Raises:
             TwinError: ``h`` not a whole number of engine steps.
@@ -532,18 +547,13 @@ class RigTwin:
         if self.thermal is not None:
             self.thermal.advance(t_end - t0)
         self._angles = t1, inner_after, cage_after = engine.angles()
-        spindle = self.spindle_sensor.update(t0, inner_before, t1, inner_after)
-        cage = self.cage_sensor.update(t0, cage_before, t1, cage_after)
-        for pulse in spindle:
-            self.spindle_counter.add(pulse)
-        for pulse in cage:
-            self.cage_counter.add(pulse)
+        spindle, cage, readings = self.instruments.observe(t0, t1, (inner_before, cage_before), (inner_after, cage_after), engine.friction_torque, self.thermal)
         if spindle:
             self._last_index["spindle"] = spindle[-1].pulse_index
         if cage:
             self._last_index["cage"] = cage[-1].pulse_index
         truth = self._truth(engine.observe()) if with_truth else None
-        return TickOutput(t0, t1, spindle, cage, self.measured(t1), truth)
+        return TickOutput(t0, t1, spindle, cage, self.measured(t1), truth, readings)
 
     def measured(self, now: float | None = None) -> MeasuredSpeeds:
         """The counters' speeds and pulse-counted angles at ``now`` (s; default: the twin's time)."""

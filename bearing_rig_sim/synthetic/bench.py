@@ -33,7 +33,7 @@ import numpy as np
 
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS, SPINDLE_PULSES
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 BENCH_EPOCH_S = 1_732_300_000.0
 """A bench computer's system clock at the start of a recording, s since 1970."""

@@ -27,12 +27,18 @@ from bearing_rig_sim.config import read_mapping, rpm_to_rad_s
 from bearing_rig_sim.dynamics import calibrations
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
-from bearing_rig_sim.rig.fibre_optic import Pulse
+from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.settings_model import validate_mapping
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.twin import RigTwin
-from bearing_rig_sim.thermal import sensors as bench_sensors
+from bearing_rig_sim.instruments.first_order import ThermocoupleSettings
+from bearing_rig_sim.instruments.registry import InstrumentSet
+
+
+def shipped_thermocouple() -> ThermocoupleSettings:
+    """The shipped rig file's thermocouple on ``/rig/outer_ring/temperature``."""
+    return InstrumentSet.from_rig_file().on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings)
 
 
 @dataclass(frozen=True)
@@ -112,11 +118,6 @@ def twin_bench_run(
     rng = random.Random(seed)
     run = BenchRun([], [], [], [])
     coupling = twin.attach_thermal(bearing_file, initial_rise_k=initial_rise_k, feedback=feedback) if thermal else None
-    thermocouple, torque_meter = bench_sensors.Thermocouple(), bench_sensors.TorqueMeter()
-    chunk = twin.chunk
-    temperature_every = max(1, round(1.0 / (bench_sensors.THERMOCOUPLE_RATE_HZ * chunk)))
-    torque_every = max(1, round(1.0 / (bench_sensors.TORQUE_METER_RATE_HZ * chunk)))
-    chunks = 0
 
     def shifted(p: Pulse) -> Pulse:
         return Pulse(p.time + clock_offset_s, p.strip_id, p.strip_count, p.revolution, p.pulse_index, p.sensor_id)
@@ -130,12 +131,11 @@ def twin_bench_run(
             run.spindle.extend(shifted(p) for p in out.spindle_pulses)
             run.cage.extend(shifted(p) for p in out.cage_pulses)
             run.forces.append((out.time + clock_offset_s, hold.axial_load_n + rng.gauss(0.0, load_noise_std_n)))
-            chunks += 1
-            if coupling is not None:
-                if chunks % temperature_every == 0:
-                    run.temperatures.append((out.time + clock_offset_s, thermocouple.update(coupling.temperature("outer_ring"), temperature_every * chunk)))
-                if chunks % torque_every == 0:
-                    run.torques.append((out.time + clock_offset_s, torque_meter.update(twin.engine.friction_torque(), torque_every * chunk)))
+            if coupling is not None:  # the rig file's thermocouple and torque meter, as the simulator publishes them
+                for r in out.readings.get(OUTER_RING_TEMPERATURE.name, []):
+                    run.temperatures.append((r.time + clock_offset_s, float(r.message_fields()["temperature"])))
+                for r in out.readings.get(HOUSING_TORQUE.name, []):
+                    run.torques.append((r.time + clock_offset_s, float(r.message_fields()["wrench.torque.z"])))
         truth = twin.truth()
         run.truth_slip.append(truth.slip_rate)
     return run
@@ -144,11 +144,11 @@ def twin_bench_run(
 def departed(run: BenchRun, *, from_s: float, outer_ring_hotter_k: float = 0.0, torque_factor: float = 1.0) -> BenchRun:
     """The bench of ``run`` departing from the twin at bench time ``from_s`` (s): its outer ring
     ``outer_ring_hotter_k`` K hotter, seen through the thermocouple's first-order lag
-    (:data:`~bearing_rig_sim.thermal.sensors.THERMOCOUPLE_TIME_CONSTANT_S`: the reading's offset
+    (the shipped rig file's ``time_constant_s``, :func:`shipped_thermocouple`: the reading's offset
     is dT (1 - exp(-(t - from_s) / tau))), and its friction torque ``torque_factor`` times the
     twin's (the torque meter's 10 ms lag and its 0.2 mN m noise, under 0.3 % of the torque, are
     scaled with it). Pulses and load-cell samples are those of ``run``."""
-    tau = bench_sensors.THERMOCOUPLE_TIME_CONSTANT_S
+    tau = shipped_thermocouple().time_constant_s
     temperatures = [
         (t, v + (outer_ring_hotter_k * (1.0 - math.exp(-(t - from_s) / tau)) if t > from_s else 0.0)) for t, v in run.temperatures
     ]
@@ -168,6 +168,7 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
         ns = int(round(t * 1e9))
         return types["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
 
+    variance = shipped_thermocouple().noise_std_k ** 2
     with BagWriter(path, typestore=store) as writer:
         topics = [SPINDLE_PULSES, CAGE_PULSES, AXIAL_LOAD_FORCE]
         topics += [OUTER_RING_TEMPERATURE] if run.temperatures else []
@@ -177,7 +178,7 @@ def write_bench_bag(run: BenchRun, path: str | Path) -> Path:
         for t, kind, payload in run.events():
             header = types["std_msgs/msg/Header"](stamp=stamp(t), frame_id="bench")
             if kind == "temperature":
-                msg = types["sensor_msgs/msg/Temperature"](header=header, temperature=float(payload), variance=bench_sensors.THERMOCOUPLE_NOISE_K**2)  # type: ignore[arg-type]  # rosbags' message constructors are loosely typed
+                msg = types["sensor_msgs/msg/Temperature"](header=header, temperature=float(payload), variance=variance)  # type: ignore[arg-type]  # rosbags' message constructors are loosely typed
                 writer.write_message(OUTER_RING_TEMPERATURE.name, int(round(t * 1e9)), msg)
                 continue
             if kind == "torque":

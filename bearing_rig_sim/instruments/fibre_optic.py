@@ -16,13 +16,15 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import ClassVar
 
 import numpy as np
 
-from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.rig.parameters import ParameterRecord, bounded
+from bearing_rig_sim.config import ConfigError
+from bearing_rig_sim.instruments.base import SHAFT_ANGLES, InstrumentError, InstrumentSettings, Measurand
+from bearing_rig_sim.rig.parameters import bounded
 
 TWO_PI = 2.0 * math.pi
 
@@ -38,10 +40,8 @@ electronic trigger's timing error is bounded; the truncation keeps every pulse w
 MAX_STRIP_COUNT = 65535
 """Largest strip count the pulse message can carry (``uint16 strip_count``)."""
 
-Shaft = Literal["spindle", "cage"]
 
-
-class SensorError(RigError):
+class SensorError(InstrumentError):
     """Bad input to a sensor model or a pulse counter (non-finite, time going backwards, ...)."""
 
 
@@ -63,6 +63,17 @@ class Pulse:
     index tells the receiver that pulses were lost."""
     sensor_id: str = ""
     """Which shaft's sensor gave the pulse (``"spindle"`` or ``"cage"``); empty if unknown."""
+
+    def message_fields(self) -> dict[str, float | int | str]:
+        """The fields of its FibreOpticPulse message (the stamp is :attr:`time`)."""
+        return {
+            "header.frame_id": f"{self.sensor_id}_sensor",
+            "sensor_id": self.sensor_id,
+            "strip_id": self.strip_id,
+            "strip_count": self.strip_count,
+            "revolution": self.revolution,
+            "pulse_index": self.pulse_index,
+        }
 
 
 def _require_finite(owner: str, **values: float) -> None:
@@ -124,6 +135,27 @@ class FibreOpticSensor:
         self._rng = np.random.default_rng(seed)
         self._spacing = TWO_PI / strip_count
         self.reset()
+
+    settings: FibreOpticSettings
+    """The settings block it was built from (:meth:`from_settings`)."""
+
+    @classmethod
+    def from_settings(cls, settings: FibreOpticSettings) -> FibreOpticSensor:
+        """The sensor of a settings block."""
+        sensor = cls(
+            settings.sensor_id,
+            settings.strip_count,
+            jitter_std=settings.timing_jitter_std_s,
+            phase=settings.phase_rad,
+            seed=settings.seed,
+            drop_probability=settings.pulse_drop_probability,
+        )
+        sensor.settings = settings
+        return sensor
+
+    def observe(self, t0: float, t1: float, measurand: Measurand) -> list[Pulse]:
+        """The pulses of the chunk (t0, t1] from the shaft angle at both ends (:meth:`update`)."""
+        return self.update(t0, measurand.at_start(), t1, measurand.at_end())
 
     def reset(self) -> None:
         """Start afresh (e.g. after a clock jump): the next update starts a new pulse count.
@@ -311,54 +343,34 @@ class PulseCounter:
 
 
 @dataclass(frozen=True)
-class ShaftSensorParams(ParameterRecord):
-    """The strips and sensor on one shaft (``sensors.spindle`` or ``sensors.cage``)."""
+class FibreOpticSettings(InstrumentSettings):
+    """One fibre-optic sensor's block in the rig file's ``sensors`` section (measuring a shaft
+    angle) and the bench counter that turns its pulses into a speed."""
 
+    MSGTYPE: ClassVar[str] = "bearing_rig_msgs/msg/FibreOpticPulse"
+
+    sensor_id: str
+    """Which shaft's sensor it is, as its pulses name it (``"spindle"``, ``"cage"``); the
+    pulse's frame is ``<sensor_id>_sensor``."""
     strip_count: int = bounded(ge=1, le=MAX_STRIP_COUNT)
-    """Reflective strips on the shaft (1). Not in the paper: the assumption and its reason are in
-    ``config/rig.yaml``, section ``sensors``."""
-    phase_rad: float = bounded(ge=0.0, lt=TWO_PI)
+    """Reflective strips on the shaft (1)."""
+    phase_rad: float = bounded(ge=0.0, lt=TWO_PI, unit="rad")
     """Shaft angle at which strip 0 passes the sensor, rad."""
+    timing_jitter_std_s: float = bounded(ge=0.0, le=1e-3, unit="s")
+    """Standard deviation of the pulse timing jitter, s."""
+    pulse_drop_probability: float = bounded(ge=0.0, lt=1.0, unit="1")
+    """Probability that a strip passage gives no pulse (1); 0 on a healthy bench."""
+    counter_revolutions_per_window: int = bounded(ge=1, le=1000)
+    """Whole revolutions per speed estimate of the sensor's counter (1)."""
     seed: int = bounded(ge=0)
     """Seed of this sensor's random generator (jitter, drops) (1)."""
 
+    def check_consistency(self, error: Callable[[str, str], ConfigError]) -> None:
+        """The common checks; the measurand is a shaft angle."""
+        super().check_consistency(error)
+        if self.measures not in SHAFT_ANGLES:
+            raise error("measures", f"a fibre-optic sensor watches a shaft: must be one of {', '.join(SHAFT_ANGLES)}, got {self.measures!r}")
 
-@dataclass(frozen=True)
-class FibreOpticConfig(ParameterRecord):
-    """The ``sensors`` section of ``config/rig.yaml``: both fibre-optic sensors and the counter."""
-
-    SECTION: ClassVar[str] = "sensors"
-
-    spindle: ShaftSensorParams
-    """Sensor on the motor spindle, which carries the inner ring."""
-    cage: ShaftSensorParams
-    """Sensor on the cage."""
-    timing_jitter_std_s: float = bounded(ge=0.0, le=1e-3)
-    """Standard deviation of the pulse timing jitter, s."""
-    pulse_drop_probability: float = bounded(ge=0.0, lt=1.0)
-    """Probability that a strip passage gives no pulse (1); 0 on a healthy bench."""
-    counter_revolutions_per_window: int = bounded(ge=1, le=1000)
-    """Whole revolutions per speed estimate of the counter (1)."""
-
-    def sensor(self, shaft: Shaft) -> FibreOpticSensor:
-        """A sensor model for ``"spindle"`` or ``"cage"`` with these parameters."""
-        params = self._shaft(shaft)
-        return FibreOpticSensor(
-            shaft,
-            params.strip_count,
-            jitter_std=self.timing_jitter_std_s,
-            phase=params.phase_rad,
-            seed=params.seed,
-            drop_probability=self.pulse_drop_probability,
-        )
-
-    def counter(self, shaft: Shaft) -> PulseCounter:
-        """A pulse counter matching the sensor of ``"spindle"`` or ``"cage"``."""
-        return PulseCounter(self._shaft(shaft).strip_count, self.counter_revolutions_per_window)
-
-    def _shaft(self, shaft: Shaft) -> ShaftSensorParams:
-        if shaft == "spindle":
-            return self.spindle
-        if shaft == "cage":
-            return self.cage
-        raise SensorError(f"unknown shaft {shaft!r}; expected 'spindle' or 'cage'")
+    def counter(self) -> PulseCounter:
+        """A pulse counter matching this sensor."""
+        return PulseCounter(self.strip_count, self.counter_revolutions_per_window)

@@ -14,12 +14,15 @@ load cell's force is fed too. The criterion is the run's test program's ``stabil
 when the bag records the program. Nothing depends on a wall clock: two runs over one bag give
 bit-identical results.
 
-**What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
-of the five fields the monitor needs (little-endian CDR; other encodings through the reader's
-general decoder); the 1 kHz topics (speeds, load cell, bearing force) are not decoded message by
-message but their latest bytes are kept and decoded when a status row samples them. Memory does
-not grow with the bag's length: rows and windows stream to CSV files as they are made, and only
-a decimated copy of the rows (at most ``max_points``) and the state changes are kept for plots.
+**What is read.** Only the topics the analysis uses, as raw CDR, in one pass over the bag's
+chunks (:meth:`~bearing_rig_sim.bags.reader.BagReader.ordered_batches`: each chunk decompressed
+once, its messages as arrays): the pulses decoded as arrays
+(:func:`~bearing_rig_sim.bags.cdr.decode_pulses`; other encodings through the reader's general
+decoder, one by one); the load cell, recorded statuses and spindle commands one by one; the 1 kHz
+speeds and the other sampled topics (:data:`SAMPLED_TOPICS`) not message by message: a chunk of
+them is kept and only the message a status row samples is decoded. Memory does not grow with
+the bag's length: rows and windows stream to CSV files as they are made, and only a decimated
+copy of the rows (at most ``max_points``) and the state changes are kept for plots.
 
 **The topics** (:data:`PULSE_TOPICS` required, :data:`CONTEXT_TOPICS` used when present; the
 bench records the same contract, and bags without the simulator's truth are analysed alike):

@@ -4,13 +4,14 @@ what rosbags' general decoder gives."""
 
 from __future__ import annotations
 
+import contextlib
 import struct
 
 import numpy as np
 import pytest
 
 from bearing_rig_sim.bags import BagError, rig_typestore
-from bearing_rig_sim.bags.cdr import PULSE_TYPE, decode_pulse, has_sequences, length_function, header_stamp_ns, make_decoder, make_normaliser
+from bearing_rig_sim.bags.cdr import PULSE_TYPE, decode_pulse, decode_pulses, has_sequences, length_function, header_stamp_ns, make_decoder, make_normaliser
 from bearing_rig_sim.synthetic.traffic import message_fields, sample_message
 
 STORE = rig_typestore()
@@ -65,6 +66,36 @@ def test_pulse_decoder_agrees_with_rosbags() -> None:
         fields = decode_pulse(bytes(STORE.serialize_cdr(message, PULSE_TYPE)))
         stamp = message.header.stamp
         assert fields == (stamp.sec + stamp.nanosec * 1e-9, message.strip_id, message.strip_count, message.revolution, message.pulse_index, message.sensor_id)
+
+
+def test_pulse_arrays_agree_with_rosbags_and_refuse_what_the_single_decoder_refuses() -> None:
+    """:func:`decode_pulses` over one buffer of messages of varied string lengths (so varied
+    alignments), each checked against rosbags' decoder; the messages the one-by-one decoder
+    refuses (cut, big-endian, bad UTF-8) are marked invalid, and their neighbours still decode."""
+    good = [bytes(STORE.serialize_cdr(sample_message(PULSE_TYPE, seed, STORE), PULSE_TYPE)) for seed in range(20)]
+    big = bytes(STORE.serialize_cdr(sample_message(PULSE_TYPE, 3, STORE), PULSE_TYPE, little_endian=False))
+    bad_text = bytearray(good[4])
+    bad_text[4 + ((12 + struct.unpack_from("<I", good[4], 12)[0] + 3) & ~3) + 4] = 0xFF  # first byte of sensor_id
+    messages = [*good[:10], good[10][:-3], big, bytes(bad_text), b"\x00\x01", *good[10:]]
+    refused = set()
+    for k, data in enumerate(messages):
+        with contextlib.suppress(BagError):
+            decode_pulse(data)
+            continue
+        refused.add(k)
+    assert refused == {10, 11, 12, 13}
+    ends = np.cumsum([len(m) for m in messages])
+    arrays = decode_pulses(b"".join(messages), ends - [len(m) for m in messages], ends)
+    assert set(np.flatnonzero(~arrays.valid).tolist()) == refused
+    columns = (arrays.time, arrays.strip_id, arrays.strip_count, arrays.revolution, arrays.pulse_index)
+    for k, data in enumerate(messages):
+        if k in refused:
+            continue
+        message = STORE.deserialize_cdr(data, PULSE_TYPE)
+        stamp = message.header.stamp
+        expected = (stamp.sec + stamp.nanosec * 1e-9, message.strip_id, message.strip_count, message.revolution, message.pulse_index, message.sensor_id)
+        got = (*(c.tolist()[k] for c in columns), arrays.sensor_id[k])
+        assert got == expected, k
 
 
 def test_header_stamp_is_read_in_both_byte_orders() -> None:

@@ -70,6 +70,13 @@ def chunk_message_counts(mcap_path: Path) -> list[tuple[int, int, int]]:
     return out
 
 
+def chunk_time_ranges(mcap_path: Path) -> list[tuple[int, int, int]]:
+    """(start offset, first and last log time) of every chunk, from the mcap library's summary."""
+    with open(mcap_path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    return [(c.chunk_start_offset, c.message_start_time, c.message_end_time) for c in summary.chunk_indexes]
+
+
 @pytest.fixture(scope="module")
 def traffic_bag(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int]:
     path = tmp_path_factory.mktemp("bags") / "traffic"
@@ -131,6 +138,34 @@ def test_batches_hold_each_topics_messages_as_the_mcap_library_reads_them(traffi
     assert batches > 1  # 4 kB chunks
     for topic in topics:
         assert got[topic] == expected[topic] and len(got[topic]) > 10
+
+
+def test_ordered_batches_give_the_messages_in_the_order_messages_gives_them(traffic_bag: tuple[Path, int], tmp_path: Path) -> None:
+    """:meth:`BagReader.ordered_batches` (chunks through their message indexes) against
+    :meth:`BagReader.messages` (checked against AnyReader above): the same topics, log times and
+    bytes in the same order, each message's topic as its position in the list asked for; chunks
+    that overlap in time (a file whose chunks are out of order) are merged the same way."""
+    path, _count = traffic_bag
+    topics = [TRUTH_TOPIC, SPEEDS_TOPIC]
+    overlapping = tmp_path / "overlapping.mcap"  # written topic by topic with the mcap library: the chunks overlap
+    with open(overlapping, "wb") as stream:
+        writer = McapWriter(stream, chunk_size=2048)
+        writer.start("ros2", "test")
+        channels = {topic: writer.register_channel(topic, "cdr", writer.register_schema(msgtype, "ros2msg", b"")) for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()}
+        for topic, time_ns, data in sorted(rig_traffic(0.2), key=lambda m: m[0]):
+            writer.add_message(channels[topic], time_ns, data, time_ns)
+        writer.finish()
+    starts_ends = sorted((start, end) for _offset, start, end in chunk_time_ranges(overlapping))
+    assert any(b[0] < a[1] for a, b in zip(starts_ends, starts_ends[1:]))
+    for where in (path, overlapping):
+        with open_bag(where) as bag:
+            expected = [(m.topic, m.log_time_ns, m.message) for m in bag.messages(topics, raw=True)]
+            got = []
+            for batch in bag.ordered_batches(topics):
+                got += [(topics[c], t, batch.data[a:b]) for c, t, a, b in zip(*(x.tolist() for x in (batch.channel_ids, batch.log_times, batch.starts, batch.ends)))]
+            with pytest.raises(BagError, match="no topic /rig/nothing"):
+                next(bag.ordered_batches(["/rig/nothing"]))
+        assert got == expected and len(got) > 100, where
 
 
 def test_a_single_mcap_file_opens_as_a_bag(traffic_bag: tuple[Path, int]) -> None:

@@ -8,7 +8,10 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Callable
-from typing import Any, cast
+from typing import Any, NamedTuple, cast
+
+import numpy as np
+import numpy.typing as npt
 
 from rosbags.interfaces import Nodetype
 from rosbags.serde import SerdeError
@@ -184,3 +187,67 @@ def header_stamp_ns(data: CdrBytes | bytearray) -> int | None:
         return None
     sec, nanosec = struct.unpack_from("<iI" if little else ">iI", data, 4)
     return int(sec) * 1_000_000_000 + int(nanosec)
+
+
+class PulseArrays(NamedTuple):
+    """The fields of many ``FibreOpticPulse`` messages (:func:`decode_pulses`), one entry per
+    message: ``valid`` False where the bytes are not a complete little-endian message (its other
+    entries then meaningless: decode it alone, :func:`decode_pulse`, for the reason)."""
+
+    valid: npt.NDArray[np.bool_]
+    time: npt.NDArray[np.float64]
+    strip_id: npt.NDArray[np.int64]
+    strip_count: npt.NDArray[np.int64]
+    revolution: npt.NDArray[np.uint64]
+    pulse_index: npt.NDArray[np.uint64]
+    sensor_id: list[str]
+
+
+def _read(raw: npt.NDArray[np.uint8], at: npt.NDArray[np.int64], dtype: str) -> npt.NDArray[Any]:
+    """The value of ``dtype`` at each byte offset ``at`` of ``raw`` (offsets within ``raw``)."""
+    size = np.dtype(dtype).itemsize
+    values: npt.NDArray[Any] = raw[at[:, None] + np.arange(size)].view(dtype).ravel()
+    return values
+
+
+def decode_pulses(data: bytes, starts: npt.NDArray[np.int64], ends: npt.NDArray[np.int64]) -> PulseArrays:
+    """:func:`decode_pulse` of the messages ``data[starts[k]:ends[k]]`` at once, as arrays (numpy
+    over the byte offsets; the variable-length strings located per message from their lengths),
+    with the same values bit for bit; an hour of the rig's traffic has 600,000 pulses."""
+    raw = np.frombuffer(data, dtype=np.uint8)
+    n = len(starts)
+    size = ends - starts
+    last = max(len(raw) - 1, 0)
+
+    def read(at: npt.NDArray[np.int64], dtype: str, valid: npt.NDArray[np.bool_]) -> npt.NDArray[Any]:
+        return _read(raw, np.where(valid, np.minimum(starts + at, last - np.dtype(dtype).itemsize + 1), 0), dtype)
+
+    valid = size >= 16  # encapsulation, stamp, frame_id length
+    valid &= read(np.zeros(n, np.int64), "<u2", valid) == 0x0100  # bytes 00 01: little-endian CDR
+    sec = read(np.full(n, 4, np.int64), "<i4", valid)
+    nanosec = read(np.full(n, 8, np.int64), "<u4", valid)
+    pos = (12 + read(np.full(n, 12, np.int64), "<u4", valid).astype(np.int64) + 3) & ~3  # body offsets, as decode_pulse
+    valid &= 4 + pos + 4 <= size
+    length = read(4 + pos, "<u4", valid).astype(np.int64)
+    sensor_start = starts + 8 + pos
+    sensor_stop = sensor_start + np.maximum(length - 1, 0)
+    pos = (pos + 4 + length + 1) & ~1
+    strips = 4 + pos
+    pos = (pos + 4 + 7) & ~7
+    valid &= 4 + pos + 16 <= size
+    strip_id = read(strips, "<u2", valid).astype(np.int64)
+    strip_count = read(strips + 2, "<u2", valid).astype(np.int64)
+    revolution = read(4 + pos, "<u8", valid)
+    pulse_index = read(12 + pos, "<u8", valid)
+    names: dict[bytes, str] = {}
+    sensors = []
+    for k, (a, b) in enumerate(zip(sensor_start.tolist(), sensor_stop.tolist())):
+        text = data[a:b] if valid[k] else b""
+        name = names.get(text)
+        if name is None:
+            try:
+                name = names[text] = text.decode("utf-8")
+            except UnicodeDecodeError:
+                valid[k], name = False, ""
+        sensors.append(name)
+    return PulseArrays(valid, sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensors)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import itertools
 import struct
 from dataclasses import dataclass, field
 from collections.abc import Callable, Iterable, Iterator
@@ -377,6 +378,37 @@ def damaged_chunk_bytes(index: McapIndex) -> int:
     return damaged
 
 
+def _chunks_of(index: McapIndex, wanted: frozenset[int] | None, low: int, high: int) -> list[ChunkRef]:
+    """The chunks that may hold messages on ``wanted`` channels (None: any) with ``low <=
+    log_time < high``, in the order :meth:`McapFormat.messages` merges them."""
+    refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
+    return sorted(refs, key=lambda r: (r.start_ns, r.offset))
+
+
+def _chunk_batches(index: McapIndex, report: ProblemSink, refs: list[ChunkRef], wanted: frozenset[int]) -> Iterator[ChunkBatch]:
+    """The wanted messages of each chunk of ``refs`` in turn (none empty); damaged chunks reported
+    through ``report`` and skipped."""
+    stream = _open(index, report)
+    if stream is None:
+        return
+    with stream:
+        for ref in refs:
+            try:
+                batch = read_chunk_batch(stream, ref, wanted)
+            except DamagedRecord as exc:
+                report(f"{index.path.name}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
+                continue
+            if batch.log_times.size:
+                yield batch
+
+
+def batched(messages: Iterable[MessageTuple], size: int) -> Iterator[ChunkBatch]:
+    """Messages read one by one, in batches of ``size``."""
+    messages = iter(messages)
+    while block := list(itertools.islice(messages, size)):
+        yield ChunkBatch.of(block)
+
+
 def _lazy_chunk(stream: BinaryIO, ref: ChunkRef, wanted: frozenset[int] | None, low: int, high: int, report: ProblemSink, label: str) -> Iterator[MessageTuple]:
     """A chunk's wanted messages after a marker (channel -1) at its start time, so that a merge
     holds many chunks without reading them."""
@@ -420,8 +452,7 @@ class McapFormat:
         def keep(channel_id: int, log_time: int) -> bool:
             return (wanted is None or channel_id in wanted) and low <= log_time < high
 
-        refs = [r for r in index.chunks if r.end_ns >= low and r.start_ns < high and (wanted is None or r.channel_ids is None or r.channel_ids & wanted)]
-        refs.sort(key=lambda r: (r.start_ns, r.offset))
+        refs = _chunks_of(index, wanted, low, high)
         stream = _open(index, report)
         if stream is None:
             return
@@ -437,6 +468,20 @@ class McapFormat:
             chunks = [(r.start_ns, r.end_ns, _lazy_chunk(stream, r, wanted, low, high, report, index.path.name)) for r in refs]
             yield from (m for m in merge_in_time(chunks) if m[1] >= 0)
 
+    def ordered_batches(self, index: FileIndex, report: ProblemSink, channel_ids: Iterable[int], size: int = 4096) -> Iterator[ChunkBatch]:
+        """The messages of one file on ``channel_ids`` in the order of :meth:`messages`, as
+        batches of arrays (:class:`ChunkBatch`): a chunk's through its message indexes when the
+        chunks follow each other in time (what a recorder writes), else (chunks overlapping in
+        time) the merged messages in batches of ``size``. Damaged chunks are reported through
+        ``report`` and skipped."""
+        assert isinstance(index, McapIndex)
+        wanted = frozenset(channel_ids)
+        refs = _chunks_of(index, wanted, -1, 2**64)
+        if index.unchunked or any(b.start_ns < a.end_ns for a, b in zip(refs, refs[1:])):  # merge_in_time's chaining rule
+            yield from batched(self.messages(index, report, wanted), size)
+            return
+        yield from _chunk_batches(index, report, refs, wanted)
+
     def batches(self, index: FileIndex, report: ProblemSink, channel_ids: Iterable[int]) -> Iterator[ChunkBatch]:
         """The messages of one file on ``channel_ids`` chunk by chunk (:class:`ChunkBatch`), the
         chunks in the order of their start times: for a topic sampled rather than read message by
@@ -447,16 +492,4 @@ class McapFormat:
         if index.unchunked:
             yield ChunkBatch.of(list(self.messages(index, report, wanted)))
             return
-        refs = sorted((r for r in index.chunks if r.channel_ids is None or r.channel_ids & wanted), key=lambda r: (r.start_ns, r.offset))
-        stream = _open(index, report)
-        if stream is None:
-            return
-        with stream:
-            for ref in refs:
-                try:
-                    batch = read_chunk_batch(stream, ref, wanted)
-                except DamagedRecord as exc:
-                    report(f"{index.path.name}: chunk at offset {ref.offset}: {exc}; its messages are skipped")
-                    continue
-                if batch.log_times.size:
-                    yield batch
+        yield from _chunk_batches(index, report, _chunks_of(index, wanted, -1, 2**64), wanted)

@@ -10,13 +10,14 @@ problem is a :class:`BagWarning` and a line in :attr:`BagReader.problems` (:clas
 
 from __future__ import annotations
 
-import itertools
 import warnings
 from dataclasses import dataclass
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
 from types import TracebackType
-from typing import Literal, NamedTuple
+from typing import Literal, NamedTuple, cast
+
+import numpy as np
 
 from rosbags.interfaces.typing import Constdefs, Fielddefs, Typesdict
 from rosbags.typesys import Stores, get_types_from_idl, get_types_from_msg, get_typestore
@@ -25,7 +26,7 @@ from rosbags.typesys.store import Typestore
 from bearing_rig_sim.bags.cdr import make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.layout import BagLayout, layout_from_indexes, read_layout
-from bearing_rig_sim.bags.mcapfile import ChunkBatch, McapFormat
+from bearing_rig_sim.bags.mcapfile import ChunkBatch, McapFormat, batched
 from bearing_rig_sim.bags.sqlite import Sqlite3Format
 from bearing_rig_sim.bags.storage import FileIndex, MessageTuple, merge_in_time
 from bearing_rig_sim.bags.qos import QosSpec
@@ -183,11 +184,36 @@ class BagReader:
             found = (
                 self._format.batches(index, self._report, wanted)
                 if isinstance(self._format, McapFormat)
-                else _blocks(self._format.messages(index, self._report, wanted), size)
+                else batched(self._format.messages(index, self._report, wanted), size)
             )
             for batch in found:
                 split = {name: batch.of_channels([c for c, n in wanted.items() if n == name]) for name in set(wanted.values())}
                 yield {name: part for name, part in split.items() if part.log_times.size}
+
+    def ordered_batches(self, topics: Sequence[str], *, size: int = 4096) -> Iterator[ChunkBatch]:
+        """The raw messages of ``topics`` in the order of :meth:`messages` (log time), as batches
+        of arrays (:class:`.mcapfile.ChunkBatch`) whose ``channel_ids`` are each message's topic
+        as its position in ``topics``: an MCAP chunk at a time through its message indexes when
+        the chunks and files follow each other in time, else the merged messages in batches of
+        ``size`` (their ``publish_times`` then 0). For topics read whole but decoded as arrays
+        (no message object built). BagError for a topic not in the bag."""
+        if self._closed:
+            raise BagError(f"{self.path}: the bag is closed")
+        unknown = sorted(set(topics) - self.topics.keys())
+        if unknown:
+            raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self.topics)) or 'none'})")
+        position = {name: k for k, name in enumerate(topics)}
+        files = [(index, {cid: position[name] for cid, name in topic_of.items() if name in position}) for index, topic_of in zip(self._indexes, self._channel_topics)]
+        files = sorted(((i, w) for i, w in files if w and i.message_count), key=lambda f: f[0].start_ns)
+        if not isinstance(self._format, McapFormat) or any(b.start_ns < a.end_ns for (a, _), (b, _) in zip(files, files[1:])):
+            names = self._iterate(set(topics), None, None, raw=True)
+            yield from batched(((log_time, position[name], 0, cast(bytes, data)) for name, log_time, _type, data in names), size)
+            return
+        for index, wanted in files:
+            lookup = np.full(max(wanted) + 1, -1, dtype=np.int64)
+            lookup[list(wanted)] = list(wanted.values())
+            for batch in self._format.ordered_batches(index, self._report, wanted, size):
+                yield batch._replace(channel_ids=lookup[batch.channel_ids])
 
     def close(self) -> None:
         """Mark the reader closed (files are opened only while messages are read)."""
@@ -278,12 +304,6 @@ class BagReader:
         for name, count in failed.items():
             if count > 1:
                 self._report(f"{self.path.name}: topic {name}: {count} messages could not be decoded in all")
-
-
-def _blocks(messages: Iterator[MessageTuple], size: int) -> Iterator[ChunkBatch]:
-    """Messages read one by one, in batches of ``size``."""
-    while block := list(itertools.islice(messages, size)):
-        yield ChunkBatch.of(block)
 
 
 TIMELINE_GAP_NS = DEFAULT_MAX_STEP_NS

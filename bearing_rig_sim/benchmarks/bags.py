@@ -24,7 +24,9 @@ prints one JSON object per line:
   windows, trailing slopes and verdicts), ``report_s`` (plots and markdown), ``cpu_s`` (the
   process's CPU time over both: the figure to trust on a busy machine), ``target_s`` (10 for an
   hour, pro rata), ``peak_rss_mb`` (target 200), ``baseline_rss_mb``, and the counts (pulses,
-  windows, status rows).
+  windows, status rows). With ``--workdir`` the bags are kept there and a complete one of the
+  same length is analysed again rather than recorded anew (``bag_reused``; the hour takes some
+  minutes to generate): remove the folder after changing the traffic's generators.
 """
 
 from __future__ import annotations
@@ -48,7 +50,7 @@ import psutil
 
 from bearing_rig_sim.interfaces import SLIP_STATUS
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.bags import BagWriter, open_bag, rig_typestore
+from bearing_rig_sim.bags import BagError, BagWriter, open_bag, rig_typestore
 from bearing_rig_sim.synthetic.traffic import (
     CAGE_PULSES_TOPIC,
     RIG_TRAFFIC_TOPICS,
@@ -81,7 +83,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--minutes", type=float, default=None, help="length of the long read-back bag (simulated minutes)")
     parser.add_argument("--messages", type=int, default=200_000, help="messages per recorder throughput run")
     parser.add_argument("--repeats", type=int, default=3, help="recorder throughput runs and analyses of each bag; medians are reported")
-    parser.add_argument("--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed)")
+    parser.add_argument("--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed); analysis bags are kept there and reused")
     parser.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES), help="cases to run (default: all)")
 
 
@@ -188,12 +190,33 @@ def program_traffic(duration_s: float, seed: int = 0, transient_pct: float = 2.0
             yield STATUS_TOPIC, step * 1_000_000, bytes(store.serialize_cdr(status, "bearing_rig_msgs/msg/SlipStatus"))
 
 
+def _rig_bag_program(minutes: float) -> str:
+    """The test program the analysis bag of ``minutes`` records (what tells a kept one)."""
+    return f"validation speeds over and over, {minutes} min (benchmark)"
+
+
+def _kept_rig_bag(folder: Path, minutes: float) -> tuple[float, int, int] | None:
+    """A complete analysis bag of ``minutes`` left in ``folder`` by an earlier run with the same
+    ``--workdir``, as (0 s, messages, bytes); None when there is none."""
+    if not (folder / "metadata.yaml").is_file():
+        return None
+    try:
+        with open_bag(folder) as bag:
+            if not bag.complete or bag.run_metadata.get("test_program") != _rig_bag_program(minutes):
+                return None
+            count = bag.message_count
+    except BagError:
+        return None
+    return 0.0, count, sum(f.stat().st_size for f in folder.iterdir())
+
+
 def _record_rig_bag(folder: Path, minutes: float) -> tuple[float, int, int]:
     """Seconds to generate and record ``minutes`` of the rig's traffic for the analysis (see the
     module documentation), messages and bytes."""
     start = time.perf_counter()
     steady = ((topic, t, data) for topic, t, data in rig_traffic(minutes * 60.0) if topic not in (SPINDLE_PULSES_TOPIC, CAGE_PULSES_TOPIC))
-    with BagWriter(folder, metadata={"test_program": f"validation speeds over and over, {minutes} min (benchmark)"}) as bag:
+    shutil.rmtree(folder, ignore_errors=True)  # an incomplete one left by an interrupted run
+    with BagWriter(folder, metadata={"test_program": _rig_bag_program(minutes)}) as bag:
         for topic, (msgtype, qos) in RIG_TRAFFIC_TOPICS.items():
             bag.add_topic(topic, msgtype, qos)
         bag.add_topic(STATUS_TOPIC, "bearing_rig_msgs/msg/SlipStatus", "transient_local")
@@ -313,7 +336,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
             shutil.rmtree(folder)
         for minutes in (long_minutes / 4, long_minutes) if "analyse" in args.cases else ():
             folder = workdir / f"rig-{minutes:g}min"
-            write_s, count, size = _record_rig_bag(folder, minutes)
+            kept = _kept_rig_bag(folder, minutes) if args.workdir is not None else None
+            write_s, count, size = kept if kept is not None else _record_rig_bag(folder, minutes)
             analyses: list[dict[str, Any]] = []
             for _ in range(max(1, args.repeats)):  # each in a fresh process; medians of time, the largest peak
                 with ProcessPoolExecutor(max_workers=1, mp_context=context) as pool:
@@ -331,6 +355,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "messages": count,
                 "bag_mb": round(size / 2**20, 1),
                 "write_s": round(write_s, 2),
+                "bag_reused": kept is not None,
                 "analyse_s": round(analysis["analyse_s"], 2),
                 "monitor_s": round(analysis["monitor_s"], 2),
                 "report_s": round(analysis["report_s"], 2),
@@ -344,7 +369,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "peak_rss_mb": round(analysis["peak_rss_mb"], 1),
                 "baseline_rss_mb": round(analysis["baseline_rss_mb"], 1),
             }
-            shutil.rmtree(folder)
+            if args.workdir is None:
+                shutil.rmtree(folder)
             shutil.rmtree(workdir / f"report-{minutes:g}min", ignore_errors=True)
     finally:
         if args.workdir is None:

@@ -14,12 +14,15 @@ load cell's force is fed too. The criterion is the run's test program's ``stabil
 when the bag records the program. Nothing depends on a wall clock: two runs over one bag give
 bit-identical results.
 
-**What is read.** Only the topics the analysis uses, as raw CDR: pulses through a small decoder
-of the five fields the monitor needs (little-endian CDR; other encodings through the reader's
-general decoder); the 1 kHz topics (speeds, load cell, bearing force) are not decoded message by
-message but their latest bytes are kept and decoded when a status row samples them. Memory does
-not grow with the bag's length: rows and windows stream to CSV files as they are made, and only
-a decimated copy of the rows (at most ``max_points``) and the state changes are kept for plots.
+**What is read.** Only the topics the analysis uses, as raw CDR, in one pass over the bag's
+chunks (:meth:`~bearing_rig_sim.bags.reader.BagReader.ordered_batches`: each chunk decompressed
+once, its messages as arrays): the pulses decoded as arrays
+(:func:`~bearing_rig_sim.bags.cdr.decode_pulses`; other encodings through the reader's general
+decoder, one by one); the load cell, recorded statuses and spindle commands one by one; the 1 kHz
+speeds and the other sampled topics (:data:`SAMPLED_TOPICS`) not message by message: a chunk of
+them is kept and only the message a status row samples is decoded. Memory does not grow with
+the bag's length: rows and windows stream to CSV files as they are made, and only a decimated
+copy of the rows (at most ``max_points``) and the state changes are kept for plots.
 
 **The topics** (:data:`PULSE_TOPICS` required, :data:`CONTEXT_TOPICS` used when present; the
 bench records the same contract, and bags without the simulator's truth are analysed alike):
@@ -50,7 +53,7 @@ import math
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
+from typing import Any
 from collections.abc import Callable
 
 import numpy as np
@@ -62,7 +65,7 @@ from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
-from bearing_rig_sim.bags.cdr import make_decoder
+from bearing_rig_sim.bags.cdr import decode_pulses, make_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.mcapfile import ChunkBatch
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -142,6 +145,22 @@ def decode_pulse(data: bytes | memoryview) -> Pulse:
         BagError: not little-endian CDR, or the bytes end before the message does.
     """
     return Pulse(*pulse_fields(data))
+
+
+def _pulses_of(batch: ChunkBatch) -> list[Pulse | None]:
+    """The pulses of a batch (topic positions 0 and 1), decoded as arrays
+    (:func:`~bearing_rig_sim.bags.cdr.decode_pulses`); None for the other messages and for
+    pulses to decode alone (not little-endian CDR, or malformed)."""
+    found: list[Pulse | None] = [None] * len(batch.log_times)
+    where = np.flatnonzero(batch.channel_ids < 2)
+    if not where.size:
+        return found
+    fields = decode_pulses(batch.data, batch.starts[where], batch.ends[where])
+    columns = (fields.time.tolist(), fields.strip_id.tolist(), fields.strip_count.tolist(), fields.revolution.tolist(), fields.pulse_index.tolist())
+    for k, valid, time, strip_id, strip_count, revolution, pulse_index, sensor in zip(where.tolist(), fields.valid.tolist(), *columns, fields.sensor_id):
+        if valid:
+            found[k] = Pulse(time, strip_id, strip_count, revolution, pulse_index, sensor)
+    return found
 
 
 def _pulse_from_message(message: Any) -> Pulse:
@@ -294,28 +313,27 @@ class _Sampled(_Decoding):
 
 
 class _SampledTopics:
-    """The sampled context topics (:data:`SAMPLED_TOPICS`) of a bag, read a chunk ahead of the
-    time asked for: times asked for may go back a little (pulses released in stamp order), not
-    before the chunk the latest time reached."""
+    """The sampled context topics (:data:`SAMPLED_TOPICS`) of a bag, given a chunk at a time as
+    the bag is read (:meth:`push`, a chunk ahead of the messages read one by one) and taken
+    when the time asked for reaches them: times asked for may go back a little (pulses released
+    in stamp order), not before the chunk the latest time reached."""
 
     def __init__(self, bag: BagReader, names: list[str]) -> None:
         self.topics = {name: _Sampled(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in names}
-        self._batches = bag.batches(names) if names else iter(())
-        self._next = next(self._batches, None)
+        self._pending: deque[dict[str, ChunkBatch]] = deque()
+
+    def push(self, batches: dict[str, ChunkBatch]) -> None:
+        """The topics' messages of the next chunk (each in log-time order; none empty)."""
+        if batches:
+            self._pending.append(batches)
 
     def get(self, at_ns: int) -> dict[str, Any]:
         """Each topic's latest message logged at or before ``at_ns`` (ns), decoded (None if none)."""
-        while self._next is not None and min(int(b.log_times[0]) for b in self._next.values()) <= at_ns:
-            for name, batch in self._next.items():
+        pending = self._pending
+        while pending and min(int(b.log_times[0]) for b in pending[0].values()) <= at_ns:
+            for name, batch in pending.popleft().items():
                 self.topics[name].take(batch)
-            self._next = next(self._batches, None)
         return {name: topic.get(at_ns) for name, topic in self.topics.items()}
-
-    def close(self) -> None:
-        """Release the bag's file."""
-        close = getattr(self._batches, "close", None)
-        if close is not None:
-            close()
 
 
 def monitor_settings_from_run(run_metadata: dict[str, str], source: str) -> MonitorSettings | None:
@@ -480,26 +498,25 @@ class OfflineAnalysis:
     # -- the pass ------------------------------------------------------------------------------
     def run(self) -> OfflineResult:
         """Read the bag once and return the result; CSV files are closed whatever happens."""
-        handlers: dict[str, Callable[[int, bytes], None]] = {t: functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()}
+        sampled = list(self._sampled.topics)
+        topics = [*PULSE_TOPICS.values(), *self._latest, *sampled]  # pulses first: positions 0 and 1
+        handlers: list[Callable[[int, bytes], None]] = [functools.partial(self._on_pulse, t) for t in PULSE_TOPICS.values()]
         for name in self._latest:
-            handlers[name] = {STATUS: self._on_recorded_status, COMMAND: self._on_command}.get(name, functools.partial(self._on_context, name))
-            if name == LOAD_CELL:  # the load sweep's abscissa and the kinematic slip's contact angle
-                handlers[name] = self._on_load_cell
+            handler = {STATUS: self._on_recorded_status, COMMAND: self._on_command, LOAD_CELL: self._on_load_cell}.get(name)
+            handlers.append(handler if handler is not None else functools.partial(self._on_context, name))
+        read_whole = list(range(len(handlers)))
         try:
-            for topic, log_time_ns, _msgtype, data in self.bag.messages(list(handlers), raw=True):
-                while self._commands_ahead and self._commands_ahead[0][0] <= log_time_ns * 1e-9:
-                    start, command = self._commands_ahead.pop(0)
-                    for shaft, pulse in self._order.release_until(start):
-                        self._feed(shaft, pulse)
-                    for scheduled in self.schedule.advance_to(start):  # the ticks of the ending segment
-                        self._emit(scheduled.time, scheduled.reason, scheduled.status)
-                    self._start_segment(start, command)
-                self._read += 1
-                self._log_ns = log_time_ns
-                handlers[topic](log_time_ns, cast(bytes, data))  # raw=True: the CDR bytes
+            ahead: ChunkBatch | None = None
+            for batch in self.bag.ordered_batches(topics):  # each chunk decompressed once for every topic
+                parts = {name: batch.of_channels([len(handlers) + k]) for k, name in enumerate(sampled)}
+                self._sampled.push({name: part for name, part in parts.items() if part.log_times.size})
+                if ahead is not None:  # the sampled topics a chunk ahead of the messages read one by one
+                    self._take_batch(ahead, handlers)
+                ahead = batch.of_channels(read_whole)
+            if ahead is not None:
+                self._take_batch(ahead, handlers)
             self._finish()
         finally:
-            self._sampled.close()
             for sink in self._sinks:
                 sink.close()
         result = self.result
@@ -516,6 +533,30 @@ class OfflineAnalysis:
             result.csv_files = [sink.path for sink in self._sinks] + [write_segments_csv(self._csv_dir / SEGMENTS_CSV, result.segments)]
         return result
 
+    def _take_batch(self, batch: ChunkBatch, handlers: list[Callable[[int, bytes], None]]) -> None:
+        """A batch of the messages read one by one (:meth:`.BagReader.ordered_batches`: topic
+        positions 0 and 1 the pulses, decoded here as arrays), in the bag's order."""
+        codes, times = batch.channel_ids.tolist(), batch.log_times.tolist()
+        starts, ends, data = batch.starts.tolist(), batch.ends.tolist(), batch.data
+        pulses = _pulses_of(batch)
+        topics = list(PULSE_TOPICS.values())
+        for k, code in enumerate(codes):
+            log_time_ns = times[k]
+            while self._commands_ahead and self._commands_ahead[0][0] <= log_time_ns * 1e-9:
+                start, command = self._commands_ahead.pop(0)
+                for shaft, held in self._order.release_until(start):
+                    self._feed(shaft, held)
+                for scheduled in self.schedule.advance_to(start):  # the ticks of the ending segment
+                    self._emit(scheduled.time, scheduled.reason, scheduled.status)
+                self._start_segment(start, command)
+            self._read += 1
+            self._log_ns = log_time_ns
+            pulse = pulses[k] if code < 2 else None
+            if pulse is not None:
+                self._take_pulse(topics[code], log_time_ns, pulse)
+            else:  # another topic, or a pulse that needs the general decoder (or does not decode)
+                handlers[code](log_time_ns, data[starts[k] : ends[k]])
+
     def _on_pulse(self, topic: str, log_time_ns: int, data: bytes) -> None:
         try:
             pulse = decode_pulse(data) if data[:2] == b"\x00\x01" else _pulse_from_message(self._decode_pulse_message(data))
@@ -524,6 +565,9 @@ class OfflineAnalysis:
             if self._bad_pulses == 1:
                 self._report(f"{self.bag.path.name}: topic {topic}: {exc}; such pulses are skipped")
             return
+        self._take_pulse(topic, log_time_ns, pulse)
+
+    def _take_pulse(self, topic: str, log_time_ns: int, pulse: Pulse) -> None:
         if unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
             self._unstamped += 1
             if self._unstamped == 1:

@@ -10,8 +10,9 @@ nodes, the session, replay and the live view runs without ROS.
 * :mod:`bearing_rig_sim.clock_guard`: validation of a simulation clock read from outside.
 * :mod:`bearing_rig_sim.executors`: where many independent jobs run (forked processes or Dask).
 * :mod:`bearing_rig_sim.dynamics`: the bearing's equations of motion and steady states (numpy + numba).
-* :mod:`bearing_rig_sim.thermal`: the bearing's thermal network, coupled to the dynamics; thermocouple and torque meter.
-* :mod:`bearing_rig_sim.rig`: sensor and loading-chain models of the bench, test programs.
+* :mod:`bearing_rig_sim.thermal`: the bearing's thermal network, coupled to the dynamics.
+* :mod:`bearing_rig_sim.instruments`: the bench's instruments (fibre-optic sensors, thermocouple, torque meter).
+* :mod:`bearing_rig_sim.rig`: the loading chain, mounting, speed profile and test programs of the bench.
 * :mod:`bearing_rig_sim.analysis`: slip rate, Gaussian fits, slope criterion, streaming verdict.
 * :mod:`bearing_rig_sim.simulation`: the simulator's core (drive, twin, pacing, settings, health).
 * :mod:`bearing_rig_sim.monitoring`: the monitor's core (slip windows, verdicts, schedule).

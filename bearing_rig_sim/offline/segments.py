@@ -54,7 +54,9 @@ class SegmentSummary:
         axial_load: mean axial load (:attr:`StatusRow.axial_load`), N.
         slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
             status / simulator truth, %.
-        final_state / final_recorded_state: state at the segment's end (recorded: -1 if none).
+        final_state: the offline monitor's state at the segment's last status row.
+        final_recorded_state: the state of the last recorded status in the segment (-1 if none):
+            at rest, where no pulse makes a row, the monitor's own verdict of the silence.
         time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one):
             from the ramp's end, or for a run-up (constant acceleration) from its start.
         rows: status rows after the ramp end (1).
@@ -107,7 +109,6 @@ class _Segment:
     def add_row(self, row: StatusRow) -> None:
         self.end = row.time
         self.final_state = row.state
-        self.final_recorded = row.recorded_state
         if math.isfinite(row.window_end):
             self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence, row.inner_ring_speed)
         if row.time < self.ramp_end:
@@ -123,6 +124,7 @@ class _Segment:
         return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
 
     def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
+        self.final_recorded = state
         self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)
 
     def summary(self) -> SegmentSummary:

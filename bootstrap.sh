@@ -4,7 +4,8 @@
 #   ./bootstrap.sh setup            create .venv, install the pinned dependencies, build and
 #                                   install the bearing_rig_msgs interfaces, install the package
 #   ./bootstrap.sh run [args...]    setup, then `bearing-rig run args...`
-#   ./bootstrap.sh test [args...]   setup, then `python -m pytest args...`
+#   ./bootstrap.sh test [args...]   setup, then `python -m pytest args...`, on every core
+#                                   (pytest-xdist `-n auto --dist worksteal` unless args give -n)
 #
 # Needs python3.11, cmake, a C and C++ compiler (gcc, g++), make or ninja, network access to
 # PyPI. Every step leaves a stamp (a hash of its inputs) in .venv/.bootstrap-stamps and is
@@ -219,7 +220,13 @@ case "$cmd" in
         setup
         cd "$ROOT"
         status=0
-        "$PY" -m pytest "$@" || status=$?
+        # One worker per core (each test leases its own ROS domain, test/conftest.py); the
+        # workers steal from each other, so the long session tests do not end the run alone.
+        parallel=(-n auto --dist worksteal)
+        for arg in "$@"; do
+            [[ "$arg" == -n* || "$arg" == --numprocesses* ]] && parallel=()
+        done
+        "$PY" -m pytest "${parallel[@]}" "$@" || status=$?
         if [[ $status -eq 5 ]]; then
             die "pytest collected no tests (exit 5): that counts as a failure"
         fi

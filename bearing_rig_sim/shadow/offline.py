@@ -187,7 +187,7 @@ def shadow_bag(
     if out_dir is not None:
         out = Path(out_dir)
         out.mkdir(parents=True, exist_ok=True)
-        result.files = [write_csv(out / RESIDUALS_CSV, rows, result.origin), write_report(out / REPORT_MD, result, st)]
+        result.files = [write_csv(out / RESIDUALS_CSV, rows, result.origin), write_report(out / REPORT_MD, result, st, twin.timing_jitter_std_s)]
         plot = write_plot(out / PLOT_PNG, result)
         if plot is not None:
             result.files.append(plot)
@@ -249,8 +249,9 @@ def write_csv(path: Path, rows: list[ResidualWindow], origin: float) -> Path:
     return path
 
 
-def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
-    """``report.md``: inputs, rule, counts, flagged stretches, estimate."""
+def write_report(path: Path, result: ShadowResult, st: ShadowSettings, jitter_std_s: float) -> Path:
+    """``report.md``: inputs, rule, counts, flagged stretches, estimate (``jitter_std_s``: the
+    rig file's pulse-timing jitter the band took, s)."""
     c = result.counts
     lines = [
         f"# Shadow mode: {result.bag.name}",
@@ -260,7 +261,7 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings) -> Path:
         f"({result.origin:.6f} s on the bench clock).",
         "",
         f"Band: {st.band_coverage:g} x sqrt(calibration RMS {st.calibration_rms_slip_pct:.4f} pp^2 + "
-        f"(100 x 2 x {st.timing_jitter_std_s:.2g} s / window)^2). Anomaly: outside the band for more than "
+        f"(100 x 2 x {jitter_std_s:.2g} s / window)^2). Anomaly: outside the band for more than "
         f"{st.warn_after_s:g} s: WARN, more than {st.error_after_s:g} s: ERROR.",
         "",
         "| windows | compared | inside the band | flagged |",

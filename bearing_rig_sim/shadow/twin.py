@@ -50,10 +50,10 @@ from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import BearingParameters, Mounting
 from bearing_rig_sim.health import Health, HealthLevel
-from bearing_rig_sim.instruments.fibre_optic import Pulse
-from bearing_rig_sim.instruments.first_order import ThermocoupleSettings
+from bearing_rig_sim.instruments.fibre_optic import FibreOpticSettings, Pulse
+from bearing_rig_sim.instruments.first_order import ThermocoupleSettings, TorqueMeterSettings
 from bearing_rig_sim.instruments.registry import InstrumentSet
-from bearing_rig_sim.interfaces import OUTER_RING_TEMPERATURE
+from bearing_rig_sim.interfaces import CAGE_PULSES, HOUSING_TORQUE, OUTER_RING_TEMPERATURE, SPINDLE_PULSES
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.shadow.inputs import LoadCellTrack, SpindleSpeedTrack
 from bearing_rig_sim.shadow.measured import MeasuredWindow, MeasuredWindows
@@ -160,8 +160,15 @@ class ShadowTwin:
             except ConfigError:
                 self.thermal_config = None  # a bearing file without a thermal: section
         self.mounting = Mounting.of(MountingConfig.from_rig_file(settings.rig_file))
-        self.thermocouple = InstrumentSet.from_rig_file(settings.rig_file).on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings)
+        instruments = InstrumentSet.from_rig_file(settings.rig_file)
+        self.thermocouple = instruments.on_topic(OUTER_RING_TEMPERATURE.name, ThermocoupleSettings)
         """The rig file's outer-ring thermocouple, whose lag the predicted reading follows."""
+        self.torque_meter = instruments.on_topic(HOUSING_TORQUE.name, TorqueMeterSettings)
+        """The rig file's housing torque meter, whose noise enters the torque band."""
+        self.timing_jitter_std_s = max(
+            instruments.on_topic(topic.name, FibreOpticSettings).timing_jitter_std_s for topic in (SPINDLE_PULSES, CAGE_PULSES)
+        )
+        """Pulse-timing jitter of the bench's fibre-optic sensors (the rig file's, the larger of the two), s."""
         """The test bearing's mounting, from the rig file (as the simulator's engine has it)."""
         self.drive = self._make_drive(self.params)
         self.rule = AnomalyRule(settings.warn_after_s, settings.error_after_s)
@@ -330,7 +337,7 @@ class ShadowTwin:
         kin = self.kinematics
         measured = float(kin.slip_rate(w.cage_speed, w.inner_ring_speed)) if w.inner_ring_speed > 0.0 else math.nan
         band = band_pct(
-            w.end_time - w.start_time, calibration_rms_pct=st.calibration_rms_slip_pct, jitter_std_s=st.timing_jitter_std_s, coverage=st.band_coverage
+            w.end_time - w.start_time, calibration_rms_pct=st.calibration_rms_slip_pct, jitter_std_s=self.timing_jitter_std_s, coverage=st.band_coverage
         )
         predicted = cage = load = math.nan
         if prediction is not None and prediction.inner_ring_speed > 0.0:
@@ -385,7 +392,7 @@ class ShadowTwin:
         t_band = temperature_band_k(
             t_pred, start, model_fraction=st.temperature_model_fraction, sensor_k=st.thermocouple_uncertainty_k, coverage=st.band_coverage
         )
-        m_band = torque_band_nm(m_pred, samples, model_fraction=st.torque_model_fraction, noise_nm=st.torque_meter_noise_nm, coverage=st.band_coverage)
+        m_band = torque_band_nm(m_pred, samples, model_fraction=st.torque_model_fraction, noise_nm=self.torque_meter.noise_std_n_m, coverage=st.band_coverage)
         t_res = t_meas - t_pred if math.isfinite(t_meas) and math.isfinite(t_pred) else math.nan
         m_res = m_meas - m_pred if math.isfinite(m_meas) and math.isfinite(m_pred) else math.nan
         t_state = self.temperature_rule.add(w.start_time, w.end_time, t_res if math.isfinite(t_res) else None, t_band, unit="K")

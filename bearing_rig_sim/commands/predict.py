@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.commands import describe, rig_limit_text
-from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
+from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, mapping_at, read_mapping, rpm_to_rad_s, shipped_bearing_file
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.calibrations import DEFAULT_CALIBRATION, calibration_file
@@ -134,7 +134,7 @@ def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: P
     file in place of the bearing file's (the calibration then only when named explicitly). The
     shipped calibration belongs to the shipped bearing: another bearing file gets it only when
     named."""
-    path = bearing or config_path("bearings", "h7006c.yaml")
+    path = bearing or shipped_bearing_file()
     doc, source = read_mapping(path), str(path)
     if lubricant is not None:
         lub = mapping_at(doc, ("lubricant",), source)

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.config import ConfigError, shipped_bearing_file
 from bearing_rig_sim.dynamics.bearing_file import BearingFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
@@ -98,7 +98,7 @@ class ThermalConfig:
     @classmethod
     def from_yaml(cls, path: str | Path | None = None) -> ThermalConfig:
         """The bearing file's thermal data (default: the shipped H7006C)."""
-        path = path or config_path("bearings", "h7006c.yaml")
+        path = path or shipped_bearing_file()
         return cls.from_file(read_file(BearingFile, path), str(path))
 
     @classmethod

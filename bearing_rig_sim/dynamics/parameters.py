@@ -44,7 +44,7 @@ from bearing_rig_sim.config import read_mapping, shipped_bearing_file, shipped_c
 from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE as CALIBRATABLE  # what a calibration may set, re-exported
 from bearing_rig_sim.dynamics.bearing_file import FRICTION_MODELS, BearingFile, CalibrationFile
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import HertzContact, point_contact, raceway_contacts
+from bearing_rig_sim.bearing.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
 from bearing_rig_sim.settings_model import read_file, validate_mapping

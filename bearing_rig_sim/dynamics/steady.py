@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.bearing.kinematics import epicyclic_ratio, slip_pct
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics, ChunkAverage, DynamicsInputError, Mounting
 from bearing_rig_sim.dynamics.parameters import BearingParameters
@@ -365,7 +365,7 @@ class SteadySolver:
         self.engine = BearingDynamics(params, mounting=mounting)
         self.step = float(step) if step is not None else self.engine.time_step
         self.basin_time = BASIN_S
-        self.kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
+        self.epicyclic_ratio = epicyclic_ratio(params.ball_diameter, params.pitch_diameter, params.contact_angle)
         z = params.ball_count
         self._ball = np.zeros((z, kn.NB))
         self._cage = np.zeros((z, kn.NC))
@@ -546,7 +546,7 @@ class SteadySolver:
     def _engine_point(self, x: np.ndarray, omega: float, load: float, power: float, origin: str, method: str, iterations: int, stable: bool) -> SteadyPoint:
         """The point of the state ``x`` with the engine's films as they stand, power ``power`` W."""
         film_inner, film_outer = self.engine.minimum_films()
-        slip = float(self.kinematics.slip_rate(float(x[2]), omega))
+        slip = slip_pct(float(x[2]), omega, self.epicyclic_ratio)
         return SteadyPoint(
             inner_ring_speed=omega,
             axial_load=float(load),

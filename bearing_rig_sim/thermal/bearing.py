@@ -48,7 +48,7 @@ from bearing_rig_sim.dynamics.bearing_file import BearingFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
-from bearing_rig_sim.thermal.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
+from bearing_rig_sim.bearing.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
 from bearing_rig_sim.thermal.network import Conductance, Node, ThermalNetwork
 from bearing_rig_sim.settings_model import read_file
 

@@ -9,6 +9,7 @@ nodes, the session, replay and the live view runs without ROS.
 * :mod:`bearing_rig_sim.health`: the health levels every node core reports.
 * :mod:`bearing_rig_sim.clock_guard`: validation of a simulation clock read from outside.
 * :mod:`bearing_rig_sim.executors`: where many independent jobs run (forked processes or Dask).
+* :mod:`bearing_rig_sim.bearing`: the bearing's shared facts (slip rate, pure-rolling cage speed, Hertz contact, materials).
 * :mod:`bearing_rig_sim.dynamics`: the bearing's equations of motion and steady states (numpy + numba).
 * :mod:`bearing_rig_sim.thermal`: the bearing's thermal network, coupled to the dynamics.
 * :mod:`bearing_rig_sim.instruments`: the bench's instruments (fibre-optic sensors, thermocouple, torque meter).

@@ -178,11 +178,11 @@ def test_every_speed_and_axial_load_of_the_envelope_has_a_steady_state(steady: S
     body), within the engine's speed tolerance; the friction torque and power dissipated, not
     gained (>= 0); a state Newton found says it is stable, an average says it is not."""
     point = steady.solve(speed, axial)
-    values = [point.cage_speed, point.ball_orbit_speed, point.ball_spin_speed, point.slip_pct, point.power, point.torque]
+    values = [point.cage_speed, point.ball_orbit_speed, point.ball_spin_speed, point.slip_pct, point.power_loss, point.friction_torque]
     assert all(math.isfinite(v) for v in values), point
     for rate in (point.cage_speed, point.ball_orbit_speed):
         assert -SPEED_TOLERANCE <= rate <= 0.5 * speed + SPEED_TOLERANCE, point
-    assert point.power >= 0.0 and point.torque >= 0.0, point
+    assert point.power_loss >= 0.0 and point.friction_torque >= 0.0, point
     assert point.stable == (point.method != METHOD_INTEGRATION)
 
 
@@ -200,7 +200,7 @@ def test_every_combined_load_of_the_envelope_has_a_periodic_steady_state(
     """The periodic steady state under a combined load (integrated and averaged over whole
     ball-pass periods): the same bounds as the axial one's (forty cases: each integrates 0.35 s)."""
     point = steady.periodic(speed, axial, radial, moment=moment)
-    assert all(math.isfinite(v) for v in (point.cage_speed, point.ball_orbit_speed, point.power)), point
+    assert all(math.isfinite(v) for v in (point.cage_speed, point.ball_orbit_speed, point.power_loss)), point
     for rate in (point.cage_speed, point.ball_orbit_speed):
         assert -SPEED_TOLERANCE <= rate <= 0.5 * speed + SPEED_TOLERANCE, point
-    assert point.power >= 0.0, point
+    assert point.power_loss >= 0.0, point

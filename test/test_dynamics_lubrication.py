@@ -16,7 +16,7 @@ from scipy.optimize import brentq
 
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
+from bearing_rig_sim.bearing.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, gyroscopic_moment, hamrock_dowson, rolling_force, skf_frictional_moment
 from bearing_rig_sim.dynamics.traction import ellipse_traction, table_lookup
 from bearing_rig_sim.dynamics.parameters import traction_table

@@ -13,7 +13,7 @@ References (hand calculations, each stated at its test; none uses the engine's k
   scipy for a held tilt: A1_j = A sin a0 + delta_a + R_i theta_x cos psi_j,
   A2_j = A cos a0 + delta_x cos psi_j, Q_j = K_n (|A_j| - A)^1.5 at rest.
 * K_n = (K_i^(-2/3) + K_o^(-2/3))^(-3/2) (Harris and Kotzalas Eq. 7.19) from the Hertz
-  constants of dynamics/hertz.py at the free contact angle.
+  constants of bearing/hertz.py at the free contact angle.
 
 Balls at rest: no centrifugal force, so each ball lies on the line of its two curvature
 centres, the case the thrust equation describes.
@@ -30,11 +30,11 @@ from scipy.optimize import brentq, fsolve
 from bearing_rig_sim.config import config_path
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters, DynamicsInputError, Mounting
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import raceway_contacts
+from bearing_rig_sim.bearing.hertz import raceway_contacts
 from bearing_rig_sim.dynamics.parameters import derive
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 from bearing_rig_sim.thermal.coupling import ThermalCoupling
-from bearing_rig_sim.thermal.materials import BEARING_STEEL
+from bearing_rig_sim.bearing.materials import BEARING_STEEL
 
 
 @pytest.fixture(scope="module")

@@ -15,7 +15,7 @@ from bearing_rig_sim.dynamics.steady import (
     ORIGIN_ROLLING_START,
     STATE_ROLLING,
     STATE_SKID,
-    SteadyPoint,
+    SteadyState,
     SteadySolver,
 )
 
@@ -44,7 +44,7 @@ def integrated_slip(params: BearingParameters, rpm: float, load: float, settle: 
     return float(kin.slip_rate(avg.cage_speed, avg.inner_ring_speed))
 
 
-def engine_in_state(params: BearingParameters, point: SteadyPoint) -> BearingDynamics:
+def engine_in_state(params: BearingParameters, point: SteadyState) -> BearingDynamics:
     """A fresh engine at the point's speed and load, every ball and pocket in the solved state."""
     engine = BearingDynamics(params)
     engine.initialise(point.inner_ring_speed, point.axial_load)
@@ -123,8 +123,8 @@ def test_torque_power_and_films_are_the_engines_at_the_solution(params: BearingP
     omega = rpm_to_rad_s(3000)
     point = solver.solve(omega, 300.0)
     reference = solver.integrate(omega, 300.0)
-    assert point.power > 0.0 and point.torque == pytest.approx(point.power / omega, rel=1e-12)
-    assert point.power == pytest.approx(reference.power, rel=1e-4)
+    assert point.power_loss > 0.0 and point.friction_torque == pytest.approx(point.power_loss / omega, rel=1e-12)
+    assert point.power_loss == pytest.approx(reference.power_loss, rel=1e-4)
     assert point.film_min_inner == pytest.approx(reference.film_min_inner, rel=1e-4)
 
 

@@ -22,7 +22,10 @@ FLOORS: tuple[tuple[str, frozenset[str]], ...] = (
         "foundation: the contract, configuration, errors and plumbing",
         frozenset({"", "errors", "config", "interfaces", "health", "clock_guard", "dds_profile", "executors", "settings_model", "numba_cache"}),
     ),
-    ("models: the bearing's dynamics, the rig's models, analysis, bag files", frozenset({"dynamics", "thermal", "rig", "instruments", "analysis", "bags"})),
+    ("bearing: the bearing's shared facts (kinematics, Hertz contact, materials)", frozenset({"bearing"})),
+    ("measurement: the slip analysis, the rig's models and instruments, bag files", frozenset({"analysis", "rig", "instruments", "bags"})),
+    ("dynamics: the bearing's dynamics engine, its steady states and quasi-static model", frozenset({"dynamics"})),
+    ("thermal: the bearing's heat network, coupled to the dynamics", frozenset({"thermal"})),
     (
         "cores: what the nodes and commands run, without ROS shells",
         frozenset({"simulation", "monitoring", "load_control", "shadow", "offline", "replay", "live", "synthetic", "studies", "sweep"}),
@@ -170,6 +173,12 @@ def test_every_unit_of_the_package_is_on_one_floor() -> None:
     placed = [u for _, floor in FLOORS for u in floor]
     assert len(placed) == len(set(placed)), "a unit is on two floors"
     assert units == set(placed), f"not on a floor: {sorted(units - set(placed))}; gone: {sorted(set(placed) - units)}"
+
+
+def test_the_models_are_layered() -> None:
+    """The shared bearing facts lie below the analysis, the analysis below the dynamics and the
+    dynamics below the heat network: three floors, not one."""
+    assert floor_of("bearing") < floor_of("analysis") < floor_of("dynamics") < floor_of("thermal")
 
 
 def test_no_import_cycle() -> None:

@@ -16,15 +16,6 @@ PACKAGE = ROOT / "bearing_rig_sim"
 
 SHIPPED_NAME = re.compile(r"h7006c\.yaml|h7006c_table3\.yaml")
 
-NOT_YET_MOVED = {
-    "bearing_rig_sim/dynamics/parameters.py",
-    "bearing_rig_sim/thermal/bearing.py",
-    "bearing_rig_sim/commands/predict.py",
-}
-"""Modules that still spell a shipped file's name: each should call
-config.shipped_bearing_file() / shipped_calibration_file() instead."""
-
-
 def test_the_shipped_files_exist_where_config_names_them() -> None:
     assert config.shipped_bearing_file().is_file() and config.shipped_bearing_file().name == "h7006c.yaml"
     assert config.shipped_calibration_file().is_file() and config.shipped_calibration_file().parent.name == "calibration"
@@ -33,7 +24,8 @@ def test_the_shipped_files_exist_where_config_names_them() -> None:
 
 def test_no_other_module_spells_the_shipped_names() -> None:
     """Outside config.py (and its docstring example) no code names the shipped bearing or
-    calibration file; the list of modules still doing so only shrinks."""
+    calibration file: every default goes through config.shipped_bearing_file() /
+    shipped_calibration_file()."""
     spelled = set()
     for path in sorted(PACKAGE.rglob("*.py")):
         name = str(path.relative_to(ROOT))
@@ -41,7 +33,7 @@ def test_no_other_module_spells_the_shipped_names() -> None:
         code = "\n".join(line.split("#", 1)[0] for line in code.splitlines())
         if name != "bearing_rig_sim/config.py" and SHIPPED_NAME.search(code):
             spelled.add(name)
-    assert spelled <= NOT_YET_MOVED, sorted(spelled - NOT_YET_MOVED)
+    assert not spelled, sorted(spelled)
 
 
 def test_the_node_files_name_the_shipped_bearing_and_calibration() -> None:

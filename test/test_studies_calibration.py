@@ -95,7 +95,7 @@ def test_thermal_rows_are_the_coupled_thermal_steady_states() -> None:
     speeds = [rpm_to_rad_s(n) for n in (900, 2700)]
     rows = steady_states(params, [(w, 100.0) for w in speeds], workers=2, thermal=cfg)
     direct = thermal_steady_state(params, cfg, speeds[0], 100.0)
-    assert rows[0].slip_pct == direct.point.slip_pct and rows[0].friction_torque == direct.point.torque
+    assert rows[0].slip_pct == direct.point.slip_pct and rows[0].friction_torque == direct.point.friction_torque
     assert rows[0].lubricant_temperature == direct.temperatures["lubricant"]
     assert rows[0].outer_ring_temperature == direct.temperatures["outer_ring"]
     assert cfg.ambient < rows[0].outer_ring_temperature < rows[1].outer_ring_temperature
@@ -103,7 +103,8 @@ def test_thermal_rows_are_the_coupled_thermal_steady_states() -> None:
 
 
 def test_a_thermal_calibration_file_says_so_and_gives_each_rows_temperatures(tmp_path: Path) -> None:
-    from bearing_rig_sim.studies.calibration import CalibrationResult, SteadyState
+    from bearing_rig_sim.dynamics.steady import SteadyState
+    from bearing_rig_sim.studies.calibration import CalibrationResult
 
     params = BearingParameters.calibrated()
     point = BenchPoint(rpm_to_rad_s(900), 100.0, 3.22)

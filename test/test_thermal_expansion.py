@@ -9,7 +9,7 @@ import pytest
 
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, LoadDistributionError, solve, thermal_clearance_change
-from bearing_rig_sim.thermal.materials import BEARING_STEEL
+from bearing_rig_sim.bearing.materials import BEARING_STEEL
 
 BEARING = Path(__file__).resolve().parents[1] / "config" / "bearings" / "h7006c.yaml"
 

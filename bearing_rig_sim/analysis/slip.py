@@ -1,17 +1,10 @@
 """Cage slip rate from the inner-ring and cage speeds (paper Eq. 11-12; docs/paper.md section 6).
 
-The epicyclic (pure-rolling) cage speed is
-
-    n_s = n_i / 2 * (1 - Dw cos(alpha) / dm)
-
-and the slip rate, in **percent**, is
-
-    S_c = (1 - n_c / n_s) * 100
-
-with n_i the inner-ring speed, n_c the cage speed (both rad/s here; any common unit cancels),
-Dw the ball diameter, dm the pitch diameter (m) and alpha the contact angle (rad). The nominal
-(free) contact angle is the default; pass the loaded angle to use it instead
-(:meth:`BearingKinematics.at_contact_angle`).
+The epicyclic (pure-rolling) cage speed n_s = n_i / 2 * (1 - Dw cos(alpha) / dm) and the slip
+rate S_c = (1 - n_c / n_s) * 100, in **percent**, are defined once in
+:mod:`bearing_rig_sim.bearing.kinematics`; :class:`BearingKinematics` checks its geometry and
+the speeds handed to it and applies them. The nominal (free) contact angle is the default; pass
+the loaded angle to use it instead (:meth:`BearingKinematics.at_contact_angle`).
 
 Speeds are SI (rad/s) and the slip rate is the one quantity kept in percent, as in the paper.
 
@@ -39,6 +32,8 @@ from bearing_rig_sim.analysis.inputs import (
     same_length,
     strictly_increasing,
 )
+from bearing_rig_sim.bearing.hertz import raceway_contacts
+from bearing_rig_sim.bearing.kinematics import epicyclic_ratio, slip_pct
 from bearing_rig_sim.config import ConfigError, read_mapping
 from bearing_rig_sim.settings_model import FileSection, Integer, Number, quantity, validate_mapping
 
@@ -138,7 +133,7 @@ class BearingKinematics:
 
     def epicyclic_ratio(self) -> float:
         """n_s / n_i = (1 - Dw cos(alpha) / dm) / 2, dimensionless (0.4283 for H7006C at 15 deg)."""
-        return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+        return epicyclic_ratio(self.ball_diameter, self.pitch_diameter, self.contact_angle)
 
     @overload
     def cage_speed_epicyclic(self, inner_ring_speed: float) -> float: ...
@@ -185,7 +180,7 @@ class BearingKinematics:
         bad = np.flatnonzero(~(inner > 0.0))
         if bad.size:
             raise AnalysisError(f"inner_ring_speed: must be > 0 rad/s for a slip rate, got {float(inner[bad[0]])!r} at index {bad[0]}")
-        out = (1.0 - cage / (self.epicyclic_ratio() * inner)) * 100.0
+        out = slip_pct(cage, inner, self.epicyclic_ratio())
         return float(out[0]) if cage_scalar and inner_scalar else out
 
 
@@ -334,8 +329,6 @@ class ThrustContact:
         Raises:
             ConfigError: naming the file and key of a missing or out-of-range value.
         """
-        from bearing_rig_sim.dynamics.hertz import raceway_contacts  # the elliptical Hertz solution
-
         doc = validate_mapping(_ContactReading, read_mapping(source), str(source))
         g, ball, ring = doc.geometry, doc.materials.ball, doc.materials.ring
         dw, fi, fo = g.ball_diameter_m, g.inner_groove_curvature_ratio, g.outer_groove_curvature_ratio
@@ -370,4 +363,4 @@ def loaded_slip_rate(kinematics: BearingKinematics, thrust: ThrustContact, cage_
     angle = thrust.loaded_contact_angle(axial_load)
     if not math.isfinite(angle):
         return math.nan
-    return (1.0 - cage_speed / (kinematics.at_contact_angle(angle).epicyclic_ratio() * inner_ring_speed)) * 100.0
+    return slip_pct(cage_speed, inner_ring_speed, kinematics.at_contact_angle(angle).epicyclic_ratio())

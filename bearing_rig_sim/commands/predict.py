@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from bearing_rig_sim.commands import describe, rig_limit_text
-from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, config_path, mapping_at, read_mapping, rpm_to_rad_s
+from bearing_rig_sim.config import RPM_TO_RAD_S, check_number, mapping_at, read_mapping, rpm_to_rad_s, shipped_bearing_file
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD, BearingParameters, Mounting
 from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
 from bearing_rig_sim.dynamics.calibrations import DEFAULT_CALIBRATION, calibration_file
@@ -22,11 +22,11 @@ from bearing_rig_sim.dynamics.parameters import overlay_calibration
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
 from bearing_rig_sim.analysis.slip import BearingKinematics, ThrustContact
 from bearing_rig_sim.dynamics.models import BENCH, DEFAULT_MODEL, MODELS, model_parameters
-from bearing_rig_sim.dynamics.steady import SKID_SLIP_PCT, CageWhirl, SteadySolver, solver_for
+from bearing_rig_sim.dynamics.steady import SKID_SLIP_PCT, CageWhirl, SteadySolver, SteadyState, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.mounting import MountingConfig
 from bearing_rig_sim.settings_model import check_within_rig, read_file, validate_mapping
-from bearing_rig_sim.studies.calibration import SteadyState, steady_states
+from bearing_rig_sim.studies.calibration import steady_states
 
 
 def register(subparsers: Any) -> None:
@@ -134,7 +134,7 @@ def load_parameters(bearing: Path | None, calibration: Path | None, lubricant: P
     file in place of the bearing file's (the calibration then only when named explicitly). The
     shipped calibration belongs to the shipped bearing: another bearing file gets it only when
     named."""
-    path = bearing or config_path("bearings", "h7006c.yaml")
+    path = bearing or shipped_bearing_file()
     doc, source = read_mapping(path), str(path)
     if lubricant is not None:
         lub = mapping_at(doc, ("lubricant",), source)
@@ -188,8 +188,7 @@ def run(args: argparse.Namespace) -> int:
         whirl: dict[str, Any] | None = None
         if radial is not None and combined:
             solver = solver_for(params)
-            pt = solver.periodic(s.inner_ring_speed, s.axial_load, radial[k], moment=None if args.moment is None else (args.moment[0], args.moment[1]))
-            s = SteadyState(pt.inner_ring_speed, pt.axial_load, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+            s = solver.periodic(s.inner_ring_speed, s.axial_load, radial[k], moment=None if args.moment is None else (args.moment[0], args.moment[1]))
             whirl = whirl_row(solver.engine.cage_whirl_radius, solver.last_whirl)
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
@@ -232,8 +231,7 @@ def _run_mounted(args: argparse.Namespace, params: BearingParameters, loads: lis
         omega = rpm_to_rad_s(n)
         side = radial[k] if radial is not None else 0.0
         periodic = mounting.misalignment != (0.0, 0.0) or side > 0.0 or moment is not None
-        pt = solver.periodic(omega, f, side, moment=moment) if periodic else solver.solve(omega, f)
-        s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+        s = solver.periodic(omega, f, side, moment=moment) if periodic else solver.solve(omega, f)
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(row["rpm"], 3)
         row.update(s.losses_row(params.composite_roughness))
@@ -363,7 +361,6 @@ def _print(row: dict[str, Any], as_json: bool) -> None:
 
 def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: list[float], radial: list[float] | None = None) -> int:
     from bearing_rig_sim.config import rad_s_to_rpm
-    from bearing_rig_sim.studies.calibration import SteadyState
     from bearing_rig_sim.thermal.bearing import ThermalConfig
     from bearing_rig_sim.thermal.coupling import params_at_temperature, thermal_steady_state, warm_up
 
@@ -379,8 +376,7 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
                 _print({"rpm": n, "axial_load_n": f, **extra, **r}, args.json)
             continue
         ts = thermal_steady_state(params, cfg, omega, f, radial_load=f_r, moment=moment) if combined else thermal_steady_state(params, cfg, omega, f)
-        pt = ts.point
-        s = SteadyState(pt.inner_ring_speed, f, pt.cage_speed, pt.slip_pct, pt.torque, pt.power, pt.film_min_inner, pt.film_min_outer)
+        s = ts.point
         row: dict[str, Any] = dict(s.as_row())
         row["rpm"] = round(rad_s_to_rpm(omega), 3)
         row.update(s.losses_row(params.composite_roughness))
@@ -405,15 +401,15 @@ def _run_thermal(args: argparse.Namespace, params: BearingParameters, loads: lis
                 # the coupled twin: its unmeasured inputs widen the interval (model form); the
                 # parameters' gradients are taken at the steady temperature
                 warm = params_at_temperature(params, ts.temperatures["lubricant"])
-                _add_interval(row, warm, unc, omega, f, pt.slip_pct, cfg, form, reference=params)
+                _add_interval(row, warm, unc, omega, f, s.slip_pct, cfg, form, reference=params)
             elif _thermal_calibration(args):
                 # fitted through the thermal steady states: so are the interval's gradients
-                _add_interval(row, params, unc, omega, f, pt.slip_pct, cfg)
+                _add_interval(row, params, unc, omega, f, s.slip_pct, cfg)
             else:
-                _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, pt.slip_pct)
+                _add_interval(row, params_at_temperature(params, ts.temperatures["lubricant"]), unc, omega, f, s.slip_pct)
         if combined:
             iso_pt = solver_for(params).periodic(omega, f, f_r, moment=moment)
-            iso_slip, iso_torque = iso_pt.slip_pct, iso_pt.torque
+            iso_slip, iso_torque = iso_pt.slip_pct, iso_pt.friction_torque
         else:
             iso = steady_states(params, [(omega, f)], workers=1)[0]
             iso_slip, iso_torque = iso.slip_pct, iso.friction_torque

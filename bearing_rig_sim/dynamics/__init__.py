@@ -36,8 +36,8 @@ _HOME = {
     **dict.fromkeys(("OperatingEnvelope", "StepLimit", "StepLimitError"), "step_limit"),
 }
 """Where each public name lives: imported on first use (PEP 562), so that a user of a light
-module of the package (``hertz``: the monitor's contact angle) does not load numba and the
-kernels (60 MB and a third of a second)."""
+module of the package (``bearing_file``: a bearing file's validation) does not load numba and
+the kernels (60 MB and a third of a second)."""
 
 
 def __getattr__(name: str) -> Any:

@@ -40,11 +40,11 @@ from typing import Any, cast
 
 import numpy as np
 
-from bearing_rig_sim.config import config_path, read_mapping
+from bearing_rig_sim.config import read_mapping, shipped_bearing_file, shipped_calibration_file
 from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE as CALIBRATABLE  # what a calibration may set, re-exported
 from bearing_rig_sim.dynamics.bearing_file import FRICTION_MODELS, BearingFile, CalibrationFile
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import HertzContact, point_contact, raceway_contacts
+from bearing_rig_sim.bearing.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
 from bearing_rig_sim.settings_model import read_file, validate_mapping
@@ -142,7 +142,7 @@ class BearingParameters:
     def from_yaml(cls, path: str | Path | None = None, calibration: str | Path | None = None) -> BearingParameters:
         """Load and validate a bearing file (default: the shipped H7006C), optionally with a
         calibration file laid over it (see :func:`overlay_calibration`)."""
-        path = path or config_path("bearings", "h7006c.yaml")
+        path = path or shipped_bearing_file()
         data, source = read_mapping(path), str(path)
         if calibration is not None:
             data, source = overlay_calibration(data, read_file(CalibrationFile, calibration)), f"{source} + {calibration}"
@@ -151,7 +151,7 @@ class BearingParameters:
     @classmethod
     def calibrated(cls) -> BearingParameters:
         """The shipped H7006C with the shipped bench calibration (``config/calibration/``)."""
-        return cls.from_yaml(None, config_path("calibration", "h7006c_table3.yaml"))
+        return cls.from_yaml(None, shipped_calibration_file())
 
     @classmethod
     def from_mapping(cls, data: Mapping[str, Any], source: str) -> BearingParameters:

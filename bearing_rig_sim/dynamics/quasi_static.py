@@ -56,7 +56,7 @@ from scipy.optimize import root
 
 from bearing_rig_sim.dynamics.parameters import BearingParameters
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.thermal.materials import BEARING_STEEL
+from bearing_rig_sim.bearing.materials import BEARING_STEEL
 
 
 class LoadDistributionError(RigError):
@@ -106,7 +106,7 @@ def thermal_clearance_change(
 
     Args:
         expansion: linear expansion coefficient, 1/K (default: bearing steel,
-            :data:`bearing_rig_sim.thermal.materials.BEARING_STEEL`; the same for rings and balls).
+            :data:`bearing_rig_sim.bearing.materials.BEARING_STEEL`; the same for rings and balls).
     """
     alpha = BEARING_STEEL.expansion if expansion is None else float(expansion)
     for name, value in (("inner_ring_c", inner_ring_c), ("outer_ring_c", outer_ring_c), ("balls_c", balls_c), ("reference_c", reference_c)):

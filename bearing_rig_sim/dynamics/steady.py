@@ -40,12 +40,13 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.analysis.slip import BearingKinematics
+from bearing_rig_sim.bearing.kinematics import epicyclic_ratio, slip_pct
+from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics, ChunkAverage, DynamicsInputError, Mounting
 from bearing_rig_sim.dynamics.parameters import BearingParameters
@@ -295,58 +296,92 @@ def cage_whirl(time: np.ndarray, x: np.ndarray, y: np.ndarray, *, land_clearance
 
 
 @dataclass(frozen=True)
-class SteadyPoint:
-    """A steady operating point of the engine (SI; slip in percent at the nominal angle).
+class SteadyState:
+    """A steady operating point of the bearing (SI; slip in percent at the nominal angle): the
+    steady solver's result, a coupled thermal steady state's (with its temperatures), a
+    calibration's or a study's row.
+
+    A row read back from a study's cache carries the first eight quantities only: the solver's
+    unknowns are then NaN and its diagnostics empty.
 
     Attributes:
         inner_ring_speed: rad/s.
         axial_load: N.
         cage_speed: rad/s.
+        slip_pct: cage slip S_c, % (paper Eq. 11-12, nominal contact angle).
+        friction_torque: friction torque on the inner ring, N m (power loss over inner-ring speed).
+        power_loss: power loss of the bearing, W (:meth:`BearingDynamics.power_loss`).
+        film_min_inner / film_min_outer: minimum film thickness of the inner and outer contacts,
+            m (:meth:`BearingDynamics.minimum_films`; NaN without a lubricant file).
+        lubricant_temperature / outer_ring_temperature: degC, the coupled thermal steady state's
+            (NaN: isothermal, at the bearing file's temperature; left out of equality, NaN being
+            unequal to itself).
         ball_orbit_speed: rad/s.
         ball_spin_speed: rad/s (about the rolling axis, absolute).
         pocket_offset: m, ball centre ahead of its pocket centre at the pitch radius.
-        slip_pct: cage slip S_c, % (digest Eq. 11-12, nominal contact angle).
-        torque: friction torque on the inner ring, N m (power loss over inner-ring speed).
-        power: power loss of the bearing, W (:meth:`BearingDynamics.power_loss`).
-        film_min_inner / film_min_outer: minimum film thickness of the inner and outer contacts,
-            m (:meth:`BearingDynamics.minimum_films`; NaN without a lubricant file).
-        state: :data:`STATE_ROLLING` or :data:`STATE_SKID`.
-        origin: :data:`ORIGIN_ROLLING_START` or :data:`ORIGIN_CONTINUATION`.
-        method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON`,
-            :data:`METHOD_INTEGRATION` or :data:`METHOD_PERIODIC`.
-        iterations: Newton iterations of the last Newton run (0 if none converged).
-        stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
-            False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
         ball_pivot_speed: rad/s, the ball's pivot omega_t (about e_t, driven by the gyroscopic
             moment, resisted by the transverse tractions).
         ball_pitch_speed: rad/s, the ball's pitch rate omega_p (its angular velocity about the
             third axis of the radial-axial plane, relative to raceway control: the rolling
             axis's tilt; resisted by the contacts' spin moments).
+        origin: :data:`ORIGIN_ROLLING_START` or :data:`ORIGIN_CONTINUATION` (empty: not solved here).
+        method: :data:`METHOD_NEWTON`, :data:`METHOD_INTEGRATION_NEWTON`,
+            :data:`METHOD_INTEGRATION` or :data:`METHOD_PERIODIC` (empty: not solved here).
+        iterations: Newton iterations of the last Newton run (0 if none converged).
+        stable: True when Newton found the state and its Jacobian shows a stable equilibrium;
+            False for an integration average (:data:`METHOD_INTEGRATION`), not checked.
     """
 
     inner_ring_speed: float
     axial_load: float
     cage_speed: float
-    ball_orbit_speed: float
-    ball_spin_speed: float
-    pocket_offset: float
     slip_pct: float
-    torque: float
-    power: float
-    film_min_inner: float
-    film_min_outer: float
-    state: str
-    origin: str
-    method: str
-    iterations: int
-    stable: bool
+    friction_torque: float = math.nan
+    power_loss: float = math.nan
+    film_min_inner: float = math.nan
+    film_min_outer: float = math.nan
+    lubricant_temperature: float = field(default=math.nan, compare=False)
+    outer_ring_temperature: float = field(default=math.nan, compare=False)
+    ball_orbit_speed: float = math.nan
+    ball_spin_speed: float = math.nan
+    pocket_offset: float = math.nan
     ball_pivot_speed: float = 0.0
     ball_pitch_speed: float = 0.0
+    origin: str = ""
+    method: str = ""
+    iterations: int = 0
+    stable: bool = False
+
+    @property
+    def state(self) -> str:
+        """:data:`STATE_SKID` above :data:`SKID_SLIP_PCT` of slip, else :data:`STATE_ROLLING`."""
+        return STATE_SKID if self.slip_pct > SKID_SLIP_PCT else STATE_ROLLING
 
     @property
     def vector(self) -> np.ndarray:
         """(omega_m, omega_a, Omega, u, omega_t, omega_p): the solver's unknowns, to continue from."""
         return np.array([self.ball_orbit_speed, self.ball_spin_speed, self.cage_speed, self.pocket_offset, self.ball_pivot_speed, self.ball_pitch_speed])
+
+    def as_row(self) -> dict[str, float]:
+        """The point at the edge: rpm, N, %."""
+        return {
+            "rpm": round(rad_s_to_rpm(self.inner_ring_speed), 6),
+            "axial_load_n": self.axial_load,
+            "cage_rpm": round(rad_s_to_rpm(self.cage_speed), 4),
+            "slip_pct": round(self.slip_pct, 4),
+        }
+
+    def losses_row(self, composite_roughness: float = 0.0) -> dict[str, object]:
+        """Torque (N m), power (W), minimum films (um) and, with a composite roughness (m), the
+        film parameter lambda = h_min / sigma of the thinner contact."""
+        row: dict[str, object] = {
+            "friction_torque_nm": round(self.friction_torque, 6),
+            "power_loss_w": round(self.power_loss, 4),
+            "film_min_um": {"inner": round(self.film_min_inner * 1e6, 4), "outer": round(self.film_min_outer * 1e6, 4)},
+        }
+        if composite_roughness > 0.0:
+            row["lambda_ratio"] = round(min(self.film_min_inner, self.film_min_outer) / composite_roughness, 3)
+        return row
 
 
 class SteadySolver:
@@ -365,7 +400,7 @@ class SteadySolver:
         self.engine = BearingDynamics(params, mounting=mounting)
         self.step = float(step) if step is not None else self.engine.time_step
         self.basin_time = BASIN_S
-        self.kinematics = BearingKinematics(params.ball_diameter, params.pitch_diameter, params.contact_angle)
+        self.epicyclic_ratio = epicyclic_ratio(params.ball_diameter, params.pitch_diameter, params.contact_angle)
         z = params.ball_count
         self._ball = np.zeros((z, kn.NB))
         self._cage = np.zeros((z, kn.NC))
@@ -379,7 +414,7 @@ class SteadySolver:
         """The cage centre's whirl over the last :meth:`periodic` point's window (:func:`cage_whirl`)."""
 
     # -- public --------------------------------------------------------------------------------
-    def solve(self, inner_ring_speed: float, axial_load: float, start: SteadyPoint | None = None) -> SteadyPoint:
+    def solve(self, inner_ring_speed: float, axial_load: float, start: SteadyState | None = None) -> SteadyState:
         """The steady state at ``inner_ring_speed`` (rad/s, > 0) and ``axial_load`` (N).
 
         Args:
@@ -423,7 +458,7 @@ class SteadySolver:
                 return self._point(x, omega, axial_load, origin, METHOD_INTEGRATION_NEWTON, iterations)
         return self._averaged(omega, axial_load, origin)
 
-    def integrate(self, inner_ring_speed: float, axial_load: float) -> SteadyPoint:
+    def integrate(self, inner_ring_speed: float, axial_load: float) -> SteadyState:
         """The reference: integrate from the rolling start for :data:`SETTLE_S`, then average
         the cage speed over :data:`AVERAGE_S`."""
         omega, axial_load = self._inputs(inner_ring_speed, axial_load)
@@ -433,7 +468,7 @@ class SteadySolver:
 
     def periodic(
         self, inner_ring_speed: float, axial_load: float, radial_load: float, *, radial_angle: float = 0.0, moment: tuple[float, float] | None = None
-    ) -> SteadyPoint:
+    ) -> SteadyState:
         """The steady state under a combined load (N; ``moment`` N m with the tilts free, see
         :meth:`BearingDynamics.set_moment`), averaged over whole ball-pass periods.
 
@@ -482,7 +517,7 @@ class SteadySolver:
         self.last_whirl = cage_whirl(times, xs, ys, land_clearance=self.params.land_clearance, cage_speed=avg.cage_speed)
         return avg
 
-    def _averaged(self, omega: float, axial_load: float, origin: str) -> SteadyPoint:
+    def _averaged(self, omega: float, axial_load: float, origin: str) -> SteadyState:
         avg = self.engine.advance(AVERAGE_S, axial_load=axial_load)
         x = self._vector_of_engine()
         x[2] = avg.cage_speed
@@ -497,10 +532,10 @@ class SteadySolver:
             )
         return omega, float(axial_load)
 
-    def sweep_load(self, inner_ring_speed: float, loads: list[float]) -> list[SteadyPoint]:
+    def sweep_load(self, inner_ring_speed: float, loads: list[float]) -> list[SteadyState]:
         """Continuation along ``loads`` (N) at one speed, as a live load sweep: the first point
         from the rolling start, each next one from the previous solution."""
-        points: list[SteadyPoint] = []
+        points: list[SteadyState] = []
         for load in loads:
             points.append(self.solve(inner_ring_speed, load, points[-1] if points else None))
         return points
@@ -536,18 +571,18 @@ class SteadySolver:
             return _NOT_CONVERGED, 0
         return int(status), int(iterations)
 
-    def _point(self, x: np.ndarray, omega: float, load: float, origin: str, method: str, iterations: int, stable: bool = True) -> SteadyPoint:
+    def _point(self, x: np.ndarray, omega: float, load: float, origin: str, method: str, iterations: int, stable: bool = True) -> SteadyState:
         e = self.engine
         # the engine's own diagnostics (power loss, films) at the solution: one step from it
         self._load_engine(x, omega)
         e.advance(e.time_step, axial_load=load)
         return self._engine_point(x, omega, load, e.power_loss(), origin, method, iterations, stable)
 
-    def _engine_point(self, x: np.ndarray, omega: float, load: float, power: float, origin: str, method: str, iterations: int, stable: bool) -> SteadyPoint:
+    def _engine_point(self, x: np.ndarray, omega: float, load: float, power: float, origin: str, method: str, iterations: int, stable: bool) -> SteadyState:
         """The point of the state ``x`` with the engine's films as they stand, power ``power`` W."""
         film_inner, film_outer = self.engine.minimum_films()
-        slip = float(self.kinematics.slip_rate(float(x[2]), omega))
-        return SteadyPoint(
+        slip = slip_pct(float(x[2]), omega, self.epicyclic_ratio)
+        return SteadyState(
             inner_ring_speed=omega,
             axial_load=float(load),
             cage_speed=float(x[2]),
@@ -555,11 +590,10 @@ class SteadySolver:
             ball_spin_speed=float(x[1]),
             pocket_offset=float(x[3]),
             slip_pct=slip,
-            torque=power / omega,
-            power=power,
+            friction_torque=power / omega,
+            power_loss=power,
             film_min_inner=film_inner,
             film_min_outer=film_outer,
-            state=STATE_SKID if slip > SKID_SLIP_PCT else STATE_ROLLING,
             origin=origin,
             method=method,
             iterations=iterations,

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.dynamics.hertz import HertzContact
+from bearing_rig_sim.bearing.hertz import HertzContact
 from bearing_rig_sim.dynamics.lubrication import Lubricant, film_thickness, harris_thrust_angle
 
 GRID = 24

@@ -193,7 +193,7 @@ def run_states(params: BearingParameters, cfg: ThermalConfig, rows: Sequence[Run
             temperatures = net.temperatures.copy()
             pt, _ = heat(net.temperature("lubricant"))
         names = list(net.names)
-        out.append(RunState(pt.slip_pct, float(temperatures[names.index("outer_ring")]), float(temperatures[names.index("lubricant")]), pt.torque))
+        out.append(RunState(pt.slip_pct, float(temperatures[names.index("outer_ring")]), float(temperatures[names.index("lubricant")]), pt.friction_torque))
     return out
 
 

@@ -22,7 +22,7 @@ import math
 import os
 from concurrent.futures import Executor
 from contextlib import nullcontext
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from collections.abc import Callable, Iterable, Sequence
 
@@ -33,7 +33,7 @@ from scipy.optimize import least_squares
 from bearing_rig_sim.config import check_number, rad_s_to_rpm, rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingParameters, DynamicsDivergedError
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
-from bearing_rig_sim.dynamics.steady import solver_for
+from bearing_rig_sim.dynamics.steady import SteadyState, solver_for
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.executors import process_pool
 from bearing_rig_sim.thermal.bearing import ThermalConfig
@@ -86,46 +86,6 @@ class BenchPoint:
     inner_ring_speed: float
     axial_load: float
     slip_pct: float
-
-
-@dataclass(frozen=True)
-class SteadyState:
-    """Steady operating point of the engine (SI; slip in percent at the nominal angle)."""
-
-    inner_ring_speed: float
-    axial_load: float
-    cage_speed: float
-    slip_pct: float
-    friction_torque: float = math.nan
-    power_loss: float = math.nan
-    film_min_inner: float = math.nan
-    film_min_outer: float = math.nan
-    lubricant_temperature: float = field(default=math.nan, compare=False)
-    """degC: the thermal steady state's lubricant temperature (NaN: isothermal, at the bearing
-    file's temperature; left out of equality, NaN being unequal to itself)."""
-    outer_ring_temperature: float = field(default=math.nan, compare=False)
-    """degC: the thermal steady state's outer-ring temperature (NaN: isothermal)."""
-
-    def as_row(self) -> dict[str, float]:
-        """The point at the edge: rpm, N, %."""
-        return {
-            "rpm": round(rad_s_to_rpm(self.inner_ring_speed), 6),
-            "axial_load_n": self.axial_load,
-            "cage_rpm": round(rad_s_to_rpm(self.cage_speed), 4),
-            "slip_pct": round(self.slip_pct, 4),
-        }
-
-    def losses_row(self, composite_roughness: float = 0.0) -> dict[str, object]:
-        """Torque (N m), power (W), minimum films (um) and, with a composite roughness (m), the
-        film parameter lambda = h_min / sigma of the thinner contact."""
-        row: dict[str, object] = {
-            "friction_torque_nm": round(self.friction_torque, 6),
-            "power_loss_w": round(self.power_loss, 4),
-            "film_min_um": {"inner": round(self.film_min_inner * 1e6, 4), "outer": round(self.film_min_outer * 1e6, 4)},
-        }
-        if composite_roughness > 0.0:
-            row["lambda_ratio"] = round(min(self.film_min_inner, self.film_min_outer) / composite_roughness, 3)
-        return row
 
 
 @dataclass(frozen=True)
@@ -191,23 +151,8 @@ def steady_state(params: BearingParameters, inner_ring_speed: float, axial_load:
         from bearing_rig_sim.thermal.coupling import thermal_steady_state
 
         ts = thermal_steady_state(params, thermal, inner_ring_speed, axial_load)
-        pt = ts.point
-        return SteadyState(
-            pt.inner_ring_speed,
-            axial_load,
-            pt.cage_speed,
-            pt.slip_pct,
-            pt.torque,
-            pt.power,
-            pt.film_min_inner,
-            pt.film_min_outer,
-            ts.temperatures["lubricant"],
-            ts.temperatures["outer_ring"],
-        )
-    point = solver_for(params).solve(inner_ring_speed, axial_load)
-    return SteadyState(
-        point.inner_ring_speed, axial_load, point.cage_speed, point.slip_pct, point.torque, point.power, point.film_min_inner, point.film_min_outer
-    )
+        return replace(ts.point, lubricant_temperature=ts.temperatures["lubricant"], outer_ring_temperature=ts.temperatures["outer_ring"])
+    return solver_for(params).solve(inner_ring_speed, axial_load)
 
 
 def _steady_state_job(job: tuple[BearingParameters, float, float, ThermalConfig | None]) -> SteadyState:

@@ -20,9 +20,10 @@ import numpy as np
 
 from bearing_rig_sim.analysis.slip import BearingKinematics
 from bearing_rig_sim.executors import process_pool
-from bearing_rig_sim.studies.calibration import SteadyState, steady_states
+from bearing_rig_sim.studies.calibration import steady_states
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.dynamics import BearingDynamics, BearingParameters
+from bearing_rig_sim.dynamics.steady import SteadyState
 
 VALIDATION_RPM: tuple[float, ...] = (900, 1200, 1500, 1800, 2100, 2400, 2700)
 """Digest section 9: 900-2700 rpm in steps of 300, at 100 N."""

@@ -23,7 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from bearing_rig_sim import __version__
-from bearing_rig_sim.studies.calibration import SteadyState
+from bearing_rig_sim.dynamics.steady import SteadyState
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.studies.experiments import (
     ACCELERATION_LOAD_N,
@@ -67,7 +67,8 @@ def _state_to_json(s: SteadyState) -> list[float]:
 
 
 def _state_from_json(v: list[float]) -> SteadyState:
-    return SteadyState(*map(float, v))
+    speed, load, cage, slip, torque, power, film_inner, film_outer = map(float, v)
+    return SteadyState(speed, load, cage, slip, torque, power, film_inner, film_outer)
 
 
 def save_raw(raw: RawResults, path: Path) -> None:

@@ -36,7 +36,7 @@ from bearing_rig_sim.analysis.stability import (
 from bearing_rig_sim.config import rad_s_to_rpm
 from bearing_rig_sim.dynamics import BearingParameters
 from bearing_rig_sim.dynamics.lubrication import skf_frictional_moment
-from bearing_rig_sim.studies.calibration import SteadyState
+from bearing_rig_sim.dynamics.steady import SteadyState
 from bearing_rig_sim.studies.experiments import SWEEP_LOADS_N
 from bearing_rig_sim.studies.experiments import AccelerationSeries
 from bearing_rig_sim.studies.paper_data import PAPER_TABLE3, PAPER_TABLE4, PAPER_TABLE5_1000RPM, PAPER_TABLE6, PAPER_TABLE7

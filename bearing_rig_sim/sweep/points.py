@@ -35,7 +35,7 @@ from bearing_rig_sim.dynamics.steady import (
     SKID_SLIP_PCT,
     STATE_ROLLING,
     STATE_SKID,
-    SteadyPoint,
+    SteadyState,
     solver_for,
 )
 from bearing_rig_sim.dynamics.quasi_static import LoadCase, QuasiStaticBearing
@@ -198,12 +198,12 @@ def _base_row(point: dict[str, float], key: str, branch: str) -> dict[str, Any]:
     return row
 
 
-def _fill(row: dict[str, Any], result: SteadyPoint) -> dict[str, Any]:
+def _fill(row: dict[str, Any], result: SteadyState) -> dict[str, Any]:
     row.update(
         cage_rpm=rad_s_to_rpm(result.cage_speed),
         slip_pct=result.slip_pct,
-        torque_n_m=result.torque,
-        power_w=result.power,
+        torque_n_m=result.friction_torque,
+        power_w=result.power_loss,
         film_min_inner_m=result.film_min_inner,
         film_min_outer_m=result.film_min_outer,
         state=result.state,
@@ -262,7 +262,7 @@ def _steady_row(task: SweepTask, point: dict[str, float], key: str) -> dict[str,
 
 def _continuation_rows(task: SweepTask) -> list[dict[str, Any]]:
     rows: list[dict[str, Any]] = []
-    previous: SteadyPoint | None = None
+    previous: SteadyState | None = None
     for point, key in zip(task.points, task.keys):
         row = _base_row(point, key, KIND_CONTINUATION)
         try:

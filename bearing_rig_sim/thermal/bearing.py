@@ -43,12 +43,12 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
-from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.config import ConfigError, shipped_bearing_file
 from bearing_rig_sim.dynamics.bearing_file import BearingFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
-from bearing_rig_sim.thermal.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
+from bearing_rig_sim.bearing.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
 from bearing_rig_sim.thermal.network import Conductance, Node, ThermalNetwork
 from bearing_rig_sim.settings_model import read_file
 
@@ -98,7 +98,7 @@ class ThermalConfig:
     @classmethod
     def from_yaml(cls, path: str | Path | None = None) -> ThermalConfig:
         """The bearing file's thermal data (default: the shipped H7006C)."""
-        path = path or config_path("bearings", "h7006c.yaml")
+        path = path or shipped_bearing_file()
         return cls.from_file(read_file(BearingFile, path), str(path))
 
     @classmethod

@@ -38,7 +38,7 @@ from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, traction_table
 from bearing_rig_sim.dynamics.quasi_static import thermal_clearance_change
-from bearing_rig_sim.dynamics.steady import SteadyPoint, SteadySolver
+from bearing_rig_sim.dynamics.steady import SteadyState, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.dynamics.traction import (
     HEADER,
@@ -495,7 +495,7 @@ class ThermalSteadyState:
             K (within the tolerance when converged).
     """
 
-    point: SteadyPoint
+    point: SteadyState
     sources: HeatSources
     temperatures: dict[str, float]
     iterations: int
@@ -534,9 +534,9 @@ class HeatAtTemperature:
     ) -> None:
         self.params, self.speed, self.load = params, inner_ring_speed, axial_load
         self.radial, self.moment = radial_load, moment
-        self.cache: dict[float, tuple[SteadyPoint, HeatSources]] = {}
+        self.cache: dict[float, tuple[SteadyState, HeatSources]] = {}
 
-    def __call__(self, temperature_c: float) -> tuple[SteadyPoint, HeatSources]:
+    def __call__(self, temperature_c: float) -> tuple[SteadyState, HeatSources]:
         key = round(float(temperature_c), 3)
         got = self.cache.get(key)
         if got is None:
@@ -657,7 +657,7 @@ def warm_up(
     net = build_network(params, config, inner_ring_speed, axial_load, lubricant_temperature=t_hi, initial=config.ambient)
     names = list(net.names)
     q_grid = np.array([net.heat_vector(node_heat(src)) for _, src in table])
-    torque_grid = np.array([pt.torque for pt, _ in table])
+    torque_grid = np.array([pt.friction_torque for pt, _ in table])
     rows = []
     t = 0.0
     while t < duration - 1e-9:

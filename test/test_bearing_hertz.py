@@ -1,6 +1,6 @@
 """Hertz contact: the elliptical solution against independent closed forms.
 
-References computed here, independently of ``dynamics/hertz.py``:
+References computed here, independently of ``bearing/hertz.py``:
 * the complete elliptic integrals by Gauss-Legendre quadrature of their defining integrals and
   the ellipticity by bisection on Harris and Kotzalas Eq. 6.26 (exact closed form);
 * Brewe and Hamrock's approximations (ASME J. Lubr. Tech. 1977), accurate to about 1-3 %;
@@ -16,7 +16,7 @@ import pytest
 
 from bearing_rig_sim.dynamics import BearingParameters, derive
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.dynamics.hertz import point_contact, raceway_contacts
+from bearing_rig_sim.bearing.hertz import point_contact, raceway_contacts
 
 E_STEEL, NU_STEEL = 208e9, 0.3
 DW, DM, ALPHA = 6.3e-3, 42.45e-3, math.radians(15.0)

@@ -5,7 +5,7 @@
 #                                   install the bearing_rig_msgs interfaces, install the package
 #   ./bootstrap.sh run [args...]    setup, then `bearing-rig run args...`
 #   ./bootstrap.sh test [args...]   setup, then `python -m pytest args...`, on every core
-#                                   (pytest-xdist `-n auto --dist worksteal` unless args give -n)
+#                                   (pytest-xdist `-n logical --dist worksteal` unless args give -n)
 #
 # Needs python3.11, cmake, a C and C++ compiler (gcc, g++), make or ninja, network access to
 # PyPI. Every step leaves a stamp (a hash of its inputs) in .venv/.bootstrap-stamps and is
@@ -222,7 +222,7 @@ case "$cmd" in
         status=0
         # One worker per core (each test leases its own ROS domain, test/conftest.py); the
         # workers steal from each other, so the long session tests do not end the run alone.
-        parallel=(-n auto --dist worksteal)
+        parallel=(-n logical --dist worksteal)
         for arg in "$@"; do
             [[ "$arg" == -n* || "$arg" == --numprocesses* ]] && parallel=()
         done

@@ -89,19 +89,7 @@ from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.thermal import sensors as bench_sensors
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.nodes.common import (
-    UNKNOWN_NODE_NAME,
-    drain,
-    qos_profile,
-    RELIABLE_QOS,
-    STATUS_QOS,
-    diagnostic_array,
-    diagnostic_status,
-    from_stamp,
-    node_main,
-    unspun_reader,
-    to_stamp,
-)
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, UNKNOWN_NODE_NAME, diagnostic_array, diagnostic_status, drain, from_stamp, node_main, qos_profile, to_stamp, unspun_reader
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.fibre_optic import Pulse
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code

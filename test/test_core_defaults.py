@@ -15,6 +15,7 @@ import yaml
 
 from bearing_rig_sim.analysis.streaming import TrailingSlope
 from bearing_rig_sim.config import config_path
+from bearing_rig_sim.monitoring.windows import SlipWindows
 from bearing_rig_sim.simulation.drive import SpindleDrive
 from bearing_rig_sim.simulation.pacing import RealTimePacer
 from bearing_rig_sim.simulation.settings import SimulatorSettings
@@ -67,6 +68,7 @@ CORES: list[tuple[Callable[..., Any], str, dict[str, str]]] = [
             "change_threshold": "change_threshold",
         },
     ),
+    (SlipWindows.__init__, "monitor", {"window_revolutions": "window_revolutions", "min_window_s": "min_window_s"}),
 ]
 """Constructor, the node whose shipped file holds its parameters, argument -> key in that file."""
 

@@ -1,11 +1,10 @@
 """The load controller's core (no ROS): the operation of the axial loading chain
 (:mod:`.operation`) and the node's validated settings (:mod:`.settings`)."""
 
+from bearing_rig_sim.health import Health, HealthLevel
 from bearing_rig_sim.load_control.operation import (
     AdvanceResult,
     AxialLoadOperation,
-    Health,
-    HealthLevel,
     RadialLoad,
     Reply,
     SetpointSource,

@@ -78,19 +78,6 @@ from bearing_rig_sim.rig.program import RigLimits
 if TYPE_CHECKING:
     from bearing_rig_sim.load_control.settings import LoadControllerSettings
 
-__all__ = [
-    "AdvanceResult",
-    "AxialLoadOperation",
-    "Health",
-    "HealthLevel",
-    "RadialLoad",
-    "Reply",
-    "SetpointSource",
-    "closed_loop_time_constant",
-    "settle_band",
-    "settle_time_bound",
-]
-
 
 class SetpointSource(str, Enum):
     """Where a set-point request came from; compares equal to its string value."""

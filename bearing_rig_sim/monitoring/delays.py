@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 
 import numpy as np
 
@@ -57,6 +57,29 @@ def first_stable(times: np.ndarray, states: np.ndarray) -> tuple[float, bool]:
     return float(stable[0]), bool(np.all(states[times >= stable[0]] == SlipState.STABLE))
 
 
+def first_stable_after(
+    settings: MonitorSettings, scenarios: Iterable[BenchScenario], onset: float, *, slipping_expected: bool
+) -> tuple[list[float], set[str]]:
+    """For each recording, the first STABLE status's delay after ``onset`` (s from the
+    recording's start; inf if none), and what went wrong in any of them: a STABLE before the
+    onset, a SLIPPING where none is expected (a constant slip), a STABLE not kept, a FAULT."""
+    delays: list[float] = []
+    notes: set[str] = set()
+    for scenario in scenarios:
+        times, states = statuses(settings, scenario)
+        at, kept = first_stable(times, states)
+        delays.append(at - onset)
+        if np.any(states[times < onset] == SlipState.STABLE):
+            notes.add("STABLE before the onset")
+        if not slipping_expected and SlipState.SLIPPING in states:
+            notes.add("a false SLIPPING")
+        if not kept:
+            notes.add("not kept")
+        if SlipState.FAULT in states:
+            notes.add("FAULT")
+    return delays, notes
+
+
 DELAY_BOUND_S = 1.5
 """Issue 25's bound on the first STABLE after the true onset, s: each case prints the share of
 seeds within it."""
@@ -92,34 +115,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     for label, acceleration, bursts in run_ups:
         onset = table7_onset(acceleration, k2)
-        delays, notes = [], set()
-        for seed in seeds:
-            times, states = statuses(settings, table7_run_up(acceleration, epicyclic_ratio=ratio, seed=seed, bursts=bursts))
-            at, kept = first_stable(times, states)
-            delays.append(at - onset)
-            if np.any(states[times < onset] == SlipState.STABLE):
-                notes.add("STABLE before the onset")
-            if not kept:
-                notes.add("not kept")
-            if SlipState.FAULT in states:
-                notes.add("FAULT")
-        print(_line(f"{label} (onset {onset:.2f} s)", delays, notes))
+        run_up = (table7_run_up(acceleration, epicyclic_ratio=ratio, seed=seed, bursts=bursts) for seed in seeds)
+        print(_line(f"{label} (onset {onset:.2f} s)", *first_stable_after(settings, run_up, onset, slipping_expected=True)))
     print("10 s holds at 2 % slip, 50 us jitter: first STABLE after the start, s")
     for rpm in (900.0, 1500.0, 3000.0, 9000.0):
         w = rpm * math.pi / 30.0
-        firsts, notes = [], set()
-        for seed in seeds:
-            scenario = BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=ratio, jitter_s=50e-6, seed=seed)
-            times, states = statuses(settings, scenario)
-            at, kept = first_stable(times, states)
-            firsts.append(at)
-            if SlipState.SLIPPING in states:
-                notes.add("a false SLIPPING")
-            if not kept:
-                notes.add("not kept")
-            if SlipState.FAULT in states:
-                notes.add("FAULT")
-        print(_line(f"{rpm:5.0f} rpm", firsts, notes))
+        holds = (BenchScenario(10.0, constant(w), constant(2.0), epicyclic_ratio=ratio, jitter_s=50e-6, seed=seed) for seed in seeds)
+        print(_line(f"{rpm:5.0f} rpm", *first_stable_after(settings, holds, 0.0, slipping_expected=False)))
     return 0
 
 

@@ -216,7 +216,7 @@ class SlipWindows:
             shaft restarts), s.
     """
 
-    def __init__(self, window_revolutions: int, rules: LossRules, clock_jump_tolerance_s: float, min_window_s: float = 0.0) -> None:
+    def __init__(self, window_revolutions: int, rules: LossRules, clock_jump_tolerance_s: float, min_window_s: float) -> None:
         self.window_revolutions = window_revolutions
         self.min_window_s = min_window_s
         self.rules = rules

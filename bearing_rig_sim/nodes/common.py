@@ -18,6 +18,7 @@ from typing import Any
 import rclpy
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -270,6 +271,20 @@ def run_node(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | 
     return 0
 
 
+def node_main(node_name: str, factory: Callable[[], Node], argv: Sequence[str] | None = None) -> int:
+    """A node's console script: :func:`run_node`, with a user's error (malformed ROS arguments, a
+    parameter refused at start) said in one line ``<node_name>: error: ...`` on stderr.
+
+    Returns:
+        The process exit status: :func:`run_node`'s, or 2 after such an error.
+    """
+    try:
+        return run_node(node_name, factory, argv)
+    except RigError as exc:
+        print(f"{node_name}: error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+
+
 def _autostart(node: Node) -> str:
     """Configure then activate a lifecycle node; why it failed, or "" when it is active."""
     from rclpy.lifecycle import TransitionCallbackReturn
@@ -298,6 +313,17 @@ def drain(subscription: Any, msgtype: type, serialized: bool = True) -> list[tup
         while (taken := handle.take_message(msgtype, serialized)) is not None:
             taken_all.append((taken[0], taken[1]))
     return taken_all
+
+
+def unspun_reader(tap: Node, msgtype: type, topic: str, qos: QoSProfile) -> Any:
+    """A subscription of ``tap``, a node no executor spins, whose queue is taken by hand
+    (:func:`drain`): no callback runs for its messages and no QoS-event handler is installed
+    (an executor would otherwise walk it on every wake-up)."""
+    return tap.create_subscription(msgtype, topic, _never_called, qos, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False))
+
+
+def _never_called(_msg: object) -> None:  # pragma: no cover - an unspun reader's node is never spun
+    """Callback of an :func:`unspun_reader`; its queue is taken by :func:`drain`."""
 
 
 CONTRACT_QOS_PROFILES: dict[str, QoSProfile] = {name: qos_profile(name) for name in QOS_DESCRIPTIONS}

@@ -80,7 +80,7 @@ from geometry_msgs.msg import WrenchStamped
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import Clock as RosClock
 from rclpy.clock import ClockType, ROSClock
-from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
+from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.time import Time as RosTime
@@ -104,19 +104,7 @@ from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, RadialLoad, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
-from bearing_rig_sim.nodes.common import (
-    drain,
-    qos_profile,
-    ERROR,
-    OK,
-    RELIABLE_QOS,
-    WARN,
-    diagnostic_array,
-    diagnostic_status,
-    from_stamp,
-    run_node,
-    to_stamp,
-)
+from bearing_rig_sim.nodes.common import ERROR, OK, RELIABLE_QOS, WARN, diagnostic_array, diagnostic_status, drain, from_stamp, node_main, qos_profile, to_stamp, unspun_reader
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 
@@ -183,22 +171,12 @@ class LoadControllerNode(ManagedNode):
             self.create_service(SetBool, AXIAL_LOAD_CLUTCH.name, self._on_clutch),
         ]
         self._clock_tap = Node(f"{NODE_NAME}_inputs", context=self.context)
-        self._clock_sub = self._clock_tap.create_subscription(
-            Clock, CLOCK.name, _unused, CLOCK_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
-        )
+        self._clock_sub = unspun_reader(self._clock_tap, Clock, CLOCK.name, CLOCK_QOS)
         # The set-points too are taken by the step, before it steps: one that came since the
         # last step is in force for every sample this step publishes (a callback of its own
         # could run after the step and leave a lagging node's samples on the old set-point).
-        self._setpoint_sub = self._clock_tap.create_subscription(
-            Float64, AXIAL_LOAD_SETPOINT.name, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
-        )
-        self._load_sub = self._clock_tap.create_subscription(
-            WrenchStamped,
-            LOAD_SETPOINT.name,
-            _unused,
-            qos_profile(LOAD_SETPOINT),
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-        )
+        self._setpoint_sub = unspun_reader(self._clock_tap, Float64, AXIAL_LOAD_SETPOINT.name, RELIABLE_QOS)
+        self._load_sub = unspun_reader(self._clock_tap, WrenchStamped, LOAD_SETPOINT.name, qos_profile(LOAD_SETPOINT))
         self.timer(settings.step_period_s, self._on_step, clock=RosClock(clock_type=ClockType.STEADY_TIME))
         self._bearing_msg = WrenchStamped()
         self._bearing_msg.header.frame_id = "bearing"
@@ -420,10 +398,6 @@ class LoadControllerNode(ManagedNode):
                 self._apply(self.operation.request_setpoint(_as_number(parameter.value), SetpointSource.PARAMETER))
 
 
-def _unused(_msg: object) -> None:  # pragma: no cover - the readers' node is never spun
-    """Callback of the /clock and set-point readers; their queues are taken by the step timer."""
-
-
 def _as_number(value: object) -> object:
     """An integer parameter as a float (``ros2 param set ... 100`` gives an integer); anything else
     unchanged, for the chain to judge."""
@@ -435,11 +409,7 @@ def _as_number(value: object) -> object:
 def main(argv: Sequence[str] | None = None) -> int:
     """Console script ``load_controller`` / ``bearing-rig-load-controller``: the node starts
     unconfigured (``lifecycle_msgs`` services); ``--autostart`` configures and activates it."""
-    try:
-        return run_node(NODE_NAME, LoadControllerNode, argv)
-    except RigError as exc:
-        print(f"{NODE_NAME}: error: {' '.join(str(exc).split())}", file=sys.stderr)
-        return 2
+    return node_main(NODE_NAME, LoadControllerNode, argv)
 
 
 if __name__ == "__main__":

@@ -44,7 +44,6 @@ from rclpy.clock import Clock, ClockType
 
 from bearing_rig_msgs.msg import FibreOpticPulse, SlipStatus
 from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SLIP_STATUS
-from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import AXIAL_LOAD_FORCE, PULSE_TOPICS
 from bearing_rig_sim.monitoring import (
     DIAGNOSTIC_NAME,
@@ -67,7 +66,7 @@ from bearing_rig_sim.nodes.common import (
     diagnostic_status,
     from_stamp,
     qos_profile,
-    run_node,
+    node_main,
     to_stamp,
 )
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
@@ -279,11 +278,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ROS arguments (``--ros-args -p name:=value``, ``--params-file``) set the parameters of
     ``config/monitor.yaml``.
     """
-    try:
-        return run_node(NODE_NAME, MonitorNode, list(sys.argv if argv is None else argv))
-    except RigError as exc:
-        print(f"{NODE_NAME}: error: {exc}", file=sys.stderr)
-        return 2
+    return node_main(NODE_NAME, MonitorNode, argv)
 
 
 if __name__ == "__main__":

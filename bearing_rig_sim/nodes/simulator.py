@@ -78,7 +78,6 @@ from lifecycle_msgs.msg import State as LifecycleState
 from lifecycle_msgs.msg import TransitionEvent
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
-from rclpy.event_handler import SubscriptionEventCallbacks
 from rclpy.node import Node
 from rclpy.serialization import deserialize_message
 from rclpy.subscription import Subscription
@@ -91,18 +90,7 @@ from bearing_rig_sim.interfaces import topic as contract_topic
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.nodes.common import (
-    UNKNOWN_NODE_NAME,
-    drain,
-    qos_profile,
-    RELIABLE_QOS,
-    STATUS_QOS,
-    diagnostic_array,
-    diagnostic_status,
-    from_stamp,
-    run_node,
-    to_stamp,
-)
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, UNKNOWN_NODE_NAME, diagnostic_array, diagnostic_status, drain, from_stamp, node_main, qos_profile, to_stamp, unspun_reader
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.instruments.base import Reading
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code
@@ -265,21 +253,8 @@ class SimulatorNode(ManagedNode):
         # The force comes at 1 kHz: its queue is taken by the loop (one wake-up per loop call
         # instead of one per message), from a reader on a node no executor spins.
         self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
-        self._force_sub = self._force_tap.create_subscription(
-            WrenchStamped,
-            BEARING_AXIAL_FORCE.name,
-            _unused,
-            FORCE_QOS,
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-        )
-
-        self._status_sub = self._force_tap.create_subscription(
-            SlipStatus,
-            SLIP_STATUS.name,
-            _unused,
-            STATUS_QOS,
-            event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False),
-        )
+        self._force_sub = unspun_reader(self._force_tap, WrenchStamped, BEARING_AXIAL_FORCE.name, FORCE_QOS)
+        self._status_sub = unspun_reader(self._force_tap, SlipStatus, SLIP_STATUS.name, STATUS_QOS)
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
@@ -397,9 +372,7 @@ class SimulatorNode(ManagedNode):
             for info in infos:
                 topic = f"{info.node_namespace.rstrip('/')}/{info.node_name}/transition_event"
                 if topic not in self._lifecycle_events:
-                    reader = tap.create_subscription(
-                        TransitionEvent, topic, _unused, RELIABLE_QOS, event_callbacks=SubscriptionEventCallbacks(use_default_callbacks=False)
-                    )
+                    reader = unspun_reader(tap, TransitionEvent, topic, RELIABLE_QOS)
                     self._lifecycle_events[topic] = (reader, set())
                 self._lifecycle_events[topic][1].add(name)
         for reader, streams in self._lifecycle_events.values():
@@ -600,10 +573,6 @@ class SimulatorNode(ManagedNode):
         self._diag_pub.publish(diagnostic_array(to_stamp(max(twin.time, 0.0)), [status]))
 
 
-def _unused(_msg: object) -> None:  # pragma: no cover - the force reader's node is never spun
-    """Callback of the force reader; its queue is taken by the loop."""
-
-
 def message_class(msgtype: str) -> Any:
     """The rclpy message class of a contract type ``pkg/msg/Name``."""
     package, _, name = msgtype.split("/")
@@ -638,12 +607,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     ``--no-realtime`` runs as fast as possible; ROS arguments (``--ros-args -p name:=value``,
     ``--params-file``) set the parameters of ``config/simulator.yaml``.
     """
-    args = node_arguments(list(sys.argv if argv is None else argv))
-    try:
-        return run_node(NODE_NAME, SimulatorNode, args)
-    except RigError as exc:
-        print(f"{NODE_NAME}: error: {exc}", file=sys.stderr)
-        return 2
+    return node_main(NODE_NAME, SimulatorNode, node_arguments(list(sys.argv if argv is None else argv)))
 
 
 if __name__ == "__main__":

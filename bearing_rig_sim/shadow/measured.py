@@ -38,8 +38,10 @@ class MeasuredWindows:
 
     def __init__(self, window_revolutions: int, monitor_settings: MonitorSettings | None = None) -> None:
         base = monitor_settings if monitor_settings is not None else MonitorSettings.from_yaml()
-        self.settings = base.replace(window_revolutions=window_revolutions)
-        self._counter = SlipWindows(window_revolutions, self.settings.loss_rules(), self.settings.clock_jump_tolerance_s)
+        # The shadow compares the bench with the twin window by window over exactly
+        # ``window_revolutions`` (config/shadow.yaml): no minimum duration stretches a window.
+        self.settings = base.replace(window_revolutions=window_revolutions, min_window_s=0.0)
+        self._counter = SlipWindows(window_revolutions, self.settings.loss_rules(), self.settings.clock_jump_tolerance_s, self.settings.min_window_s)
         self._invalid: dict[str, tuple[float | None, str]] = {}
 
     @property

@@ -1,8 +1,10 @@
 """The style is enforced, not just described: ruff (ruff.toml) and mypy (setup.cfg) pass on the
-tree, ``mypy --strict`` on the interface contract and the parameter model, and every remaining ``type: ignore`` says why."""
+tree, ``mypy --strict`` on the interface contract and the parameter model, every remaining ``type: ignore`` says why,
+and no function of the package runs over :data:`MAX_FUNCTION_LINES` lines."""
 
 from __future__ import annotations
 
+import ast
 import re
 import subprocess
 import sys
@@ -12,6 +14,9 @@ from conftest import time_left
 
 ROOT = Path(__file__).resolve().parent.parent
 BIN = Path(sys.executable).parent
+MAX_FUNCTION_LINES = 150
+"""The longest function (decorators and docstring included) the house allows: beyond it a function
+does several stages' work, which belong in functions of their own."""
 
 
 def run(tool: str, *args: str) -> subprocess.CompletedProcess[str]:
@@ -57,3 +62,31 @@ def test_every_type_ignore_gives_its_reason() -> None:
             if match and not re.search(r"[-#]\s*\w", match.group(2)):
                 bare.append(f"{path.relative_to(ROOT)}:{number}")
     assert not bare, "type: ignore without a reason: " + ", ".join(bare)
+
+
+def long_functions(source: str, limit: int = MAX_FUNCTION_LINES) -> list[tuple[str, int]]:
+    """The functions and methods of a module's source longer than ``limit`` lines: (name, lines)."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            first = min([node.lineno, *(d.lineno for d in node.decorator_list)])
+            lines = (node.end_lineno or node.lineno) - first + 1
+            if lines > limit:
+                found.append((node.name, lines))
+    return found
+
+
+def test_no_function_runs_over_150_lines() -> None:
+    giants = [
+        f"{path.relative_to(ROOT)}:{name} ({lines} lines)"
+        for path in sorted((ROOT / "bearing_rig_sim").rglob("*.py"))
+        for name, lines in long_functions(path.read_text(encoding="utf-8"))
+    ]
+    assert not giants, f"functions over {MAX_FUNCTION_LINES} lines: " + ", ".join(giants)
+
+
+def test_the_length_check_counts_a_long_function() -> None:
+    """The check itself can fail: a decorated function of 151 lines is caught, one of 150 is not."""
+    body = "".join(f"    x{i} = {i}\n" for i in range(148))
+    source = f"@staticmethod\ndef f():\n{body}    return 0\n\ndef g():\n{body}    return 0\n"
+    assert long_functions(source) == [("f", 151)]

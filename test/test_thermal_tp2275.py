@@ -50,7 +50,11 @@ MODEL_FORM = (
     "The published laws, tried): Parker's jet cavity share read in percent takes the drag away (0.37-0.73 x), read "
     "as a fraction it overshoots from 48 000 rpm (1.68-1.84 x), the inlet shear heating reduction of the rolling force "
     "lowers the 28 000 rpm point that is already short; the heat missing at the percent reading is 221-378 W, a "
-    "near-constant torque of 0.05-0.075 N m (a load-dependent friction, not churning)"
+    "near-constant torque of 0.05-0.075 N m (a load-dependent friction, not churning). The raceway contacts do not "
+    "supply it: outer-raceway control at the centrifugal contact angles spins the inner contacts 2.1-5.3 x faster than "
+    "the traction table's equal-angle spin, but the film's spin friction (0.0024 effective at 28 000 rpm) keeps that "
+    "loss at 2-26 W; the SKF model is outside its speed range here (3.4-21 x the report; docs/thermal.md, The raceway "
+    "contacts examined)"
 )
 HOUSING = (
     "the assumed housing and shaft lead heat to 22 degC air; the report's rig (oil at 394 K, outer-ring cooling) "

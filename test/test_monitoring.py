@@ -464,3 +464,37 @@ def test_the_published_parameters_give_back_the_running_settings():
     kept, problem = shipped.with_published({**published, "parameter/stable_confidence": "1.5"})
     assert kept == shipped and "stable_confidence" in problem
     assert shipped.with_published({"state": "stable"}) == (shipped, "")  # nothing published: as it was
+
+
+@pytest.mark.parametrize("disorder", ["none", "at_the_window_end", "evicted_and_at_the_window_end"])
+def test_a_windows_load_is_the_mean_of_the_load_cell_samples_stamped_inside_it(disorder):
+    """A window's axial_load is the mean of the load-cell samples whose stamps lie in the window
+    (computed here from the samples themselves), whatever order they came in: a pair received
+    out of order across the window's end (one sample inside, one after it), alone or after an
+    earlier pair that has since left the kept history (more than LOAD_HISTORY samples later)."""
+    from bearing_rig_sim.monitoring.monitor import LOAD_HISTORY
+
+    period = TWO_PI / CAGE
+    spindle = train(constant(INNER, 4, 0.0, 6 * period), 4, "spindle")
+    cage = train(constant(CAGE, 4, 0.0, 6 * period, phase=0.2), 4, "cage")
+    probe = make()
+    feed(probe, spindle, cage)
+    assert probe.latest_window is not None
+    start, end = probe.latest_window.start_time, probe.latest_window.end_time
+    rate_hz = 1000.0  # the load cell's
+    times = end - np.arange(LOAD_HISTORY + 2000, -200, -1) / rate_hz - 0.25e-3  # none on an end
+    forces = 400.0 + 300.0 * np.sin(7.0 * times) + np.random.default_rng(3).normal(0.0, 5.0, times.size)
+    order = np.arange(times.size)
+    last_inside = int(np.flatnonzero(times <= end)[-1])
+    if disorder != "none":
+        order[[last_inside, last_inside + 1]] = order[[last_inside + 1, last_inside]]
+    if disorder == "evicted_and_at_the_window_end":
+        order[[10, 11]] = order[[11, 10]]
+    monitor = make()
+    for k in order:
+        monitor.add_load(float(times[k]), float(forces[k]))
+    feed(monitor, spindle, cage)
+    inside = (times >= start) & (times <= end)
+    assert monitor.latest_window is not None and monitor.latest_window.end_time == end
+    assert inside.sum() == pytest.approx((end - start) * rate_hz, abs=1.0)
+    assert monitor.latest_window.axial_load == pytest.approx(float(np.mean(forces[inside])), rel=1e-12)

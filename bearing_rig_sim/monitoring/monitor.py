@@ -30,6 +30,7 @@ Units: s, rad/s, N; slip and slopes in percent, percent per second or per newton
 
 from __future__ import annotations
 
+import bisect
 import math
 from collections import deque
 from dataclasses import dataclass
@@ -78,6 +79,11 @@ LOAD_WAIT_S = 8.0
 """With the load criterion, a window waits for the load cell's samples up to its end (the load
 cell's topic can run seconds behind the pulses' without real time) at most this long after its
 end, rig s; then it is judged on the samples at hand (half the kept history)."""
+
+
+def _stamp(sample: tuple[float, float]) -> float:
+    """A load-cell sample's time, s."""
+    return sample[0]
 
 
 @dataclass(frozen=True)
@@ -210,6 +216,8 @@ class SlipMonitor:
         self.counter = SlipWindows(settings.window_revolutions, settings.loss_rules(), settings.clock_jump_tolerance_s, settings.min_window_s)
         self._notes: deque[tuple[float | None, str]] = deque(maxlen=5)
         self._loads: deque[tuple[float, float]] = deque(maxlen=LOAD_HISTORY)
+        self._loads_unordered = 0
+        """Samples in :attr:`_loads` stamped before their predecessor there (0: in time order)."""
         self.reset()
 
     # -- state ---------------------------------------------------------------------------------
@@ -232,6 +240,7 @@ class SlipMonitor:
         """Windows completed since the last reset (1)."""
         self._notes.clear()
         self._loads.clear()
+        self._loads_unordered = 0
         if reason:
             self._notes.append((None, reason))
 
@@ -253,7 +262,12 @@ class SlipMonitor:
         """A load-cell sample: axial force ``force`` (N) at rig time ``time`` (s); non-finite
         samples are ignored."""
         if math.isfinite(time) and math.isfinite(force):
-            self._loads.append((time, force))
+            loads = self._loads
+            if len(loads) == loads.maxlen and loads[1][0] < loads[0][0]:
+                self._loads_unordered -= 1  # its successor, out of order after it, no longer is
+            if loads and time < loads[-1][0]:
+                self._loads_unordered += 1
+            loads.append((time, force))
             if self._sweep_pending and time >= self._sweep_pending[0].end_time:
                 self._feed_sweep(time)
 
@@ -335,7 +349,11 @@ class SlipMonitor:
         if not loads:
             return math.nan
         if loads[-1][0] >= t0 and loads[0][0] <= t1:
-            inside = [f for t, f in loads if t0 <= t <= t1]
+            if self._loads_unordered:
+                inside = [f for t, f in loads if t0 <= t <= t1]
+            else:  # in time order: the same samples, in the same order, found by bisection
+                i, j = bisect.bisect_left(loads, t0, key=_stamp), bisect.bisect_right(loads, t1, key=_stamp)
+                inside = [loads[k][1] for k in range(i, j)]
             if inside:
                 return sum(inside) / len(inside)
         last_time, last_force = loads[-1]

@@ -514,6 +514,31 @@ def test_a_set_point_never_shown_is_flagged(late: TestProgram) -> None:
     assert runner.outcomes[-1].conditions == ("load off: the load controller never showed the set-point 100 N during the segment",)
 
 
+SHORT_LOAD_UP = """
+name: short_load_up
+stability_criterion: time
+bearing: bearings/h7006c.yaml
+segments:
+  - {name: load_up, speed_rpm: 0, axial_load_n: 100, dwell_s: 0.3}
+  - {name: n0900, speed_rpm: 900, ramp_s: 1.0, axial_load_n: 100, dwell_s: 1.0}
+"""
+
+
+def test_a_dwell_shorter_than_the_settling_time_is_not_flagged_for_a_set_point_shown_after_it(tmp_path: Path) -> None:
+    """A 0.3 s load-up dwell, shorter than LOAD_SETTLE_S (0.5 s): its set-point may reach the load
+    controller after the dwell's end without the segment being off (the rule applies to segments
+    longer than that). The session noticing the end late (here at 2.0 s of sim time, the
+    simulator having run ahead) does not lengthen the segment: its end is its deadline, 0.3 s."""
+    path = tmp_path / "short.yaml"
+    path.write_text(SHORT_LOAD_UP, encoding="utf-8")
+    runner = ProgramRunner(load_program(path))
+    runner.start(0.0)
+    feed_state(runner, 0.0, 0.3, 0.0, 0.0)  # the load controller still at its initial 0 N
+    runner.update(2.0)
+    load_up = runner.outcomes[-1]
+    assert load_up.name == "load_up" and load_up.conditions == ()
+
+
 def test_the_radial_force_on_the_bearing_is_judged_against_the_segments(tmp_path: Path) -> None:
     """A 500 N radial load at 90 deg: (0, 500) N expected in force.x/y; (500, 0) N is the right
     magnitude in the wrong direction, 707 N off, beyond settle_band(500 N) = 10 N."""

@@ -636,13 +636,16 @@ class ProgramRunner:
 
 
 def _load_conditions(data: _SegmentData, now: float) -> list[str]:
-    """What was off in a segment's load (see the module documentation)."""
+    """What was off in a segment's load (see the module documentation), the segment ending at
+    ``now`` (s of sim time) or, a dwell, at its deadline: the session may notice the end later,
+    and what is stamped after the deadline belongs to the next segment."""
     segment = data.plan.segment
+    end = min(now, data.plan.deadline) if segment.dwell is not None else now
     off = []
     for what, (_excess, value, time) in data.worst.items():
         target = segment.radial_load if what.startswith("radial") else segment.axial_load
         off.append(f"{what} {value:.1f} N at t = {time:.3f} s, {target:g} N commanded (+- {settle_band(target):.3g} N)")
-    if data.setpoint_seen is None and data.setpoint_states > 0 and now - data.plan.start_time > LOAD_SETTLE_S:
+    if data.setpoint_seen is None and data.setpoint_states > 0 and end - data.plan.start_time > LOAD_SETTLE_S:
         off.append(f"the load controller never showed the set-point {segment.axial_load:g} N during the segment")
     return off
 

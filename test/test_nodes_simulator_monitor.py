@@ -250,6 +250,34 @@ def test_monitor_reports_error_when_the_pulses_stop(ros_graph):
     )
 
 
+def test_a_stopped_rigs_statuses_follow_the_simulation_clock(ros_graph):
+    """Once the spindle has stopped no slip window closes, yet the monitor's statuses (its idle
+    checks, at status_rate_hz of the steady clock) are stamped at the rig time of the check once the
+    rig is found stopped: on ``/clock`` they follow the simulation, so a reader by header stamp
+    (the session's end, the simulator's pacing on the statuses) sees the monitor keep up with the
+    clock, and they describe the stopped rig, not its last window. Were they stamped at the last
+    window's end, no status would ever lie 2 s past the last pulse."""
+    start(ros_graph, "simulator", f"initial_speed_rad_s:={1200 * RPM!r}", flags=("--no-realtime",))
+    start(ros_graph, "monitor", "use_sim_time:=true")
+    probe = Probe(ros_graph)
+    probe.wait(lambda: any(math.isfinite(s.slip_rate) for s in probe.status), "a first slip window")
+    probe.send_command(0.0, 0.2)
+
+    def last_pulse() -> float:
+        return max(from_stamp(m.header.stamp) for shaft in probe.pulses.values() for m in shaft)
+
+    def followed() -> bool:
+        if not probe.clock or not probe.pulses["spindle"] or probe.clock[-1] < last_pulse() + 3.0:
+            return False
+        return any(from_stamp(s.header.stamp) > last_pulse() + 2.0 for s in probe.status)
+
+    probe.wait(followed, "a status stamped 2 s of sim time past the last pulse, after the stop")
+    late = [s for s in probe.status if from_stamp(s.header.stamp) > last_pulse() + 2.0]
+    # a status past the last pulse describes the stopped rig: no verdict, both speeds 0, no slip
+    assert all(s.state == SlipStatus.STATE_UNKNOWN and "stopped" in s.detail for s in late), [s.detail for s in late]
+    assert all(s.inner_ring_speed == 0.0 and s.cage_speed == 0.0 and math.isnan(s.slip_rate) for s in late), [(s.inner_ring_speed, s.cage_speed, s.slip_rate) for s in late]
+
+
 def test_monitor_warns_of_lost_pulses_with_counts_and_no_fault(ros_graph):
     """Bench-like pulses (4 strips, a bench clock) with a burst of 20 lost cage pulses, published
     at the recording's own pace: /diagnostics says WARN with the counts, no status is a FAULT,

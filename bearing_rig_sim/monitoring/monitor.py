@@ -91,7 +91,10 @@ class MonitorStatus:
     """The monitor's status (the fields of SlipStatus.msg, SI units, slip in percent).
 
     ``time`` is the end of the latest window (None before the first); speeds, slip and slope
-    are NaN when not known; ``faults`` lists the active faults' reasons, ``warnings`` the recent
+    are NaN when not known. Once the rig has stopped (the pulses slowed, then ceased), the status
+    describes the rig as it is, not its last window: ``time`` and ``window_start`` None (a node
+    stamps it at the rig time of its check), both speeds 0, the slip and the window's load and
+    angles NaN; ``faults`` lists the active faults' reasons, ``warnings`` the recent
     losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
     the pulses lost per shaft since the start, ``windows_skipped`` the cage windows skipped and
     ``duplicates`` the exact repeats of a pulse dropped per shaft (spindle, cage).
@@ -497,7 +500,10 @@ class SlipMonitor:
             detail = f"{detail}; warning: {'; '.join(warnings)}"
         if notes:
             detail = f"{detail}; note: {notes[-1]}"
-        inner = latest.inner_ring_speed if latest is not None else math.nan
+        if self.counter.stopped:
+            latest = None  # no window describes a stopped rig
+        at_rest = 0.0 if self.counter.stopped else math.nan
+        inner = latest.inner_ring_speed if latest is not None else at_rest
         books = self.counter.books
         if self.criterion == "axial_load":  # the fit's verdict is not a probability: 1 stable, 0 else
             fitted_slope = sweep.slope_at_end if sweep is not None else math.nan
@@ -509,7 +515,7 @@ class SlipMonitor:
             state=state,
             time=latest.end_time if latest is not None else None,
             inner_ring_speed=inner,
-            cage_speed=latest.cage_speed if latest is not None else math.nan,
+            cage_speed=latest.cage_speed if latest is not None else at_rest,
             theoretical_cage_speed=self._ratio * inner,
             slip_rate=latest.slip_rate if latest is not None else math.nan,
             fitted_slope=fitted_slope,

@@ -8,8 +8,10 @@ angle of the kinematic slip), all best effort with a deep queue (``pulse_reader`
 unchanged on the bench's topics. Publishes:
 
 * ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): when the
-  schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes);
-  when the pulses stop, at ``status_rate_hz`` of the steady clock;
+  schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes),
+  stamped at the latest window's end; when the pulses stop, at ``status_rate_hz`` of the steady
+  clock, and once the rig is found stopped those statuses (speeds 0, no slip) are stamped at the
+  rig time of the check, so that a stopped rig's statuses follow its clock;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` (wall) and
   on every change of level: OK stable, WARN slipping, unknown or pulses lost lately (with the
   counts), ERROR sustained sensor loss or invalid data.

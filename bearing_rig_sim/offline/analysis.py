@@ -20,7 +20,9 @@ once, its messages as arrays): the pulses decoded as arrays
 (:func:`~bearing_rig_sim.bags.cdr.decode_pulses`; other encodings through the reader's general
 decoder, one by one); the load cell, recorded statuses and spindle commands one by one; the 1 kHz
 speeds and the other sampled topics (:data:`SAMPLED_TOPICS`) not message by message: a chunk of
-them is kept and only the message a status row samples is decoded. Memory does not grow with
+them is kept and only the message a status row samples is decoded (the speeds' and the truth's
+fields by hand, :func:`~bearing_rig_sim.bags.cdr.decode_joint_velocities` and
+:func:`~bearing_rig_sim.bags.cdr.decode_truth_speeds`: a status row samples both). Memory does not grow with
 the bag's length: rows and windows stream to CSV files as they are made, and only a decimated
 copy of the rows (at most ``max_points``) and the state changes are kept for plots.
 
@@ -65,7 +67,7 @@ from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
-from bearing_rig_sim.bags.cdr import decode_pulses, make_decoder
+from bearing_rig_sim.bags.cdr import decode_joint_velocities, decode_pulses, decode_truth_speeds, make_decoder, make_field_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.mcapfile import ChunkBatch
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -319,7 +321,11 @@ class _SampledTopics:
     in stamp order), not before the chunk the latest time reached."""
 
     def __init__(self, bag: BagReader, names: list[str]) -> None:
-        self.topics = {name: _Sampled(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in names}
+        by_hand = {SPEEDS: decode_joint_velocities, TRUTH: decode_truth_speeds}  # sampled by every row
+        self.topics = {
+            name: _Sampled(make_field_decoder(bag.typestore, CONTEXT_TOPICS[name], by_hand[name]) if name in by_hand else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            for name in names
+        }
         self._pending: deque[dict[str, ChunkBatch]] = deque()
 
     def push(self, batches: dict[str, ChunkBatch]) -> None:

@@ -309,6 +309,8 @@ class SlipMonitor:
                 self.slope.refresh(external)
 
     def _take_events(self) -> None:
+        if not self.counter.events:
+            return
         for kind, when, text in self.counter.events:
             if kind == "reset":
                 self.slope.reset()

@@ -277,13 +277,17 @@ class StampOrder:
         return self._release(math.inf)
 
     def _release(self, until: float) -> list[tuple[str, Pulse]]:
+        """The held pulses that may go on, in stamp order (the cage's first at equal stamps)."""
         out: list[tuple[str, Pulse]] = []
-        while True:
-            heads = [(float(q[0].time), name) for name, q in self._held.items() if q]
-            if not heads:
-                return out
-            t, name = min(heads)
-            other = "cage" if name == "spindle" else "spindle"
-            if not (t <= until or self._latest[other] >= t or self._latest[name] - t > self.max_lead_s):
-                return out
-            out.append((name, self._held[name].popleft()))
+        spindle, cage = self._held["spindle"], self._held["cage"]
+        latest = self._latest
+        while spindle or cage:
+            if cage and (not spindle or float(cage[0].time) <= float(spindle[0].time)):
+                name, other, queue = "cage", "spindle", cage
+            else:
+                name, other, queue = "spindle", "cage", spindle
+            t = float(queue[0].time)
+            if not (t <= until or latest[other] >= t or latest[name] - t > self.max_lead_s):
+                break
+            out.append((name, queue.popleft()))
+        return out

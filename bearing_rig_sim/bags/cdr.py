@@ -18,7 +18,7 @@ from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.typestore import dependencies
+from bearing_rig_sim.bags.typestore import dependencies, rig_typestore
 from bearing_rig_sim.interfaces import CAGE_PULSES
 
 PULSE_TYPE = CAGE_PULSES.msgtype
@@ -316,12 +316,64 @@ def decode_truth_speeds(data: CdrBytes) -> TruthSpeeds:
     return TruthSpeeds(inner, cage, slip, axial)
 
 
+class Stamp(NamedTuple):
+    """A ``builtin_interfaces/Time``."""
+
+    sec: int
+    nanosec: int
+
+
+class StampHeader(NamedTuple):
+    """The stamp of a ``std_msgs/Header``."""
+
+    stamp: Stamp
+
+
+class StatusFields(NamedTuple):
+    """The fields of a ``SlipStatus`` the offline analysis reads (rad/s, percent, 1)."""
+
+    header: StampHeader
+    inner_ring_speed: float
+    cage_speed: float
+    slip_rate: float
+    state: int
+    confidence: float
+    sweep_speed: float
+    sweep_verdict: str
+
+
+_STATUS_SPEEDS = struct.Struct("<6dB")  # inner_ring_speed .. critical_slope, state
+_STATUS_SWEEP = struct.Struct("<5d")  # axial_load .. sweep_stable_from
+
+
+def decode_status_fields(data: CdrBytes) -> StatusFields:
+    """Stamp, speeds, slip, state, confidence and load-sweep verdict of a little-endian CDR
+    ``SlipStatus`` read by hand (the values rosbags' decoder gives); struct.error or
+    UnicodeDecodeError for bad bytes."""
+    sec, nanosec = _PULSE_HEAD.unpack_from(data, 4)[:2]
+    _frame, at = _text(data, 8)
+    at = (at + 7) & ~7
+    inner, cage, _theoretical, slip, _fitted, _critical, state = _STATUS_SPEEDS.unpack_from(data, 4 + at)
+    _criterion, at = _text(data, (at + 49 + 3) & ~3)
+    at = (at + 7) & ~7
+    confidence, _revolutions = struct.unpack_from("<dI", data, 4 + at)
+    _detail, at = _text(data, (at + 12 + 3) & ~3)
+    at = (at + 7) & ~7
+    sweep_speed = _STATUS_SWEEP.unpack_from(data, 4 + at)[3]
+    verdict, _at = _text(data, (at + 40 + 3) & ~3)
+    return StatusFields(StampHeader(Stamp(sec, nanosec)), inner, cage, slip, state, confidence, sweep_speed, verdict)
+
+
 def make_field_decoder(typestore: Typestore, msgtype: str, fields: Callable[[CdrBytes], object]) -> Callable[[CdrBytes], object]:
     """A function giving ``fields(data)`` for a complete little-endian message of ``msgtype`` (its
     length walked first, so what :func:`make_decoder` refuses is not read by hand) and
-    :func:`make_decoder`'s message for any other bytes (BagError for a malformed or cut one)."""
+    :func:`make_decoder`'s message for any other bytes (BagError for a malformed or cut one).
+    ``fields`` reads the rig's own layout of the type: a ``typestore`` (a bag's) that defines
+    it otherwise, such as an older recording's, is decoded by :func:`make_decoder` alone."""
     general = make_decoder(typestore, msgtype)
-    length = length_function(typestore, msgtype)
+    rig = rig_typestore()
+    same_layout = all(typestore.fielddefs.get(name) == rig.fielddefs.get(name) for name in dependencies(rig, [msgtype]))
+    length = length_function(typestore, msgtype) if same_layout else None
 
     def decode(data: CdrBytes) -> object:
         if length is not None and bytes(data[:2]) == LITTLE_ENDIAN:

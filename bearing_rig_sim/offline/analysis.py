@@ -22,7 +22,8 @@ decoder, one by one); the load cell, recorded statuses and spindle commands one 
 speeds and the other sampled topics (:data:`SAMPLED_TOPICS`) not message by message: a chunk of
 them is kept and only the message a status row samples is decoded (the speeds' and the truth's
 fields by hand, :func:`~bearing_rig_sim.bags.cdr.decode_joint_velocities` and
-:func:`~bearing_rig_sim.bags.cdr.decode_truth_speeds`: a status row samples both). Memory does not grow with
+:func:`~bearing_rig_sim.bags.cdr.decode_truth_speeds`: a status row samples both; the recorded
+statuses' likewise, :func:`~bearing_rig_sim.bags.cdr.decode_status_fields`). Memory does not grow with
 the bag's length: rows and windows stream to CSV files as they are made, and only a decimated
 copy of the rows (at most ``max_points``) and the state changes are kept for plots.
 
@@ -67,7 +68,7 @@ from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
-from bearing_rig_sim.bags.cdr import decode_joint_velocities, decode_pulses, decode_truth_speeds, make_decoder, make_field_decoder
+from bearing_rig_sim.bags.cdr import decode_joint_velocities, decode_pulses, decode_status_fields, decode_truth_speeds, make_decoder, make_field_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.mcapfile import ChunkBatch
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -92,6 +93,7 @@ from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype
+STATUS_TYPE = contract.SLIP_STATUS.msgtype
 DIAGNOSTICS = contract.DIAGNOSTICS.name
 """Where the monitor publishes the parameters its statuses are judged by."""
 PULSE_TOPICS: dict[str, str] = {shaft: t.name for shaft, t in contract.PULSE_TOPICS.items()}
@@ -422,7 +424,11 @@ class OfflineAnalysis:
         )
         self._rows = RowDecimator(max_points)
         self._on_row, self._on_window = on_row, on_window
-        self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context if name not in SAMPLED_TOPICS}
+        self._latest = {
+            name: _Latest(make_field_decoder(bag.typestore, STATUS_TYPE, decode_status_fields) if name == STATUS else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            for name in self._context
+            if name not in SAMPLED_TOPICS
+        }
         self._sampled = _SampledTopics(bag, [name for name in self._context if name in SAMPLED_TOPICS])
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0

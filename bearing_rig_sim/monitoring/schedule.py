@@ -256,9 +256,13 @@ class StampOrder:
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
         t = pulse.time
-        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
-            return [(shaft, pulse)]
-        self._latest[shaft] = max(self._latest[shaft], float(t))
+        if not (type(t) is float and math.isfinite(t) and shaft in self._held):  # the common case first
+            if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+                return [(shaft, pulse)]
+            t = float(t)
+        latest = self._latest
+        if t > latest[shaft]:
+            latest[shaft] = t
         self._held[shaft].append(pulse)
         return self._release(-math.inf)
 

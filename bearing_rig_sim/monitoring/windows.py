@@ -96,6 +96,10 @@ start: lost only once the other shaft has turned ``silent_shaft_revolutions`` si
 pulse, so a spindle turned by hand at rest, or a stray edge of a strip standing at the sensor,
 is no fault. Once one shaft runs, each is judged by its own silence."""
 
+SPINDLE_PRUNE_PULSES = 64
+"""Spindle pulses kept beyond those still needed before the old ones are dropped (1): a pruning
+at every pulse cost more than the rest of the pulse's handling."""
+
 SPACING_AVERAGE_REVOLUTIONS = 32
 """Revolutions over which each strip's spacing error is averaged: the plain mean of the first 32
 samples, then an exponential weight of 1/32."""
@@ -182,6 +186,7 @@ class _Shaft:
     recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
     recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
     other_pulses_at_last: int = 0  # the other shaft's pulses received when this one last pulsed
+    prune_at: int = 0  # kept spindle pulses at which the next pruning is due
 
     def established(self) -> bool:
         """Whether the shaft has turned :data:`ESTABLISHED_REVOLUTIONS` since its restart, so that
@@ -352,8 +357,10 @@ class SlipWindows:
         s.last_time, s.last_index = t, index
         s.pulses += 1
         s.other_pulses_at_last = self._shafts[OTHER[shaft]].pulses
-        self.silent.pop(shaft, None)
-        self._suspect.discard(shaft)
+        if self.silent:
+            self.silent.pop(shaft, None)
+        if self._suspect:
+            self._suspect.discard(shaft)
         self.stopped = ""
         if shaft == "spindle":
             self._add_spindle_pulse(s, t, index)
@@ -398,7 +405,7 @@ class SlipWindows:
             return
         # the parabola through the first three passages, at the fourth: 3 revolutions if the
         # acceleration is constant
-        predicted = _lagrange((t0, t1, t2), (0.0, 1.0, 2.0), t3)
+        predicted = _parabola(t0, t1, t2, 0.0, 1.0, 2.0, t3)
         if not abs(predicted - 3.0) <= STEADY_ANGLE_TOLERANCE_REV:
             return
         middle = recent[n + 1 : 2 * n + 1]
@@ -484,7 +491,12 @@ class SlipWindows:
         return done
 
     def _prune_spindle(self) -> None:
+        """Drop the spindle pulses no window or cage pulse waiting can need, once
+        :data:`SPINDLE_PRUNE_PULSES` have come since the last time (keeping older ones changes
+        no interpolation: the pulse before the bracket is kept either way)."""
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
+        if len(spindle.times) < spindle.prune_at:
+            return
         starts = [t0 for t0, _, _ in self._pending]
         if self._phase_pending:
             starts.append(self._phase_pending[0][0])
@@ -496,6 +508,7 @@ class SlipWindows:
         if k > 0:
             del spindle.times[:k]
             del spindle.indices[:k]
+        spindle.prune_at = len(spindle.times) + SPINDLE_PRUNE_PULSES
 
     # -- time-based checks ---------------------------------------------------------------------
     def check(self, now: float) -> None:

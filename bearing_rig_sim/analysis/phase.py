@@ -177,7 +177,7 @@ class PhaseSlope:
         np.multiply(z[:, :, None], z[:, None, :], out=outer[:, 0])
         np.multiply(dz[:, :, None], dz[:, None, :], out=outer[:, 1])
         flat = outer.reshape(n, 2 * dim * dim)
-        np.cumsum(flat, axis=0, out=flat)
+        np.add.accumulate(flat, axis=0, out=flat)  # np.cumsum without its dispatch
         np.add(self._sums[lo], flat, out=self._sums[lo + 1 : hi + 1])
         self._summed, self._z_last = hi, z[-1]
 

@@ -49,6 +49,7 @@ Units: SI inside (s, rad/s, N), slip in percent; the CSV files speak rpm, percen
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 from collections import deque
 import functools
@@ -295,6 +296,8 @@ class _Sampled(_Decoding):
     def __init__(self, decode: Callable[[bytes], Any]) -> None:
         super().__init__(decode)
         self._current: ChunkBatch | None = None
+        self._times: list[int] = []  # the current batch's log times (a list: bisected at every row)
+        self._entry: tuple[int, tuple[int, bytes]] | None = None  # (position, entry) last asked for
         self._before: tuple[int, bytes] | None = None  # the last message of the batches left behind
 
     def take(self, batch: ChunkBatch) -> None:
@@ -302,7 +305,7 @@ class _Sampled(_Decoding):
         current = self._current
         if current is not None:
             self._before = (int(current.log_times[-1]), current.data[int(current.starts[-1]) : int(current.ends[-1])])
-        self._current = batch
+        self._current, self._times, self._entry = batch, batch.log_times.tolist(), None
 
     def get(self, at_ns: int) -> Any:
         """The latest message taken logged at or before ``at_ns`` (ns), decoded; None if none
@@ -310,9 +313,11 @@ class _Sampled(_Decoding):
         entry = self._before
         current = self._current
         if current is not None:
-            k = int(np.searchsorted(current.log_times, at_ns, side="right")) - 1
+            k = bisect.bisect_right(self._times, at_ns) - 1
             if k >= 0:
-                entry = (int(current.log_times[k]), current.data[int(current.starts[k]) : int(current.ends[k])])
+                if self._entry is None or self._entry[0] != k:
+                    self._entry = (k, (self._times[k], current.data[int(current.starts[k]) : int(current.ends[k])]))
+                entry = self._entry[1]
         return self._value(entry)
 
 
@@ -328,18 +333,18 @@ class _SampledTopics:
             name: _Sampled(make_field_decoder(bag.typestore, CONTEXT_TOPICS[name], by_hand[name]) if name in by_hand else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
             for name in names
         }
-        self._pending: deque[dict[str, ChunkBatch]] = deque()
+        self._pending: deque[tuple[int, dict[str, ChunkBatch]]] = deque()  # (first log time, batches)
 
     def push(self, batches: dict[str, ChunkBatch]) -> None:
         """The topics' messages of the next chunk (each in log-time order; none empty)."""
         if batches:
-            self._pending.append(batches)
+            self._pending.append((min(int(b.log_times[0]) for b in batches.values()), batches))
 
     def get(self, at_ns: int) -> dict[str, Any]:
         """Each topic's latest message logged at or before ``at_ns`` (ns), decoded (None if none)."""
         pending = self._pending
-        while pending and min(int(b.log_times[0]) for b in pending[0].values()) <= at_ns:
-            for name, batch in pending.popleft().items():
+        while pending and pending[0][0] <= at_ns:
+            for name, batch in pending.popleft()[1].items():
                 self.topics[name].take(batch)
         return {name: topic.get(at_ns) for name, topic in self.topics.items()}
 
@@ -580,7 +585,7 @@ class OfflineAnalysis:
         self._take_pulse(topic, log_time_ns, pulse)
 
     def _take_pulse(self, topic: str, log_time_ns: int, pulse: Pulse) -> None:
-        if unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
+        if pulse.time == 0.0 and unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
             self._unstamped += 1
             if self._unstamped == 1:
                 self._report(
@@ -596,14 +601,8 @@ class OfflineAnalysis:
 
     def _feed(self, shaft: str, pulse: Pulse) -> None:
         """One pulse, in stamp order, through the schedule; its statuses take the context read
-        before it."""
+        before it (a failure ends the analysis: no later status takes that context)."""
         self._context_before, self._context_time = self._read_at.pop(id(pulse), (None, self._log_ns))
-        try:
-            self._schedule_pulse(shaft, pulse)
-        finally:
-            self._context_before, self._context_time = None, self._log_ns
-
-    def _schedule_pulse(self, shaft: str, pulse: Pulse) -> None:
         for scheduled in self.schedule.on_pulse(shaft, pulse):
             if scheduled.reason == "window":
                 latest = self.monitor.latest_window
@@ -620,6 +619,7 @@ class OfflineAnalysis:
             if not math.isfinite(self.result.first_time):
                 self.result.first_time = clock
             self.result.last_time = clock
+        self._context_before, self._context_time = None, self._log_ns
 
     def _on_load_cell(self, log_time_ns: int, data: bytes) -> None:
         """The load cell's force, for the axial-load criterion (and the rows)."""

@@ -270,8 +270,9 @@ class SlipMonitor:
         if counter.phase or self.phase is None or counter.epoch != self._phase_epoch:
             self._take_phase(shaft, pulse)
         t = pulse.time
-        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
-            self._now = float(t) if self._now is None else max(self._now, float(t))
+        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
+            if self._now is None or t > self._now:
+                self._now = float(t)
         for window in done:
             self._add_window(window)
         return bool(done)

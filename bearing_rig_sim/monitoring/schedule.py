@@ -57,7 +57,7 @@ class StatusSchedule:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
         t = pulse.time
-        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
             self._advance(float(t), out)
         if self.monitor.add_pulse(shaft, pulse):
             out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
@@ -71,7 +71,8 @@ class StatusSchedule:
             self.monitor.check(tick)
             out.append(ScheduledStatus(tick, "tick", self.monitor.status()))
             self._tick += 1
-        self.clock = max(self.clock, t)
+        if t > self.clock:
+            self.clock = t
 
     def advance_to(self, t: float) -> list[ScheduledStatus]:
         """The ticks due up to the rig time ``t`` (s) without a pulse: those the next pulse would

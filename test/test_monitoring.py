@@ -498,3 +498,44 @@ def test_a_windows_load_is_the_mean_of_the_load_cell_samples_stamped_inside_it(d
     assert monitor.latest_window is not None and monitor.latest_window.end_time == end
     assert inside.sum() == pytest.approx((end - start) * rate_hz, abs=1.0)
     assert monitor.latest_window.axial_load == pytest.approx(float(np.mean(forces[inside])), rel=1e-12)
+
+
+def test_pruning_the_spindle_pulses_late_changes_no_window_and_keeps_few(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Old spindle pulses are dropped every SPINDLE_PRUNE_PULSES pulses, not at every one: the
+    windows, their phase points and the statuses are those of pruning at every pulse, to the
+    bit (the interpolation always finds the pulse before its bracket), and the pulses kept stay
+    within the prune period of what a waiting window needs. A run-up with a lost spindle pulse
+    and a spindle gap, so the parabola's picks and the spacing measurement both move."""
+    from bearing_rig_sim.monitoring import windows
+
+    rng = np.random.default_rng(11)
+    accelerating = 0.5 * 40.0 * np.linspace(0.0, 6.0, 4000) ** 2  # spindle angle at 40 rad/s^2, rad
+    spindle_times = np.interp(np.arange(1, int(accelerating[-1] / (TWO_PI / 4))) * TWO_PI / 4, accelerating, np.linspace(0.0, 6.0, 4000))
+    spindle_times = spindle_times + rng.normal(0.0, 2e-6, spindle_times.size)
+    spindle = [p for k, p in enumerate(train(spindle_times, 4, "spindle")) if k not in (300, 301, 302, 900)]
+    cage_angle = 0.41 * accelerating
+    cage_times = np.interp(np.arange(1, int(cage_angle[-1] / (TWO_PI / 3))) * TWO_PI / 3, cage_angle, np.linspace(0.0, 6.0, 4000))
+    cage = train(cage_times, 3, "cage")
+
+    def run(prune_every: int) -> tuple[list[str], list[str], int]:
+        """reprs (NaN-safe, exact to the bit) of the windows with the phase slope's latest
+        spindle angle, and of every status; the most spindle pulses kept."""
+        monkeypatch.setattr(windows, "SPINDLE_PRUNE_PULSES", prune_every)
+        monitor = make()
+        done: list[str] = []
+        statuses: list[str] = []
+        kept = 0
+        for _t, shaft, pulse in sorted((p.time, p.sensor_id, p) for p in spindle + cage):
+            if monitor.add_pulse(shaft, pulse):
+                phase = monitor.phase
+                done.append(repr((monitor.latest_window, phase._inner[-1] if phase is not None and phase._inner else None)))
+            statuses.append(repr(monitor.status()))
+            kept = max(kept, len(monitor.counter._shafts["spindle"].times))
+        return done, statuses, kept
+
+    period = windows.SPINDLE_PRUNE_PULSES
+    every = run(0)
+    late = run(period)
+    assert len(every[0]) > 20
+    assert late[:2] == every[:2]
+    assert every[2] < late[2] <= every[2] + period

@@ -84,3 +84,18 @@ def test_analyze_of_a_bag_recorded_out_of_order_gives_the_stamp_orders_statuses(
     rows: list = []
     analyse_bag(write_bench_bag(tmp_path / "late", SCENARIO, log_lag_s={"spindle": 0.7}), on_row=rows.append)
     assert [r.state for r in rows] == [state for _, _, state, _ in EXPECTED]
+
+
+def test_equal_stamps_go_on_cage_first_and_each_shaft_in_its_own_order() -> None:
+    """The release rule at ties: a pulse goes on once the other shaft has one at or after it, the
+    cage's before the spindle's at the same stamp; the end of the recording flushes the rest in
+    stamp order."""
+    order = StampOrder(max_lead_s=5.0)
+    spindle = [Pulse(t, 0, 1, 0, k) for k, t in enumerate((1.0, 2.0, 2.0, 3.0))]
+    cage = [Pulse(t, 0, 1, 0, k) for k, t in enumerate((2.0, 2.5))]
+    released = [p for s in spindle for p in order.push("spindle", s)]
+    assert released == []  # no cage pulse yet, and the spindle has not run max_lead_s ahead
+    released = order.push("cage", cage[0])
+    assert released == [("spindle", spindle[0]), ("cage", cage[0]), ("spindle", spindle[1]), ("spindle", spindle[2])]
+    assert order.push("cage", cage[1]) == [("cage", cage[1])]  # the spindle is at 3.0 already
+    assert order.flush() == [("spindle", spindle[3])]  # the cage never reached 3.0

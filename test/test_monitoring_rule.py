@@ -120,3 +120,17 @@ def test_the_phase_slope_at_k2_is_stable_with_probability_1_minus_c(confidence: 
         slope, se, dof = phase_estimate(rng, K2, 20e-6)
         count += stable_after_one_estimate(slope, se, dof, confidence)
     assert within_binomial(count, trials, 1.0 - confidence), (count / trials, 1.0 - confidence)
+
+
+def test_unrolled_interpolations_equal_the_lagrange_polynomial_to_the_bit() -> None:
+    """The spindle angle's parabola and the spacing's cubic, written out for speed, are the
+    general Lagrange formula with the same operations, so the windows do not move by an ulp."""
+    from bearing_rig_sim.monitoring.windows import _cubic, _lagrange, _parabola
+
+    rng = np.random.default_rng(7)
+    for _ in range(2000):
+        xs = np.sort(rng.uniform(0.0, 50.0, 4)).tolist()
+        ys = rng.uniform(-1e4, 1e4, 3).tolist()
+        x = float(rng.uniform(xs[0] - 1.0, xs[3] + 1.0))
+        assert _parabola(*xs[:3], *ys, x) == _lagrange(tuple(xs[:3]), tuple(ys), x)
+        assert _cubic(*xs, x) == _lagrange(tuple(xs), (0.0, 1.0, 2.0, 3.0), x)

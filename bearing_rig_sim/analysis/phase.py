@@ -132,16 +132,20 @@ class PhaseSlope:
         spindle's angle then (rad, spacing-corrected). Kept as given: the sums take it in at
         the next :meth:`estimate` (with the others since, in one vectorised step), and now and
         then (once a ``span``) they are rebuilt on a new reference, O(pulses kept)."""
-        if self.points and not (time > self._t[-1] and cage_index > self._index[-1]):
+        times, indices = self._t, self._index
+        if len(times) > self._head and not (time > times[-1] and cage_index > indices[-1]):
             self.reset()
-        self._t.append(time)
-        self._index.append(cage_index)
+            times, indices = self._t, self._index
+        times.append(time)
+        indices.append(cage_index)
         self._strip.append(strip % self.strips)
         self._inner.append(spindle_angle)
         keep = max(self.max_span, MIN_PHASE_REVOLUTIONS * 2.0 * math.pi / max(self._cage_speed(), 1e-9))
-        while self.points > 2 and time - self._t[self._head] > keep:
-            self._head += 1
-        if time - self._ref_time > self.span or self.points >= 2 * self._rebuilt_at or 2 * self._head > len(self._t):
+        head, count = self._head, len(times)
+        while count - head > 2 and time - times[head] > keep:
+            head += 1
+        self._head = head
+        if time - self._ref_time > self.span or count - head >= 2 * self._rebuilt_at or 2 * head > count:
             self._rebuild()
 
     def _rows(self, lo: int, hi: int) -> FloatArray:
@@ -168,9 +172,13 @@ class PhaseSlope:
             grown = np.zeros((max(64, 1 << (hi + 1).bit_length()), self._sums.shape[1]))
             grown[: lo + 1] = self._sums[: lo + 1]
             self._sums = grown
-        n = hi - lo
-        outer = np.concatenate((np.einsum("ki,kj->kij", z, z).reshape(n, -1), np.einsum("ki,kj->kij", dz, dz).reshape(n, -1)), axis=1)
-        self._sums[lo + 1 : hi + 1] = self._sums[lo] + np.cumsum(outer, axis=0)
+        n, dim = hi - lo, self._dim
+        outer = np.empty((n, 2, dim, dim))  # each point's z z' and dz dz', then their running sums
+        np.multiply(z[:, :, None], z[:, None, :], out=outer[:, 0])
+        np.multiply(dz[:, :, None], dz[:, None, :], out=outer[:, 1])
+        flat = outer.reshape(n, 2 * dim * dim)
+        np.add.accumulate(flat, axis=0, out=flat)  # np.cumsum without its dispatch
+        np.add(self._sums[lo], flat, out=self._sums[lo + 1 : hi + 1])
         self._summed, self._z_last = hi, z[-1]
 
     def _rebuild(self) -> None:
@@ -234,17 +242,19 @@ class PhaseSlope:
             return None
         first, last = found
         dim, d2 = self._dim, self._dim * self._dim
-        sums = self._sums[last + 1] - self._sums[first]
-        gram = sums[:d2].reshape(dim, dim)
-        pairs = (self._sums[last + 1, d2:] - self._sums[first + 1, d2:]).reshape(dim, dim)
-        columns = np.flatnonzero(np.diag(gram)[:-1] > 0.0)  # u, u^2 and the strips present
+        sums = self._sums
+        gram = (sums[last + 1, :d2] - sums[first, :d2]).reshape(dim, dim)
+        pairs = (sums[last + 1, d2:] - sums[first + 1, d2:]).reshape(dim, dim)
+        columns = np.flatnonzero(gram.diagonal()[:-1] > 0.0)  # u, u^2 and the strips present
         n, p = last - first + 1, len(columns)
         if n < p + MIN_DOF:
             return None
-        a = gram[columns][:, columns]
-        b = gram[columns, -1]
-        root = 1.0 / np.sqrt(np.diag(a))
-        scale = np.outer(root, root)
+        if p == dim - 1:  # every strip present: no columns to pick (b contiguous, as the dot products below expect)
+            a, b = gram[:-1, :-1], gram[:-1, -1].copy()
+        else:
+            a, b = gram[columns][:, columns], gram[columns, -1]
+        root = 1.0 / np.sqrt(a.diagonal())
+        scale = root[:, None] * root
         eigenvalues, vectors = np.linalg.eigh(a * scale)  # equilibrated: eigenvalues of order 1
         if not eigenvalues[0] > 1e-12 * eigenvalues[-1]:
             return None

@@ -18,7 +18,7 @@ from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
 
 from bearing_rig_sim.bags.errors import BagError
-from bearing_rig_sim.bags.typestore import dependencies
+from bearing_rig_sim.bags.typestore import dependencies, rig_typestore
 from bearing_rig_sim.interfaces import CAGE_PULSES
 
 PULSE_TYPE = CAGE_PULSES.msgtype
@@ -66,12 +66,37 @@ def _repeat(item: Walk | int, count: int | None) -> Walk:
     return walk
 
 
+def _primitives(sizes: list[int]) -> Walk:
+    """Consecutive primitive fields of these sizes, each aligned to its size (one step, not one
+    per field: a message of many numbers is walked at a fraction of the cost)."""
+    run = tuple(sizes)
+
+    def walk(_body: memoryview, position: int, _u32: Callable[..., tuple[int, ...]]) -> int:
+        for size in run:
+            position = ((position + size - 1) & -size) + size
+        return position
+
+    return walk
+
+
 def _walker(typestore: Typestore, kind: Nodetype, arg: Any) -> Walk:
     """The walk over one field (raises KeyError for a type it cannot walk: ``wstring``)."""
     if kind == Nodetype.BASE:
         return _string if arg[0] == "string" else _repeat(_SIZES[arg[0]], 1)
     if kind == Nodetype.NAME:
-        steps = [_walker(typestore, *cast("tuple[Nodetype, Any]", desc)) for _name, desc in typestore.fielddefs[arg][1]]
+        steps: list[Walk] = []
+        sizes: list[int] = []  # a run of single primitive fields, walked in one step
+        for _name, desc in typestore.fielddefs[arg][1]:
+            field_kind, field_arg = cast("tuple[Nodetype, Any]", desc)
+            if field_kind == Nodetype.BASE and field_arg[0] != "string":
+                sizes.append(_SIZES[field_arg[0]])
+                continue
+            if sizes:
+                steps.append(_primitives(sizes))
+                sizes = []
+            steps.append(_walker(typestore, field_kind, field_arg))
+        if sizes:
+            steps.append(_primitives(sizes))
 
         def walk(body: memoryview, position: int, u32: Callable[..., tuple[int, ...]]) -> int:
             for step in steps:
@@ -251,3 +276,137 @@ def decode_pulses(data: bytes, starts: npt.NDArray[np.int64], ends: npt.NDArray[
                 valid[k], name = False, ""
         sensors.append(name)
     return PulseArrays(valid, sec + nanosec * 1e-9, strip_id, strip_count, revolution, pulse_index, sensors)
+
+
+class JointVelocities(NamedTuple):
+    """The fields of a ``sensor_msgs/JointState`` the offline status rows read (rad/s by joint)."""
+
+    name: list[str]
+    velocity: tuple[float, ...]
+
+
+class TruthSpeeds(NamedTuple):
+    """The fields of a ``SimulatorTruth`` the offline status rows read (rad/s, percent, N)."""
+
+    inner_ring_speed: float
+    cage_speed: float
+    slip_rate: float
+    axial_load: float
+
+
+def _text(data: CdrBytes, at: int) -> tuple[str, int]:
+    """The CDR string whose length is at byte ``at`` of ``data`` (body offsets from byte 4, aligned
+    to 4 already), and the body offset after it."""
+    (length,) = _U32[True](data, 4 + at)
+    return bytes(data[8 + at : 8 + at + max(length - 1, 0)]).decode("utf-8"), at + 4 + length
+
+
+def _doubles(data: CdrBytes, at: int) -> tuple[tuple[float, ...], int]:
+    """The float64 sequence at body offset ``at`` and the body offset after it (an empty one is
+    not aligned to 8, as :func:`length_function` walks it)."""
+    at = (at + 3) & ~3
+    (count,) = _U32[True](data, 4 + at)
+    at += 4
+    if not count:
+        return (), at
+    at = (at + 7) & ~7
+    return struct.unpack_from(f"<{count}d", data, 4 + at), at + 8 * count
+
+
+def decode_joint_velocities(data: CdrBytes) -> JointVelocities:
+    """Names and velocities of a little-endian CDR ``sensor_msgs/JointState`` read by hand (the
+    values rosbags' decoder gives, bit for bit, at a tenth of its cost); struct.error or
+    UnicodeDecodeError for bytes that end early or a name that is not UTF-8."""
+    _frame, at = _text(data, 8)
+    at = (at + 3) & ~3
+    (count,) = _U32[True](data, 4 + at)
+    at += 4
+    names = []
+    for _ in range(count):
+        name, at = _text(data, (at + 3) & ~3)
+        names.append(name)
+    _position, at = _doubles(data, at)
+    velocity, _at = _doubles(data, at)
+    return JointVelocities(names, velocity)
+
+
+_TRUTH_HEAD = struct.Struct("<6d")  # inner_ring_speed .. axial_load
+
+
+def decode_truth_speeds(data: CdrBytes) -> TruthSpeeds:
+    """Speeds, slip and load of a little-endian CDR ``SimulatorTruth`` read by hand (the fields
+    right after its header); struct.error or UnicodeDecodeError for bad bytes."""
+    _frame, at = _text(data, 8)
+    inner, _acceleration, cage, _theoretical, slip, axial = _TRUTH_HEAD.unpack_from(data, 4 + ((at + 7) & ~7))
+    return TruthSpeeds(inner, cage, slip, axial)
+
+
+class Stamp(NamedTuple):
+    """A ``builtin_interfaces/Time``."""
+
+    sec: int
+    nanosec: int
+
+
+class StampHeader(NamedTuple):
+    """The stamp of a ``std_msgs/Header``."""
+
+    stamp: Stamp
+
+
+class StatusFields(NamedTuple):
+    """The fields of a ``SlipStatus`` the offline analysis reads (rad/s, percent, 1)."""
+
+    header: StampHeader
+    inner_ring_speed: float
+    cage_speed: float
+    slip_rate: float
+    state: int
+    confidence: float
+    sweep_speed: float
+    sweep_verdict: str
+
+
+_STATUS_SPEEDS = struct.Struct("<6dB")  # inner_ring_speed .. critical_slope, state
+_STATUS_SWEEP = struct.Struct("<5d")  # axial_load .. sweep_stable_from
+
+
+def decode_status_fields(data: CdrBytes) -> StatusFields:
+    """Stamp, speeds, slip, state, confidence and load-sweep verdict of a little-endian CDR
+    ``SlipStatus`` read by hand (the values rosbags' decoder gives); struct.error or
+    UnicodeDecodeError for bad bytes."""
+    sec, nanosec = _PULSE_HEAD.unpack_from(data, 4)[:2]
+    _frame, at = _text(data, 8)
+    at = (at + 7) & ~7
+    inner, cage, _theoretical, slip, _fitted, _critical, state = _STATUS_SPEEDS.unpack_from(data, 4 + at)
+    _criterion, at = _text(data, (at + 49 + 3) & ~3)
+    at = (at + 7) & ~7
+    confidence, _revolutions = struct.unpack_from("<dI", data, 4 + at)
+    _detail, at = _text(data, (at + 12 + 3) & ~3)
+    at = (at + 7) & ~7
+    sweep_speed = _STATUS_SWEEP.unpack_from(data, 4 + at)[3]
+    verdict, _at = _text(data, (at + 40 + 3) & ~3)
+    return StatusFields(StampHeader(Stamp(sec, nanosec)), inner, cage, slip, state, confidence, sweep_speed, verdict)
+
+
+def make_field_decoder(typestore: Typestore, msgtype: str, fields: Callable[[CdrBytes], object]) -> Callable[[CdrBytes], object]:
+    """A function giving ``fields(data)`` for a complete little-endian message of ``msgtype`` (its
+    length walked first, so what :func:`make_decoder` refuses is not read by hand) and
+    :func:`make_decoder`'s message for any other bytes (BagError for a malformed or cut one).
+    ``fields`` reads the rig's own layout of the type: a ``typestore`` (a bag's) that defines
+    it otherwise, such as an older recording's, is decoded by :func:`make_decoder` alone."""
+    general = make_decoder(typestore, msgtype)
+    rig = rig_typestore()
+    same_layout = all(typestore.fielddefs.get(name) == rig.fielddefs.get(name) for name in dependencies(rig, [msgtype]))
+    length = length_function(typestore, msgtype) if same_layout else None
+
+    def decode(data: CdrBytes) -> object:
+        if length is not None and bytes(data[:2]) == LITTLE_ENDIAN:
+            try:
+                length(data)
+                return fields(data)
+            except (BagError, *_MALFORMED):
+                pass
+        return general(data)
+
+    return decode

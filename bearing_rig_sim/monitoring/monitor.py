@@ -280,12 +280,16 @@ class SlipMonitor:
         Returns:
             Whether a slip window was completed (the status may have changed).
         """
-        done = self.counter.add_pulse(shaft, pulse)
-        self._take_events()
-        self._take_phase(shaft, pulse)
+        counter = self.counter
+        done = counter.add_pulse(shaft, pulse)
+        if counter.events:
+            self._take_events()
+        if counter.phase or self.phase is None or counter.epoch != self._phase_epoch:
+            self._take_phase(shaft, pulse)
         t = pulse.time
-        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
-            self._now = float(t) if self._now is None else max(self._now, float(t))
+        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
+            if self._now is None or t > self._now:
+                self._now = float(t)
         for window in done:
             self._add_window(window)
         return bool(done)
@@ -326,6 +330,8 @@ class SlipMonitor:
                 self.slope.refresh(external)
 
     def _take_events(self) -> None:
+        if not self.counter.events:
+            return
         for kind, when, text in self.counter.events:
             if kind == "reset":
                 self.slope.reset()

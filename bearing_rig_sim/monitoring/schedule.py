@@ -57,7 +57,7 @@ class StatusSchedule:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
         t = pulse.time
-        if isinstance(t, (int, float)) and not isinstance(t, bool) and math.isfinite(t):
+        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
             self._advance(float(t), out)
         if self.monitor.add_pulse(shaft, pulse):
             out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
@@ -71,7 +71,8 @@ class StatusSchedule:
             self.monitor.check(tick)
             out.append(ScheduledStatus(tick, "tick", self.monitor.status()))
             self._tick += 1
-        self.clock = max(self.clock, t)
+        if t > self.clock:
+            self.clock = t
 
     def advance_to(self, t: float) -> list[ScheduledStatus]:
         """The ticks due up to the rig time ``t`` (s) without a pulse: those the next pulse would
@@ -256,9 +257,13 @@ class StampOrder:
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
         t = pulse.time
-        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
-            return [(shaft, pulse)]
-        self._latest[shaft] = max(self._latest[shaft], float(t))
+        if not (type(t) is float and math.isfinite(t) and shaft in self._held):  # the common case first
+            if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+                return [(shaft, pulse)]
+            t = float(t)
+        latest = self._latest
+        if t > latest[shaft]:
+            latest[shaft] = t
         self._held[shaft].append(pulse)
         return self._release(-math.inf)
 
@@ -277,13 +282,17 @@ class StampOrder:
         return self._release(math.inf)
 
     def _release(self, until: float) -> list[tuple[str, Pulse]]:
+        """The held pulses that may go on, in stamp order (the cage's first at equal stamps)."""
         out: list[tuple[str, Pulse]] = []
-        while True:
-            heads = [(float(q[0].time), name) for name, q in self._held.items() if q]
-            if not heads:
-                return out
-            t, name = min(heads)
-            other = "cage" if name == "spindle" else "spindle"
-            if not (t <= until or self._latest[other] >= t or self._latest[name] - t > self.max_lead_s):
-                return out
-            out.append((name, self._held[name].popleft()))
+        spindle, cage = self._held["spindle"], self._held["cage"]
+        latest = self._latest
+        while spindle or cage:
+            if cage and (not spindle or float(cage[0].time) <= float(spindle[0].time)):
+                name, other, queue = "cage", "spindle", cage
+            else:
+                name, other, queue = "spindle", "cage", spindle
+            t = float(queue[0].time)
+            if not (t <= until or latest[other] >= t or latest[name] - t > self.max_lead_s):
+                break
+            out.append((name, queue.popleft()))
+        return out

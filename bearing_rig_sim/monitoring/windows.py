@@ -96,6 +96,10 @@ start: lost only once the other shaft has turned ``silent_shaft_revolutions`` si
 pulse, so a spindle turned by hand at rest, or a stray edge of a strip standing at the sensor,
 is no fault. Once one shaft runs, each is judged by its own silence."""
 
+SPINDLE_PRUNE_PULSES = 64
+"""Spindle pulses kept beyond those still needed before the old ones are dropped (1): a pruning
+at every pulse cost more than the rest of the pulse's handling."""
+
 SPACING_AVERAGE_REVOLUTIONS = 32
 """Revolutions over which each strip's spacing error is averaged: the plain mean of the first 32
 samples, then an exponential weight of 1/32."""
@@ -182,6 +186,7 @@ class _Shaft:
     recent_gaps: deque[tuple[int, int]] = field(default_factory=deque)  # (index, lost)
     recent: deque[tuple[int, float]] = field(default_factory=deque)  # last pulses (index, time)
     other_pulses_at_last: int = 0  # the other shaft's pulses received when this one last pulsed
+    prune_at: int = 0  # kept spindle pulses at which the next pruning is due
 
     def established(self) -> bool:
         """Whether the shaft has turned :data:`ESTABLISHED_REVOLUTIONS` since its restart, so that
@@ -352,8 +357,10 @@ class SlipWindows:
         s.last_time, s.last_index = t, index
         s.pulses += 1
         s.other_pulses_at_last = self._shafts[OTHER[shaft]].pulses
-        self.silent.pop(shaft, None)
-        self._suspect.discard(shaft)
+        if self.silent:
+            self.silent.pop(shaft, None)
+        if self._suspect:
+            self._suspect.discard(shaft)
         self.stopped = ""
         if shaft == "spindle":
             self._add_spindle_pulse(s, t, index)
@@ -398,11 +405,11 @@ class SlipWindows:
             return
         # the parabola through the first three passages, at the fourth: 3 revolutions if the
         # acceleration is constant
-        predicted = _lagrange((t0, t1, t2), (0.0, 1.0, 2.0), t3)
+        predicted = _parabola(t0, t1, t2, 0.0, 1.0, 2.0, t3)
         if not abs(predicted - 3.0) <= STEADY_ANGLE_TOLERANCE_REV:
             return
         middle = recent[n + 1 : 2 * n + 1]
-        d = [_lagrange((t0, t1, t2, t3), (0.0, 1.0, 2.0, 3.0), time) - (index - first_index) / n for index, time in middle]
+        d = [_cubic(t0, t1, t2, t3, time) - (index - first_index) / n for index, time in middle]
         mean = sum(d) / n
         assert s.offset is not None
         for (index, _), dm in zip(middle, d):
@@ -454,8 +461,10 @@ class SlipWindows:
         if k >= len(times) - 1:
             return self._angle(spindle, len(times) - 1)
         first = max(0, min(k - 1, len(times) - 3))
-        picks = range(first, min(first + 3, len(times)))
-        return _lagrange(tuple(times[j] for j in picks), tuple(self._angle(spindle, j) for j in picks), t)
+        if first + 3 > len(times):
+            picks = range(first, len(times))
+            return _lagrange(tuple(times[j] for j in picks), tuple(self._angle(spindle, j) for j in picks), t)
+        return _parabola(times[first], times[first + 1], times[first + 2], self._angle(spindle, first), self._angle(spindle, first + 1), self._angle(spindle, first + 2), t)
 
     def _angle(self, spindle: _Shaft, j: int) -> float:
         """Angle of the spindle's kept pulse ``j``, revolutions, with its strip's spacing error."""
@@ -482,7 +491,12 @@ class SlipWindows:
         return done
 
     def _prune_spindle(self) -> None:
+        """Drop the spindle pulses no window or cage pulse waiting can need, once
+        :data:`SPINDLE_PRUNE_PULSES` have come since the last time (keeping older ones changes
+        no interpolation: the pulse before the bracket is kept either way)."""
         spindle, cage = self._shafts["spindle"], self._shafts["cage"]
+        if len(spindle.times) < spindle.prune_at:
+            return
         starts = [t0 for t0, _, _ in self._pending]
         if self._phase_pending:
             starts.append(self._phase_pending[0][0])
@@ -494,6 +508,7 @@ class SlipWindows:
         if k > 0:
             del spindle.times[:k]
             del spindle.indices[:k]
+        spindle.prune_at = len(spindle.times) + SPINDLE_PRUNE_PULSES
 
     # -- time-based checks ---------------------------------------------------------------------
     def check(self, now: float) -> None:
@@ -563,9 +578,31 @@ def _lagrange(xs: tuple[float, ...], ys: tuple[float, ...], x: float) -> float:
     return total
 
 
+def _parabola(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float, x: float) -> float:
+    """:func:`_lagrange` through three points, with the same operations in the same order (so
+    the same value to the bit), without its loops."""
+    return 0.0 + (x - x1) / (x0 - x1) * ((x - x2) / (x0 - x2)) * y0 + (x - x0) / (x1 - x0) * ((x - x2) / (x1 - x2)) * y1 + (x - x0) / (x2 - x0) * ((x - x1) / (x2 - x1)) * y2
+
+
+def _cubic(x0: float, x1: float, x2: float, x3: float, x: float) -> float:
+    """:func:`_lagrange` through (x0, 0), (x1, 1), (x2, 2), (x3, 3), with the same operations in
+    the same order (so the same value to the bit), without its loops."""
+    a0, a1, a2, a3 = x - x0, x - x1, x - x2, x - x3
+    w0 = a1 / (x0 - x1) * (a2 / (x0 - x2)) * (a3 / (x0 - x3))
+    w1 = a0 / (x1 - x0) * (a2 / (x1 - x2)) * (a3 / (x1 - x3))
+    w2 = a0 / (x2 - x0) * (a1 / (x2 - x1)) * (a3 / (x2 - x3))
+    w3 = a0 / (x3 - x0) * (a1 / (x3 - x1)) * (a2 / (x3 - x2))
+    return 0.0 + w0 * 0.0 + w1 * 1.0 + w2 * 2.0 + w3 * 3.0
+
+
 def _malformed(pulse: Pulse) -> str:
     """Why a pulse cannot be used ("" if it can)."""
     t = pulse.time
+    strip_id, strip_count, pulse_index = pulse.strip_id, pulse.strip_count, pulse.pulse_index
+    # the common case first, on exact types (a bool is no int here); anything else is checked below
+    if type(t) is float and type(strip_id) is int and type(strip_count) is int and type(pulse_index) is int:
+        if math.isfinite(t) and 0 <= strip_id < strip_count and pulse_index >= 0:
+            return ""
     if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
         return f"time {t!r} is not a finite number"
     for name in ("strip_id", "strip_count", "pulse_index"):

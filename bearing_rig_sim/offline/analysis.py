@@ -20,7 +20,10 @@ once, its messages as arrays): the pulses decoded as arrays
 (:func:`~bearing_rig_sim.bags.cdr.decode_pulses`; other encodings through the reader's general
 decoder, one by one); the load cell, recorded statuses and spindle commands one by one; the 1 kHz
 speeds and the other sampled topics (:data:`SAMPLED_TOPICS`) not message by message: a chunk of
-them is kept and only the message a status row samples is decoded. Memory does not grow with
+them is kept and only the message a status row samples is decoded (the speeds' and the truth's
+fields by hand, :func:`~bearing_rig_sim.bags.cdr.decode_joint_velocities` and
+:func:`~bearing_rig_sim.bags.cdr.decode_truth_speeds`: a status row samples both; the recorded
+statuses' likewise, :func:`~bearing_rig_sim.bags.cdr.decode_status_fields`). Memory does not grow with
 the bag's length: rows and windows stream to CSV files as they are made, and only a decimated
 copy of the rows (at most ``max_points``) and the state changes are kept for plots.
 
@@ -46,6 +49,7 @@ Units: SI inside (s, rad/s, N), slip in percent; the CSV files speak rpm, percen
 
 from __future__ import annotations
 
+import bisect
 import dataclasses
 from collections import deque
 import functools
@@ -65,7 +69,7 @@ from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
-from bearing_rig_sim.bags.cdr import decode_pulses, make_decoder
+from bearing_rig_sim.bags.cdr import decode_joint_velocities, decode_pulses, decode_status_fields, decode_truth_speeds, make_decoder, make_field_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
 from bearing_rig_sim.bags.mcapfile import ChunkBatch
 from bearing_rig_sim.bags.reader import BagReader, open_bag
@@ -90,6 +94,7 @@ from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype
+STATUS_TYPE = contract.SLIP_STATUS.msgtype
 DIAGNOSTICS = contract.DIAGNOSTICS.name
 """Where the monitor publishes the parameters its statuses are judged by."""
 PULSE_TOPICS: dict[str, str] = {shaft: t.name for shaft, t in contract.PULSE_TOPICS.items()}
@@ -291,6 +296,8 @@ class _Sampled(_Decoding):
     def __init__(self, decode: Callable[[bytes], Any]) -> None:
         super().__init__(decode)
         self._current: ChunkBatch | None = None
+        self._times: list[int] = []  # the current batch's log times (a list: bisected at every row)
+        self._entry: tuple[int, tuple[int, bytes]] | None = None  # (position, entry) last asked for
         self._before: tuple[int, bytes] | None = None  # the last message of the batches left behind
 
     def take(self, batch: ChunkBatch) -> None:
@@ -298,7 +305,7 @@ class _Sampled(_Decoding):
         current = self._current
         if current is not None:
             self._before = (int(current.log_times[-1]), current.data[int(current.starts[-1]) : int(current.ends[-1])])
-        self._current = batch
+        self._current, self._times, self._entry = batch, batch.log_times.tolist(), None
 
     def get(self, at_ns: int) -> Any:
         """The latest message taken logged at or before ``at_ns`` (ns), decoded; None if none
@@ -306,9 +313,11 @@ class _Sampled(_Decoding):
         entry = self._before
         current = self._current
         if current is not None:
-            k = int(np.searchsorted(current.log_times, at_ns, side="right")) - 1
+            k = bisect.bisect_right(self._times, at_ns) - 1
             if k >= 0:
-                entry = (int(current.log_times[k]), current.data[int(current.starts[k]) : int(current.ends[k])])
+                if self._entry is None or self._entry[0] != k:
+                    self._entry = (k, (self._times[k], current.data[int(current.starts[k]) : int(current.ends[k])]))
+                entry = self._entry[1]
         return self._value(entry)
 
 
@@ -319,19 +328,23 @@ class _SampledTopics:
     in stamp order), not before the chunk the latest time reached."""
 
     def __init__(self, bag: BagReader, names: list[str]) -> None:
-        self.topics = {name: _Sampled(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in names}
-        self._pending: deque[dict[str, ChunkBatch]] = deque()
+        by_hand = {SPEEDS: decode_joint_velocities, TRUTH: decode_truth_speeds}  # sampled by every row
+        self.topics = {
+            name: _Sampled(make_field_decoder(bag.typestore, CONTEXT_TOPICS[name], by_hand[name]) if name in by_hand else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            for name in names
+        }
+        self._pending: deque[tuple[int, dict[str, ChunkBatch]]] = deque()  # (first log time, batches)
 
     def push(self, batches: dict[str, ChunkBatch]) -> None:
         """The topics' messages of the next chunk (each in log-time order; none empty)."""
         if batches:
-            self._pending.append(batches)
+            self._pending.append((min(int(b.log_times[0]) for b in batches.values()), batches))
 
     def get(self, at_ns: int) -> dict[str, Any]:
         """Each topic's latest message logged at or before ``at_ns`` (ns), decoded (None if none)."""
         pending = self._pending
-        while pending and min(int(b.log_times[0]) for b in pending[0].values()) <= at_ns:
-            for name, batch in pending.popleft().items():
+        while pending and pending[0][0] <= at_ns:
+            for name, batch in pending.popleft()[1].items():
                 self.topics[name].take(batch)
         return {name: topic.get(at_ns) for name, topic in self.topics.items()}
 
@@ -416,7 +429,11 @@ class OfflineAnalysis:
         )
         self._rows = RowDecimator(max_points)
         self._on_row, self._on_window = on_row, on_window
-        self._latest = {name: _Latest(make_decoder(bag.typestore, CONTEXT_TOPICS[name])) for name in self._context if name not in SAMPLED_TOPICS}
+        self._latest = {
+            name: _Latest(make_field_decoder(bag.typestore, STATUS_TYPE, decode_status_fields) if name == STATUS else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            for name in self._context
+            if name not in SAMPLED_TOPICS
+        }
         self._sampled = _SampledTopics(bag, [name for name in self._context if name in SAMPLED_TOPICS])
         self._decode_pulse_message = make_decoder(bag.typestore, PULSE_TYPE)
         self._bad_pulses = 0
@@ -568,7 +585,7 @@ class OfflineAnalysis:
         self._take_pulse(topic, log_time_ns, pulse)
 
     def _take_pulse(self, topic: str, log_time_ns: int, pulse: Pulse) -> None:
-        if unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
+        if pulse.time == 0.0 and unstamped(pulse.time, log_time_ns * 1e-9):  # a counter that does not stamp: the reception time
             self._unstamped += 1
             if self._unstamped == 1:
                 self._report(
@@ -584,14 +601,8 @@ class OfflineAnalysis:
 
     def _feed(self, shaft: str, pulse: Pulse) -> None:
         """One pulse, in stamp order, through the schedule; its statuses take the context read
-        before it."""
+        before it (a failure ends the analysis: no later status takes that context)."""
         self._context_before, self._context_time = self._read_at.pop(id(pulse), (None, self._log_ns))
-        try:
-            self._schedule_pulse(shaft, pulse)
-        finally:
-            self._context_before, self._context_time = None, self._log_ns
-
-    def _schedule_pulse(self, shaft: str, pulse: Pulse) -> None:
         for scheduled in self.schedule.on_pulse(shaft, pulse):
             if scheduled.reason == "window":
                 latest = self.monitor.latest_window
@@ -608,6 +619,7 @@ class OfflineAnalysis:
             if not math.isfinite(self.result.first_time):
                 self.result.first_time = clock
             self.result.last_time = clock
+        self._context_before, self._context_time = None, self._log_ns
 
     def _on_load_cell(self, log_time_ns: int, data: bytes) -> None:
         """The load cell's force, for the axial-load criterion (and the rows)."""

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import math
+import operator
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -133,18 +134,18 @@ class CsvWriter:
         self._file = open(path, "w", encoding="utf-8", newline="")
         self._writer = csv.writer(self._file)
         self._writer.writerow([name for name, _attr, _scale in columns])
+        self._values = operator.attrgetter(*(attr for _name, attr, _scale in columns)) if len(columns) > 1 else None
+        self._scales = [None if scale == 1.0 else scale for _name, _attr, scale in columns]
 
     def write(self, row: Any) -> None:
         """Append one row."""
-        out = []
-        for _name, attr, scale in self.columns:
-            value = getattr(row, attr)
-            if isinstance(value, float):
-                value = repr(value * scale if scale != 1.0 else value)
-            elif value is None:
-                value = ""
-            out.append(value)
-        self._writer.writerow(out)
+        values = self._values(row) if self._values is not None else tuple(getattr(row, attr) for _name, attr, _scale in self.columns)
+        self._writer.writerow(
+            [
+                (repr(value) if scale is None else repr(value * scale)) if isinstance(value, float) else "" if value is None else value
+                for value, scale in zip(values, self._scales)
+            ]
+        )
 
     def close(self) -> None:
         """Close the file."""

@@ -73,7 +73,12 @@ def test_every_qos_name_means_the_same_to_the_nodes_and_to_the_bags() -> None:
     # The twin's high-rate streams are the ones a recorder must get whole (issue: no pulse lost in a bag).
     # The load cell's stream is among them: as sensor data a loaded host lost 7 % of it to the bag.
     streams = {t.name for t in interfaces.TOPICS if t.qos == "reliable_stream"}
-    assert streams == {"/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force", "/rig/axial_load/force"}
+    assert streams >= {"/clock", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/speeds", "/rig/truth", "/rig/bearing/axial_force", "/rig/axial_load/force"}
+    # Depth 10 only for what comes on request or about once a second: a periodic stream (the
+    # load controller's state, the thermocouple, the torque meter, the monitor's statuses, the
+    # shadow's residuals) on it lost the odd sample to a recorder held up under load.
+    shallow = {t.name for t in interfaces.TOPICS if interfaces.QOS_TABLE[t.qos].depth < 1000}
+    assert shallow == {"/rig/spindle/command", "/rig/axial_load/setpoint", "/twin/calibration_estimate", "/diagnostics"}
     # The load set-points, sent ahead all at once (a load sweep's 40): a depth of 10 would drop 30;
     # transient local, so a reader whose own side matched after the writer's still gets the first.
     setpoints = interfaces.QOS_TABLE[interfaces.LOAD_SETPOINT.qos]

@@ -53,7 +53,8 @@ def test_every_topic_of_the_interface_table_is_declared_with_its_qos(fake: tuple
     assert writer.topics["/rig/speeds"] == ("sensor_msgs/msg/JointState", "reliable_stream")
     assert writer.topics["/rig/axial_load/force"][1] == "reliable_stream"
     assert writer.topics["/rig/load/setpoint"][1] == "transient_stream"
-    assert writer.topics["/rig/slip_status"][1] == "transient_local"
+    assert writer.topics["/rig/slip_status"][1] == "transient_stream"
+    assert writer.topics["/rig/housing/torque"][1] == "reliable_stream"
     assert writer.topics["/clock"][1] == "reliable_stream"
 
 

@@ -1,7 +1,7 @@
 """Each bearing quantity named once: every field of the engine's bearing records names the
 bearing-file key it is read from (:mod:`bearing_rig_sim.bearing.file_record`), the records built
 from the shipped files hold what those files write, and the names a calibration may set are
-kept apart from them. The files are read here with PyYAML, not through the models,
+derived from the same declarations. The files are read here with PyYAML, not through the models,
 so a value cannot agree with itself."""
 
 from __future__ import annotations
@@ -18,9 +18,11 @@ import pytest
 import yaml
 
 from bearing_rig_sim.bearing.file_record import CONVERT, file_field, file_keys, file_record, file_values
-from bearing_rig_sim.config import config_path
+from bearing_rig_sim.config import ConfigError, config_path
+from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE_KEYS, CalibrationFile
 from bearing_rig_sim.dynamics.models import PAPER, model_parameters
 from bearing_rig_sim.dynamics.parameters import CALIBRATABLE, BearingParameters
+from bearing_rig_sim.settings_model import validate_mapping
 from bearing_rig_sim.thermal.bearing import ThermalConfig
 
 BEARINGS = [Path(p) for p in sorted(glob.glob(str(config_path("bearings", "*.yaml"))))]
@@ -45,6 +47,34 @@ def written(doc: dict[str, Any], key: str) -> tuple[bool, Any]:
     if isinstance(value, str) and re.fullmatch(r"[0-9.]+e[0-9]+", value):
         value = float(value)
     return True, value
+
+
+def test_calibratable_names_and_keys_are_those_the_calibration_files_use() -> None:
+    """The engine names and bearing-file keys a calibration may set, as written by hand before
+    they were derived from the declarations (calibration files and ``--fit`` use them)."""
+    assert CALIBRATABLE == {
+        "stiction_velocity": ("friction", "stiction_velocity_m_s"),
+        "static_friction": ("friction", "static_coefficient"),
+        "ball_drag_scale": ("resistances", "ball_drag_scale"),
+        "cage_land_viscous_scale": ("resistances", "cage_land_viscous_scale"),
+        "cage_land_boundary_torque_scale": ("resistances", "cage_land_boundary_torque_scale"),
+        "rolling_hysteresis_factor": ("resistances", "rolling_hysteresis_factor"),
+        "oil_volume_fraction": ("lubricant", "oil_volume_fraction"),
+        "yield_stress": ("lubricant", "yield_stress_pa"),
+        "consistency": ("lubricant", "consistency_pa_sn"),
+        "fill_fraction": ("lubricant", "fill_fraction"),
+        "eyring_stress": ("lubricant", "eyring_stress_pa"),
+        "consistency_temperature_exponent": ("lubricant", "consistency_temperature_exponent"),
+        "ball_set_resistance": ("resistances", "ball_set_resistance_n"),
+        "ball_set_resistance_speed_exponent": ("resistances", "ball_set_resistance_speed_exponent"),
+    }
+    assert sorted(CALIBRATABLE_KEYS) == sorted(f"{sec}.{key}" for sec, key in CALIBRATABLE.values())
+
+
+def test_a_key_not_declared_calibratable_is_refused_in_a_calibration_file() -> None:
+    with pytest.raises(ConfigError) as info:
+        validate_mapping(CalibrationFile, {"parameters": {"friction.dynamic_coefficient": 0.1}}, "cal.yaml")
+    assert str(info.value).startswith("cal.yaml: parameters.friction.dynamic_coefficient: not a calibratable parameter; allowed: friction.static_coefficient,")
 
 
 @pytest.mark.parametrize("record", list(RECORDS), ids=lambda r: r.__name__)

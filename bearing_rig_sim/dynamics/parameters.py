@@ -41,10 +41,9 @@ from typing import Any, cast
 import numpy as np
 
 from bearing_rig_sim.config import read_mapping, shipped_bearing_file, shipped_calibration_file
-from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE as CALIBRATABLE  # what a calibration may set, re-exported
-from bearing_rig_sim.dynamics.bearing_file import FRICTION_MODELS, BearingFile, CalibrationFile
+from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE_KEYS, FRICTION_MODELS, LUBRICANT_OVERRIDES, BearingFile, CalibrationFile
 from bearing_rig_sim.dynamics import kernels as kn
-from bearing_rig_sim.bearing.file_record import file_field, file_record, file_values
+from bearing_rig_sim.bearing.file_record import file_field, file_keys, file_record, file_values
 from bearing_rig_sim.bearing.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
@@ -253,6 +252,19 @@ class BearingParameters:
     def epicyclic_ratio(self) -> float:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+
+def _calibratable() -> dict[str, tuple[str, str]]:
+    names = {key: name for name, key in file_keys(BearingParameters).items()}
+    names |= {f"lubricant.{key}": field for key, field in LUBRICANT_OVERRIDES.items()}
+    return {names[key]: (key.partition(".")[0], key.partition(".")[2]) for key in CALIBRATABLE_KEYS}
+
+
+CALIBRATABLE: dict[str, tuple[str, str]] = _calibratable()
+"""Parameters a calibration file may set: name -> (section, key) in the bearing file. The keys
+are those declared calibratable (:data:`.bearing_file.CALIBRATABLE_KEYS`); a name is that of the
+:class:`BearingParameters` field reading the key, or of the :class:`.lubrication.Lubricant`
+field the key overrides (:data:`.bearing_file.LUBRICANT_OVERRIDES`)."""
 
 
 def overlay_calibration(bearing: Mapping[str, Any], calibration: CalibrationFile) -> dict[str, Any]:

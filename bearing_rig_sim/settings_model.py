@@ -237,11 +237,14 @@ def quantity(
     lt: float | None = None,
     le: float | None = None,
     default: Any = ...,
+    calibratable: bool = False,
 ) -> Any:
     """One physical parameter of a data file (bearing, lubricant, calibration, sweep): what it
     is, its SI unit (``"1"`` for a pure number), where its plausible range (``gt``, ``ge``,
-    ``lt``, ``le``) comes from, and its default where the key may be left out."""
-    return Field(default, description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra={"unit": unit, "source": source})
+    ``lt``, ``le``) comes from, its default where the key may be left out, and whether a
+    calibration file may set it."""
+    extra: dict[str, Any] = {"unit": unit, "source": source} | ({"calibratable": True} if calibratable else {})
+    return Field(default, description=description, gt=gt, ge=ge, lt=lt, le=le, json_schema_extra=extra)
 
 
 @dataclass(frozen=True)

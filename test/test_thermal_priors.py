@@ -19,7 +19,8 @@ import numpy as np
 import pytest
 
 from bearing_rig_sim.dynamics import BearingParameters
-from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE, CalibrationFile
+from bearing_rig_sim.dynamics.bearing_file import CalibrationFile
+from bearing_rig_sim.dynamics.parameters import CALIBRATABLE
 from bearing_rig_sim.dynamics.calibrations import COUPLED, DEFAULT_CALIBRATION, ISOTHERMAL, NAMED, calibration_file, is_coupled
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.settings_model import read_file

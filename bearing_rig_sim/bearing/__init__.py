@@ -6,6 +6,8 @@
   constant, contact ellipse);
 * :mod:`.materials`: the thermal and elastic facts of the bearing's materials and the cavity's
   fluids, each with its source.
+* :mod:`.file_record`: the engine's bearing records, each field declared once with the
+  bearing-file key it is read from.
 
 ``dynamics/``, ``thermal/`` and ``analysis/`` import these; nothing here imports them.
 """

@@ -10,15 +10,17 @@ The values each file states, and where they come from, are in the file's comment
 here are what any bearing or lubricant of this kind may have. The objects the engine uses are
 built from the validated files in :mod:`.parameters` (:class:`~.parameters.BearingParameters`)
 and :mod:`.lubrication` (:class:`~.lubrication.Lubricant`); the thermal network reads the same
-bearing file (:class:`~bearing_rig_sim.thermal.bearing.ThermalConfig`). No ROS import.
+bearing file (:class:`~bearing_rig_sim.thermal.bearing.ThermalConfig`). Each field of those
+records names its key here once (:mod:`bearing_rig_sim.bearing.file_record`); whether a
+calibration file may set a key is stated at the key (``calibratable=True``). No ROS import.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Annotated, Any, Self
+from typing import Annotated, Any, Self, get_args
 
-from pydantic import BeforeValidator, ConfigDict, Field, model_validator
+from pydantic import BaseModel, BeforeValidator, ConfigDict, Field, model_validator
 
 from bearing_rig_sim.config import check_number
 from bearing_rig_sim.settings_model import FileSection, Flag, Integer, Number, StatedQuantity, Text, field_error, one_of, quantity, validate_mapping
@@ -54,24 +56,6 @@ LUBRICANT_OVERRIDES = {
 }
 """Keys of the bearing file's ``lubricant:`` section that override the lubricant file (a
 calibration sets them): key -> :class:`~.lubrication.Lubricant` field."""
-
-CALIBRATABLE: dict[str, tuple[str, str]] = {
-    "stiction_velocity": ("friction", "stiction_velocity_m_s"),
-    "static_friction": ("friction", "static_coefficient"),
-    "ball_drag_scale": ("resistances", "ball_drag_scale"),
-    "cage_land_viscous_scale": ("resistances", "cage_land_viscous_scale"),
-    "cage_land_boundary_torque_scale": ("resistances", "cage_land_boundary_torque_scale"),
-    "rolling_hysteresis_factor": ("resistances", "rolling_hysteresis_factor"),
-    "oil_volume_fraction": ("lubricant", "oil_volume_fraction"),
-    "yield_stress": ("lubricant", "yield_stress_pa"),
-    "consistency": ("lubricant", "consistency_pa_sn"),
-    "fill_fraction": ("lubricant", "fill_fraction"),
-    "eyring_stress": ("lubricant", "eyring_stress_pa"),
-    "consistency_temperature_exponent": ("lubricant", "consistency_temperature_exponent"),
-    "ball_set_resistance": ("resistances", "ball_set_resistance_n"),
-    "ball_set_resistance_speed_exponent": ("resistances", "ball_set_resistance_speed_exponent"),
-}
-"""Parameters a calibration file may set: field name -> (section, key) in the bearing file."""
 
 HARRIS = "Harris and Kotzalas, Essential Concepts of Bearing Technology (2006)"
 SOLID = "an isotropic solid (Poisson ratio below 0.5)"
@@ -189,8 +173,8 @@ class Friction(FileSection):
     """``friction:``; the transition velocity lies above the stiction velocity."""
 
     model: Annotated[str, one_of(tuple(FRICTION_MODELS))] = Field(description="traction law (FRICTION_MODELS)")
-    static_coefficient: Number = quantity("static friction coefficient mu_s (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0)
-    stiction_velocity_m_s: Number = quantity("stiction velocity v_s (paper law)", unit="m/s", source="a speed", gt=0.0)
+    static_coefficient: Number = quantity("static friction coefficient mu_s (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0, calibratable=True)
+    stiction_velocity_m_s: Number = quantity("stiction velocity v_s (paper law)", unit="m/s", source="a speed", gt=0.0, calibratable=True)
     dynamic_coefficient: Number = quantity("dynamic friction coefficient mu_d (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0)
     transition_velocity_m_s: Number = quantity("transition velocity v_d (paper law, above v_s)", unit="m/s", source="a speed above v_s")
     ehl_max_coefficient: Number = quantity(
@@ -222,13 +206,13 @@ class BearingLubricant(FileSection):
     air_viscosity_pa_s: Number = quantity("cavity air dynamic viscosity", unit="Pa s", source="a gas", gt=0.0)
     oil_density_kg_m3: Number | None = quantity("oil density (inline form)", unit="kg/m^3", source="a liquid", gt=0.0, default=None)
     oil_viscosity_pa_s: Number | None = quantity("oil dynamic viscosity (inline form)", unit="Pa s", source="a liquid", gt=0.0, default=None)
-    oil_volume_fraction: Number | None = quantity("oil share of the oil-air mixture (inline form)", unit="1", source="a fraction", ge=0.0, le=1.0, default=None)
-    yield_stress_pa: Number | None = quantity("grease yield stress override", unit="Pa", source="sheared NLGI 1-3 greases", ge=0.0, le=5e3, default=None)
-    consistency_pa_sn: Number | None = quantity("grease consistency override", unit="Pa s^n", source="sheared NLGI 1-3 greases", ge=0.0, le=1e3, default=None)
-    fill_fraction: Number | None = quantity("fill fraction override", unit="1", source="a fraction", ge=0.0, le=1.0, default=None)
-    eyring_stress_pa: Number | None = quantity("Eyring stress override", unit="Pa", source="EHL films of mineral and ester oils", ge=1e5, le=5e7, default=None)
+    oil_volume_fraction: Number | None = quantity("oil share of the oil-air mixture (inline form)", unit="1", source="a fraction", ge=0.0, le=1.0, default=None, calibratable=True)
+    yield_stress_pa: Number | None = quantity("grease yield stress override", unit="Pa", source="sheared NLGI 1-3 greases", ge=0.0, le=5e3, default=None, calibratable=True)
+    consistency_pa_sn: Number | None = quantity("grease consistency override", unit="Pa s^n", source="sheared NLGI 1-3 greases", ge=0.0, le=1e3, default=None, calibratable=True)
+    fill_fraction: Number | None = quantity("fill fraction override", unit="1", source="a fraction", ge=0.0, le=1.0, default=None, calibratable=True)
+    eyring_stress_pa: Number | None = quantity("Eyring stress override", unit="Pa", source="EHL films of mineral and ester oils", ge=1e5, le=5e7, default=None, calibratable=True)
     consistency_temperature_exponent: Number | None = quantity(
-        "grease consistency's temperature exponent override", unit="1", source="between the thickener alone (0) and the base oil (1)", ge=0.0, le=1.0, default=None
+        "grease consistency's temperature exponent override", unit="1", source="between the thickener alone (0) and the base oil (1)", ge=0.0, le=1.0, default=None, calibratable=True
     )
 
     @model_validator(mode="after")
@@ -252,14 +236,14 @@ class Resistances(FileSection):
     ball_drag_coefficient: Number = quantity(
         "C_d of a sphere at high Reynolds number", unit="1", source=f"{HARRIS} ch. 7 (0.1-1 at Re 1e3-1e5)", ge=0.0, le=5.0
     )
-    ball_drag_scale: Number = quantity("multiplier on the inertial sphere drag", unit="1", source=SCALE, ge=0.0)
-    cage_land_viscous_scale: Number = quantity("multiplier on the land's film torque", unit="1", source=SCALE, ge=0.0)
+    ball_drag_scale: Number = quantity("multiplier on the inertial sphere drag", unit="1", source=SCALE, ge=0.0, calibratable=True)
+    cage_land_viscous_scale: Number = quantity("multiplier on the land's film torque", unit="1", source=SCALE, ge=0.0, calibratable=True)
     cage_land_friction_coefficient: Number = quantity(
         "boundary friction of the cage on its land", unit="1", source="lubricated polymer on steel", ge=0.0, le=1.0
     )
-    cage_land_boundary_torque_scale: Number = quantity("multiplier on mu x cage weight x land radius", unit="1", source=SCALE, ge=0.0)
+    cage_land_boundary_torque_scale: Number = quantity("multiplier on mu x cage weight x land radius", unit="1", source=SCALE, ge=0.0, calibratable=True)
     rolling_hysteresis_factor: Number = quantity(
-        "elastic hysteresis factor alpha_h", unit="1", source=f"{HARRIS} ch. 7 (bearing steel about 0.007)", ge=0.0, le=0.5
+        "elastic hysteresis factor alpha_h", unit="1", source=f"{HARRIS} ch. 7 (bearing steel about 0.007)", ge=0.0, le=0.5, calibratable=True
     )
     ehl_rolling_scale: Number = quantity("multiplier on Houpert's EHL rolling force", unit="1", source=SCALE, ge=0.0, default=1.0)
     ball_set_resistance_n: Number = quantity(
@@ -269,6 +253,7 @@ class Resistances(FileSection):
         ge=0.0,
         le=10.0,
         default=0.0,
+        calibratable=True,
     )
     ball_set_resistance_speed_exponent: Number = quantity(
         "dry model only: exponent m of the orbit speed in the ball-set resistance",
@@ -277,6 +262,7 @@ class Resistances(FileSection):
         ge=0.0,
         le=2.0,
         default=1.0,
+        calibratable=True,
     )
     ball_set_resistance_load_exponent: Number = quantity(
         "dry model only: exponent k of the mean contact load in the ball-set resistance",
@@ -374,6 +360,24 @@ class BearingFile(FileSection):
                 "is the dry model's stand-in for its unstated resistances; a lubricated bearing has its own (set lubricant.dry: true or 0)",
             )
         return self
+
+
+def calibratable_keys(model: type[BaseModel], prefix: str = "") -> tuple[str, ...]:
+    """The dotted keys of ``model`` and the sections nested in it whose :func:`quantity` a
+    calibration file may set (``calibratable=True``), in the file's order."""
+    keys: list[str] = []
+    for name, info in model.model_fields.items():
+        if isinstance(info.json_schema_extra, dict) and info.json_schema_extra.get("calibratable"):
+            keys.append(prefix + name)
+        for kind in (info.annotation, *get_args(info.annotation)):
+            if isinstance(kind, type) and issubclass(kind, BaseModel):
+                keys.extend(calibratable_keys(kind, f"{prefix}{name}."))
+    return tuple(keys)
+
+
+CALIBRATABLE_KEYS: tuple[str, ...] = calibratable_keys(BearingFile)
+"""The bearing-file keys a calibration file may set (``section.key``); the engine's names for
+them: :data:`~.parameters.CALIBRATABLE`."""
 
 
 # ---------------------------------------------------------------------------------------------
@@ -484,10 +488,10 @@ class LubricantFile(FileSection):
 # ---------------------------------------------------------------------------------------------
 def _calibrated_values(raw: object) -> dict[str, float]:
     """``parameters:`` of a calibration file: ``section.key`` -> a number (>= 0) or a
-    :class:`~bearing_rig_sim.settings_model.StatedQuantity`; only the keys of :data:`CALIBRATABLE`."""
+    :class:`~bearing_rig_sim.settings_model.StatedQuantity`; only the keys of :data:`CALIBRATABLE_KEYS`."""
     if not isinstance(raw, Mapping):
         raise ValueError(f"must be a mapping, got {type(raw).__name__}")
-    allowed = sorted(f"{sec}.{key}" for sec, key in CALIBRATABLE.values())
+    allowed = sorted(CALIBRATABLE_KEYS)
     values: dict[str, float] = {}
     for name, entry in raw.items():
         if name not in allowed:

@@ -41,9 +41,9 @@ from typing import Any, cast
 import numpy as np
 
 from bearing_rig_sim.config import read_mapping, shipped_bearing_file, shipped_calibration_file
-from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE as CALIBRATABLE  # what a calibration may set, re-exported
-from bearing_rig_sim.dynamics.bearing_file import FRICTION_MODELS, BearingFile, CalibrationFile
+from bearing_rig_sim.dynamics.bearing_file import CALIBRATABLE_KEYS, FRICTION_MODELS, LUBRICANT_OVERRIDES, BearingFile, CalibrationFile
 from bearing_rig_sim.dynamics import kernels as kn
+from bearing_rig_sim.bearing.file_record import file_field, file_keys, file_record, file_values
 from bearing_rig_sim.bearing.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
 from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
@@ -53,9 +53,11 @@ GRAVITY = 9.80665
 """Standard gravity, m/s^2 (CGPM 1901)."""
 
 
-@dataclass(frozen=True)
+@file_record
 class BearingParameters:
-    """Primary bearing data, SI units. Sources: ``config/bearings/h7006c.yaml`` comments.
+    """Primary bearing data, SI units, each field read from the bearing-file key it names
+    (:func:`~bearing_rig_sim.bearing.file_record.file_field`; the key states the file's unit, its
+    range and source are in :mod:`.bearing_file`, the values' sources in the file's comments).
 
     Geometry: ``ball_diameter`` Dw (m), ``pitch_diameter`` dm (m), ``contact_angle`` free
     contact angle (rad), ``ball_count`` Z, groove curvature ratios f_i, f_o (1), cage inner and
@@ -75,66 +77,67 @@ class BearingParameters:
     not given) for the film parameter, ``spindle_axis`` (``horizontal`` or ``vertical``).
     """
 
-    name: str
-    ball_diameter: float
-    pitch_diameter: float
-    contact_angle: float
-    ball_count: int
-    inner_curvature_ratio: float
-    outer_curvature_ratio: float
-    cage_inner_diameter: float
-    cage_outer_diameter: float
-    cage_width: float
-    pocket_diameter: float
-    land_clearance: float
-    land_width: float
-    cage_loss_factor: float
-    ring_density: float
-    ring_modulus: float
-    ring_poisson: float
-    ball_density: float
-    ball_modulus: float
-    ball_poisson: float
-    cage_density: float
-    cage_modulus: float
-    cage_poisson: float
-    inner_ring_axial_mass: float
-    hunt_crossley_coefficient: float
-    hunt_crossley_exponent: float
-    full_damping_penetration: float
-    friction_model: str
-    static_friction: float
-    stiction_velocity: float
-    dynamic_friction: float
-    transition_velocity: float
-    ehl_max_coefficient: float
-    ehl_reference_srr: float
-    pocket_friction: float
-    oil_density: float
-    oil_viscosity: float
-    air_density: float
-    air_viscosity: float
-    oil_volume_fraction: float
-    ball_drag_coefficient: float
-    ball_drag_scale: float
-    cage_land_viscous_scale: float
-    cage_land_friction: float
-    cage_land_boundary_torque_scale: float
-    rolling_hysteresis_factor: float
-    reduced_time_step: float
-    stiff_time_step: float
-    dynamic_load_rating: float = 13000.0
-    lubricant: Lubricant | None = None
-    lubricant_temperature: float = 40.0
-    ehl_rolling_scale: float = 1.0
-    composite_roughness: float = 0.0
-    spindle_axis: str = "horizontal"
-    land_count: int = 1
-    dry: bool = False
-    ball_set_resistance: float = 0.0
-    ball_set_resistance_speed_exponent: float = 1.0
-    ball_set_resistance_load_exponent: float = 0.0
-    ball_set_resistance_reference_load: float = 10.0
+    name: str = file_field("bearing.name")
+    ball_diameter: float = file_field("geometry.ball_diameter_m")
+    pitch_diameter: float = file_field("geometry.pitch_diameter_m")
+    contact_angle: float = file_field("geometry.contact_angle_deg", convert=math.radians)
+    ball_count: int = file_field("geometry.ball_count")
+    inner_curvature_ratio: float = file_field("geometry.inner_groove_curvature_ratio")
+    outer_curvature_ratio: float = file_field("geometry.outer_groove_curvature_ratio")
+    cage_inner_diameter: float = file_field("cage.inner_diameter_m")
+    cage_outer_diameter: float = file_field("cage.outer_diameter_m")
+    cage_width: float = file_field("cage.width_m")
+    pocket_diameter: float = file_field("cage.pocket_diameter_m")
+    land_clearance: float = file_field("cage.land_radial_clearance_m")
+    land_width: float = file_field("cage.land_width_m")
+    cage_loss_factor: float = file_field("cage.material_loss_factor")
+    ring_density: float = file_field("materials.ring.density_kg_m3")
+    ring_modulus: float = file_field("materials.ring.youngs_modulus_pa")
+    ring_poisson: float = file_field("materials.ring.poisson_ratio")
+    ball_density: float = file_field("materials.ball.density_kg_m3")
+    ball_modulus: float = file_field("materials.ball.youngs_modulus_pa")
+    ball_poisson: float = file_field("materials.ball.poisson_ratio")
+    cage_density: float = file_field("materials.cage.density_kg_m3")
+    cage_modulus: float = file_field("materials.cage.youngs_modulus_pa")
+    cage_poisson: float = file_field("materials.cage.poisson_ratio")
+    inner_ring_axial_mass: float = file_field("inner_ring.axial_mass_kg")
+    hunt_crossley_coefficient: float = file_field("contact.hunt_crossley_coefficient_s_m")
+    hunt_crossley_exponent: float = file_field("contact.hunt_crossley_exponent")
+    full_damping_penetration: float = file_field("contact.full_damping_penetration_m")
+    friction_model: str = file_field("friction.model")
+    static_friction: float = file_field("friction.static_coefficient")
+    stiction_velocity: float = file_field("friction.stiction_velocity_m_s")
+    dynamic_friction: float = file_field("friction.dynamic_coefficient")
+    transition_velocity: float = file_field("friction.transition_velocity_m_s")
+    ehl_max_coefficient: float = file_field("friction.ehl_max_coefficient")
+    ehl_reference_srr: float = file_field("friction.ehl_reference_slide_roll_ratio")
+    pocket_friction: float = file_field("friction.pocket_coefficient")
+    # the oil's three values: these inline keys, or the lubricant file's, or 0 when dry (from_file)
+    oil_density: float = file_field("lubricant.oil_density_kg_m3")
+    oil_viscosity: float = file_field("lubricant.oil_viscosity_pa_s")
+    air_density: float = file_field("lubricant.air_density_kg_m3")
+    air_viscosity: float = file_field("lubricant.air_viscosity_pa_s")
+    oil_volume_fraction: float = file_field("lubricant.oil_volume_fraction")
+    ball_drag_coefficient: float = file_field("resistances.ball_drag_coefficient")
+    ball_drag_scale: float = file_field("resistances.ball_drag_scale")
+    cage_land_viscous_scale: float = file_field("resistances.cage_land_viscous_scale")
+    cage_land_friction: float = file_field("resistances.cage_land_friction_coefficient")
+    cage_land_boundary_torque_scale: float = file_field("resistances.cage_land_boundary_torque_scale")
+    rolling_hysteresis_factor: float = file_field("resistances.rolling_hysteresis_factor")
+    reduced_time_step: float = file_field("integration.reduced_time_step_s")
+    stiff_time_step: float = file_field("integration.stiff_time_step_s")
+    dynamic_load_rating: float = file_field("bearing.dynamic_load_rating_n")
+    lubricant: Lubricant | None  # the lubricant.file key's file, with the section's overrides (from_file)
+    lubricant_temperature: float = file_field("lubricant.temperature_c")
+    ehl_rolling_scale: float = file_field("resistances.ehl_rolling_scale")
+    composite_roughness: float = file_field("geometry.composite_roughness_rq_m")
+    spindle_axis: str = file_field("installation.spindle_axis")
+    land_count: int = file_field("cage.land_count")
+    dry: bool = file_field("lubricant.dry")
+    ball_set_resistance: float = file_field("resistances.ball_set_resistance_n")
+    ball_set_resistance_speed_exponent: float = file_field("resistances.ball_set_resistance_speed_exponent")
+    ball_set_resistance_load_exponent: float = file_field("resistances.ball_set_resistance_load_exponent")
+    ball_set_resistance_reference_load: float = file_field("resistances.ball_set_resistance_reference_load_n")
     source: str = "<memory>"
 
     # -- construction --------------------------------------------------------------------------
@@ -161,75 +164,21 @@ class BearingParameters:
 
     @classmethod
     def from_file(cls, doc: BearingFile, source: str) -> BearingParameters:
-        """The parameters of a validated bearing file (SI: the contact angle in radians)."""
-        g, c, mat, lub, fr, res = doc.geometry, doc.cage, doc.materials, doc.lubricant, doc.friction, doc.resistances
+        """The parameters of a validated bearing file: each field from the key it names, in SI;
+        the lubricant from its file, with the section's overrides (a calibration's) laid over it."""
+        lub = doc.lubricant
         lubricant = Lubricant.from_yaml(lub.file) if lub.file is not None else None
         if lubricant is not None and lub.overrides():
             lubricant = lubricant.replace_rheology(**lub.overrides())
-        temperature = lub.temperature_c
-        return cls(
-            name=doc.bearing.name,
-            ball_diameter=g.ball_diameter_m,
-            pitch_diameter=g.pitch_diameter_m,
-            contact_angle=math.radians(g.contact_angle_deg),
-            ball_count=g.ball_count,
-            inner_curvature_ratio=g.inner_groove_curvature_ratio,
-            outer_curvature_ratio=g.outer_groove_curvature_ratio,
-            cage_inner_diameter=c.inner_diameter_m,
-            cage_outer_diameter=c.outer_diameter_m,
-            cage_width=c.width_m,
-            pocket_diameter=c.pocket_diameter_m,
-            land_clearance=c.land_radial_clearance_m,
-            land_width=c.land_width_m,
-            cage_loss_factor=c.material_loss_factor,
-            ring_density=mat.ring.density_kg_m3,
-            ring_modulus=mat.ring.youngs_modulus_pa,
-            ring_poisson=mat.ring.poisson_ratio,
-            ball_density=mat.ball.density_kg_m3,
-            ball_modulus=mat.ball.youngs_modulus_pa,
-            ball_poisson=mat.ball.poisson_ratio,
-            cage_density=mat.cage.density_kg_m3,
-            cage_modulus=mat.cage.youngs_modulus_pa,
-            cage_poisson=mat.cage.poisson_ratio,
-            inner_ring_axial_mass=doc.inner_ring.axial_mass_kg,
-            hunt_crossley_coefficient=doc.contact.hunt_crossley_coefficient_s_m,
-            hunt_crossley_exponent=doc.contact.hunt_crossley_exponent,
-            full_damping_penetration=doc.contact.full_damping_penetration_m,
-            friction_model=fr.model,
-            static_friction=fr.static_coefficient,
-            stiction_velocity=fr.stiction_velocity_m_s,
-            dynamic_friction=fr.dynamic_coefficient,
-            transition_velocity=fr.transition_velocity_m_s,
-            ehl_max_coefficient=fr.ehl_max_coefficient,
-            ehl_reference_srr=fr.ehl_reference_slide_roll_ratio,
-            pocket_friction=fr.pocket_coefficient,
-            oil_density=lubricant.density(temperature) if lubricant else 0.0 if lub.dry else cast(float, lub.oil_density_kg_m3),
-            oil_viscosity=lubricant.dynamic_viscosity(temperature) if lubricant else 0.0 if lub.dry else cast(float, lub.oil_viscosity_pa_s),
-            air_density=lub.air_density_kg_m3,
-            air_viscosity=lub.air_viscosity_pa_s,
-            oil_volume_fraction=lubricant.oil_volume_fraction if lubricant else 0.0 if lub.dry else cast(float, lub.oil_volume_fraction),
-            ball_drag_coefficient=res.ball_drag_coefficient,
-            ball_drag_scale=res.ball_drag_scale,
-            cage_land_viscous_scale=res.cage_land_viscous_scale,
-            cage_land_friction=res.cage_land_friction_coefficient,
-            cage_land_boundary_torque_scale=res.cage_land_boundary_torque_scale,
-            rolling_hysteresis_factor=res.rolling_hysteresis_factor,
-            reduced_time_step=doc.integration.reduced_time_step_s,
-            stiff_time_step=doc.integration.stiff_time_step_s,
-            dynamic_load_rating=doc.bearing.dynamic_load_rating_n,
-            lubricant=lubricant,
-            lubricant_temperature=temperature,
-            ehl_rolling_scale=res.ehl_rolling_scale,
-            composite_roughness=g.composite_roughness_rq_m,
-            spindle_axis=doc.installation.spindle_axis,
-            land_count=c.land_count,
-            dry=lub.dry,
-            ball_set_resistance=res.ball_set_resistance_n,
-            ball_set_resistance_speed_exponent=res.ball_set_resistance_speed_exponent,
-            ball_set_resistance_load_exponent=res.ball_set_resistance_load_exponent,
-            ball_set_resistance_reference_load=res.ball_set_resistance_reference_load_n,
-            source=source,
-        )
+        # not a plain copy: with a lubricant file the oil's values are its own at the operating
+        # temperature (the inline keys are absent); a dry bearing has none
+        oil: dict[str, float] = {}
+        if lubricant is not None:
+            t = lub.temperature_c
+            oil = {"oil_density": lubricant.density(t), "oil_viscosity": lubricant.dynamic_viscosity(t), "oil_volume_fraction": lubricant.oil_volume_fraction}
+        elif lub.dry:
+            oil = dict.fromkeys(("oil_density", "oil_viscosity", "oil_volume_fraction"), 0.0)
+        return cls(**file_values(cls, doc, lubricant=lubricant, source=source, **oil))
 
     def replace(self, **changes: object) -> BearingParameters:
         """A copy with some fields changed (e.g. calibrated scale factors)."""
@@ -303,6 +252,19 @@ class BearingParameters:
     def epicyclic_ratio(self) -> float:
         """n_s / n_i at the free contact angle (paper Eq. 12), 1."""
         return 0.5 * (1.0 - self.ball_diameter * math.cos(self.contact_angle) / self.pitch_diameter)
+
+
+def _calibratable() -> dict[str, tuple[str, str]]:
+    names = {key: name for name, key in file_keys(BearingParameters).items()}
+    names |= {f"lubricant.{key}": field for key, field in LUBRICANT_OVERRIDES.items()}
+    return {names[key]: (key.partition(".")[0], key.partition(".")[2]) for key in CALIBRATABLE_KEYS}
+
+
+CALIBRATABLE: dict[str, tuple[str, str]] = _calibratable()
+"""Parameters a calibration file may set: name -> (section, key) in the bearing file. The keys
+are those declared calibratable (:data:`.bearing_file.CALIBRATABLE_KEYS`); a name is that of the
+:class:`BearingParameters` field reading the key, or of the :class:`.lubrication.Lubricant`
+field the key overrides (:data:`.bearing_file.LUBRICANT_OVERRIDES`)."""
 
 
 def overlay_calibration(bearing: Mapping[str, Any], calibration: CalibrationFile) -> dict[str, Any]:

@@ -48,6 +48,7 @@ from bearing_rig_sim.dynamics.bearing_file import BearingFile
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
 from bearing_rig_sim.dynamics.parameters import BearingParameters, derive
+from bearing_rig_sim.bearing.file_record import file_field, file_record, file_values
 from bearing_rig_sim.bearing.materials import AIR_40C, BEARING_STEEL, POLYIMIDE, Fluid
 from bearing_rig_sim.thermal.network import Conductance, Node, ThermalNetwork
 from bearing_rig_sim.settings_model import read_file
@@ -57,9 +58,10 @@ AMBIENT = "ambient"
 OIL_INLET = "oil_inlet"
 
 
-@dataclass(frozen=True)
+@file_record
 class ThermalConfig:
-    """The bearing file's geometry the network needs and its ``thermal:`` section (SI, degC).
+    """The bearing file's geometry the network needs and its ``thermal:`` section (SI, degC), each
+    field read from the bearing-file key it names (:func:`~bearing_rig_sim.bearing.file_record.file_field`).
 
     Attributes:
         bore, outside_diameter, width: d, D, B of the bearing, m.
@@ -75,24 +77,24 @@ class ThermalConfig:
         source: file name.
     """
 
-    bore: float
-    outside_diameter: float
-    width: float
-    inner_shoulder: float
-    outer_shoulder: float
-    ambient: float
-    fit_conductance: float
-    housing_mass: float
-    housing_area: float
-    housing_film: float
-    frame_conductance: float
-    shaft_diameter: float
-    shaft_length: float
-    motor_conductance: float
-    grease_fill: float
-    air_flow: float
-    oil_flow: float
-    oil_inlet: float
+    bore: float = file_field("geometry.bore_m")
+    outside_diameter: float = file_field("geometry.outside_diameter_m")
+    width: float = file_field("geometry.width_m")
+    inner_shoulder: float = file_field("geometry.inner_shoulder_diameter_m")
+    outer_shoulder: float = file_field("geometry.outer_shoulder_diameter_m")
+    ambient: float = file_field("thermal.ambient_temperature_c")
+    fit_conductance: float = file_field("thermal.fit_contact_conductance_w_m2_k")
+    housing_mass: float = file_field("thermal.housing.mass_kg")
+    housing_area: float = file_field("thermal.housing.outer_area_m2")
+    housing_film: float = file_field("thermal.housing.film_coefficient_w_m2_k")
+    frame_conductance: float = file_field("thermal.housing.frame_conductance_w_k")
+    shaft_diameter: float = file_field("thermal.shaft.diameter_m")
+    shaft_length: float = file_field("thermal.shaft.length_m")
+    motor_conductance: float = file_field("thermal.shaft.motor_conductance_w_k")
+    grease_fill: float = file_field("thermal.grease_fill_fraction")
+    air_flow: float = file_field("thermal.cavity_air_flow_m3_s")
+    oil_flow: float = file_field("thermal.oil_flow_m3_s")
+    oil_inlet: float = file_field("thermal.oil_inlet_temperature_c")  # absent from the file: the ambient (from_file)
     source: str = "<memory>"
 
     @classmethod
@@ -108,30 +110,11 @@ class ThermalConfig:
         Raises:
             ConfigError: the file has no ``thermal:`` section.
         """
-        g, t = doc.geometry, doc.thermal
+        t = doc.thermal
         if t is None:
             raise ConfigError(source, "thermal", "missing (required)")
-        return cls(
-            bore=g.bore_m,
-            outside_diameter=g.outside_diameter_m,
-            width=g.width_m,
-            inner_shoulder=g.inner_shoulder_diameter_m,
-            outer_shoulder=g.outer_shoulder_diameter_m,
-            ambient=t.ambient_temperature_c,
-            fit_conductance=t.fit_contact_conductance_w_m2_k,
-            housing_mass=t.housing.mass_kg,
-            housing_area=t.housing.outer_area_m2,
-            housing_film=t.housing.film_coefficient_w_m2_k,
-            frame_conductance=t.housing.frame_conductance_w_k,
-            shaft_diameter=t.shaft.diameter_m,
-            shaft_length=t.shaft.length_m,
-            motor_conductance=t.shaft.motor_conductance_w_k,
-            grease_fill=t.grease_fill_fraction,
-            air_flow=t.cavity_air_flow_m3_s,
-            oil_flow=t.oil_flow_m3_s,
-            oil_inlet=t.oil_inlet_temperature_c if t.oil_inlet_temperature_c is not None else t.ambient_temperature_c,
-            source=source,
-        )
+        inlet = {} if t.oil_inlet_temperature_c is not None else {"oil_inlet": t.ambient_temperature_c}
+        return cls(**file_values(cls, doc, source=source, **inlet))
 
 
 @dataclass(frozen=True)

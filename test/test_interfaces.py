@@ -3,6 +3,7 @@ the recorder records it, replay offers its QoS, and every type exists as a messa
 
 from __future__ import annotations
 
+import ast
 import importlib.util
 import re
 import sys
@@ -180,3 +181,33 @@ def test_the_topic_name_pattern_finds_a_stale_name() -> None:
     """The scan above can fail: it finds a topic name in a YAML comment, and not a namespace."""
     found = TOPIC_NAME.findall("    status_rate_hz: 10.0   # /twin/status, wall clock; the /twin/* topics; a/rig/x path\n")
     assert found == ["/twin/status"]
+
+
+def publisher_calls(path: Path) -> list[ast.Call]:
+    """The calls in ``path`` that make a publisher (``self.publisher(...)``, a ManagedNode's, or
+    rclpy's ``create_publisher(...)``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return [
+        node
+        for node in ast.walk(tree)
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in ("publisher", "create_publisher") and len(node.args) >= 3
+    ]
+
+
+def test_every_publisher_of_the_rig_takes_its_topics_contract_profile() -> None:
+    """A publisher made with a profile of its own (the load controller's state on the shallow
+    ``reliable`` profile while the table said ``reliable_stream``) publishes what the contract
+    does not say: its writer kept 10 samples and a recorder held up under load lost 72 of 2050.
+    Each publisher of the rig's nodes and session is made as ``publisher(Type, TOPIC.name,
+    qos_profile(TOPIC))``, the topic and its profile named by the same contract entry."""
+    paths = sorted((ROOT / "bearing_rig_sim" / "nodes").glob("*.py")) + [ROOT / "bearing_rig_sim" / "session" / "node.py"]
+    calls = [(path, call) for path in paths for call in publisher_calls(path)]
+    assert len(calls) >= 15, [ast.unparse(c) for _, c in calls]  # every node's, not none found
+    for path, call in calls:
+        topic, qos = call.args[1], call.args[2]
+        where = f"{path.name}: {ast.unparse(call)}"
+        if "topic" in [ast.unparse(a) for a in call.args]:  # ManagedNode.publisher itself, passing its arguments on
+            continue
+        assert isinstance(topic, ast.Attribute) and topic.attr == "name", where
+        assert isinstance(qos, ast.Call) and ast.unparse(qos.func) == "qos_profile" and len(qos.args) == 1, where
+        assert ast.unparse(qos.args[0]) == ast.unparse(topic.value), where

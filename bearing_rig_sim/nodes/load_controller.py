@@ -163,8 +163,8 @@ class LoadControllerNode(ManagedNode):
         quiet = PublisherEventCallbacks(use_default_callbacks=False)
         self._force_pub = self.publisher(WrenchStamped, BEARING_AXIAL_FORCE.name, qos_profile(BEARING_AXIAL_FORCE), event_callbacks=quiet)
         self._load_cell_pub = self.publisher(WrenchStamped, AXIAL_LOAD_FORCE.name, qos_profile(AXIAL_LOAD_FORCE), event_callbacks=quiet)
-        self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, RELIABLE_QOS, event_callbacks=quiet)
-        self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS, event_callbacks=quiet)
+        self._state_pub = self.publisher(AxialLoadState, AXIAL_LOAD_STATE.name, qos_profile(AXIAL_LOAD_STATE), event_callbacks=quiet)
+        self._diagnostics_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS), event_callbacks=quiet)
         self._rig_services = [
             self.create_service(SetAxialLoad, AXIAL_LOAD_SET.name, self._on_set_service),
             self.create_service(Trigger, AXIAL_LOAD_RESET_FAULT.name, self._on_reset_fault),

@@ -233,11 +233,12 @@ class SimulatorNode(ManagedNode):
         self._instrument_pubs: dict[str, tuple[Any, Any]] = {}
         """Contract topic -> its publisher and message class, one per instrument of the rig file."""
         for name in self.twin.instruments.set.topics():
-            topic, kind = contract_topic(name), message_class(contract_topic(name).msgtype)
-            self._instrument_pubs[name] = (self.publisher(kind, name, qos_profile(topic)), kind)
+            topic = contract_topic(name)
+            kind = message_class(topic.msgtype)
+            self._instrument_pubs[name] = (self.publisher(kind, topic.name, qos_profile(topic)), kind)
         self._speeds_pub = self.publisher(JointState, SPEEDS.name, qos_profile(SPEEDS))
         self._truth_pub = self.publisher(SimulatorTruth, TRUTH.name, qos_profile(TRUTH))
-        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, RELIABLE_QOS)
+        self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         self._attach_thermal(s.bearing_file)
         self._stream_pubs = {
             topic.name: pub

@@ -47,7 +47,7 @@ from bearing_rig_sim.interfaces import (
     TOPICS,
     TRUTH,
 )
-from bearing_rig_sim.nodes.common import STATUS_QOS, UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
+from bearing_rig_sim.nodes.common import UNKNOWN_NODE_NAME, drain, from_stamp, qos_profile, to_stamp
 from bearing_rig_sim.monitoring.settings import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
 from bearing_rig_sim.nodes.shell import PUBLISHED_SUFFIX
 from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
@@ -163,7 +163,7 @@ class SessionNode(Node):
         self.runner = runner
         self.on_event = on_event
         self.live = LiveValues()
-        self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, STATUS_QOS)
+        self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, qos_profile(SPINDLE_COMMAND))
         self._setpoint = self.create_publisher(WrenchStamped, LOAD_SETPOINT.name, qos_profile(LOAD_SETPOINT))
         self.tap = Node(f"{name}_recorder", context=context)
         self._recorded = [

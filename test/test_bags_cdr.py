@@ -167,6 +167,22 @@ def test_field_decoder_hands_other_bytes_to_the_general_decoder() -> None:
             decode(little[:-cut])
 
 
+@pytest.mark.parametrize("msgtype, fields", [(TRUTH, decode_truth_speeds), (STATUS, decode_status_fields), (JOINT_STATE, decode_joint_velocities)])
+def test_field_decoders_refuse_every_cut_of_a_message(msgtype: str, fields: Any) -> None:
+    """A decoder by hand reads a message to its end: cut anywhere (the last field included), the
+    message is refused as rosbags refuses it, and padding after it is ignored."""
+    message = _joint_state(3, ["inner_ring", "cage"], [10.0, 4.0], [0.5, 0.25]) if msgtype == JOINT_STATE else sample_message(msgtype, 5, STORE)
+    raw = bytes(STORE.serialize_cdr(message, msgtype))
+    decode = make_field_decoder(STORE, msgtype, fields)
+    assert decode(raw + bytes(8)) == decode(raw) == fields(raw)
+    for end in range(4, len(raw)):
+        cut = raw[:end]
+        with pytest.raises(BagError):
+            decode(cut)
+        with pytest.raises((struct.error, UnicodeDecodeError)):
+            fields(cut)
+
+
 def test_field_decoder_leaves_another_layout_of_the_type_to_rosbags() -> None:
     """A bag whose SlipStatus has other fields (an older recording) is not read by hand at the
     rig's offsets: its messages decode as that definition says."""

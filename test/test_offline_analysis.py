@@ -21,7 +21,7 @@ from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonito
 from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_typestore
 from bearing_rig_sim.offline.analysis import analyse_bag, decode_pulse
 from bearing_rig_sim.offline.segments import PROFILE_CONSTANT_ACCELERATION, SEGMENTS_CSV, SegmentTracker
-from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, RowDecimator, SlipWindowRow, StatusRow
+from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, CsvWriter, RowDecimator, SlipWindowRow, StatusRow, csv_columns
 from bearing_rig_sim.synthetic.traffic import NO_BALLS, RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
 from bearing_rig_sim.bags.typestore import msg_folder
 from bearing_rig_sim.instruments.fibre_optic import Pulse
@@ -305,6 +305,22 @@ def test_rows_are_decimated_evenly_in_bounded_memory() -> None:
     assert len(kept) <= 101 and kept[0] == 0 and kept[-1] == 9_999
     steps = {b - a for a, b in zip(kept[:-2], kept[1:-1])}
     assert steps == {decimator.stride}
+
+
+def test_csv_rows_write_floats_exactly_speeds_in_rpm(tmp_path: Path) -> None:
+    """Each float as its repr (read back, the same float), None as an empty field, an int as it
+    is, speeds in rpm (1 rad/s = 30 / pi rpm)."""
+    columns = csv_columns(SlipWindowRow)
+    assert [name for name, _attr, _scale in columns] == ["start_time_s", "end_time_s", "inner_ring_rpm", "cage_rpm", "slip_rate_pct"]
+    writer = CsvWriter(tmp_path / "w.csv", columns)
+    for row in (SlipWindowRow(0.1, 0.30000000000000004, math.pi, 2.0, math.nan), SlipWindowRow(1.0, 2.0, 3, 1.0, None)):  # type: ignore[arg-type]
+        writer.write(row)
+    writer.close()
+    header, first, second = (tmp_path / "w.csv").read_text().splitlines()
+    cells = first.split(",")
+    assert cells[:2] == ["0.1", "0.30000000000000004"] and cells[4] == "nan"
+    assert float(cells[2]) == pytest.approx(30.0, rel=1e-15) and float(cells[3]) == pytest.approx(60.0 / math.pi, rel=1e-15)
+    assert second.split(",")[2:] == ["3", repr(float(second.split(",")[3])), ""] and float(second.split(",")[3]) == pytest.approx(30.0 / math.pi, rel=1e-15)
 
 
 def test_bag_without_pulse_topics_names_them(tmp_path: Path) -> None:

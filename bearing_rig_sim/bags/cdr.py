@@ -313,10 +313,26 @@ def _doubles(data: CdrBytes, at: int) -> tuple[tuple[float, ...], int]:
     return struct.unpack_from(f"<{count}d", data, 4 + at), at + 8 * count
 
 
+def _past_doubles(data: CdrBytes, at: int) -> int:
+    """The body offset after the float64 sequence at body offset ``at`` (aligned as
+    :func:`_doubles` reads it), not reading its values."""
+    at = (at + 3) & ~3
+    (count,) = _U32[True](data, 4 + at)
+    at += 4
+    return ((at + 7) & ~7) + 8 * count if count else at
+
+
+def _whole(data: CdrBytes, end: int) -> None:
+    """Raise struct.error unless the message, ending at body offset ``end``, lies within ``data``
+    (a decoder by hand reads its fields at offsets that only grow: within the bytes if its end is)."""
+    if 4 + end > len(data):
+        raise struct.error(f"{len(data)} bytes end before the message does ({4 + end} needed)")
+
+
 def decode_joint_velocities(data: CdrBytes) -> JointVelocities:
     """Names and velocities of a little-endian CDR ``sensor_msgs/JointState`` read by hand (the
     values rosbags' decoder gives, bit for bit, at a tenth of its cost); struct.error or
-    UnicodeDecodeError for bytes that end early or a name that is not UTF-8."""
+    UnicodeDecodeError for bytes that end before the message does or a name that is not UTF-8."""
     _frame, at = _text(data, 8)
     at = (at + 3) & ~3
     (count,) = _U32[True](data, 4 + at)
@@ -326,18 +342,30 @@ def decode_joint_velocities(data: CdrBytes) -> JointVelocities:
         name, at = _text(data, (at + 3) & ~3)
         names.append(name)
     _position, at = _doubles(data, at)
-    velocity, _at = _doubles(data, at)
+    velocity, at = _doubles(data, at)
+    _whole(data, _past_doubles(data, at))  # effort
     return JointVelocities(names, velocity)
 
 
 _TRUTH_HEAD = struct.Struct("<6d")  # inner_ring_speed .. axial_load
+_TRUTH_NUMBERS = 15 * 8 + 8 + 4 + 4 + 3 * 8
+"""Bytes from ``inner_ring_speed`` (aligned to 8) to the end of ``cage_whirl_radius_um``: 15 float64,
+a uint64, a uint32 (with 4 bytes of padding to the next float64), 3 float64."""
+_TRUTH_SEQUENCES = 8  # ball_azimuth .. ball_pocket_load, float64[] each
+_TRUTH_TAIL = 2 * 8  # cage_centre_x, cage_centre_y
 
 
 def decode_truth_speeds(data: CdrBytes) -> TruthSpeeds:
     """Speeds, slip and load of a little-endian CDR ``SimulatorTruth`` read by hand (the fields
-    right after its header); struct.error or UnicodeDecodeError for bad bytes."""
+    right after its header); struct.error or UnicodeDecodeError for bytes that end before the
+    message does or a frame id that is not UTF-8."""
     _frame, at = _text(data, 8)
-    inner, _acceleration, cage, _theoretical, slip, axial = _TRUTH_HEAD.unpack_from(data, 4 + ((at + 7) & ~7))
+    at = (at + 7) & ~7
+    inner, _acceleration, cage, _theoretical, slip, axial = _TRUTH_HEAD.unpack_from(data, 4 + at)
+    at += _TRUTH_NUMBERS
+    for _ in range(_TRUTH_SEQUENCES):
+        at = _past_doubles(data, at)
+    _whole(data, ((at + 7) & ~7) + _TRUTH_TAIL)
     return TruthSpeeds(inner, cage, slip, axial)
 
 
@@ -374,7 +402,7 @@ _STATUS_SWEEP = struct.Struct("<5d")  # axial_load .. sweep_stable_from
 def decode_status_fields(data: CdrBytes) -> StatusFields:
     """Stamp, speeds, slip, state, confidence and load-sweep verdict of a little-endian CDR
     ``SlipStatus`` read by hand (the values rosbags' decoder gives); struct.error or
-    UnicodeDecodeError for bad bytes."""
+    UnicodeDecodeError for bytes that end before the message does or text that is not UTF-8."""
     sec, nanosec = _PULSE_HEAD.unpack_from(data, 4)[:2]
     _frame, at = _text(data, 8)
     at = (at + 7) & ~7
@@ -385,25 +413,26 @@ def decode_status_fields(data: CdrBytes) -> StatusFields:
     _detail, at = _text(data, (at + 12 + 3) & ~3)
     at = (at + 7) & ~7
     sweep_speed = _STATUS_SWEEP.unpack_from(data, 4 + at)[3]
-    verdict, _at = _text(data, (at + 40 + 3) & ~3)
+    verdict, at = _text(data, (at + 40 + 3) & ~3)
+    _whole(data, at)
     return StatusFields(StampHeader(Stamp(sec, nanosec)), inner, cage, slip, state, confidence, sweep_speed, verdict)
 
 
 def make_field_decoder(typestore: Typestore, msgtype: str, fields: Callable[[CdrBytes], object]) -> Callable[[CdrBytes], object]:
-    """A function giving ``fields(data)`` for a complete little-endian message of ``msgtype`` (its
-    length walked first, so what :func:`make_decoder` refuses is not read by hand) and
+    """A function giving ``fields(data)`` for a complete little-endian message of ``msgtype`` and
     :func:`make_decoder`'s message for any other bytes (BagError for a malformed or cut one).
-    ``fields`` reads the rig's own layout of the type: a ``typestore`` (a bag's) that defines
-    it otherwise, such as an older recording's, is decoded by :func:`make_decoder` alone."""
+    ``fields`` reads the rig's own layout of the type to the message's end and raises
+    (struct.error, UnicodeDecodeError) for bytes that end before it, so what :func:`make_decoder`
+    refuses is not read by hand (:func:`decode_joint_velocities`, :func:`decode_truth_speeds`,
+    :func:`decode_status_fields`): a ``typestore`` (a bag's) that defines the type otherwise,
+    such as an older recording's, is decoded by :func:`make_decoder` alone."""
     general = make_decoder(typestore, msgtype)
     rig = rig_typestore()
     same_layout = all(typestore.fielddefs.get(name) == rig.fielddefs.get(name) for name in dependencies(rig, [msgtype]))
-    length = length_function(typestore, msgtype) if same_layout else None
 
     def decode(data: CdrBytes) -> object:
-        if length is not None and bytes(data[:2]) == LITTLE_ENDIAN:
+        if same_layout and bytes(data[:2]) == LITTLE_ENDIAN:
             try:
-                length(data)
                 return fields(data)
             except (BagError, *_MALFORMED):
                 pass

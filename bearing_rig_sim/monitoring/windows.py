@@ -400,7 +400,7 @@ class SlipWindows:
         if len(recent) != 3 * n + 1 or recent[-1][0] - recent[0][0] != 3 * n:
             return
         first_index = recent[0][0]
-        t0, t1, t2, t3 = (recent[k * n][1] for k in range(4))
+        t0, t1, t2, t3 = recent[0][1], recent[n][1], recent[2 * n][1], recent[3 * n][1]
         if not t0 < t1 < t2 < t3:
             return
         # the parabola through the first three passages, at the fourth: 3 revolutions if the
@@ -409,7 +409,7 @@ class SlipWindows:
         if not abs(predicted - 3.0) <= STEADY_ANGLE_TOLERANCE_REV:
             return
         middle = recent[n + 1 : 2 * n + 1]
-        d = [_cubic(t0, t1, t2, t3, time) - (index - first_index) / n for index, time in middle]
+        d = [value - (index - first_index) / n for (index, _), value in zip(middle, _cubic_at(t0, t1, t2, t3, [time for _, time in middle]))]
         mean = sum(d) / n
         assert s.offset is not None
         for (index, _), dm in zip(middle, d):
@@ -593,6 +593,22 @@ def _cubic(x0: float, x1: float, x2: float, x3: float, x: float) -> float:
     w2 = a0 / (x2 - x0) * (a1 / (x2 - x1)) * (a3 / (x2 - x3))
     w3 = a0 / (x3 - x0) * (a1 / (x3 - x1)) * (a2 / (x3 - x2))
     return 0.0 + w0 * 0.0 + w1 * 1.0 + w2 * 2.0 + w3 * 3.0
+
+
+def _cubic_at(x0: float, x1: float, x2: float, x3: float, xs: list[float]) -> list[float]:
+    """:func:`_cubic` at each of ``xs``, its differences of the nodes taken once (the same
+    operations on the same values: the same floats to the bit)."""
+    d01, d02, d03, d12, d13, d23 = x0 - x1, x0 - x2, x0 - x3, x1 - x2, x1 - x3, x2 - x3
+    d10, d20, d30, d21, d31, d32 = x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1, x3 - x2
+    values = []
+    for x in xs:
+        a0, a1, a2, a3 = x - x0, x - x1, x - x2, x - x3
+        w0 = a1 / d01 * (a2 / d02) * (a3 / d03)
+        w1 = a0 / d10 * (a2 / d12) * (a3 / d13)
+        w2 = a0 / d20 * (a1 / d21) * (a3 / d23)
+        w3 = a0 / d30 * (a1 / d31) * (a2 / d32)
+        values.append(0.0 + w0 * 0.0 + w1 * 1.0 + w2 * 2.0 + w3 * 3.0)
+    return values
 
 
 def _malformed(pulse: Pulse) -> str:

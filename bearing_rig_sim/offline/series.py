@@ -26,6 +26,9 @@ WINDOWS_CSV = "slip_windows.csv"
 
 _NAN = math.nan
 _RAD_S_TO_RPM = 1.0 / RPM_TO_RAD_S
+_AS_THEY_ARE = frozenset((float, int, bool, str, type(None)))
+"""Value types the csv module writes as :class:`CsvWriter` means them (a float as its ``repr``,
+None as an empty field): a row of these alone is handed over as it is."""
 
 
 @dataclass(frozen=True)
@@ -136,16 +139,24 @@ class CsvWriter:
         self._writer.writerow([name for name, _attr, _scale in columns])
         self._values = operator.attrgetter(*(attr for _name, attr, _scale in columns)) if len(columns) > 1 else None
         self._scales = [None if scale == 1.0 else scale for _name, _attr, scale in columns]
+        self._scaled = [(k, scale) for k, scale in enumerate(self._scales) if scale is not None]
 
     def write(self, row: Any) -> None:
         """Append one row."""
-        values = self._values(row) if self._values is not None else tuple(getattr(row, attr) for _name, attr, _scale in self.columns)
-        self._writer.writerow(
-            [
-                (repr(value) if scale is None else repr(value * scale)) if isinstance(value, float) else "" if value is None else value
-                for value, scale in zip(values, self._scales)
-            ]
-        )
+        values = list(self._values(row)) if self._values is not None else [getattr(row, attr) for _name, attr, _scale in self.columns]
+        if not set(map(type, values)) <= _AS_THEY_ARE:
+            self._writer.writerow(
+                [
+                    (repr(value) if scale is None else repr(value * scale)) if isinstance(value, float) else "" if value is None else value
+                    for value, scale in zip(values, self._scales)
+                ]
+            )
+            return
+        for k, scale in self._scaled:
+            value = values[k]
+            if type(value) is float:
+                values[k] = value * scale
+        self._writer.writerow(values)  # the csv module writes a float as its repr and None as ""
 
     def close(self) -> None:
         """Close the file."""

@@ -40,12 +40,13 @@ HELD_REPORTS = 3
 beyond the time a loop not held would take to run 0.5 s of sim time (a few hundred ms)."""
 
 
-def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_status(ros_graph: Any) -> None:
-    """The spindle turns at 900 rpm from the start, so pulses flow throughout."""
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime", "--ros-args", "-p", f"initial_speed_rad_s:={900 * RPM!r}")
-    node = ros_graph.node("monitor")  # plays the monitor
+def play_the_monitor(ros_graph: Any) -> tuple[Any, Any, dict[str, Any], Any]:
+    """A node playing the monitor: its executor, what it has seen (the latest ``/clock``, and
+    from the simulator's periodic reports the monitor pacing's state, their count and sim time)
+    and its status publisher."""
+    node = ros_graph.node("monitor")
     executor = ros_graph.executor([node])
-    seen = {"clock": -math.inf, "pacing": "", "reports": 0, "sim_time": -math.inf}
+    seen: dict[str, Any] = {"clock": -math.inf, "pacing": "", "reports": 0, "sim_time": -math.inf}
 
     def on_clock(msg: Clock) -> None:
         seen["clock"] = max(seen["clock"], from_stamp(msg.clock))
@@ -60,7 +61,13 @@ def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_stat
 
     node.create_subscription(Clock, CLOCK.name, on_clock, qos_profile("clock_reader"))
     node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, RELIABLE_QOS)
-    statuses = node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+    return node, executor, seen, node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+
+
+def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_status(ros_graph: Any) -> None:
+    """The spindle turns at 900 rpm from the start, so pulses flow throughout."""
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime", "--ros-args", "-p", f"initial_speed_rad_s:={900 * RPM!r}")
+    node, executor, seen, statuses = play_the_monitor(ros_graph)
 
     def publish(stamp: float) -> None:
         msg = SlipStatus()
@@ -104,22 +111,7 @@ def test_at_rest_the_monitors_silence_does_not_hold_the_simulation(ros_graph: An
     stopped, which needs more silence than the lead) does not hold the clock: it runs past the
     last status by more than the lead, and the simulator says why the statuses do not pace it."""
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
-    node = ros_graph.node("monitor")  # plays the monitor
-    executor = ros_graph.executor([node])
-    seen = {"clock": -math.inf, "pacing": ""}
-
-    def on_clock(msg: Clock) -> None:
-        seen["clock"] = max(seen["clock"], from_stamp(msg.clock))
-
-    def on_diagnostics(msg: DiagnosticArray) -> None:
-        for status in msg.status:
-            values = {kv.key: kv.value for kv in status.values}
-            if "monitor_pacing" in values:
-                seen["pacing"] = values["monitor_pacing"]
-
-    node.create_subscription(Clock, CLOCK.name, on_clock, qos_profile("clock_reader"))
-    node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, RELIABLE_QOS)
-    statuses = node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+    _node, executor, seen, statuses = play_the_monitor(ros_graph)
     assert ros_graph.spin_until(lambda: seen["clock"] > 0.0, WAIT, executor=executor), seen
     last = seen["clock"]
     msg = SlipStatus()

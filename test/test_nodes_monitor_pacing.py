@@ -1,6 +1,7 @@
 """Without real time the simulator keeps within ``MONITOR_LEAD_S`` (0.5 s of sim time) of the
-monitor's latest ``/rig/slip_status``: a monitor that falls silent holds the simulation there,
-and its next status lets it go on.
+monitor's latest ``/rig/slip_status`` while pulses flow: a monitor that falls silent holds the
+simulation there, and its next status lets it go on. With the rig at rest (no pulse) the monitor
+has nothing to take, and its statuses do not hold the simulation.
 
 The simulator (``--no-realtime``) runs as a process on the test's isolated domain; the test's
 node plays the monitor, publishing statuses stamped with the latest ``/clock`` it took, as the
@@ -24,7 +25,9 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 
 from bearing_rig_sim.interfaces import CLOCK, DIAGNOSTICS, SLIP_STATUS  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, from_stamp, qos_profile, to_stamp  # noqa: E402
-from bearing_rig_sim.nodes.simulator import MONITOR_LEAD_S  # noqa: E402
+from bearing_rig_sim.nodes.simulator import AT_REST, MONITOR_LEAD_S  # noqa: E402
+
+RPM = math.pi / 30.0
 
 WAIT = 120.0
 """Guard on any one wait, wall s."""
@@ -37,11 +40,13 @@ HELD_REPORTS = 3
 beyond the time a loop not held would take to run 0.5 s of sim time (a few hundred ms)."""
 
 
-def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_status(ros_graph: Any) -> None:
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
-    node = ros_graph.node("monitor")  # plays the monitor
+def play_the_monitor(ros_graph: Any) -> tuple[Any, Any, dict[str, Any], Any]:
+    """A node playing the monitor: its executor, what it has seen (the latest ``/clock``, and
+    from the simulator's periodic reports the monitor pacing's state, their count and sim time)
+    and its status publisher."""
+    node = ros_graph.node("monitor")
     executor = ros_graph.executor([node])
-    seen = {"clock": -math.inf, "pacing": "", "reports": 0, "sim_time": -math.inf}
+    seen: dict[str, Any] = {"clock": -math.inf, "pacing": "", "reports": 0, "sim_time": -math.inf}
 
     def on_clock(msg: Clock) -> None:
         seen["clock"] = max(seen["clock"], from_stamp(msg.clock))
@@ -56,7 +61,13 @@ def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_stat
 
     node.create_subscription(Clock, CLOCK.name, on_clock, qos_profile("clock_reader"))
     node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, RELIABLE_QOS)
-    statuses = node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+    return node, executor, seen, node.create_publisher(SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+
+
+def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_status(ros_graph: Any) -> None:
+    """The spindle turns at 900 rpm from the start, so pulses flow throughout."""
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime", "--ros-args", "-p", f"initial_speed_rad_s:={900 * RPM!r}")
+    node, executor, seen, statuses = play_the_monitor(ros_graph)
 
     def publish(stamp: float) -> None:
         msg = SlipStatus()
@@ -92,3 +103,19 @@ def test_the_simulator_runs_no_further_than_its_lead_past_the_monitors_last_stat
     # the monitor's next status lets it go on (and sets the pacing on again if it had let go)
     publish(last + 1.0)
     assert ros_graph.spin_until(lambda: seen["clock"] > bound + 0.5, WAIT, executor=executor), seen
+
+
+def test_at_rest_the_monitors_silence_does_not_hold_the_simulation(ros_graph: Any) -> None:
+    """The spindle at rest from the start: no pulse is published, so a monitor whose statuses
+    stand still (as they do between a stop's last pulse and the monitor's finding that the rig
+    stopped, which needs more silence than the lead) does not hold the clock: it runs past the
+    last status by more than the lead, and the simulator says why the statuses do not pace it."""
+    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
+    _node, executor, seen, statuses = play_the_monitor(ros_graph)
+    assert ros_graph.spin_until(lambda: seen["clock"] > 0.0, WAIT, executor=executor), seen
+    last = seen["clock"]
+    msg = SlipStatus()
+    msg.header.stamp = to_stamp(last)
+    statuses.publish(msg)  # then silent
+    assert ros_graph.spin_until(lambda: seen["clock"] > last + 4.0 * MONITOR_LEAD_S, WAIT, executor=executor), seen
+    assert ros_graph.spin_until(lambda: seen["pacing"] == f"off: {AT_REST}", WAIT, executor=executor), seen

@@ -94,7 +94,7 @@ class MonitorStatus:
     are NaN when not known. Once the rig has stopped (the pulses slowed, then ceased), the status
     describes the rig as it is, not its last window: ``time`` and ``window_start`` None (a node
     stamps it at the rig time of its check), both speeds 0, the slip and the window's load and
-    angles NaN; ``faults`` lists the active faults' reasons, ``warnings`` the recent
+    angles NaN; run up again, it has no window until its first whole one; ``faults`` lists the active faults' reasons, ``warnings`` the recent
     losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
     the pulses lost per shaft since the start, ``windows_skipped`` the cage windows skipped and
     ``duplicates`` the exact repeats of a pulse dropped per shaft (spindle, cage).
@@ -478,6 +478,8 @@ class SlipMonitor:
         if self.counter.stopped and (self.slope.n_points or self.slope.state is not SlipState.UNKNOWN):
             self._restart_series(now, "the rig stopped")
             self._previous_inner, self._steady = None, None
+        if self.counter.stopped:
+            self._latest = None  # no window describes a stopped rig, nor the same rig run up again
 
     # -- output --------------------------------------------------------------------------------
     def faults(self) -> tuple[str, ...]:
@@ -506,8 +508,6 @@ class SlipMonitor:
             detail = f"{detail}; warning: {'; '.join(warnings)}"
         if notes:
             detail = f"{detail}; note: {notes[-1]}"
-        if self.counter.stopped:
-            latest = None  # no window describes a stopped rig
         at_rest = 0.0 if self.counter.stopped else math.nan
         inner = latest.inner_ring_speed if latest is not None else at_rest
         books = self.counter.books

@@ -148,8 +148,15 @@ latest sample, the clock's). So the monitor's pulse queue never holds more than 
 pulses (its depth, 10000, is 20 s at 9000 rpm), its verdicts keep up with the program on any
 host, and its last status at the end of a session lies within this of the clock's end. Paced as
 the force stream (:data:`FORCE_LEAD_S`): only while the statuses follow the clock, not while the
-monitor is inactive, gone, or silent for :data:`FORCE_SILENT_S` of wall time; while the spindle
-stands still the simulation then runs at most 5 s of simulated time per wall second."""
+monitor is inactive, gone, or silent for :data:`FORCE_SILENT_S` of wall time; and only while
+pulses flow: once none has been published for this long of simulated time (the rig at rest),
+the monitor has taken or will take every pulse there is, and the lead would hold the clock
+where the monitor cannot yet tell a stop from a silent sensor (its statuses keep their last
+window's stamp until the silence exceeds ``loss_min_timeout_s``, 0.5 s, and four pulse periods),
+so the simulation goes on, paced by the force stream, until a pulse comes again."""
+
+AT_REST = f"the rig at rest (no pulse for {MONITOR_LEAD_S:g} s of simulated time)"
+"""Why the monitor's statuses do not pace the loop while no pulse comes (:data:`MONITOR_LEAD_S`)."""
 
 MONITOR_FOLLOW_S = 2.0
 """A status stamp this close (s of simulated time) to the simulation when it arrives is taken as
@@ -224,6 +231,8 @@ class SimulatorNode(ManagedNode):
         self._lifecycle_events: dict[str, tuple[Subscription, set[str]]] = {}
         """The ``transition_event`` reader of each node publishing a paced stream, and those streams."""
         self._pulses = {"spindle": 0, "cage": 0}
+        self._last_pulse_time = -math.inf
+        """Simulated time of the latest chunk that published a pulse, s."""
         self._last_level: HealthLevel | None = None
         self._anchor = True
         self._clock_started = False
@@ -336,7 +345,13 @@ class SimulatorNode(ManagedNode):
         self._take_statuses()
         for name in self._leads:
             self._follow_publishers(name)
-        rooms = [r for lead in self._leads.values() if (r := lead.room(self.twin.time, self.settings.chunk_s, now)) is not None]
+        at_rest = self.twin.time - self._last_pulse_time > MONITOR_LEAD_S
+        rooms = []
+        for name, lead in self._leads.items():
+            if name == SLIP_STATUS.name and at_rest:
+                lead.off = AT_REST
+            elif (room := lead.room(self.twin.time, self.settings.chunk_s, now)) is not None:
+                rooms.append(room)
         if not rooms:
             return chunks
         room = min(rooms)
@@ -416,6 +431,8 @@ class SimulatorNode(ManagedNode):
                 pub.publish(instrument_message(kind, reading))
         self._pulses["spindle"] += len(out.spindle_pulses)
         self._pulses["cage"] += len(out.cage_pulses)
+        if out.spindle_pulses or out.cage_pulses:
+            self._last_pulse_time = out.time
         if self._chunks % self._speeds_every == 0:
             m = out.measured
             msg = self._speeds_msg

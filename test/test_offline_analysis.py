@@ -519,3 +519,20 @@ def test_recorded_stamps_on_another_clock_are_placed_on_the_pulse_clock(tmp_path
     times = [t for t, _state in result.recorded_transitions]
     assert result.recorded_transitions[0] == (0.0, 0) and [s for _t, s in result.recorded_transitions] == [0, 1, 2]
     assert times[1] == 1.0 and 0.99 < times[2] <= 1.0  # the pulse clock when it arrived
+
+
+def test_a_recorded_status_belongs_to_the_segment_its_stamp_falls_in() -> None:
+    """The monitor's verdict on a stop's silence (state unknown, stamped at its rig time within
+    the stop segment) can reach the bag after the next segment's command, which was sent ahead;
+    it is the stop's final recorded state all the same, as the live summary judges it (by stamp),
+    and not the next segment's. A status stamped before a segment's start is not that segment's."""
+    tracker = SegmentTracker(by_program=True, names=["run", "stop", "again"])
+    unknown, slipping, stable = int(MonitorState.UNKNOWN), int(MonitorState.SLIPPING), int(MonitorState.STABLE)
+    tracker.command(0.0, 100.0, 0, 0.5, 0.0, 0.0)
+    tracker.recorded(0.8, 40.0, stable, 0.9, 100.0)
+    tracker.command(1.0, 0.0, 0, 0.5, 0.0, 100.0)
+    tracker.recorded(1.3, 30.0, slipping, 0.0, 60.0)
+    tracker.command(3.0, 100.0, 0, 0.5, 0.0, 0.0)
+    tracker.recorded(2.9, 0.0, unknown, 0.0, 0.0)  # read after the command stamped 3.0
+    run, stop, again = tracker.finish()
+    assert (run.final_recorded_state, stop.final_recorded_state, again.final_recorded_state) == (stable, unknown, -1)

@@ -55,8 +55,10 @@ class SegmentSummary:
         slip_rate / recorded_slip_rate / truth_slip_rate: mean slip, offline monitor / recorded
             status / simulator truth, %.
         final_state: the offline monitor's state at the segment's last status row.
-        final_recorded_state: the state of the last recorded status in the segment (-1 if none):
-            at rest, where no pulse makes a row, the monitor's own verdict of the silence.
+        final_recorded_state: the state of the latest-stamped recorded status stamped in the
+            segment (-1 if none), as the live session summary judges: at rest, where no pulse
+            makes a row, the monitor's own verdict of the silence, which can reach the bag after
+            the next segment's command (stamped within the segment all the same).
         time_to_stable / recorded_time_to_stable: by :class:`TimeToStable`, s (None without one):
             from the ramp's end, or for a run-up (constant acceleration) from its start.
         rows: status rows after the ramp end (1).
@@ -89,6 +91,7 @@ class _Segment:
         self.rows = 0
         self.final_state = int(SlipState.UNKNOWN)
         self.final_recorded = -1
+        self.final_recorded_stamp = -math.inf
         self.settings = settings
         commanded = target if math.isfinite(target) else None  # a stretch found by speed has no command
         start_of_run_up = start if run_up else None
@@ -124,8 +127,14 @@ class _Segment:
         return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
 
     def add_recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
-        self.final_recorded = state
+        self.take_final_recorded(stamp, state)
         self.recorded_stable.observe(stamp, self.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)
+
+    def take_final_recorded(self, stamp: float, state: int) -> None:
+        """A recorded status's state, if it is the latest stamped so far (a status stamped before
+        the segment's start, in a program, is the previous segment's)."""
+        if stamp >= self.final_recorded_stamp and (stamp >= self.start or not math.isfinite(self.target)):
+            self.final_recorded, self.final_recorded_stamp = state, stamp
 
     def summary(self) -> SegmentSummary:
         return SegmentSummary(
@@ -191,6 +200,8 @@ class SegmentTracker:
         self.settings = settings if settings is not None else MonitorSettings.from_yaml()
         self.segments: list[SegmentSummary] = []
         self._open: _Segment | None = None
+        self._closed: list[_Segment] = []
+        """The last segment closed (its late recorded statuses), while it is the last."""
         self._previous_target = _NAN
         self._windows = 0
         self._stretch_sum = 0.0
@@ -234,6 +245,10 @@ class SegmentTracker:
         confidence and inner-ring speed (rad/s)."""
         if self._open is not None:
             self._open.add_recorded(stamp, cage_speed, state, confidence, inner_ring_speed)
+        last = self._closed[-1] if self._closed else None
+        if self.by_program and last is not None and last.start <= stamp < (self._open.start if self._open is not None else math.inf):
+            last.take_final_recorded(stamp, state)  # the previous segment's, read after the next began
+            self.segments[-1] = replace(self.segments[-1], final_recorded_state=last.final_recorded)
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""
@@ -251,3 +266,4 @@ class SegmentTracker:
                 return
             segment.name = f"stretch {len(self.segments) + 1}"
         self.segments.append(segment.summary())
+        self._closed = [segment]

@@ -43,7 +43,7 @@ from bearing_rig_sim.analysis.streaming import TrailingSlope
 from bearing_rig_sim.monitoring.load_sweep import SPEED_TOLERANCE as SWEEP_SPEED_TOLERANCE
 from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
-from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows
+from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows, pulse_stamp
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 MonitorState = SlipState
@@ -94,10 +94,11 @@ class MonitorStatus:
     are NaN when not known. Once the rig has stopped (the pulses slowed, then ceased), the status
     describes the rig as it is, not its last window: ``time`` and ``window_start`` None (a node
     stamps it at the rig time of its check), both speeds 0, the slip and the window's load and
-    angles NaN; run up again, it has no window until its first whole one; ``faults`` lists the active faults' reasons, ``warnings`` the recent
-    losses (lost pulses, skipped windows), ``notes`` the recent resets and refusals; ``lost``
-    the pulses lost per shaft since the start, ``windows_skipped`` the cage windows skipped and
-    ``duplicates`` the exact repeats of a pulse dropped per shaft (spindle, cage).
+    angles NaN; run up again, it has no window until its first whole one. ``faults`` lists the
+    active faults' reasons, ``warnings`` the recent losses (lost pulses, skipped windows),
+    ``notes`` the recent resets and refusals; ``lost`` the pulses lost per shaft since the start,
+    ``windows_skipped`` the cage windows skipped and ``duplicates`` the exact repeats of a pulse
+    dropped per shaft (spindle, cage).
     ``confidence`` is P(slope >= k) (0 while no slope is known). ``axial_load`` is the latest
     window's mean measured load (N, NaN without load-cell samples). With the ``axial_load``
     criterion, ``sweep_speed`` (rad/s), ``sweep_stable_from`` (N) and ``sweep_verdict`` are the
@@ -286,10 +287,9 @@ class SlipMonitor:
             self._take_events()
         if counter.phase or self.phase is None or counter.epoch != self._phase_epoch:
             self._take_phase(shaft, pulse)
-        t = pulse.time
-        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
-            if self._now is None or t > self._now:
-                self._now = float(t)
+        t = pulse_stamp(pulse)
+        if t is not None and (self._now is None or t > self._now):
+            self._now = t
         for window in done:
             self._add_window(window)
         return bool(done)
@@ -330,8 +330,6 @@ class SlipMonitor:
                 self.slope.refresh(external)
 
     def _take_events(self) -> None:
-        if not self.counter.events:
-            return
         for kind, when, text in self.counter.events:
             if kind == "reset":
                 self.slope.reset()

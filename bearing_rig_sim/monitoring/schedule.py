@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorStatus, SlipMonitor
+from bearing_rig_sim.monitoring.windows import pulse_stamp
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 
 
@@ -56,9 +57,9 @@ class StatusSchedule:
     def on_pulse(self, shaft: str, pulse: Pulse) -> list[ScheduledStatus]:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
-        t = pulse.time
-        if (type(t) is float or (isinstance(t, (int, float)) and not isinstance(t, bool))) and math.isfinite(t):
-            self._advance(float(t), out)
+        t = pulse_stamp(pulse)
+        if t is not None:
+            self._advance(t, out)
         if self.monitor.add_pulse(shaft, pulse):
             out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
         return out
@@ -193,8 +194,8 @@ class PulseMerger:
 
     def push(self, shaft: str, pulse: Pulse, wall_now: float) -> list[tuple[str, Pulse]]:
         """Take one received pulse; the pulses (of either shaft) that may go on now, in order."""
-        t = pulse.time
-        if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        t = pulse_stamp(pulse)
+        if shaft not in self._held or t is None:
             return [(shaft, pulse)]  # the monitor reports what is wrong with it
         if t > self._latest[shaft]:
             if math.isfinite(self._latest[shaft]):
@@ -256,11 +257,9 @@ class StampOrder:
 
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
-        t = pulse.time
-        if not (type(t) is float and math.isfinite(t) and shaft in self._held):  # the common case first
-            if shaft not in self._held or isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
-                return [(shaft, pulse)]
-            t = float(t)
+        t = pulse_stamp(pulse)
+        if shaft not in self._held or t is None:
+            return [(shaft, pulse)]
         latest = self._latest
         if t > latest[shaft]:
             latest[shaft] = t

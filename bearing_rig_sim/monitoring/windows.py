@@ -611,6 +611,16 @@ def _cubic_at(x0: float, x1: float, x2: float, x3: float, xs: list[float]) -> li
     return values
 
 
+def pulse_stamp(pulse: Pulse) -> float | None:
+    """A pulse's stamp as a float, s; None unless it is a finite number (a bool is none here)."""
+    t = pulse.time
+    if type(t) is float:  # the common case first
+        return t if math.isfinite(t) else None
+    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+        return None
+    return float(t)
+
+
 def _malformed(pulse: Pulse) -> str:
     """Why a pulse cannot be used ("" if it can)."""
     t = pulse.time
@@ -619,7 +629,7 @@ def _malformed(pulse: Pulse) -> str:
     if type(t) is float and type(strip_id) is int and type(strip_count) is int and type(pulse_index) is int:
         if math.isfinite(t) and 0 <= strip_id < strip_count and pulse_index >= 0:
             return ""
-    if isinstance(t, bool) or not isinstance(t, (int, float)) or not math.isfinite(t):
+    if pulse_stamp(pulse) is None:
         return f"time {t!r} is not a finite number"
     for name in ("strip_id", "strip_count", "pulse_index"):
         value = getattr(pulse, name)

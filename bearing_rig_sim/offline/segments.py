@@ -200,8 +200,8 @@ class SegmentTracker:
         self.settings = settings if settings is not None else MonitorSettings.from_yaml()
         self.segments: list[SegmentSummary] = []
         self._open: _Segment | None = None
-        self._closed: list[_Segment] = []
-        """The last segment closed (its late recorded statuses), while it is the last."""
+        self._last_closed: _Segment | None = None
+        """The segment of ``segments[-1]`` (the late recorded statuses stamped in it)."""
         self._previous_target = _NAN
         self._windows = 0
         self._stretch_sum = 0.0
@@ -245,7 +245,7 @@ class SegmentTracker:
         confidence and inner-ring speed (rad/s)."""
         if self._open is not None:
             self._open.add_recorded(stamp, cage_speed, state, confidence, inner_ring_speed)
-        last = self._closed[-1] if self._closed else None
+        last = self._last_closed
         if self.by_program and last is not None and last.start <= stamp < (self._open.start if self._open is not None else math.inf):
             last.take_final_recorded(stamp, state)  # the previous segment's, read after the next began
             self.segments[-1] = replace(self.segments[-1], final_recorded_state=last.final_recorded)
@@ -266,4 +266,4 @@ class SegmentTracker:
                 return
             segment.name = f"stretch {len(self.segments) + 1}"
         self.segments.append(segment.summary())
-        self._closed = [segment]
+        self._last_closed = segment

@@ -172,6 +172,15 @@ def test_a_paused_or_silent_stream_stops_pacing_until_it_advances_again():
     assert lead.room(1.6, 1e-3, 11.0) == 500
 
 
+def test_an_idle_source_releases_the_simulation_and_says_why_until_it_is_busy_again():
+    lead = StreamLead("monitor status", 0.5)
+    lead.observe(1.0, 1.0, 0.0)
+    lead.observe(1.1, 1.1, 0.0)
+    assert lead.room(1.1, 1e-3, 0.0, idle="the rig at rest") is None and lead.off == "the rig at rest"
+    # the stream's state is kept: busy again, the same bound as before (1.1 + 0.5 - 1.1 s in 1 ms chunks)
+    assert lead.room(1.1, 1e-3, 0.0) == 500 and lead.off == ""
+
+
 def test_a_stream_lead_refuses_a_lead_that_is_not_positive():
     with pytest.raises(PacerError, match="lead_s"):
         StreamLead("x", 0.0)

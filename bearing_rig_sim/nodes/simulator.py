@@ -348,9 +348,8 @@ class SimulatorNode(ManagedNode):
         at_rest = self.twin.time - self._last_pulse_time > MONITOR_LEAD_S
         rooms = []
         for name, lead in self._leads.items():
-            if name == SLIP_STATUS.name and at_rest:
-                lead.off = AT_REST
-            elif (room := lead.room(self.twin.time, self.settings.chunk_s, now)) is not None:
+            idle = AT_REST if name == SLIP_STATUS.name and at_rest else ""
+            if (room := lead.room(self.twin.time, self.settings.chunk_s, now, idle=idle)) is not None:
                 rooms.append(room)
         if not rooms:
             return chunks

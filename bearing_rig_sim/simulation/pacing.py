@@ -253,9 +253,14 @@ class StreamLead:
         self.pace, self.stamp, self.off = None, -math.inf, reason
         self.paused = paused
 
-    def room(self, sim_time: float, chunk: float, wall: float) -> int | None:
+    def room(self, sim_time: float, chunk: float, wall: float, *, idle: str = "") -> int | None:
         """Chunks of ``chunk`` s the simulation at ``sim_time`` (s) may still run, wall time
-        ``wall`` (s); None while the stream does not pace (see the class docstring)."""
+        ``wall`` (s); None while the stream does not pace (see the class docstring), or while
+        ``idle`` says why its source has nothing to send now (a rig at rest; :attr:`off` then
+        says so, and pacing resumes with the next call without it)."""
+        if idle:
+            self.off = idle
+            return None
         if self.pace is None or self.paused:
             self.off = self.off or f"no {self.name} following the clock"
             return None

@@ -584,20 +584,10 @@ def _parabola(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float, 
     return 0.0 + (x - x1) / (x0 - x1) * ((x - x2) / (x0 - x2)) * y0 + (x - x0) / (x1 - x0) * ((x - x2) / (x1 - x2)) * y1 + (x - x0) / (x2 - x0) * ((x - x1) / (x2 - x1)) * y2
 
 
-def _cubic(x0: float, x1: float, x2: float, x3: float, x: float) -> float:
-    """:func:`_lagrange` through (x0, 0), (x1, 1), (x2, 2), (x3, 3), with the same operations in
-    the same order (so the same value to the bit), without its loops."""
-    a0, a1, a2, a3 = x - x0, x - x1, x - x2, x - x3
-    w0 = a1 / (x0 - x1) * (a2 / (x0 - x2)) * (a3 / (x0 - x3))
-    w1 = a0 / (x1 - x0) * (a2 / (x1 - x2)) * (a3 / (x1 - x3))
-    w2 = a0 / (x2 - x0) * (a1 / (x2 - x1)) * (a3 / (x2 - x3))
-    w3 = a0 / (x3 - x0) * (a1 / (x3 - x1)) * (a2 / (x3 - x2))
-    return 0.0 + w0 * 0.0 + w1 * 1.0 + w2 * 2.0 + w3 * 3.0
-
-
 def _cubic_at(x0: float, x1: float, x2: float, x3: float, xs: list[float]) -> list[float]:
-    """:func:`_cubic` at each of ``xs``, its differences of the nodes taken once (the same
-    operations on the same values: the same floats to the bit)."""
+    """:func:`_lagrange` through (x0, 0), (x1, 1), (x2, 2), (x3, 3) at each of ``xs``, with the
+    same operations in the same order (so the same values to the bit), without its loops and with
+    the nodes' differences taken once."""
     d01, d02, d03, d12, d13, d23 = x0 - x1, x0 - x2, x0 - x3, x1 - x2, x1 - x3, x2 - x3
     d10, d20, d30, d21, d31, d32 = x1 - x0, x2 - x0, x3 - x0, x2 - x1, x3 - x1, x3 - x2
     values = []

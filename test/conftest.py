@@ -277,6 +277,16 @@ class RosGraph:
         return process
 
     # -- teardown ----------------------------------------------------------------------------
+    @staticmethod
+    def _report_output(process: subprocess.Popen[str], out: str, err: str) -> None:
+        """Print the end of what a spawned node wrote and the test left unread: pytest shows it
+        under the failing test's teardown output (and nowhere for a passing one), so a node's own
+        log explains a failure seen only in CI."""
+        text = (out + err).strip()
+        if text:
+            command = " ".join(str(a) for a in process.args[1:4]) if isinstance(process.args, list) else str(process.args)
+            print(f"--- {command} (exit {process.returncode}), last 4000 characters ---\n{text[-4000:]}", file=sys.stderr)
+
     def close(self) -> None:
         """Stop processes, then shut down executors, destroy nodes, shut down contexts."""
         for process in self._processes:
@@ -284,10 +294,13 @@ class RosGraph:
                 process.terminate()
         for process in self._processes:
             try:
-                process.communicate(timeout=5.0)
+                out, err = process.communicate(timeout=5.0)
             except subprocess.TimeoutExpired:
                 process.kill()
-                process.communicate()
+                out, err = process.communicate()
+            except ValueError:  # the test read the pipes itself (communicate closed them)
+                out, err = "", ""
+            self._report_output(process, out or "", err or "")
         leaked = kill_processes_on_domain(self.domain_id)
         if leaked:
             warnings.warn(

@@ -62,6 +62,27 @@ def stribeck_max_ball_load(radial: float) -> float:
     return 4.37 * radial / (g["ball_count"] * math.cos(math.radians(g["contact_angle_deg"])))
 
 
+ZONE_MODEL_REL = 0.03
+"""Stribeck's 4.37 against the twin's contacts: the factor is the continuous load integral's
+J_r(1/2) for a fixed contact angle; the twin's angles open under load (3 %, as for the equilibrium)."""
+
+
+def heaviest_ball_in_band(q: float, radial: float) -> bool:
+    """The heaviest ball's load lies where the load distribution puts it at any cage position.
+
+    Q_max is the load of a ball on the load line. As the balls pass, the heaviest is at most half
+    a ball spacing (pi/Z) off it (checked by :func:`check_per_ball_equilibrium`) and carries
+    Q(psi) = Q_max [1 - (1 - cos psi) / (2 eps)]^1.5 = Q_max cos^1.5(psi) with eps = 1/2 (Harris
+    and Kotzalas vol. 1, ch. 7): between Q_max cos^1.5(pi/Z) (0.971 Q_max for 16 balls, two balls
+    astride the line) and Q_max, each widened by :data:`ZONE_MODEL_REL`. The balls pass the load line
+    at Z times the cage speed, 16 x 0.5 (1 - D cos a / d_m) x 15 Hz = 103 Hz at 900 rpm without
+    slip: the truth, every 10 ms, sees nearly the same ball positions for tenths of a second, so a
+    run can see the balls astride the line throughout."""
+    q_max = stribeck_max_ball_load(radial)
+    astride = math.cos(math.pi / bearing_section("geometry")["ball_count"]) ** 1.5
+    return q_max * astride * (1.0 - ZONE_MODEL_REL) <= q <= q_max * (1.0 + ZONE_MODEL_REL)
+
+
 class Bench:
     """A test node: publishes the force on the bearing, records truth and diagnostics."""
 
@@ -181,7 +202,7 @@ def test_radial_force_on_the_topic_loads_the_twin_within_the_rig_files_limit(ros
     bench.wait(lambda: bench.time() > loaded + 0.1, "0.1 s simulated under the radial load")
     last = bench.truth[-1]
     assert last.axial_load == AXIAL_N
-    assert last.inner_contact_load_max == pytest.approx(stribeck_max_ball_load(RADIAL_N), rel=0.03)
+    assert heaviest_ball_in_band(last.inner_contact_load_max, RADIAL_N), last.inner_contact_load_max
     assert last.inner_contact_load_max > 2.0 * last.inner_contact_load_mean  # balls outside the zone unloaded
     check_per_ball_equilibrium(last, (RADIAL_X_N, RADIAL_Y_N))
     bench.wait(lambda: bench.value("radial_load_n") == "500", "the radial load in the report")
@@ -217,7 +238,7 @@ def test_radial_force_on_the_topic_loads_the_twin_within_the_rig_files_limit(ros
 
     def settled() -> bool:  # the balls' transient after the release over: 0.1 s simulated at Stribeck's Q_max
         recent = bench.truth[-round(0.1 / TRUTH_PERIOD_S) :]
-        return len(recent) > 1 and all(t.inner_contact_load_max == pytest.approx(q_max, rel=0.03) for t in recent)
+        return len(recent) > 1 and all(heaviest_ball_in_band(t.inner_contact_load_max, RADIAL_N) for t in recent)
 
     bench.wait(settled, "Stribeck's Q_max held for 0.1 s after the moment's release")
 
@@ -232,7 +253,7 @@ def test_radial_force_on_the_topic_loads_the_twin_within_the_rig_files_limit(ros
     after = [t for t in bench.truth if from_stamp(t.header.stamp) > refused]
     assert all(t.axial_load == AXIAL_N for t in after)
     loads = [t.inner_contact_load_max for t in after]
-    assert all(q == pytest.approx(q_max, rel=0.03) for q in loads), (min(loads), max(loads), q_max)
+    assert all(heaviest_ball_in_band(q, RADIAL_N) for q in loads), (min(loads), max(loads), q_max)
     assert bench.value("radial_load_n") == "500"
     stamps = [from_stamp(t.header.stamp) for t in bench.truth]
     assert all(b - a == pytest.approx(TRUTH_PERIOD_S, abs=1e-6) for a, b in zip(stamps, stamps[1:], strict=False))

@@ -309,14 +309,21 @@ def test_rows_are_decimated_evenly_in_bounded_memory() -> None:
 
 def test_csv_rows_write_floats_exactly_speeds_in_rpm(tmp_path: Path) -> None:
     """Each float as its repr (read back, the same float), None as an empty field, an int as it
-    is, speeds in rpm (1 rad/s = 30 / pi rpm)."""
+    is, speeds in rpm (1 rad/s = 30 / pi rpm); a numpy float as the Python float it equals (numpy
+    2 gives its repr as ``np.float64(...)``, which no CSV reader takes for a number)."""
     columns = csv_columns(SlipWindowRow)
     assert [name for name, _attr, _scale in columns] == ["start_time_s", "end_time_s", "inner_ring_rpm", "cage_rpm", "slip_rate_pct"]
     writer = CsvWriter(tmp_path / "w.csv", columns)
-    for row in (SlipWindowRow(0.1, 0.30000000000000004, math.pi, 2.0, math.nan), SlipWindowRow(1.0, 2.0, 3, 1.0, None)):  # type: ignore[arg-type]
+    rows = (
+        SlipWindowRow(0.1, 0.30000000000000004, math.pi, 2.0, math.nan),
+        SlipWindowRow(1.0, 2.0, 3, 1.0, None),  # type: ignore[arg-type]
+        SlipWindowRow(np.float64(0.1), 0.2, np.float64(math.pi), 2.0, np.float64(1.5)),  # type: ignore[arg-type]
+    )
+    for row in rows:
         writer.write(row)
     writer.close()
-    header, first, second = (tmp_path / "w.csv").read_text().splitlines()
+    header, first, second, third = (tmp_path / "w.csv").read_text().splitlines()
+    assert third.split(",") == ["0.1", "0.2", first.split(",")[2], first.split(",")[3], "1.5"]
     cells = first.split(",")
     assert cells[:2] == ["0.1", "0.30000000000000004"] and cells[4] == "nan"
     assert float(cells[2]) == pytest.approx(30.0, rel=1e-15) and float(cells[3]) == pytest.approx(60.0 / math.pi, rel=1e-15)

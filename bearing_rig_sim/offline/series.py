@@ -147,7 +147,7 @@ class CsvWriter:
         if not set(map(type, values)) <= _AS_THEY_ARE:
             self._writer.writerow(
                 [
-                    (repr(value) if scale is None else repr(value * scale)) if isinstance(value, float) else "" if value is None else value
+                    (repr(float(value)) if scale is None else repr(float(value) * scale)) if isinstance(value, float) else "" if value is None else value
                     for value, scale in zip(values, self._scales)
                 ]
             )

@@ -55,10 +55,12 @@ BEFORE_N, AFTER_N = 100.0, 300.0
 AHEAD_S = 3.0
 """How far ahead of the clock the set-point is stamped, s of sim time: the simulation, held by
 the stopped load controller, stays far short of it. The set-point is published just before the
-stop and acknowledged by the load controller's reader first (``wait_for_all_acked``): the writer
-can match the reader before the reader matches the writer, and a sample sent in between is
-dropped by the reader and repaired only after a heartbeat, which a resumed, fast simulation can
-outrun; CI saw the chain pass the stamp on the old set-point."""
+stop, once the load controller's reader has acknowledged a sample of this writer (the set-point
+in force, sent again): the writer can match the reader before the reader matches the writer,
+and a sample sent in between is dropped by the reader and repaired only after a heartbeat (3 s
+in the test's process), which a resumed, fast simulation outruns; CI saw the chain pass the
+stamp on the old set-point. Waiting for the acknowledgement of the stamped set-point itself
+would let the simulation pass its stamp before the stop."""
 
 
 class Probe:
@@ -149,15 +151,19 @@ def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactiv
     probe.wait(lambda: probe.setpoint.get_subscription_count() > 0, "the load controller's set-point reader")
     probe.wait(lambda: probe.pacing == "on" and probe.last_force > 1.0, "the simulator pacing on the force stream, and its forces here")
 
+    # the load controller's reader matched to this writer first: the set-point in force sent again
+    # (unstamped: on arrival, no change) until the reader acknowledges it
+    again = WrenchStamped()
+    again.wrench.force.z = BEFORE_N
+    probe.setpoint.publish(again)
+    probe.wait(lambda: probe.setpoint.wait_for_all_acked(Duration(seconds=0)), "the load controller's reader to acknowledge the set-point in force")
+
     # a set-point stamped ahead, as a session sends it; then the load controller stopped
     stamp = math.ceil((probe.clock + AHEAD_S) / 0.01) * 0.01  # on the state messages' 10 ms grid
     message = WrenchStamped()
     message.header.stamp = to_stamp(stamp)
     message.wrench.force.z = AFTER_N
     probe.setpoint.publish(message)
-    # held in the load controller's reader before the stop: a reader that has not matched this
-    # writer yet drops the sample, and its repair could come after the chain passed the stamp
-    assert probe.setpoint.wait_for_all_acked(Duration(seconds=WAIT)), "the load controller's reader never acknowledged the set-point"
     os.kill(controller.pid, signal.SIGSTOP)
     try:
         probe.wait(lambda: stopped(controller.pid), "the load controller to stop")

@@ -279,9 +279,9 @@ class RosGraph:
     # -- teardown ----------------------------------------------------------------------------
     @staticmethod
     def _report_output(process: subprocess.Popen[str], out: str, err: str) -> None:
-        """Print the end of what a spawned node wrote and the test left unread: pytest shows it
-        under the failing test's teardown output (and nowhere for a passing one), so a node's own
-        log explains a failure seen only in CI."""
+        """Print the end of what a spawned node wrote (``communicate`` gives it again to a test
+        that read it the same way): pytest shows it under the failing test's teardown output (and
+        nowhere for a passing one), so a node's own log explains a failure seen only in CI."""
         text = (out + err).strip()
         if text:
             command = " ".join(str(a) for a in process.args[1:4]) if isinstance(process.args, list) else str(process.args)
@@ -298,8 +298,6 @@ class RosGraph:
             except subprocess.TimeoutExpired:
                 process.kill()
                 out, err = process.communicate()
-            except ValueError:  # the test read the pipes itself (communicate closed them)
-                out, err = "", ""
             self._report_output(process, out or "", err or "")
         leaked = kill_processes_on_domain(self.domain_id)
         if leaked:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import bisect
 import math
+import operator
 from dataclasses import dataclass
 
 import numpy as np
@@ -42,6 +43,9 @@ from bearing_rig_sim.analysis.inputs import FloatArray
 MIN_PHASE_REVOLUTIONS = 2.0
 """A stretch covers at least this many cage revolutions (reaching back beyond the span if need
 be), so that the strips' offsets are told apart from the curvature (1)."""
+
+BULK_SUM_POINTS = 16
+"""Fresh sums over at least this many points are taken as arrays, fewer one by one (1)."""
 
 MIN_DOF = 3
 """... and at least this many pulses more than the fit's parameters (strips + 2), reaching back
@@ -81,6 +85,40 @@ class PhaseEstimate:
     white_share: float = 1.0
 
 
+class _SumLayout:
+    """Where each running sum sits in :class:`PhaseSlope`'s flat sums, for ``strips`` cage strips.
+
+    The fit's rows are z = (u, v = u^2, one indicator per strip, y), so z z' and dz dz' (dz: z
+    minus the previous pulse's z) hold few distinct numbers: the sums of uu, uv, vv, uy, vy, yy;
+    per strip its pulses and the sums of u, v and y over them; of the differences du, dv, dy the
+    same six products; per strip the sums of du, dv and dy times its indicator's difference c
+    (+1 for the pulse's strip, -1 for the previous pulse's, when they differ), and per pair of
+    strips the sum of their c's product. These are kept, not the dense matrices: a pulse costs a
+    few scalar additions, and the normal equations are assembled from them (:meth:`PhaseSlope.estimate`).
+    """
+
+    UU, UV, VV, UY, VY, YY = range(6)
+
+    def __init__(self, strips: int) -> None:
+        self.strips = strips
+        self.pairs = 6 + 4 * strips  # first of the sums over the differences
+        self.pair_strips = self.pairs + 6
+        self.pair_cross = self.pair_strips + 3 * strips
+        self.size = self.pair_cross + strips * strips
+
+    def count(self, strip: int) -> int:
+        """Pulses of ``strip``; then the sums of u, v and y over them."""
+        return 6 + 4 * strip
+
+    def pair_strip(self, strip: int) -> int:
+        """Sum of du c(strip); then of dv c(strip) and of dy c(strip)."""
+        return self.pair_strips + 3 * strip
+
+    def cross(self, strip: int, other: int) -> int:
+        """Sum of c(strip) c(other)."""
+        return self.pair_cross + strip * self.strips + other
+
+
 class PhaseSlope:
     """Trailing slope of slip against time from cage pulses and the spindle angle (module
     docstring), kept as running sums so that an estimate costs O(strips^2), whatever the pulses.
@@ -104,6 +142,7 @@ class PhaseSlope:
         # shared by its two ends
         self.angle_floor = resolution / 100.0 * 2.0 * math.pi / math.sqrt(2.0)
         self._dim = strips + 3  # z = (u, u^2, one indicator per strip, y)
+        self._layout = _SumLayout(strips)
         self.reset()
 
     def reset(self) -> None:
@@ -113,14 +152,26 @@ class PhaseSlope:
         self._strip: list[int] = []
         self._inner: list[float] = []
         self._head = 0  # first kept point of the lists
-        self._summed = 0  # points (from the lists' start) taken into the sums
-        self._z_last: FloatArray | None = None
-        # row j + 1: sums over points head..j of z z' and of dz dz' (dz: z minus the previous
-        # point's z), flattened; row 0 zero
-        self._sums = np.zeros((64, 2 * self._dim * self._dim))
         self._ref: tuple[float, int] = (0.0, 0)  # spindle angle and cage index of the reference
         self._trend: FloatArray = np.zeros(self._dim - 1)  # taken out of y: coefficients of (u, u^2, strips)
         self._ref_time, self._rebuilt_at = -math.inf, 0
+        self._restart_sums()
+
+    def _restart_sums(self) -> None:
+        """Running sums from the lists' first point on, none taken yet."""
+        self._summed = 0  # points (from the lists' start) taken into the sums
+        self._last_row: tuple[float, float, int, float] | None = None  # (u, u^2, strip, y) of the last point summed
+        # the sums (_SumLayout) over the lists' first k points: row k of _bulk for k up to
+        # _bulk_count (the points summed at once, as arrays, after a rebuild), then entry
+        # k - _bulk_count - 1 of _prefix (the points summed one by one since)
+        self._bulk: FloatArray = np.zeros((1, self._layout.size))
+        self._bulk_count = 0
+        self._prefix: list[tuple[float, ...]] = []
+        self._running = [0.0] * self._layout.size
+
+    def _sums_through(self, k: int) -> list[float] | tuple[float, ...]:
+        """The running sums over the lists' first ``k`` points (``k`` up to the points summed)."""
+        return self._bulk[k].tolist() if k <= self._bulk_count else self._prefix[k - self._bulk_count - 1]
 
     @property
     def points(self) -> int:
@@ -130,7 +181,7 @@ class PhaseSlope:
     def add(self, time: float, cage_index: int, strip: int, spindle_angle: float) -> None:
         """One cage pulse: its time (s, increasing), pulse index (increasing) and strip, and the
         spindle's angle then (rad, spacing-corrected). Kept as given: the sums take it in at
-        the next :meth:`estimate` (with the others since, in one vectorised step), and now and
+        the next :meth:`estimate` (with the others since, a few scalar additions each), and now and
         then (once a ``span``) they are rebuilt on a new reference, O(pulses kept)."""
         times, indices = self._t, self._index
         if len(times) > self._head and not (time > times[-1] and cage_index > indices[-1]):
@@ -162,24 +213,106 @@ class PhaseSlope:
         return z
 
     def _sync(self) -> None:
-        """Take the pulses added since into the sums (vectorised)."""
+        """Take the pulses added since into the running sums (:class:`_SumLayout`), a few scalar
+        additions each."""
         lo, hi = self._summed, len(self._t)
         if hi <= lo:
             return
-        z = self._rows(lo, hi)
-        dz = np.diff(z, axis=0, prepend=(z[:1] if self._z_last is None else self._z_last[None, :]))
-        if hi + 1 > self._sums.shape[0]:
-            grown = np.zeros((max(64, 1 << (hi + 1).bit_length()), self._sums.shape[1]))
-            grown[: lo + 1] = self._sums[: lo + 1]
-            self._sums = grown
-        n, dim = hi - lo, self._dim
-        outer = np.empty((n, 2, dim, dim))  # each point's z z' and dz dz', then their running sums
-        np.multiply(z[:, :, None], z[:, None, :], out=outer[:, 0])
-        np.multiply(dz[:, :, None], dz[:, None, :], out=outer[:, 1])
-        flat = outer.reshape(n, 2 * dim * dim)
-        np.add.accumulate(flat, axis=0, out=flat)  # np.cumsum without its dispatch
-        np.add(self._sums[lo], flat, out=self._sums[lo + 1 : hi + 1])
-        self._summed, self._z_last = hi, z[-1]
+        if lo == 0 and hi >= BULK_SUM_POINTS:
+            self._sum_at_once(hi)
+            return
+        layout = self._layout
+        inner_ref, index_ref = self._ref
+        trend = self._trend.tolist()
+        trend_u, trend_v = trend[0], trend[1]
+        step, ratio = 2.0 * math.pi / self.strips, self.ratio
+        # the batch's own sums, each added to the sums before it (as a cumulative sum of the batch
+        # would be): one rounding at the prefix's magnitude per point, not one per term
+        base, run, prefix = self._running, [0.0] * layout.size, self._prefix
+        UU, UV, VV, UY, VY, YY = _SumLayout.UU, _SumLayout.UV, _SumLayout.VV, _SumLayout.UY, _SumLayout.VY, _SumLayout.YY
+        pairs = layout.pairs
+        last = self._last_row
+        for inner, index, strip in zip(self._inner[lo:hi], self._index[lo:hi], self._strip[lo:hi]):
+            u = inner - inner_ref
+            v = u * u
+            y = step * (index - index_ref) - ratio * u
+            y = y - (trend_u * u + trend_v * v + trend[2 + strip])
+            run[UU] += u * u
+            run[UV] += u * v
+            run[VV] += v * v
+            run[UY] += u * y
+            run[VY] += v * y
+            run[YY] += y * y
+            k = 6 + 4 * strip
+            run[k] += 1.0
+            run[k + 1] += u
+            run[k + 2] += v
+            run[k + 3] += y
+            if last is not None:
+                du, dv, dy = u - last[0], v - last[1], y - last[3]
+                run[pairs + UU] += du * du
+                run[pairs + UV] += du * dv
+                run[pairs + VV] += dv * dv
+                run[pairs + UY] += du * dy
+                run[pairs + VY] += dv * dy
+                run[pairs + YY] += dy * dy
+                before = last[2]
+                if before != strip:
+                    k, j = layout.pair_strip(strip), layout.pair_strip(before)
+                    run[k] += du
+                    run[k + 1] += dv
+                    run[k + 2] += dy
+                    run[j] -= du
+                    run[j + 1] -= dv
+                    run[j + 2] -= dy
+                    run[layout.cross(strip, strip)] += 1.0
+                    run[layout.cross(before, before)] += 1.0
+                    run[layout.cross(strip, before)] -= 1.0
+                    run[layout.cross(before, strip)] -= 1.0
+            last = (u, v, strip, y)
+            prefix.append(tuple(map(operator.add, base, run)))
+        self._running = list(prefix[-1])
+        self._summed, self._last_row = hi, last
+
+    def _sum_at_once(self, hi: int) -> None:
+        """The lists' first ``hi`` points into fresh running sums, as arrays (after a rebuild,
+        when every kept point is summed again on the new reference): the same products and the
+        same additions in the same order as :meth:`_sync` one by one, so the same sums."""
+        layout = self._layout
+        inner_ref, index_ref = self._ref
+        trend = self._trend
+        strip = np.asarray(self._strip[:hi], dtype=np.intp)
+        u = np.asarray(self._inner[:hi]) - inner_ref
+        v = u * u
+        y = 2.0 * math.pi / self.strips * (np.asarray(self._index[:hi], dtype=np.int64) - index_ref) - self.ratio * u
+        y = y - (trend[0] * u + trend[1] * v + trend[2 + strip])
+        inc = np.zeros((hi + 1, layout.size))  # row 0: nothing summed
+        UU, UV, VV, UY, VY, YY = _SumLayout.UU, _SumLayout.UV, _SumLayout.VV, _SumLayout.UY, _SumLayout.VY, _SumLayout.YY
+        now = inc[1:]
+        now[:, UU], now[:, UV], now[:, VV], now[:, UY], now[:, VY], now[:, YY] = u * u, u * v, v * v, u * y, v * y, y * y
+        rows = np.arange(hi)
+        k = 6 + 4 * strip
+        now[rows, k], now[rows, k + 1], now[rows, k + 2], now[rows, k + 3] = 1.0, u, v, y
+        du, dv, dy = np.diff(u), np.diff(v), np.diff(y)
+        later = inc[2:]  # the differences, from the second point on
+        q = layout.pairs
+        later[:, q + UU], later[:, q + UV], later[:, q + VV] = du * du, du * dv, dv * dv
+        later[:, q + UY], later[:, q + VY], later[:, q + YY] = du * dy, dv * dy, dy * dy
+        changed = np.flatnonzero(strip[1:] != strip[:-1])
+        if changed.size:
+            now_strip, before = strip[1:][changed], strip[:-1][changed]
+            at = changed + 2
+            ks, js = layout.pair_strips + 3 * now_strip, layout.pair_strips + 3 * before
+            inc[at, ks], inc[at, ks + 1], inc[at, ks + 2] = du[changed], dv[changed], dy[changed]
+            inc[at, js], inc[at, js + 1], inc[at, js + 2] = -du[changed], -dv[changed], -dy[changed]
+            inc[at, layout.pair_cross + now_strip * (self.strips + 1)] = 1.0
+            inc[at, layout.pair_cross + before * (self.strips + 1)] = 1.0
+            inc[at, layout.pair_cross + now_strip * self.strips + before] = -1.0
+            inc[at, layout.pair_cross + before * self.strips + now_strip] = -1.0
+        np.cumsum(inc, axis=0, out=inc)
+        self._bulk, self._bulk_count, self._prefix = inc, hi, []
+        self._running = inc[-1].tolist()
+        self._summed, self._last_row = hi, (float(u[-1]), float(v[-1]), int(strip[-1]), float(y[-1]))
 
     def _rebuild(self) -> None:
         """Drop the pulses left behind, put the reference at the latest pulse (the estimates end
@@ -200,8 +333,7 @@ class PhaseSlope:
             if rank == self._dim - 1:
                 self._trend = np.asarray(fit, dtype=np.float64)
         self._ref_time, self._rebuilt_at = self._t[-1], n
-        self._sums = np.zeros((max(64, 1 << (n + 1).bit_length()), 2 * self._dim * self._dim))
-        self._summed, self._z_last = 0, None
+        self._restart_sums()
 
     def _cage_speed(self) -> float:
         if self.points < 2 or self._t[-1] <= self._t[self._head]:
@@ -241,28 +373,11 @@ class PhaseSlope:
         if found is None:
             return None
         first, last = found
-        dim, d2 = self._dim, self._dim * self._dim
-        sums = self._sums
-        gram = (sums[last + 1, :d2] - sums[first, :d2]).reshape(dim, dim)
-        pairs = (sums[last + 1, d2:] - sums[first + 1, d2:]).reshape(dim, dim)
-        columns = np.flatnonzero(gram.diagonal()[:-1] > 0.0)  # u, u^2 and the strips present
-        n, p = last - first + 1, len(columns)
-        if n < p + MIN_DOF:
+        solved = _normal_equations(self._layout, self._sums_through(first), self._sums_through(first + 1), self._sums_through(last + 1), last - first + 1)
+        if solved is None:
             return None
-        if p == dim - 1:  # every strip present: no columns to pick (b contiguous, as the dot products below expect)
-            a, b = gram[:-1, :-1], gram[:-1, -1].copy()
-        else:
-            a, b = gram[columns][:, columns], gram[columns, -1]
-        root = 1.0 / np.sqrt(a.diagonal())
-        scale = root[:, None] * root
-        eigenvalues, vectors = np.linalg.eigh(a * scale)  # equilibrated: eigenvalues of order 1
-        if not eigenvalues[0] > 1e-12 * eigenvalues[-1]:
-            return None
-        inverse = (vectors / eigenvalues) @ vectors.T * scale
-        coef = inverse @ b
-        sse = max(float(gram[-1, -1] - b @ coef), 0.0)
-        da, db = pairs[columns][:, columns], pairs[columns, -1]
-        near = max(float(pairs[-1, -1] - 2.0 * db @ coef + coef @ da @ coef), 0.0)
+        coef, c2_variance_factor, sse, near, p = solved
+        n = last - first + 1
         s2 = sse / (n - p)
         # residuals' lag-one variogram against their variance: 1 for white residuals (the
         # Durbin-Watson statistic over 2), near 0 for a wandering phase
@@ -275,9 +390,9 @@ class PhaseSlope:
         factor = -200.0 / self.ratio * speed  # dS/dt per unit of c2
         if white_share < WHITE_CHECK:
             return self._two_noise(first, last, factor, speed)
-        var_c2 = max(s2, self.angle_floor**2) * float(inverse[1, 1])
+        var_c2 = max(s2, self.angle_floor**2) * c2_variance_factor
         return PhaseEstimate(
-            slope=factor * (float(coef[1]) + float(self._trend[1])),  # the trend's curvature taken out of y
+            slope=factor * (coef + float(self._trend[1])),  # the trend's curvature taken out of y
             standard_error=abs(factor) * math.sqrt(max(var_c2, 0.0)),
             dof=n - p,
             points=n,
@@ -341,3 +456,66 @@ class PhaseSlope:
             inner_ring_speed=speed,
             white_share=white_share,
         )
+
+
+def _normal_equations(
+    layout: _SumLayout, before: list[float] | tuple[float, ...], second: list[float] | tuple[float, ...], through: list[float] | tuple[float, ...], n: int
+) -> tuple[float, float, float, float, int] | None:
+    """The least-squares fit of a stretch of ``n`` pulses from its running sums (:class:`_SumLayout`):
+    ``before`` the sums up to the pulse before its first, ``second`` up to its first (the
+    differences start at its second pulse) and ``through`` up to its last.
+
+    The strips' offsets enter the normal equations as a diagonal block (each pulse has one
+    strip), so they are eliminated exactly: u and u^2 are taken relative to their means on each
+    strip (the Schur complement of that block), which leaves two equations for c1 and c2, and
+    each strip's offset follows as its mean residual. A few dozen operations on plain floats,
+    cheaper than any call into numpy at this size. The two equations are refused as singular
+    when their determinant is not above 1e-12 of the product of their diagonal.
+
+    Returns:
+        (c2, the factor of the residual variance that gives Var(c2), the residuals' sum of
+        squares, the sum of their successive differences squared, the columns' count p: u,
+        u^2 and the strips present), or None (u or u^2 constant on every strip, too few pulses
+        for the columns with :data:`MIN_DOF` to spare, or a singular system).
+    """
+    UU, UV, VV, UY, VY, YY = _SumLayout.UU, _SumLayout.UV, _SumLayout.VV, _SumLayout.UY, _SumLayout.VY, _SumLayout.YY
+    q = layout.pairs
+    # the strips present, each as (pulses, sum u, sum v, sum y, its entry among the differences' sums)
+    strips = []
+    for s in range(layout.strips):
+        k = layout.count(s)
+        count = through[k] - before[k]
+        if count > 0.0:
+            strips.append((s, count, through[k + 1] - before[k + 1], through[k + 2] - before[k + 2], through[k + 3] - before[k + 3]))
+    p = 2 + len(strips)
+    if n < p + MIN_DOF:
+        return None
+    a11, a12, a22 = through[UU] - before[UU], through[UV] - before[UV], through[VV] - before[VV]
+    b1, b2, yy = through[UY] - before[UY], through[VY] - before[VY], through[YY] - before[YY]
+    for _s, count, su, sv, sy in strips:  # the Schur complement of the strips' diagonal block
+        a11 -= su * su / count
+        a12 -= su * sv / count
+        a22 -= sv * sv / count
+        b1 -= su * sy / count
+        b2 -= sv * sy / count
+    det = a11 * a22 - a12 * a12
+    if not (a11 > 0.0 and a22 > 0.0 and det > 1e-12 * a11 * a22):
+        return None
+    c1, c2 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+    offsets = [(s, (sy - su * c1 - sv * c2) / count) for s, count, su, sv, sy in strips]
+    # residuals' sum of squares: y'y - c'X'y
+    sse = yy - c1 * (through[UY] - before[UY]) - c2 * (through[VY] - before[VY]) - sum(e * (through[layout.count(s) + 3] - before[layout.count(s) + 3]) for s, e in offsets)
+
+    def pair(k: int) -> float:
+        return through[k] - second[k]
+
+    # their successive differences' sum of squares: dy'dy - 2 c'dX'dy + c'dX'dX c
+    dc = c1 * c1 * pair(q + UU) + 2.0 * c1 * c2 * pair(q + UV) + c2 * c2 * pair(q + VV)
+    dcy = c1 * pair(q + UY) + c2 * pair(q + VY)
+    for s, e in offsets:
+        j = layout.pair_strip(s)
+        dc += 2.0 * e * (c1 * pair(j) + c2 * pair(j + 1))
+        dcy += e * pair(j + 2)
+        dc += e * sum(f * pair(layout.cross(s, r)) for r, f in offsets)
+    near = pair(q + YY) - 2.0 * dcy + dc
+    return c2, a11 / det, max(sse, 0.0), max(near, 0.0), p

@@ -146,6 +146,9 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
     assert [line for line in out.splitlines() if line.startswith("lifecycle: ")] == expected
     logged = (bag / "logs" / "session.log").read_text(encoding="utf-8")
     assert [line.split(" ", 1)[1] for line in logged.splitlines() if " lifecycle: " in line] == expected
+    # the log ends with how the session ended and the summary it printed
+    assert re.search(r"^\S+ session ended, exit status 0$", logged, re.MULTILINE), logged[-3000:]
+    assert summary_rows(logged) == rows, logged[-3000:]
     assert lifecycle_diagnostics(bag) == [(f"lifecycle_manager: {line.split()[1]}", line.split()[2].rstrip(":")) for line in expected]
 
 
@@ -430,6 +433,9 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     assert not any(line.startswith("lifecycle: ") for line in out.splitlines())
     (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
     assert not list(run.glob("*.mcap")) and (run / "logs" / "session.log").is_file()
+    # unrecorded, the log is the session's only record: it ends with how it ended and its summary
+    logged = (run / "logs" / "session.log").read_text(encoding="utf-8")
+    assert "session ended, exit status 0\n" in logged and summary_rows(logged) == rows, logged[-3000:]
 
 
 BEST_EFFORT_PULSE_SIMULATOR = """

@@ -689,22 +689,26 @@ class _Session:
 
     def _report(self) -> int:
         self.printer.done()
-        self.session_log.close()
         status = EXIT_FAILED if self.status is None else self.status
-        if status == EXIT_FAILED:
-            self.err.write(f"bearing-rig run: {self.failure}\n")
-        elif status == EXIT_CONDITIONS:
-            self.err.write(f"bearing-rig run: {self.failure} (see the summary)\n")
-        elif status == EXIT_INTERRUPTED:
-            self.err.write(f"bearing-rig run: {self.failure}; the summary so far and the bag are complete to this point\n")
         heading = {
             EXIT_OK: "summary",
             EXIT_CONDITIONS: "summary (conditions not met)",
             EXIT_INTERRUPTED: "summary (interrupted)",
             EXIT_FAILED: "summary (failed)",
         }[status]
-        self.out.write(f"\n{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n")
-        self.out.write(format_summary(self.runner.outcomes, self.runner.sweeps) + "\n")
+        summary = f"{heading}: program {self.program.name}, {len(self.runner.outcomes)}/{self.runner.segment_count} segments\n"
+        summary += format_summary(self.runner.outcomes, self.runner.sweeps) + "\n"
+        if not self.session_log.closed:  # the log says how the session ended, and its summary
+            reason = f": {self.failure}" if status != EXIT_OK and self.failure else ""
+            self.session_log.write(f"{datetime.now(UTC):%Y-%m-%dT%H:%M:%S.%fZ} session ended, exit status {status}{reason}\n{summary}")
+        self.session_log.close()
+        if status == EXIT_FAILED:
+            self.err.write(f"bearing-rig run: {self.failure}\n")
+        elif status == EXIT_CONDITIONS:
+            self.err.write(f"bearing-rig run: {self.failure} (see the summary)\n")
+        elif status == EXIT_INTERRUPTED:
+            self.err.write(f"bearing-rig run: {self.failure}; the summary so far and the bag are complete to this point\n")
+        self.out.write(f"\n{summary}")
         counts = self.recorder.counts
         total = sum(counts.values())
         if not self.options.record:

@@ -173,13 +173,13 @@ class Ros2:
             if wanted(result) or time.monotonic() > deadline:
                 return result
 
-    def start(self, name: str, *argv: str) -> subprocess.Popen[str]:
-        """``ros2 argv...`` in the background, its output to ``<logs>/<name>.log``."""
+    def start(self, name: str, *argv: str, cwd: Path = REPO_ROOT) -> subprocess.Popen[str]:
+        """``ros2 argv...`` in the background (in ``cwd``), its output to ``<logs>/<name>.log``."""
         log = open(self.logs / f"{name}.log", "w", encoding="utf-8")
         process = subprocess.Popen(
             [self.ros2, *argv],
             env=self.env,
-            cwd=REPO_ROOT,
+            cwd=cwd,
             stdin=subprocess.DEVNULL,
             stdout=log,
             stderr=subprocess.STDOUT,
@@ -241,7 +241,8 @@ def test_launch_runs_the_validation_program_to_its_summary(ros2: Ros2) -> None:
     """Issue 26: the program step failed with "No such file or directory: 'bearing-rig'"."""
     env_path = ros2.env.get("PATH", "")
     ros2.env["PATH"] = os.pathsep.join(p for p in env_path.split(os.pathsep) if not (Path(p) / "bearing-rig").exists())
-    launch = ros2.start("launch", "launch", "bearing_rig_sim", "rig.launch.py", f"program:={VALIDATION}", "record:=false")
+    # in the test's own folder: the unrecorded session writes its log to ./bags/<run>/logs
+    launch = ros2.start("launch", "launch", "bearing_rig_sim", "rig.launch.py", f"program:={VALIDATION}", "record:=false", cwd=ros2.logs)
     code = launch.wait(timeout=time_left())
     out = ros2.output("launch")
     assert code == 0, out[-6000:]
@@ -254,6 +255,8 @@ def test_launch_runs_the_validation_program_to_its_summary(ros2: Ros2) -> None:
         row = [line for line in lines if f"  {segment}  " in line]
         assert row and f" {rpm} " in row[-1], (segment, out[-4000:])
     assert "Traceback" not in out and "FileNotFoundError" not in out, out[-6000:]
+    (run,) = (ros2.logs / "bags").iterdir()
+    assert "session ended, exit status 0\n" in (run / "logs" / "session.log").read_text(encoding="utf-8")
 
 
 def test_ros2_run_finds_every_node_and_starts_it_unconfigured(ros2: Ros2) -> None:

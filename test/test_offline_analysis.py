@@ -528,6 +528,33 @@ def test_recorded_stamps_on_another_clock_are_placed_on_the_pulse_clock(tmp_path
     assert times[1] == 1.0 and 0.99 < times[2] <= 1.0  # the pulse clock when it arrived
 
 
+def test_a_status_on_a_window_that_ended_before_the_next_segment_is_the_previous_segments() -> None:
+    """Without real time the recorder runs behind the simulator: the pulse that closes a
+    segment's last window can reach the bag after the next command took effect, so the offline
+    row on that window is made after the switch. It is judged by its window's end, as the live
+    summary judges the recorded status on the same window: found in a --no-realtime validation
+    run, where the offline time to stable of two segments was empty while the recorded one was
+    1.19 and 1.52 s. Here the first stable verdict comes on a window ending at 2.95 s, read after
+    the next segment began at 3.0 s: the first segment's time to stable is 2.95 - 0.5 = 2.45 s
+    (its evidence starts at 2.95 - (1 s + one cage revolution, 0.16 s at 40 rad/s) = 1.8 s, after
+    the ramp's end at 0.5 s), offline and recorded alike, and the next segment has none."""
+    stable, slipping = int(MonitorState.STABLE), int(MonitorState.SLIPPING)
+    tracker = SegmentTracker(by_program=True, names=["run", "next"])
+    tracker.command(0.0, 100.0, 0, 0.5, 0.0, 0.0)
+    for k in range(30):
+        tracker.row(status_row(0.1 * k, k, 100.0, state=slipping))
+    tracker.command(3.0, 150.0, 0, 0.5, 0.0, 100.0)
+    late = StatusRow(3.02, "window", stable, 2.95, 100.0, 40.0, 43.0, 1.0, 0.0, 0.99, 30, "")
+    tracker.row(late)
+    tracker.recorded(2.95, 40.0, stable, 0.99, 100.0)
+    for k in range(5):
+        tracker.row(status_row(3.1 + 0.1 * k, 31 + k, 120.0, state=slipping))
+    run, following = tracker.finish()
+    assert run.time_to_stable == pytest.approx(2.45) and run.recorded_time_to_stable == pytest.approx(2.45)
+    assert run.final_state == stable
+    assert following.time_to_stable is None and following.recorded_time_to_stable is None and following.final_state == slipping
+
+
 def test_a_recorded_status_belongs_to_the_segment_its_stamp_falls_in() -> None:
     """The monitor's verdict on a stop's silence (state unknown, stamped at its rig time within
     the stop segment) can reach the bag after the next segment's command, which was sent ahead;

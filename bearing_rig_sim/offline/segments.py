@@ -14,7 +14,9 @@ A segment's means are taken over the rows from its ramp end on whose slip window
 it; its verdicts are the last state
 in it; its time to stable follows the one rule the live session summary also uses
 (:class:`~bearing_rig_sim.monitoring.schedule.TimeToStable`), for the offline statuses and the
-recorded ones alike.
+recorded ones alike. A status belongs to the segment its window ended in, as the live summary
+judges it: one made or read after the next command took effect, on a window that ended before,
+counts for the previous segment's verdict and time to stable.
 
 Units: s, rad/s, N; slip in percent.
 """
@@ -122,6 +124,14 @@ class _Segment:
         for key in ("inner_ring_speed", "slip_rate", "recorded_slip_rate", "truth_slip_rate", "axial_load"):
             self._add(key, getattr(row, key))
 
+    def add_late_row(self, row: StatusRow) -> None:
+        """A status row on a window that ended in this segment, made after the next segment began
+        (see :meth:`SegmentTracker.row`): its verdict counts here (the final state and the time
+        to stable), its figures do not (the means are over the rows made in the segment)."""
+        self.final_state = row.state
+        if math.isfinite(row.window_end):
+            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence, row.inner_ring_speed)
+
     def evidence(self, stamp: float, cage_speed: float) -> float:
         st = self.settings
         return evidence_start(stamp, cage_speed, st.window_revolutions, st.slope_span_s, st.min_slope_points, st.min_window_s)
@@ -223,7 +233,20 @@ class SegmentTracker:
         self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings, run_up)
 
     def row(self, row: StatusRow) -> None:
-        """One status row, in time order."""
+        """One status row, in time order.
+
+        In a program, a row on a window that ended before the open segment's start is the
+        previous segment's, as the live summary judges a status by its stamp: the next command
+        takes effect when the bag's log reaches its stamp, and a pulse that closed that window
+        may have reached the recorder later (without real time the recorder runs behind the
+        simulator), so the row was made after the switch. Its verdict then counts for the
+        previous segment (:meth:`_Segment.add_late_row`).
+        """
+        late = self._late(row.window_end)
+        if late is not None:
+            late.add_late_row(row)
+            self.segments[-1] = late.summary()
+            return
         if not self.by_program and row.windows != self._windows:
             self._windows = row.windows
             inner = row.inner_ring_speed
@@ -242,13 +265,25 @@ class SegmentTracker:
 
     def recorded(self, stamp: float, cage_speed: float, state: int, confidence: float, inner_ring_speed: float = _NAN) -> None:
         """A recorded slip status: its stamp (window end, s), cage speed (rad/s), state,
-        confidence and inner-ring speed (rad/s)."""
+        confidence and inner-ring speed (rad/s). One stamped in the previous segment and read
+        after the next began is the previous segment's (its final state and time to stable)."""
         if self._open is not None:
             self._open.add_recorded(stamp, cage_speed, state, confidence, inner_ring_speed)
         last = self._last_closed
         if self.by_program and last is not None and last.start <= stamp < (self._open.start if self._open is not None else math.inf):
             last.take_final_recorded(stamp, state)  # the previous segment's, read after the next began
-            self.segments[-1] = replace(self.segments[-1], final_recorded_state=last.final_recorded)
+            last.recorded_stable.observe(stamp, last.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)
+            self.segments[-1] = replace(
+                self.segments[-1], final_recorded_state=last.final_recorded, recorded_time_to_stable=last.recorded_stable.time_to_stable
+            )
+
+    def _late(self, window_end: float) -> _Segment | None:
+        """The previous segment, when a window that ended at ``window_end`` (s) belongs to it and
+        not to the open one (see :meth:`row`); else None."""
+        last, open_ = self._last_closed, self._open
+        if not self.by_program or last is None or open_ is None or not math.isfinite(window_end):
+            return None
+        return last if last.start <= window_end < open_.start else None
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

@@ -349,6 +349,9 @@ def test_help_is_a_line_or_two_then_the_options(command: list[str], monkeypatch:
     assert text.startswith(f"usage: bearing-rig {' '.join(command)}")
     description = help_description(text)
     assert len(description) <= 5, "\n".join(description)
+    # prose, its syntax left to the usage line: no markup, no conjunction left from a stripped syntax
+    assert description[0][:1].isupper() and not re.match(r"(And|Or)\b", description[0]), description
+    assert "``" not in " ".join(description), description
     assert any(line in text.splitlines() for line in HELP_HEADINGS)
     if len(command) == 1:  # a sub-command names its section of the guide, and the section exists
         links = re.findall(r"docs/guide\.md#([\w-]+)", " ".join(description))

@@ -67,10 +67,11 @@ def rig_limit_text(rig_key: str, *, unit_in_si: float = 1.0, unit: str = "") -> 
 
 def describe(doc: str | None, command: str) -> str:
     """What ``bearing-rig COMMAND --help`` shows between the usage and the options: the first
-    paragraph of the command module's documentation (its syntax left to the usage line) and
+    paragraph of the command module's documentation (its syntax, one or more ````...```` joined
+    by commas, "and" or "or", left to the usage line) and
     where the command is explained in full (``docs/guide.md#bearing-rig-<command>``)."""
     first = " ".join((doc or "").split("\n\n")[0].split())
-    first = re.sub(r"^``[^`]*``[:.]?\s*", "", first).replace("``", "")
+    first = re.sub(r"^``[^`]*``(\s*(,|and|or)\s*``[^`]*``)*[:.]?\s*", "", first).replace("``", "")
     first = first[:1].upper() + first[1:]
     return f"{first} Details: {GUIDE}#bearing-rig-{command.replace(' ', '-')}"
 

@@ -48,7 +48,8 @@ def register(subparsers: Any) -> None:
     """Add ``bag`` (``info``, ``repair``) to the ``bearing-rig`` parser."""
     parser = subparsers.add_parser("bag", help="inspect or repair a recorded bag", description=describe(__doc__, "bag"))
     actions = parser.add_subparsers(dest="action", metavar="ACTION", required=True)
-    info = actions.add_parser("info", help="topics, counts, duration, run context and problems of a bag")
+    info_help = "topics, counts, duration, run context and problems of a bag"
+    info = actions.add_parser("info", help=info_help, description=describe(f"{info_help}.", "bag"))
     info.add_argument("bag", type=Path, metavar="BAG", help="bag directory (or a single .mcap file)")
     info.add_argument("--metadata", action="store_true", help="print every run-context value in full")
     info.add_argument(
@@ -57,10 +58,8 @@ def register(subparsers: Any) -> None:
         help="read the index only: skip decompressing every chunk (checksums, unreadable messages, log-time outliers)",
     )
     info.set_defaults(action_func=run_info)
-    repair = actions.add_parser(
-        "repair",
-        help="restore the index of bags whose recording was interrupted (originals kept as *.orig)",
-    )
+    repair_help = "restore the index of bags whose recording was interrupted (originals kept as *.orig)"
+    repair = actions.add_parser("repair", help=repair_help, description=describe(f"{repair_help}.", "bag"))
     repair.add_argument("bags", type=Path, nargs="+", metavar="BAG", help="bag directory")
     repair.set_defaults(action_func=run_repair)
     parser.set_defaults(func=run)

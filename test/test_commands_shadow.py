@@ -4,6 +4,7 @@ bench's three topics, deterministic; bad bags are one-line errors. And ``--recal
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import pytest
@@ -52,6 +53,8 @@ def test_shadow_bag_writes_residuals_report_and_plot(bench_bag: Path, tmp_path: 
     assert float(rows[0]["time_s"]) < 1.0  # counted from the first pulse, not the epoch
     report = (out / REPORT_MD).read_text()
     assert "None: the bench stayed within the twin's band." in report
+    # the band's law as residual.band_pct computes it: coverage x the two terms in quadrature, each in pp
+    assert re.search(r"Band: [\d.]+ x sqrt\(\(calibration RMS [\d.]+ pp\)\^2 \+ \(100 x 2 x [\d.e-]+ s / window\)\^2\)", report), report[:800]
     assert (out / PLOT_PNG).read_bytes().startswith(PNG_SIGNATURE)
 
 

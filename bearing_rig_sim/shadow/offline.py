@@ -260,7 +260,7 @@ def write_report(path: Path, result: ShadowResult, st: ShadowSettings, jitter_st
         f"windows of {st.window_revolutions} cage revolution(s); time counted from the first pulse "
         f"({result.origin:.6f} s on the bench clock).",
         "",
-        f"Band: {st.band_coverage:g} x sqrt(calibration RMS {st.calibration_rms_slip_pct:.4f} pp^2 + "
+        f"Band: {st.band_coverage:g} x sqrt((calibration RMS {st.calibration_rms_slip_pct:.4f} pp)^2 + "
         f"(100 x 2 x {jitter_std_s:.2g} s / window)^2). Anomaly: outside the band for more than "
         f"{st.warn_after_s:g} s: WARN, more than {st.error_after_s:g} s: ERROR.",
         "",

@@ -35,8 +35,10 @@ import bisect
 import math
 import operator
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
+import numpy.typing as npt
 
 from bearing_rig_sim.analysis.inputs import FloatArray
 
@@ -85,6 +87,10 @@ class PhaseEstimate:
     white_share: float = 1.0
 
 
+_Strip = TypeVar("_Strip", int, npt.NDArray[np.intp])
+"""A strip number, or an array of them (the indices are then taken elementwise)."""
+
+
 class _SumLayout:
     """Where each running sum sits in :class:`PhaseSlope`'s flat sums, for ``strips`` cage strips.
 
@@ -106,15 +112,15 @@ class _SumLayout:
         self.pair_cross = self.pair_strips + 3 * strips
         self.size = self.pair_cross + strips * strips
 
-    def count(self, strip: int) -> int:
+    def count(self, strip: _Strip) -> _Strip:
         """Pulses of ``strip``; then the sums of u, v and y over them."""
         return 6 + 4 * strip
 
-    def pair_strip(self, strip: int) -> int:
+    def pair_strip(self, strip: _Strip) -> _Strip:
         """Sum of du c(strip); then of dv c(strip) and of dy c(strip)."""
         return self.pair_strips + 3 * strip
 
-    def cross(self, strip: int, other: int) -> int:
+    def cross(self, strip: _Strip, other: _Strip) -> _Strip:
         """Sum of c(strip) c(other)."""
         return self.pair_cross + strip * self.strips + other
 
@@ -243,7 +249,7 @@ class PhaseSlope:
             run[UY] += u * y
             run[VY] += v * y
             run[YY] += y * y
-            k = 6 + 4 * strip
+            k = layout.count(strip)
             run[k] += 1.0
             run[k + 1] += u
             run[k + 2] += v
@@ -291,7 +297,7 @@ class PhaseSlope:
         now = inc[1:]
         now[:, UU], now[:, UV], now[:, VV], now[:, UY], now[:, VY], now[:, YY] = u * u, u * v, v * v, u * y, v * y, y * y
         rows = np.arange(hi)
-        k = 6 + 4 * strip
+        k = layout.count(strip)
         now[rows, k], now[rows, k + 1], now[rows, k + 2], now[rows, k + 3] = 1.0, u, v, y
         du, dv, dy = np.diff(u), np.diff(v), np.diff(y)
         later = inc[2:]  # the differences, from the second point on
@@ -302,13 +308,13 @@ class PhaseSlope:
         if changed.size:
             now_strip, before = strip[1:][changed], strip[:-1][changed]
             at = changed + 2
-            ks, js = layout.pair_strips + 3 * now_strip, layout.pair_strips + 3 * before
+            ks, js = layout.pair_strip(now_strip), layout.pair_strip(before)  # the layout's indices, elementwise
             inc[at, ks], inc[at, ks + 1], inc[at, ks + 2] = du[changed], dv[changed], dy[changed]
             inc[at, js], inc[at, js + 1], inc[at, js + 2] = -du[changed], -dv[changed], -dy[changed]
-            inc[at, layout.pair_cross + now_strip * (self.strips + 1)] = 1.0
-            inc[at, layout.pair_cross + before * (self.strips + 1)] = 1.0
-            inc[at, layout.pair_cross + now_strip * self.strips + before] = -1.0
-            inc[at, layout.pair_cross + before * self.strips + now_strip] = -1.0
+            inc[at, layout.cross(now_strip, now_strip)] = 1.0
+            inc[at, layout.cross(before, before)] = 1.0
+            inc[at, layout.cross(now_strip, before)] = -1.0
+            inc[at, layout.cross(before, now_strip)] = -1.0
         np.cumsum(inc, axis=0, out=inc)
         self._bulk, self._bulk_count, self._prefix = inc, hi, []
         self._running = inc[-1].tolist()
@@ -373,11 +379,11 @@ class PhaseSlope:
         if found is None:
             return None
         first, last = found
-        solved = _normal_equations(self._layout, self._sums_through(first), self._sums_through(first + 1), self._sums_through(last + 1), last - first + 1)
+        n = last - first + 1
+        solved = _normal_equations(self._layout, self._sums_through(first), self._sums_through(first + 1), self._sums_through(last + 1), n)
         if solved is None:
             return None
-        coef, c2_variance_factor, sse, near, p = solved
-        n = last - first + 1
+        c2, c2_variance_factor, sse, near, p = solved
         s2 = sse / (n - p)
         # residuals' lag-one variogram against their variance: 1 for white residuals (the
         # Durbin-Watson statistic over 2), near 0 for a wandering phase
@@ -392,7 +398,7 @@ class PhaseSlope:
             return self._two_noise(first, last, factor, speed)
         var_c2 = max(s2, self.angle_floor**2) * c2_variance_factor
         return PhaseEstimate(
-            slope=factor * (coef + float(self._trend[1])),  # the trend's curvature taken out of y
+            slope=factor * (c2 + float(self._trend[1])),  # the trend's curvature taken out of y
             standard_error=abs(factor) * math.sqrt(max(var_c2, 0.0)),
             dof=n - p,
             points=n,
@@ -480,7 +486,7 @@ def _normal_equations(
     """
     UU, UV, VV, UY, VY, YY = _SumLayout.UU, _SumLayout.UV, _SumLayout.VV, _SumLayout.UY, _SumLayout.VY, _SumLayout.YY
     q = layout.pairs
-    # the strips present, each as (pulses, sum u, sum v, sum y, its entry among the differences' sums)
+    # the strips present, each as (strip, pulses, sum u, sum v, sum y)
     strips = []
     for s in range(layout.strips):
         k = layout.count(s)
@@ -491,7 +497,8 @@ def _normal_equations(
     if n < p + MIN_DOF:
         return None
     a11, a12, a22 = through[UU] - before[UU], through[UV] - before[UV], through[VV] - before[VV]
-    b1, b2, yy = through[UY] - before[UY], through[VY] - before[VY], through[YY] - before[YY]
+    uy, vy, yy = through[UY] - before[UY], through[VY] - before[VY], through[YY] - before[YY]
+    b1, b2 = uy, vy
     for _s, count, su, sv, sy in strips:  # the Schur complement of the strips' diagonal block
         a11 -= su * su / count
         a12 -= su * sv / count
@@ -504,7 +511,7 @@ def _normal_equations(
     c1, c2 = (a22 * b1 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
     offsets = [(s, (sy - su * c1 - sv * c2) / count) for s, count, su, sv, sy in strips]
     # residuals' sum of squares: y'y - c'X'y
-    sse = yy - c1 * (through[UY] - before[UY]) - c2 * (through[VY] - before[VY]) - sum(e * (through[layout.count(s) + 3] - before[layout.count(s) + 3]) for s, e in offsets)
+    sse = yy - c1 * uy - c2 * vy - sum(e * sy for (_s, e), (_, _count, _su, _sv, sy) in zip(offsets, strips))
 
     def pair(k: int) -> float:
         return through[k] - second[k]

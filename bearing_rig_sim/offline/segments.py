@@ -113,9 +113,7 @@ class _Segment:
 
     def add_row(self, row: StatusRow) -> None:
         self.end = row.time
-        self.final_state = row.state
-        if math.isfinite(row.window_end):
-            self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence, row.inner_ring_speed)
+        self.add_late_row(row)  # its verdict; then its figures
         if row.time < self.ramp_end:
             return
         self.rows += 1
@@ -125,9 +123,10 @@ class _Segment:
             self._add(key, getattr(row, key))
 
     def add_late_row(self, row: StatusRow) -> None:
-        """A status row on a window that ended in this segment, made after the next segment began
-        (see :meth:`SegmentTracker.row`): its verdict counts here (the final state and the time
-        to stable), its figures do not (the means are over the rows made in the segment)."""
+        """A status row's verdict (the final state and the time to stable): all that counts of
+        a row on a window that ended in this segment, made after the next segment began (see
+        :meth:`SegmentTracker.row`); its figures do not (the means are over the rows made in the
+        segment, :meth:`add_row`)."""
         self.final_state = row.state
         if math.isfinite(row.window_end):
             self.stable.observe(row.window_end, self.evidence(row.window_end, row.cage_speed), row.state, row.confidence, row.inner_ring_speed)

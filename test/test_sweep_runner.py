@@ -14,6 +14,7 @@ from collections.abc import Iterator
 
 import pyarrow.parquet as pq
 import pytest
+from conftest import time_left
 
 from bearing_rig_sim.sweep.points import INTEGRATE
 from bearing_rig_sim.sweep.runner import run_sweep
@@ -98,7 +99,13 @@ def test_a_worker_killed_mid_sweep_loses_no_point_and_duplicates_none(tmp_path: 
     def kill_a_busy_worker(c: Any, done: int) -> None:
         if killed:
             return
+        # the scheduler may hand the freed worker its next task just after the client hears of the
+        # result (both workers can finish at once): wait for a worker to hold one, 11 being left
+        deadline = time.monotonic() + time_left()
         busy = [addr for addr, keys in c.processing().items() if keys]
+        while not busy and time.monotonic() < deadline:
+            time.sleep(0.01)
+            busy = [addr for addr, keys in c.processing().items() if keys]
         assert busy, "no worker holds a task after the first result: the sweep is too small for this test"
         pid = c.run(os.getpid, workers=[busy[0]])[busy[0]]
         os.kill(pid, signal.SIGKILL)

@@ -3,6 +3,7 @@ timing, /clock, unknown types, and a monitor node reaching the recorded verdict.
 
 from __future__ import annotations
 
+import math
 import struct
 import sys
 import time
@@ -102,15 +103,18 @@ TIMES_NS = [5_000_000_000 + sum(7_000_000 + 3_000_000 * (k % 5) for k in range(i
 
 @pytest.mark.parametrize("rate", [1.0, 2.0, 0.5])
 def test_schedule_follows_the_log_time_without_drift(tmp_path: Path, rate: float) -> None:
-    """Every message goes out at (log - first) / rate after the start, late by no more than one
-    oversleep plus one publish, however many messages came before (absolute deadlines)."""
+    """Every message goes out at (log - first) / rate after the start (the end of the first
+    /clock's publish), late by no more than one oversleep plus one publish, however many messages
+    came before (absolute deadlines)."""
     write_pulse_bag(tmp_path / "bag", TIMES_NS)
     clock = FakeClock()
     sink = ListSink(clock)
     with open_bag(tmp_path / "bag") as bag:
-        start = clock.t
         stats = replay_bag(bag, sink, ReplayOptions(rate=rate, topics=(CAGE,)), clock)
         first = bag.start_ns
+    first_clock = sink.sent[0]
+    assert first_clock[1] == CLOCK_TOPIC and clock_ns(first_clock[2]) == first
+    start = first_clock[0] + PUBLISH_COST
     pulses = [(t, data) for t, topic, data in sink.sent if topic == CAGE]
     assert len(pulses) == len(TIMES_NS) and stats.published == {CAGE: len(TIMES_NS)}
     for (sent_at, _data), log_ns in zip(pulses, TIMES_NS):
@@ -210,56 +214,71 @@ def test_message_classes_and_qos() -> None:
 # ---------------------------------------------------------------------------------------------
 # Into a ROS graph
 # ---------------------------------------------------------------------------------------------
-TOLERANCE_S = 0.005
-"""Replayed pulses arrive (the middleware's reception time) at their recorded offsets scaled by
-the rate, rates 1 and 2, on loopback: 90 % of them within 5 ms of the median offset ..."""
-HICCUP_S = 0.1
-"""... and every one within 100 ms: a host busy with other work (two cores shared with other test
-runs) holds a process back by tens of milliseconds now and then, and the replay then catches up.
-A wrong rate or a drifting schedule is off by hundreds of milliseconds over the bag's 1.2 s."""
+CLOCKS_APART_S = 1e-3
+"""The middleware stamps a sample (its ``source_timestamp``) on the system clock, the player keeps
+its schedule on the monotonic one. Over the replays here (2.4 s at most) the two part by the
+system clock's slewing only, at most 500 ppm on Linux (adjtimex(2): the kernel's frequency
+offset is limited to +-500 ppm), 1.2 ms at most; a wrong rate or a schedule started late is off
+by hundreds of milliseconds."""
 ATTEMPTS = 3
-"""Replays measured at most; the first within the tolerance passes (a busy host spoils some)."""
+"""Replays tried at most for the one the test can measure: the first /clock reaches the test's
+reader (its match, like the pulses', is discovery's business; the replay waits for the pulses' only)."""
 
 
 @pytest.mark.ros
-@pytest.mark.parametrize("rate", [1.0, 2.0])
-def test_replayed_pulses_keep_their_timing(ros_graph, tmp_path: Path, rate: float) -> None:
+@pytest.mark.parametrize("rate", [0.5, 2.0])
+def test_no_replayed_pulse_leaves_before_its_time(ros_graph, tmp_path: Path, rate: float) -> None:
+    """Through the middleware, on the real clocks: each pulse is published (its source timestamp)
+    no sooner than its offset in the bag divided by the rate after the replay's first /clock, and
+    all arrive, in order, with their stamps. Rate 0.5 fails if the rate is ignored or inverted
+    (the pulses would leave early). How late they leave depends on the host's load and is
+    measured by ``bearing-rig bench replay``; that no lateness accumulates (absolute deadlines)
+    is the schedule's test above, on a fake clock."""
     from bearing_rig_msgs.msg import FibreOpticPulse
     from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from rosgraph_msgs.msg import Clock
 
     write_pulse_bag(tmp_path / "bag", TIMES_NS)
+    first_ns = TIMES_NS[0] + 2  # the bag's first log time: the replay's first /clock
     node = ros_graph.node("listener")
-    arrivals: list[tuple[float, float, int]] = []
+    pulses: list[tuple[float, int]] = []
+    clocks: list[tuple[float, int]] = []
 
-    def on_pulse(message: FibreOpticPulse, info: dict) -> None:  # the middleware's times, not the spin's
-        stamp = message.header.stamp.sec * 10**9 + message.header.stamp.nanosec
-        arrivals.append((info["received_timestamp"] * 1e-9, info["source_timestamp"] * 1e-9, stamp))
+    def on_pulse(message: FibreOpticPulse, info: dict) -> None:
+        pulses.append((info["source_timestamp"] * 1e-9, message.header.stamp.sec * 10**9 + message.header.stamp.nanosec))
 
-    depth = QoSProfile(depth=len(TIMES_NS), reliability=ReliabilityPolicy.BEST_EFFORT)  # a busy test process loses none
-    node.create_subscription(FibreOpticPulse, CAGE, on_pulse, depth)
+    def on_clock(message: Clock, info: dict) -> None:
+        clocks.append((info["source_timestamp"] * 1e-9, message.clock.sec * 10**9 + message.clock.nanosec))
+
+    deep = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
+    node.create_subscription(FibreOpticPulse, CAGE, on_pulse, QoSProfile(depth=len(TIMES_NS), reliability=ReliabilityPolicy.BEST_EFFORT))
+    node.create_subscription(Clock, CLOCK_TOPIC, on_clock, deep)
     executor = ros_graph.executor([node])
-    failures = []
+    missed = []
     for _attempt in range(ATTEMPTS):
-        arrivals.clear()
+        pulses.clear()
+        clocks.clear()
         process = ros_graph.spawn_python(
             "-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--rate", str(rate), "--wait-for-subscribers", "--delay", "20"
         )
-        ros_graph.spin_until(lambda: len(arrivals) == len(TIMES_NS) or process.poll() is not None, timeout=30.0, executor=executor)  # noqa: B023 - waited on at once
-        ros_graph.spin_until(lambda: len(arrivals) == len(TIMES_NS), timeout=1.0, executor=executor)
+        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS) or process.poll() is not None, timeout=60.0, executor=executor)  # noqa: B023 - waited on at once
+        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS), timeout=1.0, executor=executor)
         out, err = process.communicate(timeout=60.0)
         assert process.returncode == 0, err
         assert "1 pass(es)" in out
-        assert [stamp for _r, _s, stamp in arrivals] == TIMES_NS, "pulses lost or out of order"
-        # arrival - recorded offset / rate is constant up to the timing errors; measured from its median
-        offsets = [received - stamp * 1e-9 / rate for received, _sent, stamp in arrivals]
-        reference = sorted(offsets)[len(offsets) // 2]
-        errors = sorted(abs(offset - reference) for offset in offsets)
-        p90 = errors[int(0.9 * (len(errors) - 1))]
-        if p90 <= TOLERANCE_S and errors[-1] <= HICCUP_S:
-            return
-        sent = max(abs(sent - stamp * 1e-9 / rate - reference) for _r, sent, stamp in arrivals)
-        failures.append(f"90 % within {p90 * 1e3:.2f} ms, largest {errors[-1] * 1e3:.2f} ms (largest as sent {sent * 1e3:.2f} ms)")
-    pytest.fail(f"timing errors in {ATTEMPTS} replays: {'; '.join(failures)}")
+        assert [stamp for _sent, stamp in pulses] == TIMES_NS, "pulses lost or out of order"
+        start = [sent for sent, value in clocks if value == first_ns]
+        if not start:
+            missed.append(f"first /clock not received ({len(clocks)} /clock messages, from {clocks[0][1] if clocks else None} ns)")
+            continue
+        early = [
+            (index, round((start[0] + (stamp - TIMES_NS[0]) * 1e-9 / rate - sent) * 1e3, 3))
+            for index, (sent, stamp) in enumerate(pulses)
+            if sent < start[0] + (stamp - TIMES_NS[0]) * 1e-9 / rate - CLOCKS_APART_S
+        ]
+        assert not early, f"pulses published before their time (index, ms early): {early[:10]}"
+        return
+    pytest.fail(f"no replay measurable in {ATTEMPTS}: {'; '.join(missed)}")
 
 
 @pytest.mark.ros
@@ -365,3 +384,17 @@ def test_interface_packages_are_told_apart_without_importing_them() -> None:
     assert is_interface_package("std_msgs") and is_interface_package("bearing_rig_msgs")
     assert not is_interface_package("this") and not is_interface_package("rclpy")
     assert not is_interface_package("venv.__main__") and not is_interface_package("")
+
+
+@pytest.mark.ros
+def test_the_replay_benchmark_measures_every_pulse_and_none_early() -> None:
+    """``bearing-rig bench replay`` (its own processes and domain): every pulse of its bag is
+    measured, and none left before its time (the contract above, to the clocks' parting)."""
+    import argparse
+
+    from bearing_rig_sim.benchmarks import replay as bench_replay
+
+    (row,) = bench_replay.run(argparse.Namespace(rate=[2.0], seconds=1.0, rpm=2700.0, repeats=1))
+    assert row["received"] == row["published"] > 200  # 2700 rpm, 4 strips, two shafts: ~ 250 pulses in 1 s
+    assert row["early_ms"] <= CLOCKS_APART_S * 1e3
+    assert all(math.isfinite(row[k]) for k in ("late_p50_ms", "late_max_ms", "transit_p99_ms"))

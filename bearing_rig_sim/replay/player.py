@@ -8,7 +8,9 @@
 **Timing.** A message recorded at log time ``L`` is published at wall time
 ``w0 + (L - L0) / rate``, ``L0`` the first log time of the replayed range and ``w0`` the moment
 the replay (or the loop) started. Deadlines are absolute: a slow publish makes the next message
-late by at most its own delay, never the rest of the bag (no drift). A message that is late is
+late by at most its own delay, never the rest of the bag (no drift). No message is published
+before it is due, and ``w0`` is taken after the range's first ``/clock`` was published, so every
+message leaves at least ``(L - L0) / rate`` after that first ``/clock``. A message that is late is
 published at once, never dropped. :class:`ReplaySchedule` is that rule with an injectable clock
 (no ROS), so it is tested with a fake one.
 
@@ -112,10 +114,11 @@ class ReplaySchedule:
     def wait(self, log_time_ns: int) -> float:
         """Wait until the message is due; returns how late it is then, s (>= 0)."""
         deadline = self.due(log_time_ns)
-        remaining = deadline - self.clock.now()
-        if remaining > 0.0:
-            self.clock.sleep(remaining)
-        return max(0.0, self.clock.now() - deadline)
+        now = self.clock.now()
+        while now < deadline:  # never early, whatever the sleep's rounding
+            self.clock.sleep(deadline - now)
+            now = self.clock.now()
+        return now - deadline
 
 
 class ReplaySink(Protocol):
@@ -241,10 +244,10 @@ def replay_bag(
         if publish_clock and not bag_clock:
             messages = heapq.merge(_clock_ticks(first + period_ns, last, period_ns), messages)
         head = next(messages, None)  # the first chunk is read before the clock starts
-        schedule.start(first)
         if publish_clock:
             sink.publish(CLOCK_TOPIC, clock_message(first))
             stats.clock_messages += 1
+        schedule.start(first)  # after the first /clock left: no message is due before it was sent
         for log_time_ns, _order, topic, data in itertools.chain([head] if head is not None else [], messages):
             late = schedule.wait(log_time_ns)
             sink.publish(topic, data)

@@ -30,6 +30,7 @@ BENCHMARKS: dict[str, str] = {
     "dynamics": "bearing_rig_sim.benchmarks.dynamics",
     "rig": "bearing_rig_sim.benchmarks.rig",
     "sweep": "bearing_rig_sim.benchmarks.sweep",
+    "replay": "bearing_rig_sim.benchmarks.replay",
     "shadow": "bearing_rig_sim.benchmarks.shadow",
     "thermal": "bearing_rig_sim.benchmarks.thermal",
 }

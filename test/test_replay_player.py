@@ -8,6 +8,7 @@ import struct
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -408,3 +409,15 @@ def test_the_replay_benchmark_measures_every_pulse_and_none_early() -> None:
     assert row["received"] == row["published"] > 200  # 2700 rpm, 4 strips, two shafts: ~ 250 pulses in 1 s
     assert row["early_ms"] <= CLOCKS_APART_S * 1e3
     assert all(math.isfinite(row[k]) for k in ("late_p50_ms", "late_max_ms", "transit_p99_ms"))
+
+
+@pytest.mark.parametrize(("option", "value"), [("rate", [0.0]), ("rate", [2.0, float("nan")]), ("seconds", -1.0), ("rpm", float("inf")), ("repeats", 0)])
+def test_the_replay_benchmark_names_a_bad_option(option: str, value: Any) -> None:
+    import argparse
+
+    from bearing_rig_sim.benchmarks import replay as bench_replay
+    from bearing_rig_sim.errors import RigError
+
+    args = argparse.Namespace(**{"rate": [1.0], "seconds": 1.0, "rpm": 2700.0, "repeats": 1, option: value})
+    with pytest.raises(RigError, match=f"bench replay: --{option} must be"):
+        next(iter(bench_replay.run(args)))

@@ -27,6 +27,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import shutil
 import statistics
 import sys
 import tempfile
@@ -55,12 +56,27 @@ def _percentile(values: list[float], q: float) -> float:
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
-    """Measure each rate (see the module docstring)."""
+    """Measure each rate (see the module docstring).
+
+    Raises:
+        RigError: an option out of its range (named), a replay that failed or reached the probe
+            without its first ``/clock``.
+    """
+    for name, value in (("--seconds", args.seconds), ("--rpm", args.rpm), *(("--rate", r) for r in args.rate)):
+        if not (math.isfinite(value) and value > 0.0):
+            raise RigError(f"bench replay: {name} must be a finite number > 0, got {value!r}")
+    if args.repeats < 1:
+        raise RigError(f"bench replay: --repeats must be >= 1, got {args.repeats}")
+    work = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-replay-"))
+    try:
+        yield from _rows(args, work)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+def _rows(args: argparse.Namespace, work: Path) -> Iterator[dict]:
     from bearing_rig_sim.synthetic.bench import BenchScenario, write_bench_bag
 
-    if not args.seconds > 0.0 or not args.rpm > 0.0 or args.repeats < 1 or not all(r > 0.0 for r in args.rate):
-        raise RigError("bench replay: --seconds, --rpm and --rate must be > 0 and --repeats >= 1")
-    work = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-replay-"))
     speed = args.rpm * RPM
     scenario = BenchScenario(args.seconds, lambda t: t * 0.0 + speed, lambda t: t * 0.0 + 2.0)
     bag = write_bench_bag(work / "bench", scenario)

@@ -148,7 +148,7 @@ def _replay(bag: Path, rate: float, work: Path) -> dict[str, Any]:
         lease.release()
     start = [sent for sent, value in clocks if value == first_ns]
     if not start:
-        raise RigError("bench replay: the replay's first /clock did not reach the probe (discovery); run again")
+        raise RigError(f"bench replay: the replay's first {CLOCK.name} did not reach the probe (discovery); run again")
     late, transit = [], []
     for sent, received, raw in pulses:
         stamp = header_stamp_ns(raw)

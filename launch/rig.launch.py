@@ -13,7 +13,7 @@ records the rig's topics with ``ros2 bag record`` (MCAP storage) into ``bag_dir`
 the interface contract (``bearing_rig_sim.interfaces.TOPICS``), as a session records them.
 
 Arguments:
-  program:=FILE       test program (YAML); empty (default): the nodes only
+  program:=PROGRAM    test program: a YAML file or a shipped program's name (validation); empty (default): the nodes only
   record:=true|false  record with ros2 bag record (default false)
   bag_dir:=DIR        where ros2 bag record writes (default bags/launch)
   realtime:=true|false  simulator locked to the wall clock (default true)
@@ -101,7 +101,7 @@ def generate_launch_description() -> LaunchDescription:
     )
     return LaunchDescription(
         [
-            DeclareLaunchArgument("program", default_value="", description="test program YAML; empty: the nodes only"),
+            DeclareLaunchArgument("program", default_value="", description="test program: a YAML file or a shipped program's name; empty: the nodes only"),
             DeclareLaunchArgument("record", default_value="false", description="record the rig's topics with ros2 bag record"),
             DeclareLaunchArgument("bag_dir", default_value="bags/launch", description="output of ros2 bag record"),
             DeclareLaunchArgument("realtime", default_value="true", description="simulator locked to the wall clock"),

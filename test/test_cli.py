@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import subprocess
 import sys
@@ -197,6 +198,27 @@ def test_non_utf8_program_and_csv(tmp_path: Path, capsys: pytest.CaptureFixture[
     data = tmp_path / "bench.csv"
     data.write_bytes("inner_ring_rpm,axial_load_n,slip_pct\n900,100,3.2\u00e9\n".encode("latin-1"))
     assert "not UTF-8 text" in one_line_error(["calibrate", str(data), "--out", str(tmp_path / "c.yaml")], capsys)
+
+
+def test_a_program_is_found_by_its_name_or_its_path(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
+    """``bearing-rig run acceleration`` runs config/programs/acceleration.yaml; a path is taken as
+    it is (also a file of a shipped program's name in the working folder); neither is one line
+    naming the argument and the shipped programs (the folder's listing)."""
+    from bearing_rig_sim.rig.program import program_file
+
+    folder = Path(__file__).resolve().parents[1] / "config" / "programs"
+    shipped = sorted(f.removesuffix(".yaml") for f in os.listdir(folder) if f.endswith(".yaml"))
+    assert "acceleration" in shipped and "validation" in shipped
+    for name in ("acceleration", "acceleration.yaml"):
+        assert program_file(name).resolve() == folder / "acceleration.yaml"
+    monkeypatch.chdir(tmp_path)
+    own = tmp_path / "acceleration.yaml"
+    own.write_text("name: own\n")
+    assert program_file("acceleration.yaml") == Path("acceleration.yaml")
+    assert program_file(str(own)) == own
+    err = one_line_error(["run", "acceleraton"], capsys)
+    assert err.startswith("bearing-rig: error: acceleraton: no such program file") and f"(shipped: {', '.join(shipped)};" in err
+    assert "no such program file" in one_line_error(["run", str(tmp_path / "sub" / "validation.yaml")], capsys)
 
 
 @pytest.mark.parametrize("value, problem", [("nan", "must be finite"), ("inf", "must be finite"), ("0", "must be > 0"), ("1e9", "must be <= 3600")])

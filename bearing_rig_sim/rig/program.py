@@ -266,6 +266,35 @@ class ProgramFile(BaseModel):
     segments: Annotated[list[SegmentFile], BeforeValidator(_segment_list)] = Field(description="the segments, in order")
 
 
+PROGRAMS_DIR = ("programs",)
+"""Where the shipped test programs are, under ``config/``."""
+
+
+def shipped_programs() -> list[str]:
+    """The names of the shipped test programs (``config/programs/<name>.yaml``), sorted."""
+    folder = config_path(*PROGRAMS_DIR)
+    return sorted(f.stem for f in folder.glob("*.yaml")) if folder.is_dir() else []
+
+
+def program_file(name: str | Path) -> Path:
+    """The file a program argument names: an existing file as given, else a shipped program by
+    its name (``acceleration`` or ``acceleration.yaml`` for ``config/programs/acceleration.yaml``).
+
+    Raises:
+        ConfigError: neither, naming the argument and listing the shipped programs.
+    """
+    path = Path(name)
+    if path.is_file():
+        return path
+    if len(path.parts) == 1 and path.suffix in ("", ".yaml"):
+        shipped = config_path(*PROGRAMS_DIR, f"{path.stem}.yaml")
+        if shipped.is_file():
+            return shipped
+    raise ConfigError(
+        str(name), "", f"no such program file, nor a shipped program of that name (shipped: {', '.join(shipped_programs()) or 'none'}; run by name or by path)"
+    )
+
+
 def load_program(path: str | Path, rig: RigLimits | None = None) -> TestProgram:
     """Read and validate a test program against the rig it will run on.
 

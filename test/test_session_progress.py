@@ -133,6 +133,16 @@ def test_segments_whose_conditions_were_not_met_are_marked_and_explained() -> No
     assert "conditions not met in segment 2 n0900: load 30.0 N on the bearing, 100 N commanded; disturbed: " in table
 
 
+def test_a_run_up_is_said_to_count_from_its_start_at_the_speed_it_became_stable() -> None:
+    """A run-up's t_stable counts from its start (paper section 4.2): the line under the table says
+    so, with the speed of its stable status (127.4 rad/s = 1216.6 rpm); a step segment adds none."""
+    run_up = outcome(1, "accel_20", 1500.0, Verdict.STABLE, run_up=True, stable_speed=127.4)
+    table = format_summary([outcome(0, "n0900", 900.0, Verdict.STABLE), run_up])
+    notes = [line for line in table.splitlines() if line.startswith("run-ups")]
+    assert notes == ["run-ups are judged during their acceleration (the paper's section 4.2): t_stable from the run-up's start, slip at the stable status (accel_20 1217 rpm)"]
+    assert "run-ups" not in format_summary([outcome(0, "n0900", 900.0, Verdict.STABLE)])
+
+
 def test_empty_summary_says_so() -> None:
     assert "(no segment ran)" in format_summary([])
 

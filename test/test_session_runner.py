@@ -314,6 +314,7 @@ def test_a_run_up_is_judged_during_the_acceleration_from_its_start(program: Test
     outcome = runner.outcomes[-1]
     assert outcome.name == "accel" and outcome.verdict == Verdict.STABLE
     assert outcome.time_to_stable == pytest.approx(1.1 + W40)
+    assert outcome.run_up and runner.outcomes[:-1] and not any(o.run_up for o in runner.outcomes[:-1])  # the others are step ramps
 
 
 # -- commands ahead of time: the plan is where the spindle is -------------------------------------
@@ -430,6 +431,7 @@ def test_a_run_up_stable_during_its_acceleration_is_judged_on_the_speed_it_holds
         runner.update(accel.deadline)
         outcome = runner.outcomes[-1]
         assert outcome.name == "accel_20" and outcome.time_to_stable == pytest.approx(2.0) and outcome.conditions_met is met
+        assert outcome.run_up and outcome.stable_speed == 40.0  # the speed of the status that made it stable
 
 
 LATE = """

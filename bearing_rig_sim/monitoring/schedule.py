@@ -17,8 +17,10 @@ and every slip window its slope rests on started at or after the ramp's end
 (:func:`evidence_start`), at the commanded speed: the status's inner-ring speed within
 :func:`speed_tolerance` of the segment's target (a spindle that took the command late, or never
 reached it, is not stable at that speed on windows of the speed before). The time to stable is
-that status's stamp (its window's end) minus the ramp's end. The live session summary and ``analyze`` both use it, on the fields a SlipStatus
-carries, so they agree.
+that status's stamp (its window's end) minus the ramp's end. A run-up (a constant-acceleration
+segment) is judged during its acceleration instead, as the paper judges it (section 4.2): from
+its start, at whatever speed (:class:`TimeToStable`). The live session summary and ``analyze``
+both use it, on the fields a SlipStatus carries, so they agree.
 """
 
 from __future__ import annotations

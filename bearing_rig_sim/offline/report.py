@@ -365,7 +365,8 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         lines += [
             "Means are taken from the ramp's end to the segment's end; verdicts are the last state in the segment; "
             f"time to stable counts from the ramp's end to the first stable status (P(slope >= k) >= {result.stable_confidence:g}, the monitor's stable_confidence) whose "
-            "slip windows all follow the ramp's end, the rule the live session summary uses.",
+            "slip windows all follow the ramp's end, the rule the live session summary uses; a run-up (a constant-acceleration segment) is judged "
+            "during its acceleration, as the paper does (section 4.2), so its time to stable counts from its start and may come before the target speed.",
             "",
             *_segment_table(result),
             "",

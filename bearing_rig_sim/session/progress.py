@@ -110,8 +110,9 @@ def format_summary(outcomes: Sequence[SegmentOutcome], sweeps: Mapping[int, str]
     ``speed rpm`` is the segment's target speed, ``meas rpm`` the monitor's measured speed after
     the ramp; ``load N`` its set-point, ``F_bearing N`` the mean force on the bearing once settled;
     the slips are the monitor's and the simulator's truth over the same window; ``t_stable s`` the
-    time from the ramp end to the stable verdict; ``conditions`` ``ok``, or what was off (the
-    lines under the table say how). ``sweeps`` (rpm -> verdict, :attr:`ProgramRunner.sweeps`) adds
+    time from the ramp end to the stable verdict (from a run-up's start: a run-up is judged during
+    its acceleration, a line under the table says so and at which speed); ``conditions`` ``ok``,
+    or what was off (the lines under the table say how). ``sweeps`` (rpm -> verdict, :attr:`ProgramRunner.sweeps`) adds
     the load sweep's verdict per speed under the table.
     """
     rows = [
@@ -139,6 +140,13 @@ def format_summary(outcomes: Sequence[SegmentOutcome], sweeps: Mapping[int, str]
     out.extend(line(r) for r in rows)
     if not rows:
         out.append("(no segment ran)")
+    run_ups = [o for o in outcomes if o.run_up and o.time_to_stable is not None]
+    if run_ups:
+        at = ", ".join(f"{o.name} {_number(None if o.stable_speed is None else rad_s_to_rpm(o.stable_speed), '.0f')} rpm" for o in run_ups)
+        out += [
+            "",
+            f"run-ups are judged during their acceleration (the paper's section 4.2): t_stable from the run-up's start, slip at the stable status ({at})",
+        ]
     off = [o for o in outcomes if o.conditions]
     if off:
         out.append("")

@@ -31,6 +31,9 @@ Rules (simulation time throughout, s):
   slip windows that all started after the ramp end (the monitor's ``slope_span_s`` and
   ``min_slope_points`` say how far back its verdict reaches). Verdict "stable", time to stable =
   that status's stamp - ramp end. Without one by ``ramp end + timeout_s``: verdict "timeout".
+* A **run-up** (a constant-acceleration segment) is judged during its acceleration, as the paper
+  judges it (section 4.2, Table 7): its time to stable counts from the run-up's start, and the
+  stable status may come before the target speed (the summary says at which speed).
 * Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
@@ -232,7 +235,7 @@ class SegmentOutcome:
     ramp_end: float
     end_time: float
     time_to_stable: float | None
-    """Stable stamp - ramp end, s; None without a stable verdict after the ramp."""
+    """Stable stamp - ramp end (a run-up's: - its start), s; None without a stable verdict."""
     measured_slip: float | None
     """Monitor's slip rate, %."""
     truth_slip: float | None
@@ -244,6 +247,12 @@ class SegmentOutcome:
     conditions: tuple[str, ...] = ()
     """What was off: speed or load not as commanded, disturbances from outside; empty when the
     segment ran under its own conditions."""
+    run_up: bool = False
+    """A constant-acceleration run-up: judged during its acceleration, as the paper judges it
+    (section 4.2), so its time to stable counts from its start, and its measured slip is that of
+    the stable status, at the speed of ``stable_speed``."""
+    stable_speed: float | None = None
+    """Inner-ring speed of the status that made the segment stable, rad/s (None without one)."""
 
     @property
     def conditions_met(self) -> bool:
@@ -498,6 +507,8 @@ class ProgramRunner:
             bearing_force=force,
             measured_speed=measured_speed,
             conditions=_conditions(plan.segment, measured_speed, _load_conditions(data, now), data.disturbances, verdict),
+            run_up=data.rule is not None and data.rule.run_up_start is not None,
+            stable_speed=data.stable.inner_ring_speed if data.stable is not None and math.isfinite(data.stable.inner_ring_speed) else None,
         )
         self.outcomes.append(outcome)
         self._data = None

@@ -586,7 +586,13 @@ class _Session:
 
     def _segment_ended(self, outcome: SegmentOutcome) -> None:
         slip = f", slip {outcome.measured_slip:.3f} %" if outcome.measured_slip is not None and math.isfinite(outcome.measured_slip) else ""
-        stable = f" {outcome.time_to_stable:.2f} s after the ramp" if outcome.time_to_stable is not None else ""
+        if outcome.time_to_stable is None:
+            stable = ""
+        elif outcome.run_up:
+            speed = f" (at {rad_s_to_rpm(outcome.stable_speed):.0f} rpm)" if outcome.stable_speed is not None else ""
+            stable = f" {outcome.time_to_stable:.2f} s after the run-up's start{speed}"
+        else:
+            stable = f" {outcome.time_to_stable:.2f} s after the ramp"
         self._event(f"segment {outcome.index + 1}/{self.runner.segment_count} {outcome.name}: {outcome.verdict.value}{stable}{slip}")
 
     def _event(self, line: str) -> None:

@@ -167,6 +167,21 @@ def test_measured_and_true_slip_compare_over_the_same_window(program: TestProgra
     assert outcome.measured_slip == 3.49
 
 
+def test_a_status_without_a_window_has_no_true_slip_beside_it(program: TestProgram) -> None:
+    """A rig found stopped: the last status has cage speed 0 and no slip; the truth's slip at
+    that moment (finite near standstill: 1 - cage / (ratio x inner) of vanishing speeds) is not
+    shown beside it, whatever its value."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)
+    for k in range(400):
+        runner.observe_truth(k * 0.01, -67.9)
+    runner.observe_status(SlipObservation(time=3.45, state=StatusState.UNKNOWN, slip_rate=math.nan, inner_ring_speed=0.0, cage_speed=0.0, window_revolutions=1))
+    runner.update(2.5 + 4.0)
+    outcome = runner.outcomes[-1]
+    assert outcome.truth_slip is None and outcome.measured_slip is not None and math.isnan(outcome.measured_slip)
+
+
 def test_mean_bearing_force_counts_after_the_ramp(program: TestProgram) -> None:
     runner = ProgramRunner(program)
     runner.start(0.0)

@@ -37,7 +37,8 @@ Rules (simulation time throughout, s):
 * Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
   last status of the segment. Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
-  two are compared over the same stretch of time. Bearing force: mean of the load controller's
+  two are compared over the same stretch of time; none when that status has no window (a stop
+  that stopped: the monitor reports the rig stopped, and neither slip is defined). Bearing force: mean of the load controller's
   bearing force once the load has settled (after the ramp end and at least
   :data:`LOAD_SETTLE_S` after the load controller's state first shows the segment's set-point).
   Measured speed: the monitor's inner-ring speed in the segment's last status, when it is stamped
@@ -637,7 +638,11 @@ class ProgramRunner:
 
     def truth_slip_over(self, status: SlipObservation) -> float | None:
         """Mean true slip (%) over the window of ``status``; the last sample at or before its
-        stamp when the window holds none; None without any sample."""
+        stamp when the window holds none; None without any sample, and None when the status has
+        no window (a rig found stopped: its cage speed 0, its slip undefined; the truth's slip near
+        standstill, 1 - cage / (ratio x inner) of vanishing speeds, compares with nothing)."""
+        if status.window_duration <= 0.0:
+            return None
         start = status.time - status.window_duration
         inside = [s for t, s in self._truth if start <= t <= status.time]
         if inside:

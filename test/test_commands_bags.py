@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -14,7 +15,7 @@ import pytest
 
 from bearing_rig_sim.cli import main
 from bearing_rig_sim.config import rpm_to_rad_s
-from bearing_rig_sim.bags import BagWriter
+from bearing_rig_sim.bags import BagWriter, open_bag
 from bearing_rig_sim.offline.segments import SEGMENTS_CSV
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
 from bearing_rig_sim.offline.report import PLOT_FILES, REPORT_FILE
@@ -57,6 +58,12 @@ def test_analyze_writes_report_plots_and_csv(steady_bag: Path, tmp_path: Path, c
     with open(out / STATUS_CSV, newline="") as stream:
         rows = list(csv.DictReader(stream))
     assert len(rows) >= 60 and rows[-1]["reason"] == "end" and rows[-1]["state"] == "2"
+    # the report's time origin, on the rig clock the CSV files keep: the first pulse's stamp
+    with open_bag(steady_bag) as bag:
+        first = min(m.message.header.stamp.sec + m.message.header.stamp.nanosec * 1e-9 for m in bag.messages(["/rig/spindle/pulses", "/rig/cage/pulses"]))
+    origin = re.search(r"time below runs from the first pulse, at ([0-9.]+) s of rig time; the CSV files keep rig time", text)
+    assert origin is not None and float(origin.group(1)) == pytest.approx(first, abs=1e-6)
+    assert float(rows[0]["time_s"]) >= first - 1e-9
     assert float(rows[-1]["inner_ring_rpm"]) == pytest.approx(1800.0, rel=1e-6)
     assert float(rows[-1]["truth_slip_rate_pct"]) == pytest.approx(2.5)
     with open(out / WINDOWS_CSV, newline="") as stream:

@@ -134,6 +134,11 @@ def _finish(fig: Any, ax: Any, path: Path, title: str, ylabel: str, drawn: bool,
     return path
 
 
+def _origin(first_time: float) -> str:
+    """Where the report's time starts on the rig clock, for reading the CSV files beside it."""
+    return f", at {first_time:.6f} s of rig time; the CSV files keep rig time" if math.isfinite(first_time) else ""
+
+
 def _step(transitions: list[tuple[float, int]], t0: float, t_end: float) -> tuple[list[float], list[int]]:
     xs = [t - t0 for t, _s in transitions]
     ys = [s for _t, s in transitions]
@@ -335,7 +340,7 @@ def report_markdown(result: OfflineResult, plots: Sequence[Path], csv_files: Seq
         "",
         "## Summary",
         "",
-        f"* pulses: {result.pulses['spindle']} spindle, {result.pulses['cage']} cage, over {span:.3f} s of rig time (time below runs from the first pulse)",
+        f"* pulses: {result.pulses['spindle']} spindle, {result.pulses['cage']} cage, over {span:.3f} s of rig time (time below runs from the first pulse{_origin(result.first_time)})",
         f"* slip windows: {result.windows}; status rows: {result.status_rows} (one per check at the monitor's status rate and per closed window)",
     ]
     final = result.final_status

@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 import shutil
 import statistics
 import sys
@@ -36,10 +35,10 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.bags.cdr import header_stamp_ns
+from bearing_rig_sim.benchmarks import percentile, rig_graph
+from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.errors import RigError
-
-RPM = 2.0 * math.pi / 60.0
-"""rad/s per rpm."""
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -48,11 +47,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seconds", type=float, default=10.0, help="length of the bag (s of bench time)")
     parser.add_argument("--rpm", type=float, default=2700.0, help="spindle speed of the bag (rpm)")
     parser.add_argument("--repeats", type=int, default=3, help="replays per rate; medians are reported")
-
-
-def _percentile(values: list[float], q: float) -> float:
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))] if ordered else float("nan")
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
@@ -77,7 +71,7 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
 def _rows(args: argparse.Namespace, work: Path) -> Iterator[dict]:
     from bearing_rig_sim.synthetic.bench import BenchScenario, write_bench_bag
 
-    speed = args.rpm * RPM
+    speed = rpm_to_rad_s(args.rpm)
     scenario = BenchScenario(args.seconds, lambda t: t * 0.0 + speed, lambda t: t * 0.0 + 2.0)
     bag = write_bench_bag(work / "bench", scenario)
     for rate in args.rate:
@@ -94,58 +88,48 @@ def _rows(args: argparse.Namespace, work: Path) -> Iterator[dict]:
 
 def _replay(bag: Path, rate: float, work: Path) -> dict[str, Any]:
     """One replay at ``rate``, measured by a probe (see the module docstring)."""
-    import rclpy
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from rclpy.signals import SignalHandlerOptions
     from rosgraph_msgs.msg import Clock
 
     from bearing_rig_msgs.msg import FibreOpticPulse
     from bearing_rig_sim.bags import open_bag
-    from bearing_rig_sim.dds_profile import apply_rig_profile
     from bearing_rig_sim.interfaces import CAGE_PULSES, CLOCK, SPINDLE_PULSES
     from bearing_rig_sim.nodes.common import drain
-    from bearing_rig_sim.session.processes import NodeProcess, own_ros_environment, session_environment, stop_all
-    from bearing_rig_sim.session.recorder import header_stamp_ns
+    from bearing_rig_sim.session.processes import NodeProcess, stop_all
 
     with open_bag(bag) as reader:
         first_ns = reader.start_ns
         published = sum(reader.topics[t.name].message_count for t in (SPINDLE_PULSES, CAGE_PULSES))
-    env, lease = session_environment(os.environ)
-    apply_rig_profile(env, work)
     replay = NodeProcess(
         "replay",
         [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"],
         work / "replay.log",
     )
-    context = rclpy.Context()
     pulses: list[tuple[int, int, bytes]] = []
-    clocks: list[tuple[int, int]] = []
-    try:
-        with own_ros_environment(env):
-            rclpy.init(args=[], context=context, domain_id=int(env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
-            probe = Node("bench_replay_probe", context=context)
-        deep = QoSProfile(depth=100000, reliability=ReliabilityPolicy.BEST_EFFORT)
-        subs = [probe.create_subscription(FibreOpticPulse, topic.name, lambda _m: None, deep, raw=True) for topic in (SPINDLE_PULSES, CAGE_PULSES)]
-        clock_sub = probe.create_subscription(Clock, CLOCK.name, lambda _m: None, QoSProfile(depth=100000, reliability=ReliabilityPolicy.RELIABLE), raw=True)
+    clocks: list[tuple[int, int | None]] = []  # (sent, the /clock's time: the message's leading Time)
+    with rig_graph(work) as graph:
+        try:
+            probe = graph.join(lambda context: Node("bench_replay_probe", context=context))
+            deep = QoSProfile(depth=100000, reliability=ReliabilityPolicy.BEST_EFFORT)
+            subs = [probe.create_subscription(FibreOpticPulse, topic.name, lambda _m: None, deep, raw=True) for topic in (SPINDLE_PULSES, CAGE_PULSES)]
+            clock_sub = probe.create_subscription(Clock, CLOCK.name, lambda _m: None, QoSProfile(depth=100000, reliability=ReliabilityPolicy.RELIABLE), raw=True)
 
-        def take() -> None:
-            for sub in subs:
-                pulses.extend((int(info["source_timestamp"]), int(info["received_timestamp"]), raw) for raw, info in drain(sub, FibreOpticPulse))
-            clocks.extend((int(info["source_timestamp"]), _clock_ns(raw)) for raw, info in drain(clock_sub, Clock))
+            def take() -> None:
+                for sub in subs:
+                    pulses.extend((int(info["source_timestamp"]), int(info["received_timestamp"]), raw) for raw, info in drain(sub, FibreOpticPulse))
+                clocks.extend((int(info["source_timestamp"]), header_stamp_ns(raw)) for raw, info in drain(clock_sub, Clock))
 
-        replay.start(env)
-        while replay.poll() is None:
+            replay.start(graph.env)
+            while replay.poll() is None:
+                take()
+                time.sleep(0.01)
             take()
-            time.sleep(0.01)
-        take()
-        probe.destroy_node()
-        if replay.poll() != 0:
-            raise RigError(f"bench replay: {replay.describe_exit()}")
-    finally:
-        stop_all([replay])
-        context.try_shutdown()
-        lease.release()
+            probe.destroy_node()
+            if replay.poll() != 0:
+                raise RigError(f"bench replay: {replay.describe_exit()}")
+        finally:
+            stop_all([replay])
     start = [sent for sent, value in clocks if value == first_ns]
     if not start:
         raise RigError(f"bench replay: the replay's first {CLOCK.name} did not reach the probe (discovery); run again")
@@ -159,19 +143,13 @@ def _replay(bag: Path, rate: float, work: Path) -> dict[str, Any]:
     if not late:
         raise RigError("bench replay: no pulse reached the probe")
     return {
-        "late_p50_ms": _percentile(late, 0.5),
-        "late_p90_ms": _percentile(late, 0.9),
-        "late_p99_ms": _percentile(late, 0.99),
+        "late_p50_ms": percentile(late, 0.5),
+        "late_p90_ms": percentile(late, 0.9),
+        "late_p99_ms": percentile(late, 0.99),
         "late_max_ms": max(late),
         "early_ms": max(0.0, -min(late)),
-        "transit_p50_ms": _percentile(transit, 0.5),
-        "transit_p99_ms": _percentile(transit, 0.99),
+        "transit_p50_ms": percentile(transit, 0.5),
+        "transit_p99_ms": percentile(transit, 0.99),
         "received": len(late),
         "published": published,
     }
-
-
-def _clock_ns(raw: bytes) -> int:
-    """The time of a serialized ``rosgraph_msgs/Clock`` (CDR: 4-byte header, sec, nanosec)."""
-    sec = int.from_bytes(raw[4:8], "little", signed=True)
-    return sec * 10**9 + int.from_bytes(raw[8:12], "little")

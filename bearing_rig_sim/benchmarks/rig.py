@@ -46,7 +46,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
-from bearing_rig_sim.dds_profile import apply_rig_profile
+from bearing_rig_sim.benchmarks import rig_graph
 from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.interfaces import (
@@ -64,8 +64,6 @@ from bearing_rig_sim.session.processes import (
     NODES,
     NodeProcess,
     node_command,
-    own_ros_environment,
-    session_environment,
     stop_all,
 )
 from bearing_rig_sim.session.readiness import not_ready
@@ -215,53 +213,44 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
     """Start the nodes, measure, stop them; yield the rows of the module documentation."""
     if not args.seconds > 0 or not args.warmup >= 0:
         raise RigError(f"bench rig: --seconds must be > 0 and --warmup >= 0, got {args.seconds}, {args.warmup}")
-    import rclpy
-    from rclpy.signals import SignalHandlerOptions
-
     logs = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-rig-"))
-    env, lease = session_environment(os.environ)
-    apply_rig_profile(env, logs)
     children = [NodeProcess(name, node_command(spec) + ["--autostart"], logs / f"{name}.log") for name, spec in NODES.items()]
-    context = rclpy.Context()
     probe = None
     series = _Series()
-    try:
-        for child in children:
-            child.start(env)
-        with own_ros_environment(env):
-            rclpy.init(args=[], context=context, domain_id=int(env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
-            probe = _Probe(context)
+    with rig_graph(logs) as graph:
+        try:
+            for child in children:
+                child.start(graph.env)
+            probe = graph.join(_Probe)
 
-        def pump(until: float) -> None:
-            while time.monotonic() < until:
-                for child in children:
-                    if child.poll() is not None:
-                        raise RigError(f"bench rig: {child.describe_exit()}")
-                series.add(probe.take(), probe.types)
-                time.sleep(0.01)
+            def pump(until: float) -> None:
+                while time.monotonic() < until:
+                    for child in children:
+                        if child.poll() is not None:
+                            raise RigError(f"bench rig: {child.describe_exit()}")
+                    series.add(probe.take(), probe.types)
+                    time.sleep(0.01)
 
-        deadline = time.monotonic() + args.startup_timeout
-        while missing := probe.missing(series.seen):
-            if time.monotonic() > deadline:
-                name, what = next(iter(missing.items()))
-                raise RigError(f"bench rig: the {name} node did not come up within {args.startup_timeout:g} s ({what}); log {logs / (name + '.log')}")
-            pump(time.monotonic() + 0.1)
-        probe.command(rpm_to_rad_s(args.speed_rpm), args.load_n)
-        pump(time.monotonic() + args.warmup)
-        cpu_start = {c.name: c.cpu_seconds() for c in children}
-        own_start = os.times()
-        wall_start, mono_start = time.time_ns(), time.monotonic()
-        pump(mono_start + args.seconds)
-        wall_end, mono_end = time.time_ns(), time.monotonic()
-        own_end = os.times()
-        cpu_end = {c.name: c.cpu_seconds() for c in children}
-        series.add(probe.take(), probe.types)
-    finally:
-        if probe is not None:
-            probe.close()
-        stop_all(children)
-        context.try_shutdown()
-        lease.release()
+            deadline = time.monotonic() + args.startup_timeout
+            while missing := probe.missing(series.seen):
+                if time.monotonic() > deadline:
+                    name, what = next(iter(missing.items()))
+                    raise RigError(f"bench rig: the {name} node did not come up within {args.startup_timeout:g} s ({what}); log {logs / (name + '.log')}")
+                pump(time.monotonic() + 0.1)
+            probe.command(rpm_to_rad_s(args.speed_rpm), args.load_n)
+            pump(time.monotonic() + args.warmup)
+            cpu_start = {c.name: c.cpu_seconds() for c in children}
+            own_start = os.times()
+            wall_start, mono_start = time.time_ns(), time.monotonic()
+            pump(mono_start + args.seconds)
+            wall_end, mono_end = time.time_ns(), time.monotonic()
+            own_end = os.times()
+            cpu_end = {c.name: c.cpu_seconds() for c in children}
+            series.add(probe.take(), probe.types)
+        finally:
+            if probe is not None:
+                probe.close()
+            stop_all(children)
     duration = mono_end - mono_start
     yield from _rows(args, series, wall_start, wall_end, duration)
     total: float | None = 0.0

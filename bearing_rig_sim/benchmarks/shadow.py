@@ -36,7 +36,6 @@ from __future__ import annotations
 import argparse
 import bisect
 import math
-import os
 import statistics
 import sys
 import tempfile
@@ -45,6 +44,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+from bearing_rig_sim.benchmarks import percentile, rig_graph
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.shadow import ResidualWindow, ShadowSettings, ShadowTwin
 from bearing_rig_sim.errors import RigError
@@ -62,13 +62,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--recalibrate", choices=["off", "on", "both"], default="both", help="online re-calibration in the cases")
     parser.add_argument("--live", action="store_true", help="also run the node across processes, fed by bearing-rig replay")
     parser.add_argument("--rate", type=float, nargs="+", default=[1.0, 2.0], help="live: replay rates (bench seconds per wall second)")
-
-
-def _percentile(values: list[float], q: float) -> float:
-    if not values:
-        return float("nan")
-    ordered = sorted(values)
-    return ordered[min(len(ordered) - 1, int(q * len(ordered)))]
 
 
 def run(args: argparse.Namespace) -> Iterator[dict]:
@@ -130,12 +123,12 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "windows": windows,
                 "rtf": round(statistics.median(rtfs), 3),
                 "rtf_min": round(min(rtfs), 3),
-                "message_p50_ms": round(1e3 * _percentile(per_message, 0.5), 4),
-                "message_p99_ms": round(1e3 * _percentile(per_message, 0.99), 4),
+                "message_p50_ms": round(1e3 * percentile(per_message, 0.5), 4),
+                "message_p99_ms": round(1e3 * percentile(per_message, 0.99), 4),
                 "message_max_ms": round(1e3 * max(per_message), 3),
-                "residual_wait_p50_ms": round(1e3 * _percentile(waits, 0.5), 3),
-                "residual_wait_p99_ms": round(1e3 * _percentile(waits, 0.99), 3),
-                "residual_latency_p99_ms": round(1e3 * _percentile(latencies, 0.99), 3),
+                "residual_wait_p50_ms": round(1e3 * percentile(waits, 0.5), 3),
+                "residual_wait_p99_ms": round(1e3 * percentile(waits, 0.99), 3),
+                "residual_latency_p99_ms": round(1e3 * percentile(latencies, 0.99), 3),
             }
         if args.live:
             for rate in args.rate:
@@ -151,65 +144,56 @@ def _take(sub: Any, msgtype: type) -> list[tuple[int, bytes]]:
 
 def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
     """One live case (see the module docstring)."""
-    import rclpy
     from rclpy.node import Node
     from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from rclpy.signals import SignalHandlerOptions
 
     from bearing_rig_msgs.msg import FibreOpticPulse, ShadowResidual
     from bearing_rig_sim.interfaces import CAGE_PULSES, TWIN_RESIDUAL
-    from bearing_rig_sim.dds_profile import apply_rig_profile
-    from bearing_rig_sim.session.processes import NodeProcess, NodeSpec, node_command, own_ros_environment, session_environment, stop_all
+    from bearing_rig_sim.session.processes import NodeProcess, NodeSpec, node_command, stop_all
     from bearing_rig_sim.session.recorder import header_stamp_ns
     from bearing_rig_sim.shadow.offline import shadow_bag
 
     work = Path(tempfile.mkdtemp(prefix="bearing-rig-bench-shadow-"))
     bag = write_bench_bag(bench, work / "bench")
     expected = shadow_bag(bag, None).counts["windows"]
-    env, lease = session_environment(os.environ)
-    apply_rig_profile(env, work)
     shadow = NodeProcess("shadow", [*node_command(NodeSpec("shadow", "bearing-rig-shadow")), "--autostart"], work / "shadow.log")
     replay = NodeProcess(
         "replay",
         [sys.executable, "-m", "bearing_rig_sim.cli", "replay", str(bag), "--rate", str(rate), "--wait-for-subscribers", "--delay", "30", "--quiet"],
         work / "replay.log",
     )
-    context = rclpy.Context()
     pulses: list[tuple[int, bytes]] = []
     residuals: list[tuple[int, bytes]] = []
-    try:
-        shadow.start(env)
-        with own_ros_environment(env):
-            rclpy.init(args=[], context=context, domain_id=int(env["ROS_DOMAIN_ID"]), signal_handler_options=SignalHandlerOptions.NO)
-            probe = Node("bench_shadow_probe", context=context)
-        deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT)
-        reliable = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
-        cage_sub = probe.create_subscription(FibreOpticPulse, CAGE_PULSES.name, lambda _m: None, deep, raw=True)
-        residual_sub = probe.create_subscription(ShadowResidual, TWIN_RESIDUAL.name, lambda _m: None, reliable, raw=True)
+    with rig_graph(work) as graph:
+        try:
+            shadow.start(graph.env)
+            probe = graph.join(lambda context: Node("bench_shadow_probe", context=context))
+            deep = QoSProfile(depth=10000, reliability=ReliabilityPolicy.BEST_EFFORT)
+            reliable = QoSProfile(depth=10000, reliability=ReliabilityPolicy.RELIABLE)
+            cage_sub = probe.create_subscription(FibreOpticPulse, CAGE_PULSES.name, lambda _m: None, deep, raw=True)
+            residual_sub = probe.create_subscription(ShadowResidual, TWIN_RESIDUAL.name, lambda _m: None, reliable, raw=True)
 
-        def pump(seconds: float) -> None:
-            until = time.monotonic() + seconds
-            while time.monotonic() < until:
-                if shadow.poll() is not None:
-                    raise RigError(f"bench shadow: {shadow.describe_exit()}")
-                pulses.extend(_take(cage_sub, FibreOpticPulse))
-                residuals.extend(_take(residual_sub, ShadowResidual))
-                time.sleep(0.002)
+            def pump(seconds: float) -> None:
+                until = time.monotonic() + seconds
+                while time.monotonic() < until:
+                    if shadow.poll() is not None:
+                        raise RigError(f"bench shadow: {shadow.describe_exit()}")
+                    pulses.extend(_take(cage_sub, FibreOpticPulse))
+                    residuals.extend(_take(residual_sub, ShadowResidual))
+                    time.sleep(0.002)
 
-        deadline = time.monotonic() + 60.0
-        while probe.count_publishers(TWIN_RESIDUAL.name) == 0:
-            if time.monotonic() > deadline:
-                raise RigError(f"bench shadow: the shadow node did not come up within 60 s; log {shadow.log_path}")
-            pump(0.1)
-        replay.start(env)
-        while replay.poll() is None:
-            pump(0.05)
-        pump(2.0)
-        probe.destroy_node()
-    finally:
-        stop_all([shadow, replay])
-        context.try_shutdown()
-        lease.release()
+            deadline = time.monotonic() + 60.0
+            while probe.count_publishers(TWIN_RESIDUAL.name) == 0:
+                if time.monotonic() > deadline:
+                    raise RigError(f"bench shadow: the shadow node did not come up within 60 s; log {shadow.log_path}")
+                pump(0.1)
+            replay.start(graph.env)
+            while replay.poll() is None:
+                pump(0.05)
+            pump(2.0)
+            probe.destroy_node()
+        finally:
+            stop_all([shadow, replay])
     from rclpy.serialization import deserialize_message
 
     arrivals = sorted((stamp, at) for at, raw in pulses if (stamp := header_stamp_ns(raw)) is not None)
@@ -229,8 +213,8 @@ def _live(bench: BenchRun, rpm: float, rate: float) -> dict:
         "rate": rate,
         "windows_expected": expected,
         "windows_received": len(residuals),
-        "latency_p50_ms": round(_percentile(latencies, 0.5), 3),
-        "latency_p99_ms": round(_percentile(latencies, 0.99), 3),
+        "latency_p50_ms": round(percentile(latencies, 0.5), 3),
+        "latency_p99_ms": round(percentile(latencies, 0.99), 3),
         "latency_max_ms": round(max(latencies), 3) if latencies else None,
         "drain_ms": round((residuals[-1][0] - max(at for _s, at in arrivals)) * 1e-6, 3) if residuals and arrivals else None,
     }

@@ -268,8 +268,8 @@ class SegmentTracker:
         after the next began is the previous segment's (its final state and time to stable)."""
         if self._open is not None:
             self._open.add_recorded(stamp, cage_speed, state, confidence, inner_ring_speed)
-        last = self._last_closed
-        if self.by_program and last is not None and last.start <= stamp < (self._open.start if self._open is not None else math.inf):
+        last = self._late(stamp)
+        if last is not None:
             last.take_final_recorded(stamp, state)  # the previous segment's, read after the next began
             last.recorded_stable.observe(stamp, last.evidence(stamp, cage_speed), state, confidence, inner_ring_speed)
             self.segments[-1] = replace(
@@ -278,11 +278,11 @@ class SegmentTracker:
 
     def _late(self, window_end: float) -> _Segment | None:
         """The previous segment, when a window that ended at ``window_end`` (s) belongs to it and
-        not to the open one (see :meth:`row`); else None."""
-        last, open_ = self._last_closed, self._open
-        if not self.by_program or last is None or open_ is None or not math.isfinite(window_end):
+        not to the open one (see :meth:`row`), or to none open; else None."""
+        last = self._last_closed
+        if not self.by_program or last is None or not math.isfinite(window_end):
             return None
-        return last if last.start <= window_end < open_.start else None
+        return last if last.start <= window_end < (self._open.start if self._open is not None else math.inf) else None
 
     def finish(self) -> list[SegmentSummary]:
         """Close the last segment; returns every segment."""

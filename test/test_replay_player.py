@@ -238,6 +238,8 @@ def test_no_replayed_pulse_leaves_before_its_time(ros_graph, tmp_path: Path, rat
     from rclpy.qos import QoSProfile, ReliabilityPolicy
     from rosgraph_msgs.msg import Clock
 
+    from conftest import time_left
+
     write_pulse_bag(tmp_path / "bag", TIMES_NS)
     first_ns = TIMES_NS[0] + 2  # the bag's first log time: the replay's first /clock
     node = ros_graph.node("listener")
@@ -261,9 +263,9 @@ def test_no_replayed_pulse_leaves_before_its_time(ros_graph, tmp_path: Path, rat
         process = ros_graph.spawn_python(
             "-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--rate", str(rate), "--wait-for-subscribers", "--delay", "20"
         )
-        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS) or process.poll() is not None, timeout=60.0, executor=executor)  # noqa: B023 - waited on at once
-        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS), timeout=1.0, executor=executor)
-        out, err = process.communicate(timeout=60.0)
+        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS) or process.poll() is not None, timeout=time_left(), executor=executor)  # noqa: B023 - waited on at once
+        ros_graph.spin_until(lambda: len(pulses) == len(TIMES_NS), timeout=time_left(), executor=executor)  # the last ones in flight
+        out, err = process.communicate(timeout=time_left())
         assert process.returncode == 0, err
         assert "1 pass(es)" in out
         assert [stamp for _sent, stamp in pulses] == TIMES_NS, "pulses lost or out of order"

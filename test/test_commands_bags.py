@@ -8,6 +8,8 @@ import math
 import os
 import re
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import matplotlib.image
@@ -20,6 +22,7 @@ from bearing_rig_sim.offline.segments import SEGMENTS_CSV
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV
 from bearing_rig_sim.offline.report import PLOT_FILES, REPORT_FILE
 from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic
+from conftest import time_left
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -74,6 +77,26 @@ def test_analyze_writes_report_plots_and_csv(steady_bag: Path, tmp_path: Path, c
     with open(out / SEGMENTS_CSV, newline="") as stream:
         segments = list(csv.DictReader(stream))
     assert [s["name"] for s in segments] == ["stretch 1"] and segments[0]["final_state"] == "2"
+
+
+def test_analyze_loads_no_dynamics_engine(steady_bag: Path, tmp_path: Path) -> None:
+    """``bearing-rig analyze`` in its own process, as a user runs it, loads neither numba nor the
+    engine (the commands that need them are not imported): numba alone costs some 100 MB, half
+    of issue 36's 200 MB for an hour's analysis."""
+    script = (
+        "import sys\n"
+        "from bearing_rig_sim import cli\n"
+        "status = cli.main(sys.argv[1:])\n"
+        "heavy = sorted(m for m in ('numba', 'llvmlite', 'bearing_rig_sim.dynamics', 'rclpy') if m in sys.modules)\n"
+        "print('loaded:' + ''.join(' ' + m for m in heavy))\n"
+        "sys.exit(status)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", script, "analyze", str(steady_bag), "--out", str(tmp_path / "report")],
+        capture_output=True, text=True, timeout=time_left(),
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines()[-1] == "loaded:", done.stdout
 
 
 def test_analyze_a_bag_without_sensor_topics_is_one_line_error(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

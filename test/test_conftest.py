@@ -4,16 +4,19 @@
   (``CI`` set) unless ``BEARING_RIG_ALLOW_MISSING`` names the tier; a skip that names no tier
   fails in CI; a wrong tier name in the variable stops the run, naming it;
 * ``time_left()`` is the test's own timeout (its marker, else pytest.ini's) less what it has run
-  and the margin.
+  and the margin;
+* no test of the suite bounds a wait with a number of its own (pytest.ini's one timeout policy).
 """
 
 from __future__ import annotations
 
+import ast
 import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from conftest import time_left
 
 
 HERE = Path(__file__).resolve().parent
@@ -69,7 +72,7 @@ def run_suite(tmp_path: Path, *args: str, **env: str) -> subprocess.CompletedPro
         env=environ,
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=time_left(),
     )
 
 
@@ -103,3 +106,37 @@ def test_an_unknown_tier_stops_the_run_naming_it(tmp_path: Path) -> None:
     result = run_suite(tmp_path, CI="true", BEARING_RIG_ALLOW_MISSING="foxglove-clients")
     assert result.returncode == 4, result.stdout[-2000:] + result.stderr[-2000:]
     assert "BEARING_RIG_ALLOW_MISSING: unknown tier(s) foxglove-clients (tiers: ros, ros2-cli" in result.stderr, result.stderr[-2000:]
+
+
+EXEMPT_WAIT = "# not a hang guard"
+"""Written on the line of a ``timeout=`` that is a measured interval or a grace period, not a
+bound for a hang."""
+
+
+def fixed_waits(source: str) -> list[tuple[int, str]]:
+    """The ``timeout=`` arguments of ``source`` that are a number of seconds (1 s or more)
+    written into the call, as (line, call); lines marked :data:`EXEMPT_WAIT` left out."""
+    lines = source.splitlines()
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, ast.Call):
+            continue
+        for keyword in node.keywords:
+            value = keyword.value
+            if keyword.arg == "timeout" and isinstance(value, ast.Constant) and isinstance(value.value, (int, float)) and value.value >= 1:
+                if EXEMPT_WAIT not in lines[value.lineno - 1]:
+                    found.append((value.lineno, ast.unparse(node.func)))
+    return found
+
+
+def test_fixed_waits_are_found() -> None:
+    source = "p.communicate(timeout=150)\ng.spin_until(f, timeout=time_left())\nq.wait(timeout=0.5)\nr.wait(timeout=20)  # not a hang guard: grace\n"
+    assert fixed_waits(source) == [(1, "p.communicate")]
+
+
+def test_every_wait_of_the_suite_is_bounded_by_the_tests_guard() -> None:
+    """pytest.ini: every wait inside a test is bounded by ``time_left()``, so a test's timeout
+    marker is the one number that bounds it. A fixed ``timeout=150`` is either shorter than the
+    guard (a bet on the host's speed that a loaded host loses) or longer (never the real bound)."""
+    offenders = [f"{path.name}:{line} {call}" for path in sorted(HERE.glob("test_*.py")) for line, call in fixed_waits(path.read_text(encoding="utf-8"))]
+    assert offenders == [], "waits with their own timeout instead of time_left(): " + ", ".join(offenders)

@@ -361,11 +361,16 @@ def test_ctrl_c_stops_a_looping_replay_cleanly(ros_graph, tmp_path: Path) -> Non
     process = ros_graph.spawn_python(
         "-m", "bearing_rig_sim.cli", "replay", str(tmp_path / "bag"), "--loop", "--rate", "4", "--wait-for-subscribers", "--delay", "20"
     )
+    from conftest import time_left
+
     executor = ros_graph.executor([node])
-    # a second pass has begun: pulse_index 0 came again after the last one
-    assert ros_graph.spin_until(lambda: received.count(0) >= 2, timeout=30.0, executor=executor), f"received {len(received)} pulses"
+
+    def second_pass() -> bool:  # an index lower than the one before: the bag began again (best effort may drop any one pulse)
+        return any(later < earlier for earlier, later in zip(received, received[1:]))
+
+    assert ros_graph.spin_until(second_pass, timeout=time_left(), executor=executor), f"received {len(received)} pulses"
     process.send_signal(signal.SIGINT)
-    out, err = process.communicate(timeout=60.0)  # a bound for a hang, not a speed: 10 s ran out once on a loaded host
+    out, err = process.communicate(timeout=time_left())  # the test's guard bounds a hang; how soon it exits is no part of the contract
     assert process.returncode == 130, err
     assert "replay interrupted" in err and "Traceback" not in err
 

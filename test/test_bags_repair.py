@@ -17,6 +17,7 @@ from rosbags.highlevel import AnyReader
 from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, repair_bag
 from bearing_rig_sim.cli import main as cli_main
 from bearing_rig_sim.synthetic.traffic import RIG_TRAFFIC_TOPICS, rig_traffic
+from conftest import time_left
 
 REPO = Path(__file__).resolve().parents[1]
 DURABLE_BEFORE_KILL = 3000
@@ -76,7 +77,7 @@ def kill_recorder_midway(bag: Path, max_file_bytes: int) -> int:
             if durable >= DURABLE_BEFORE_KILL:
                 break
         child.send_signal(signal.SIGKILL)
-        _out, err = child.communicate(timeout=30)
+        _out, err = child.communicate(timeout=time_left())
     finally:
         if child.poll() is None:
             child.kill()

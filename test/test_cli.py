@@ -19,6 +19,7 @@ import pytest
 from bearing_rig_sim import __version__, cli
 from bearing_rig_sim.commands import bench
 from bearing_rig_sim.errors import RigError
+from conftest import time_left
 
 FAKE_MODULE = "bearing_rig_sim_test_fake_benchmark"
 
@@ -174,9 +175,9 @@ class _Capture:
 def test_installed_console_script() -> None:
     script = Path(sys.prefix) / "bin" / "bearing-rig"
     assert script.is_file(), f"{script} missing: run ./bootstrap.sh setup"
-    version = subprocess.run([str(script), "--version"], capture_output=True, text=True, timeout=60)
+    version = subprocess.run([str(script), "--version"], capture_output=True, text=True, timeout=time_left())
     assert (version.returncode, version.stdout) == (0, f"bearing-rig {__version__}\n")
-    unknown = subprocess.run([str(script), "bench", "no-such-benchmark"], capture_output=True, text=True, timeout=60)
+    unknown = subprocess.run([str(script), "bench", "no-such-benchmark"], capture_output=True, text=True, timeout=time_left())
     assert unknown.returncode == 2
     assert unknown.stdout == ""
     lines = unknown.stderr.splitlines()

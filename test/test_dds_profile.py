@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 
 from bearing_rig_sim.dds_profile import RIG_PROFILE_XML, apply_rig_profile
+from conftest import time_left
 
 
 def test_the_profile_is_written_and_a_users_own_is_kept(tmp_path: Path) -> None:
@@ -75,7 +76,7 @@ def test_a_reliable_reader_acknowledges_within_the_heartbeat(ros_graph: Any, pro
     assert "FASTRTPS_DEFAULT_PROFILES_FILE" not in ros_graph.env  # the fixture leaves Fast DDS's defaults
     reader = ros_graph.spawn_python("-c", READER)
     writer = ros_graph.spawn_python("-c", WRITER, profile)
-    out, err = writer.communicate(timeout=120)
+    out, err = writer.communicate(timeout=time_left())
     assert writer.returncode == 0, err[-2000:]
     worst = float(out.strip().splitlines()[-1])
     assert low <= worst < high, f"worst wait for acknowledgement {worst:.3f} s with the {profile} profile"

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from conftest import DOMAIN_IDS, DomainLease, kill_processes_on_domain, lease_domain, processes_on_domain
+from conftest import DOMAIN_IDS, DomainLease, kill_processes_on_domain, lease_domain, processes_on_domain, time_left
 
 pytestmark = pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="needs Linux /proc")
 
@@ -41,7 +41,7 @@ def test_a_process_on_a_domain_is_found_passed_over_and_killed() -> None:
                 other.release()
         killed = kill_processes_on_domain(lease.domain_id)
         assert orphan.pid in killed
-        assert orphan.wait(timeout=10.0) == -9
+        assert orphan.wait(timeout=time_left()) == -9
         assert orphan.pid not in processes_on_domain(lease.domain_id)
     finally:
         lease.release()

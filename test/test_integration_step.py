@@ -28,6 +28,7 @@ from bearing_rig_sim.rig.speed_profile import SpeedProfileKind
 from bearing_rig_sim.simulation.drive import SpindleCommand
 from bearing_rig_sim.simulation.health import STOPPED_KEY, SimulatorHealth, stopped_reason
 from bearing_rig_sim.simulation.twin import RigTwin, twin_options
+from conftest import time_left
 
 RPM = math.pi / 30.0
 
@@ -319,7 +320,7 @@ def test_a_session_ends_with_exit_1_naming_the_divergence(ros_graph: Any, tmp_pa
     session = ros_graph.spawn_python(
         "-m", "bearing_rig_sim.cli", "run", str(program), "--no-realtime", "--bag-dir", str(tmp_path / "bags"), "--attach", "--no-record"
     )
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     assert "the simulator stopped the simulation: dynamics diverged at t = " in out + err
 

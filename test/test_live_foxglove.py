@@ -28,6 +28,7 @@ from mcap_ros2.decoder import DecoderFactory  # noqa: E402
 
 from bearing_rig_sim.live.foxglove import FoxgloveLiveView  # noqa: E402
 from bearing_rig_sim.bags.typestore import msg_definition_text, rig_typestore  # noqa: E402
+from conftest import time_left  # noqa: E402
 
 SUBPROTOCOLS = ["foxglove.websocket.v1", "foxglove.sdk.v1"]
 MESSAGE_DATA = 0x01
@@ -122,7 +123,7 @@ def test_a_protocol_client_receives_and_decodes_rig_messages() -> None:
         view.add_topic("/rig/slip_status", "bearing_rig_msgs/msg/SlipStatus")
         view.add_topic("/rig/speeds", "sensor_msgs/msg/JointState")
         client = ProtocolClient(view.url)
-        assert client.pump_until(lambda: len(client.channels) == 2 and client.server_info, timeout=30.0)
+        assert client.pump_until(lambda: len(client.channels) == 2 and client.server_info, timeout=time_left())
         client.subscribe("/rig/slip_status", "/rig/speeds")
 
         status = store.deserialize_cdr(_slip_status_cdr(store), "bearing_rig_msgs/msg/SlipStatus")
@@ -208,13 +209,13 @@ def test_a_live_session_serves_speeds_and_slip_status(ros_graph: Any, tmp_path: 
         assert url.startswith("ws://localhost:"), url
         client = ProtocolClient(url)
         topics = ("/rig/slip_status", "/rig/speeds")
-        assert client.pump_until(lambda: {c["topic"] for c in client.channels.values()} >= set(topics), timeout=30.0), client.channels
+        assert client.pump_until(lambda: {c["topic"] for c in client.channels.values()} >= set(topics), timeout=time_left()), client.channels
         client.subscribe(*topics)
 
         def stable_slip() -> bool:
             return any(s.state in (1, 2) and math.isfinite(s.slip_rate) for s in client.decoded("/rig/slip_status"))
 
-        assert client.pump_until(lambda: bool(client.decoded("/rig/speeds")) and stable_slip(), timeout=120.0)
+        assert client.pump_until(lambda: bool(client.decoded("/rig/speeds")) and stable_slip(), timeout=time_left())
         speeds = client.decoded("/rig/speeds")[-1]
         assert list(speeds.name) == ["inner_ring", "cage"] and speeds.velocity[0] > 0.0
         status = next(s for s in client.decoded("/rig/slip_status") if math.isfinite(s.slip_rate))
@@ -223,7 +224,7 @@ def test_a_live_session_serves_speeds_and_slip_status(ros_graph: Any, tmp_path: 
         if client is not None:
             client.close()
         session.send_signal(signal.SIGINT)
-        session.communicate(timeout=60)
+        session.communicate(timeout=time_left())
     assert session.returncode == 130
 
 

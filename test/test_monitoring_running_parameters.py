@@ -27,7 +27,7 @@ import pytest
 
 pytest.importorskip("rclpy")
 
-from conftest import start_run, summary_rows, the_bag
+from conftest import start_run, summary_rows, the_bag, time_left
 
 from bearing_rig_sim.offline.analysis import analyse_bag
 
@@ -56,7 +56,7 @@ def run_with_confidence(ros_graph: Any, run_dir: Path, confidence: float) -> tup
     params = run_dir / "monitor.yaml"
     params.write_text(f"monitor:\n  ros__parameters:\n    critical_slope_pct_per_s: 0.0\n    stable_confidence: {confidence}\n", encoding="utf-8")
     session = start_run(ros_graph, program, run_dir, "--params-file", str(params))
-    out, err = session.communicate(timeout=200)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     (row,) = [r for r in summary_rows(out) if r[1] == "n0900"]
     summary = None if row[T_STABLE] == "-" else float(row[T_STABLE])

@@ -13,6 +13,7 @@ from typing import Any
 import pytest
 
 from bearing_rig_sim.nodes.service_call import RetriedCall
+from conftest import time_left
 
 
 class FakeFuture:
@@ -139,14 +140,14 @@ def test_the_lifecycle_manager_asks_again_when_the_first_answer_is_lost(ros_grap
     records: list[Any] = []
     manager = LifecycleManager(session, ["fake"], records.append, lambda: 0.0)
     executor = ros_graph.executor([server, session])
-    assert ros_graph.spin_until(lambda: not manager.services_missing(), timeout=60.0, executor=executor)
+    assert ros_graph.spin_until(lambda: not manager.services_missing(), timeout=time_left(), executor=executor)
     manager.run([Step("fake", "configure")], 60.0)
 
     def recorded() -> bool:
         manager.poll()
         return bool(records)
 
-    assert ros_graph.spin_until(recorded, timeout=120.0, executor=executor), "no record within the guard"
+    assert ros_graph.spin_until(recorded, timeout=time_left(), executor=executor), "no record within the guard"
     (record,) = records
     assert record.success, record.detail
     assert record.state == "inactive" and state["label"] == "inactive"

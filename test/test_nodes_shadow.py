@@ -14,6 +14,7 @@ from bearing_rig_sim.interfaces import DIAGNOSTICS, TWIN_RESIDUAL, TWIN_TEMPERAT
 from bearing_rig_sim.session.recorder import SessionRecorder
 from bearing_rig_sim.shadow.offline import shadow_bag
 from bearing_rig_sim.synthetic.twin_bench import Hold, twin_bench_run, write_bench_bag
+from conftest import time_left
 
 
 @pytest.mark.ros
@@ -50,9 +51,9 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     node.create_subscription(DiagnosticArray, DIAGNOSTICS.name, on_diagnostics, qos)
     executor = ros_graph.executor([node])
     shadow = ros_graph.spawn_python("-c", "import sys; from bearing_rig_sim.nodes.shadow import main; sys.exit(main())", "--autostart")
-    assert ros_graph.spin_until(lambda: bool(levels), timeout=60.0, executor=executor), "the shadow node did not come up"
+    assert ros_graph.spin_until(lambda: bool(levels), timeout=time_left(), executor=executor), "the shadow node did not come up"
     replay = ros_graph.spawn_python("-m", "bearing_rig_sim.cli", "replay", str(bench), "--wait-for-subscribers", "--delay", "20")
-    assert ros_graph.spin_until(lambda: replay.poll() is not None, timeout=120.0, executor=executor), "the replay did not end"
+    assert ros_graph.spin_until(lambda: replay.poll() is not None, timeout=time_left(), executor=executor), "the replay did not end"
     assert replay.returncode == 0, replay.communicate()[1]
     # Done when the node's diagnostics say it has taken every pulse of the bag (the windows come
     # from the pulses alone) and every residual it had published by then has arrived here: the
@@ -62,7 +63,7 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     def every_window_in() -> bool:
         return all(counts.get(k) == v for k, v in pulses.items()) and len(received) >= int(counts["windows"])
 
-    done = ros_graph.spin_until(every_window_in, timeout=120.0, executor=executor)
+    done = ros_graph.spin_until(every_window_in, timeout=time_left(), executor=executor)
     assert done, f"the shadow node did not report every pulse and window: {counts} for {pulses}, {len(received)} residuals received"
     assert shadow.poll() is None, "the shadow node died"
     expected = offline.counts["windows"]
@@ -100,7 +101,7 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     # threshold, one per window that compared them (the window's stamp): the same bench, inside
     with_sensor = {name: [m for m in by_rosbags if math.isfinite(getattr(m, field))] for name, field in
                    ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature_residual"), (TWIN_TORQUE_RESIDUAL.name, "torque_residual"))}
-    done = ros_graph.spin_until(lambda: all(len(sensors[n]) >= len(with_sensor[n]) for n in sensors), timeout=60.0, executor=executor)
+    done = ros_graph.spin_until(lambda: all(len(sensors[n]) >= len(with_sensor[n]) for n in sensors), timeout=time_left(), executor=executor)
     assert done, {n: (len(sensors[n]), len(with_sensor[n])) for n in sensors}
     for name, field in ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature"), (TWIN_TORQUE_RESIDUAL.name, "torque")):
         assert len(with_sensor[name]) >= 0.9 * len(live_compared) > 0

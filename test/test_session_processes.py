@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from conftest import time_left
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.rig.program import load_program
 from bearing_rig_sim.config import config_path
@@ -34,24 +35,21 @@ def python_child(tmp_path: Path, name: str, code: str) -> NodeProcess:
     return NodeProcess(name, [sys.executable, "-c", code], tmp_path / "logs" / f"{name}.log")
 
 
-GUARD_S = 300.0
-"""Longest wait for a child's own line, s: only a guard against a hang (a child's start on a
-loaded host is what is waited for, not this)."""
-
-
 def wait_for_output(child: NodeProcess, line: str) -> None:
-    """Wait until ``child`` has printed ``line`` (it flushes it), or fail past :data:`GUARD_S`."""
-    deadline = time.monotonic() + GUARD_S
+    """Wait until ``child`` has printed ``line`` (it flushes it), or fail when the test's guard
+    (:func:`conftest.time_left`) runs out: a child's start on a loaded host is what is waited for."""
+    guard = time_left()
+    deadline = time.monotonic() + guard
     while line not in child.output_tail().splitlines():
         assert child.poll() is None, child.describe_exit()
-        assert time.monotonic() < deadline, f"{child.name} printed no {line!r} in {GUARD_S:g} s"
+        assert time.monotonic() < deadline, f"{child.name} printed no {line!r} in {guard:.0f} s"
         child.wait(0.02)
 
 
 def test_a_dead_child_is_described_with_its_status_and_output_tail(tmp_path: Path) -> None:
     child = python_child(tmp_path, "simulator", "import sys\nfor i in range(40): print('line', i, file=sys.stderr)\nsys.exit(3)")
     child.start(os.environ)
-    assert child.wait(20.0) == 3 and not child.running
+    assert child.wait(time_left()) == 3 and not child.running
     text = child.describe_exit(lines=5)
     assert text.startswith("simulator exited with status 3")
     assert "line 39" in text and "line 35" in text and "line 34" not in text
@@ -71,7 +69,7 @@ def test_stop_all_stops_a_child_that_ignores_sigint(tmp_path: Path) -> None:
         child.start(os.environ)
     for child in (stubborn, polite):
         wait_for_output(child, "up")  # started, and the stubborn one ignores SIGINT
-    stop_all([polite], timeout=GUARD_S)
+    stop_all([polite], timeout=time_left())
     assert polite.poll() == 0  # SIGINT: a clean exit
     stop_all([stubborn], timeout=0.5)
     assert stubborn.poll() is not None and stubborn.poll() < 0  # SIGTERM after the timeout

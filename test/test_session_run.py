@@ -33,7 +33,7 @@ from mcap_ros2.decoder import DecoderFactory
 from rosbags.highlevel import AnyReader
 
 from bearing_rig_sim.bags import open_bag, rig_typestore
-from conftest import start_run, summary_rows, the_bag
+from conftest import start_run, summary_rows, the_bag, time_left
 from bearing_rig_sim.config import config_path
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -105,7 +105,7 @@ def warm_start(tmp_path: Path) -> tuple[str, str]:
 
 def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ros_graph: Any, tmp_path: Path) -> None:
     session = start_session(ros_graph, tmp_path, *warm_start(tmp_path))
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     rows = summary_rows(out)
     assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
@@ -173,7 +173,7 @@ def test_a_node_failing_to_configure_is_named_and_the_bag_finalised(ros_graph: A
     params = tmp_path / "params.yaml"
     params.write_text(f"monitor:\n  ros__parameters:\n    bearing_file: {json.dumps(str(hollow))}\n", encoding="utf-8")
     session = start_session(ros_graph, tmp_path, "--params-file", str(params))
-    out, err = session.communicate(timeout=120)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 1, f"{out[-3000:]}\n{err[-3000:]}"
     assert "the monitor node failed to configure: " in err and "hollow_bearing.yaml" in err, err[-3000:]
     assert "summary (failed)" in out
@@ -230,7 +230,7 @@ def test_a_program_naming_another_bearing_file_runs_on_it(ros_graph: Any, tmp_pa
     bearing.write_text(config_path("bearings", "h7006c.yaml").read_text(encoding="utf-8"), encoding="utf-8")
     text = SHORT_PROGRAM.replace("bearings/h7006c.yaml", json.dumps(str(bearing)))
     session = start_session(ros_graph, tmp_path, "--no-record", program_text=text)
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     assert [row[1] for row in summary_rows(out)] == ["load_up", "n0900", "n1500"]
     (run,) = [p for p in (tmp_path / "bags").iterdir() if p.is_dir()]
@@ -244,7 +244,7 @@ def test_sigint_mid_run_leaves_a_readable_bag_and_exit_130(ros_graph: Any, tmp_p
     session = start_session(ros_graph, tmp_path, program_text=LONG_HOLD_PROGRAM)
     seen = read_until(session, "[2/3 n0900 hold]")
     session.send_signal(signal.SIGINT)
-    rest, err = session.communicate(timeout=60)
+    rest, err = session.communicate(timeout=time_left())
     out = "".join(seen) + rest
     assert session.returncode == 130, f"{out[-3000:]}\n{err[-3000:]}"
     assert "summary (interrupted)" in out and "stopped by SIGINT" in err
@@ -260,7 +260,7 @@ def test_a_node_that_dies_is_named_and_the_bag_finalised(ros_graph: Any, tmp_pat
     session = start_session(ros_graph, tmp_path, program_text=LONG_HOLD_PROGRAM)
     seen = read_until(session, "segment 2/3 n0900:")
     os.kill(child_pid(session.pid, "bearing-rig-monitor"), signal.SIGKILL)
-    rest, err = session.communicate(timeout=60)
+    rest, err = session.communicate(timeout=time_left())
     out = "".join(seen) + rest
     assert session.returncode == 1, f"{out[-3000:]}\n{err[-3000:]}"
     assert "the monitor node stopped during the run: monitor was killed by signal SIGKILL" in err
@@ -298,12 +298,12 @@ def test_hostile_clock_stamps_during_a_session_are_refused_and_reported(ros_grap
     clock = node.create_publisher(Clock, "/clock", RELIABLE_QOS)
     session = start_session(ros_graph, tmp_path, program_text=HOSTILE_CLOCK_PROGRAM)
     # the recorder and the load controller (at least) subscribe /clock; the recorder (reliable) matched
-    assert ros_graph.spin_until(lambda: node.count_subscribers("/clock") >= 2 and clock.get_subscription_count() >= 2, timeout=120.0, nodes=[node])
+    assert ros_graph.spin_until(lambda: node.count_subscribers("/clock") >= 2 and clock.get_subscription_count() >= 2, timeout=time_left(), nodes=[node])
     seen = read_until(session, "segment 2/2 n0900:")
     for _ in range(3):
         clock.publish(Clock(clock=Time(sec=2**31 - 1, nanosec=0)))
         clock.publish(Clock(clock=Time(sec=-5, nanosec=0)))
-    rest, err = session.communicate(timeout=150)
+    rest, err = session.communicate(timeout=time_left())
     out = "".join(seen) + rest
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     found = re.search(r"^clock: (\d+) /clock stamp\(s\) refused \(kept off the bag's timeline\)", out, re.MULTILINE)
@@ -336,7 +336,7 @@ def test_no_pulse_is_lost_without_real_time(ros_graph: Any, tmp_path: Path) -> N
     from bearing_rig_sim.bags import open_bag as open_rig_bag
 
     session = start_session(ros_graph, tmp_path, program_text=NO_GAP_PROGRAM)
-    out, err = session.communicate(timeout=400)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     indices: dict[str, list[int]] = {"/rig/spindle/pulses": [], "/rig/cage/pulses": []}
     clock_ns: list[int] = []
@@ -416,7 +416,7 @@ def start_rig_nodes(ros_graph: Any, *simulators: tuple[str, ...]) -> None:
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
     observer = ros_graph.node("observer")
     outputs = {"/rig/truth": len(simulators), "/rig/axial_load/state": 1, "/rig/slip_status": 1}
-    up = ros_graph.spin_until(lambda: all(observer.count_publishers(t) == n for t, n in outputs.items()), timeout=300.0, nodes=[observer])
+    up = ros_graph.spin_until(lambda: all(observer.count_publishers(t) == n for t, n in outputs.items()), timeout=time_left(), nodes=[observer])
     assert up, {t: observer.count_publishers(t) for t in outputs}
 
 
@@ -425,7 +425,7 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     ``bearing-rig run --attach --no-record`` on the environment's domain."""
     start_rig_nodes(ros_graph)
     session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     rows = summary_rows(out)
     assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
@@ -466,7 +466,7 @@ def test_an_attached_session_records_pulses_a_bench_publishes_best_effort(ros_gr
 
     start_rig_nodes(ros_graph, ("-c", BEST_EFFORT_PULSE_SIMULATOR))
     session = start_session(ros_graph, tmp_path, "--attach")
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     for topic in ("/rig/spindle/pulses", "/rig/cage/pulses"):
         adapted = f"recording {topic} best effort: {{}} publishes it best effort (a reliable reader receives nothing from such a writer)"
@@ -548,7 +548,7 @@ def test_an_attached_session_refuses_a_graph_with_two_simulators(ros_graph: Any,
 
     start_rig_nodes(ros_graph, SIMULATOR_NODE, SIMULATOR_NODE)
     session = start_session(ros_graph, tmp_path, "--attach", "--no-record", program_text=LONG_HOLD_PROGRAM)
-    out, err = session.communicate(timeout=150)
+    out, err = session.communicate(timeout=time_left())
     assert session.returncode == 1, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     found = re.search(rf"more than one rig on ROS domain {ros_graph.domain_id}: 2 nodes publish /rig/truth \(([^)]*)\);", out + err)
     assert found is not None, f"{out[-3000:]}\n{err[-3000:]}"
@@ -570,10 +570,10 @@ def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_grap
     setpoint = node.create_publisher(Float64, "/rig/axial_load/setpoint", RELIABLE_QOS)
     # Matched with the load controller and the session's recorder before the segment starts, so
     # that the set-point goes out the moment it does.
-    assert ros_graph.spin_until(lambda: setpoint.get_subscription_count() >= 2, timeout=60.0, nodes=[node])
+    assert ros_graph.spin_until(lambda: setpoint.get_subscription_count() >= 2, timeout=time_left(), nodes=[node])
     seen = read_until(session, "segment 2/3 n0900:")
     setpoint.publish(Float64(data=30.0))
-    rest, err = session.communicate(timeout=150)
+    rest, err = session.communicate(timeout=time_left())
     out = "".join(seen) + rest
     assert session.returncode == 3, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
     assert "summary (conditions not met)" in out and "conditions not met in" in err

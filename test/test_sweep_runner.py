@@ -154,11 +154,11 @@ def test_the_same_sweep_on_a_dask_scheduler_and_worker_started_on_localhost(tmp_
             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         )  # fmt: skip
         with distributed.Client(address, timeout="60s") as c:
-            c.wait_for_workers(1, timeout=60)
+            c.wait_for_workers(1, timeout=time_left())
         out = tmp_path / "out"
         result = subprocess.run(
             [str(bindir / "bearing-rig"), "sweep", str(write_spec(tmp_path)), "--out", str(out), "--scheduler", address, "--json", "--no-progress"],
-            capture_output=True, text=True, timeout=240,
+            capture_output=True, text=True, timeout=time_left(),
         )  # fmt: skip
         assert result.returncode == 0, result.stderr
         summary = json.loads(result.stdout)
@@ -169,7 +169,7 @@ def test_the_same_sweep_on_a_dask_scheduler_and_worker_started_on_localhost(tmp_
             if proc is not None:
                 proc.terminate()
                 try:
-                    proc.wait(timeout=20)
+                    proc.wait(timeout=20)  # not a hang guard: the grace a terminated worker gets before it is killed
                 except subprocess.TimeoutExpired:
                     proc.kill()
 

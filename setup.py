@@ -31,9 +31,7 @@ def config_data_files() -> list[tuple[str, list[str]]]:
     for folder, _dirs, files in sorted(os.walk(HERE / "config")):
         if files:
             relative = os.path.relpath(folder, HERE)
-            entries.append(
-                (os.path.join("share", PACKAGE_NAME, relative), sorted(os.path.join(relative, f) for f in files))
-            )
+            entries.append((os.path.join("share", PACKAGE_NAME, relative), sorted(os.path.join(relative, f) for f in files)))
     return entries
 
 

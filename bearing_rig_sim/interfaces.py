@@ -94,7 +94,9 @@ monitor held up for a fraction of a second lost bursts of pulses; 10000 is some 
 the latest; reliable, because the simulator paces on their stamps without real time, and a lost
 last sample would hold it until its silence guard."""
 
-QOS_DESCRIPTIONS: dict[str, str] = {name: QOS_TABLE[name].description for name in ("reliable", "reliable_stream", "sensor_data", "transient_local", "transient_stream")}
+QOS_DESCRIPTIONS: dict[str, str] = {
+    name: QOS_TABLE[name].description for name in ("reliable", "reliable_stream", "sensor_data", "transient_local", "transient_stream")
+}
 """What each profile of the contract (:data:`QosName`) is, as the interface table says it."""
 
 

@@ -151,7 +151,10 @@ def test_ordered_batches_give_the_messages_in_the_order_messages_gives_them(traf
     with open(overlapping, "wb") as stream:
         writer = McapWriter(stream, chunk_size=2048)
         writer.start("ros2", "test")
-        channels = {topic: writer.register_channel(topic, "cdr", writer.register_schema(msgtype, "ros2msg", b"")) for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()}
+        channels = {
+            topic: writer.register_channel(topic, "cdr", writer.register_schema(msgtype, "ros2msg", b""))
+            for topic, (msgtype, _qos) in RIG_TRAFFIC_TOPICS.items()
+        }
         for topic, time_ns, data in sorted(rig_traffic(0.2), key=lambda m: m[0]):
             writer.add_message(channels[topic], time_ns, data, time_ns)
         writer.finish()
@@ -162,7 +165,9 @@ def test_ordered_batches_give_the_messages_in_the_order_messages_gives_them(traf
             expected = [(m.topic, m.log_time_ns, m.message) for m in bag.messages(topics, raw=True)]
             got = []
             for batch in bag.ordered_batches(topics):
-                got += [(topics[c], t, batch.data[a:b]) for c, t, a, b in zip(*(x.tolist() for x in (batch.channel_ids, batch.log_times, batch.starts, batch.ends)))]
+                got += [
+                    (topics[c], t, batch.data[a:b]) for c, t, a, b in zip(*(x.tolist() for x in (batch.channel_ids, batch.log_times, batch.starts, batch.ends)))
+                ]
             with pytest.raises(BagError, match="no topic /rig/nothing"):
                 next(bag.ordered_batches(["/rig/nothing"]))
         assert got == expected and len(got) > 100, where

@@ -93,7 +93,9 @@ def test_analyze_loads_no_dynamics_engine(steady_bag: Path, tmp_path: Path) -> N
     )
     done = subprocess.run(
         [sys.executable, "-c", script, "analyze", str(steady_bag), "--out", str(tmp_path / "report")],
-        capture_output=True, text=True, timeout=time_left(),
+        capture_output=True,
+        text=True,
+        timeout=time_left(),
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "loaded:", done.stdout

@@ -173,7 +173,9 @@ def test_the_simulator_waits_for_a_stopped_load_controller_and_not_for_a_deactiv
         # to be repaired come after the SIGCONT), so it reaches this at least
         probe.wait(lambda: probe.clock >= probe.last_force_sent_before(stopped_at) + FORCE_LEAD_S - 2 * CHUNK_S, "the simulation reaching the lead")
         held_clock = probe.clock
-        probe.wait(lambda: probe.clock > held_clock + FORCE_LEAD_S, "", timeout=1.0)  # not a hang guard: a second of wall time, stopped, in which nothing is expected
+        probe.wait(
+            lambda: probe.clock > held_clock + FORCE_LEAD_S, "", timeout=1.0
+        )  # not a hang guard: a second of wall time, stopped, in which nothing is expected
         clock_while_stopped = probe.clock
     finally:
         resumed_at = time.time_ns()  # before the signal: a resumed process publishes at once

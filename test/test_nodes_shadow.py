@@ -99,8 +99,10 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
     assert math.isfinite(by_rosbags[-1].predicted_slip)
     # the thermocouple's and the torque meter's residuals on their own topics, each with its
     # threshold, one per window that compared them (the window's stamp): the same bench, inside
-    with_sensor = {name: [m for m in by_rosbags if math.isfinite(getattr(m, field))] for name, field in
-                   ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature_residual"), (TWIN_TORQUE_RESIDUAL.name, "torque_residual"))}
+    with_sensor = {
+        name: [m for m in by_rosbags if math.isfinite(getattr(m, field))]
+        for name, field in ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature_residual"), (TWIN_TORQUE_RESIDUAL.name, "torque_residual"))
+    }
     done = ros_graph.spin_until(lambda: all(len(sensors[n]) >= len(with_sensor[n]) for n in sensors), timeout=time_left(), executor=executor)
     assert done, {n: (len(sensors[n]), len(with_sensor[n])) for n in sensors}
     for name, field in ((TWIN_TEMPERATURE_RESIDUAL.name, "temperature"), (TWIN_TORQUE_RESIDUAL.name, "torque")):
@@ -108,7 +110,11 @@ def test_replay_feeds_a_shadow_node_in_another_process(ros_graph, tmp_path: Path
         by_stamp = {(m.header.stamp.sec, m.header.stamp.nanosec): m for m in with_sensor[name]}
         for v in sensors[name]:
             row = by_stamp[(v.header.stamp.sec, v.header.stamp.nanosec)]
-            assert (v.vector.x, v.vector.y, v.vector.z) == (getattr(row, f"{field}_residual"), getattr(row, f"{field}_band"), getattr(row, f"predicted_{field}"))
+            assert (v.vector.x, v.vector.y, v.vector.z) == (
+                getattr(row, f"{field}_residual"),
+                getattr(row, f"{field}_band"),
+                getattr(row, f"predicted_{field}"),
+            )
             assert 0.0 < v.vector.y and abs(v.vector.x) <= v.vector.y
 
 

@@ -275,7 +275,9 @@ def test_a_stopped_rigs_statuses_follow_the_simulation_clock(ros_graph):
     late = [s for s in probe.status if from_stamp(s.header.stamp) > last_pulse() + 2.0]
     # a status past the last pulse describes the stopped rig: no verdict, both speeds 0, no slip
     assert all(s.state == SlipStatus.STATE_UNKNOWN and "stopped" in s.detail for s in late), [s.detail for s in late]
-    assert all(s.inner_ring_speed == 0.0 and s.cage_speed == 0.0 and math.isnan(s.slip_rate) for s in late), [(s.inner_ring_speed, s.cage_speed, s.slip_rate) for s in late]
+    assert all(s.inner_ring_speed == 0.0 and s.cage_speed == 0.0 and math.isnan(s.slip_rate) for s in late), [
+        (s.inner_ring_speed, s.cage_speed, s.slip_rate) for s in late
+    ]
 
 
 def test_monitor_warns_of_lost_pulses_with_counts_and_no_fault(ros_graph):

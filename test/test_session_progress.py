@@ -139,7 +139,9 @@ def test_a_run_up_is_said_to_count_from_its_start_at_the_speed_it_became_stable(
     run_up = outcome(1, "accel_20", 1500.0, Verdict.STABLE, run_up=True, stable_speed=127.4)
     table = format_summary([outcome(0, "n0900", 900.0, Verdict.STABLE), run_up])
     notes = [line for line in table.splitlines() if line.startswith("run-ups")]
-    assert notes == ["run-ups are judged during their acceleration (the paper's section 4.2): t_stable from the run-up's start, slip at the stable status (accel_20 1217 rpm)"]
+    assert notes == [
+        "run-ups are judged during their acceleration (the paper's section 4.2): t_stable from the run-up's start, slip at the stable status (accel_20 1217 rpm)"
+    ]
     assert "run-ups" not in format_summary([outcome(0, "n0900", 900.0, Verdict.STABLE)])
 
 

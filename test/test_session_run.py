@@ -390,7 +390,9 @@ def check_delivery(bag: Path, out: str) -> None:
         ordered = sorted(stamps[topic])
         widest = max(b - a for a, b in zip(ordered, ordered[1:]))
         assert widest <= 500_000_000, f"{topic}: a gap of {widest * 1e-9:.3f} s of sim time"
-    assert last - max(stamps["/rig/slip_status"]) <= 1_000_000_000, f"the last status at {max(stamps['/rig/slip_status']) * 1e-9:.3f} s, the clock ends at {last * 1e-9:.3f} s"
+    assert last - max(stamps["/rig/slip_status"]) <= 1_000_000_000, (
+        f"the last status at {max(stamps['/rig/slip_status']) * 1e-9:.3f} s, the clock ends at {last * 1e-9:.3f} s"
+    )
     assert "every published message recorded" in out, out[-3000:]
     table = out[out.index("delivery (messages per topic):") :]
     for topic in ("/clock", "/rig/axial_load/force", "/rig/truth", "/rig/spindle/pulses", "/rig/cage/pulses", "/rig/slip_status"):

@@ -393,7 +393,7 @@ def test_recalibrating_an_unknown_parameter_is_refused() -> None:
 
 
 def test_recalibration_tracks_the_first_fitted_parameter_by_default() -> None:
-    """"" names the calibration's first fitted parameter (calibration.fitted), not a fixed input
+    """ "" names the calibration's first fitted parameter (calibration.fitted), not a fixed input
     the file also sets (the coupled file's grease-law exponent, 0: nothing to scale)."""
     import yaml
 

@@ -16,6 +16,7 @@ PACKAGE = ROOT / "bearing_rig_sim"
 
 SHIPPED_NAME = re.compile(r"h7006c\.yaml|h7006c_table3\.yaml")
 
+
 def test_the_shipped_files_exist_where_config_names_them() -> None:
     assert config.shipped_bearing_file().is_file() and config.shipped_bearing_file().name == "h7006c.yaml"
     assert config.shipped_calibration_file().is_file() and config.shipped_calibration_file().parent.name == "calibration"

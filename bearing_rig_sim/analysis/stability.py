@@ -391,10 +391,7 @@ class LoadSweepVerdict:
         loads)" or "no stable state: <reason>"."""
         quality = ""
         if self.fitted:
-            quality = (
-                f"{self.n_terms}-term Gaussian, R^2 {self.r_square:.4f}, RMSE {self.rmse:.3g} %, "
-                f"{self.runs} residual runs, {len(self.loads)} loads"
-            )
+            quality = f"{self.n_terms}-term Gaussian, R^2 {self.r_square:.4f}, RMSE {self.rmse:.3g} %, {self.runs} residual runs, {len(self.loads)} loads"
             if self.left_out:
                 quality += f"; {self.left_out}"
         if self.stable_from is not None:

@@ -209,8 +209,11 @@ def read_layout(bag_dir: Path) -> BagLayout:
 
 
 def layout_from_indexes(
-    indexes: Sequence[FileIndex], previous: BagLayout | None, report: Callable[[str], None],
-    type_hash_of: Callable[[str], str] = lambda _msgtype: "", accepted: list[dict[int, str]] | None = None,
+    indexes: Sequence[FileIndex],
+    previous: BagLayout | None,
+    report: Callable[[str], None],
+    type_hash_of: Callable[[str], str] = lambda _msgtype: "",
+    accepted: list[dict[int, str]] | None = None,
 ) -> BagLayout:
     """The ``metadata.yaml`` content matching what the storage files hold: topics from their
     channels, completed by ``previous`` (the existing ``metadata.yaml``) for topics without

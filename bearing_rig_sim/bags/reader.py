@@ -203,7 +203,9 @@ class BagReader:
         if unknown:
             raise BagError(f"{self.path}: no topic {', '.join(unknown)} in the bag (it has {', '.join(sorted(self.topics)) or 'none'})")
         position = {name: k for k, name in enumerate(topics)}
-        files = [(index, {cid: position[name] for cid, name in topic_of.items() if name in position}) for index, topic_of in zip(self._indexes, self._channel_topics)]
+        files = [
+            (index, {cid: position[name] for cid, name in topic_of.items() if name in position}) for index, topic_of in zip(self._indexes, self._channel_topics)
+        ]
         files = sorted(((i, w) for i, w in files if w and i.message_count), key=lambda f: f[0].start_ns)
         if not isinstance(self._format, McapFormat) or any(b.start_ns < a.end_ns for (a, _), (b, _) in zip(files, files[1:])):
             names = self._iterate(set(topics), None, None, raw=True)

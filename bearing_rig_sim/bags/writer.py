@@ -110,8 +110,14 @@ class BagWriter:
     BagError for a bad option or an existing path."""
 
     def __init__(
-        self, path: str | Path, *, compression: Compression = "zstd", chunk_size: int = DEFAULT_CHUNK_SIZE,
-        max_file_bytes: int | None = None, metadata: dict[str, str] | None = None, typestore: Typestore | None = None,
+        self,
+        path: str | Path,
+        *,
+        compression: Compression = "zstd",
+        chunk_size: int = DEFAULT_CHUNK_SIZE,
+        max_file_bytes: int | None = None,
+        metadata: dict[str, str] | None = None,
+        typestore: Typestore | None = None,
     ) -> None:
         if compression not in ("zstd", "none"):
             raise BagError(f"compression must be 'zstd' or 'none', got {compression!r}")

@@ -83,7 +83,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--minutes", type=float, default=None, help="length of the long read-back bag (simulated minutes)")
     parser.add_argument("--messages", type=int, default=200_000, help="messages per recorder throughput run")
     parser.add_argument("--repeats", type=int, default=3, help="recorder throughput runs and analyses of each bag; medians are reported")
-    parser.add_argument("--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed); analysis bags are kept there and reused")
+    parser.add_argument(
+        "--workdir", type=Path, default=None, help="where to write the bags (default: a temporary folder, removed); analysis bags are kept there and reused"
+    )
     parser.add_argument("--cases", nargs="+", choices=CASES, default=list(CASES), help="cases to run (default: all)")
 
 

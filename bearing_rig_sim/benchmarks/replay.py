@@ -113,7 +113,9 @@ def _replay(bag: Path, rate: float, work: Path) -> dict[str, Any]:
             probe = graph.join(lambda context: Node("bench_replay_probe", context=context))
             deep = QoSProfile(depth=100000, reliability=ReliabilityPolicy.BEST_EFFORT)
             subs = [probe.create_subscription(FibreOpticPulse, topic.name, lambda _m: None, deep, raw=True) for topic in (SPINDLE_PULSES, CAGE_PULSES)]
-            clock_sub = probe.create_subscription(Clock, CLOCK.name, lambda _m: None, QoSProfile(depth=100000, reliability=ReliabilityPolicy.RELIABLE), raw=True)
+            clock_sub = probe.create_subscription(
+                Clock, CLOCK.name, lambda _m: None, QoSProfile(depth=100000, reliability=ReliabilityPolicy.RELIABLE), raw=True
+            )
 
             def take() -> None:
                 for sub in subs:

@@ -171,7 +171,7 @@ def _calibrate_run(args: argparse.Namespace, params: BearingParameters, thermal:
     header = (
         "# Calibration of the coupled twin against a logged bench run (hold, slip, outer-ring temperature,\n"
         "# torque). Regenerate with `bearing-rig calibrate RUN.csv --thermal --fit ...`; docs/thermal.md,\n"
-        "# section \"The bench run that settles the priors\".\n"
+        '# section "The bench run that settles the priors".\n'
     )
     out.write_text(header + yaml.safe_dump(doc, sort_keys=False), encoding="utf-8")
     if args.json:

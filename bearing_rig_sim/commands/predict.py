@@ -67,7 +67,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("--preload-n", type=float, default=0.0, metavar="N", help="spring preload added to the axial load, N")
     p.add_argument("--preload-displacement", type=float, default=0.0, metavar="M", help="rigid preload of a back-to-back pair, m")
     p.add_argument(
-        "--running-hours", type=float, default=None, metavar="H", help="the grease's state after H hours of running (its file's running_in law; 0: as calibrated)"
+        "--running-hours",
+        type=float,
+        default=None,
+        metavar="H",
+        help="the grease's state after H hours of running (its file's running_in law; 0: as calibrated)",
     )
     p.add_argument("--json", action="store_true", help="one JSON object per line")
     p.set_defaults(func=run)
@@ -330,7 +334,12 @@ def _add_interval(
     row["slip_pct_high"] = round(high, 4)
     row["slip_pct_parametric_low"] = round(slip - Z95 * sd, 4)
     row["slip_pct_parametric_high"] = round(slip + Z95 * sd, 4)
-    row["model_form_pp"] = {"low": round(lo_shift, 4), "high": round(hi_shift, 4), "draws_kept": kept, "short_hold_lubricant_c": round(effects.short_hold_temperature_c, 2)}
+    row["model_form_pp"] = {
+        "low": round(lo_shift, 4),
+        "high": round(hi_shift, 4),
+        "draws_kept": kept,
+        "short_hold_lubricant_c": round(effects.short_hold_temperature_c, 2),
+    }
 
 
 def _print(row: dict[str, Any], as_json: bool) -> None:

@@ -173,7 +173,9 @@ class Friction(FileSection):
     """``friction:``; the transition velocity lies above the stiction velocity."""
 
     model: Annotated[str, one_of(tuple(FRICTION_MODELS))] = Field(description="traction law (FRICTION_MODELS)")
-    static_coefficient: Number = quantity("static friction coefficient mu_s (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0, calibratable=True)
+    static_coefficient: Number = quantity(
+        "static friction coefficient mu_s (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0, calibratable=True
+    )
     stiction_velocity_m_s: Number = quantity("stiction velocity v_s (paper law)", unit="m/s", source="a speed", gt=0.0, calibratable=True)
     dynamic_coefficient: Number = quantity("dynamic friction coefficient mu_d (paper law)", unit="1", source="lubricated steel", ge=0.0, le=1.0)
     transition_velocity_m_s: Number = quantity("transition velocity v_d (paper law, above v_s)", unit="m/s", source="a speed above v_s")
@@ -206,13 +208,27 @@ class BearingLubricant(FileSection):
     air_viscosity_pa_s: Number = quantity("cavity air dynamic viscosity", unit="Pa s", source="a gas", gt=0.0)
     oil_density_kg_m3: Number | None = quantity("oil density (inline form)", unit="kg/m^3", source="a liquid", gt=0.0, default=None)
     oil_viscosity_pa_s: Number | None = quantity("oil dynamic viscosity (inline form)", unit="Pa s", source="a liquid", gt=0.0, default=None)
-    oil_volume_fraction: Number | None = quantity("oil share of the oil-air mixture (inline form)", unit="1", source="a fraction", ge=0.0, le=1.0, default=None, calibratable=True)
-    yield_stress_pa: Number | None = quantity("grease yield stress override", unit="Pa", source="sheared NLGI 1-3 greases", ge=0.0, le=5e3, default=None, calibratable=True)
-    consistency_pa_sn: Number | None = quantity("grease consistency override", unit="Pa s^n", source="sheared NLGI 1-3 greases", ge=0.0, le=1e3, default=None, calibratable=True)
+    oil_volume_fraction: Number | None = quantity(
+        "oil share of the oil-air mixture (inline form)", unit="1", source="a fraction", ge=0.0, le=1.0, default=None, calibratable=True
+    )
+    yield_stress_pa: Number | None = quantity(
+        "grease yield stress override", unit="Pa", source="sheared NLGI 1-3 greases", ge=0.0, le=5e3, default=None, calibratable=True
+    )
+    consistency_pa_sn: Number | None = quantity(
+        "grease consistency override", unit="Pa s^n", source="sheared NLGI 1-3 greases", ge=0.0, le=1e3, default=None, calibratable=True
+    )
     fill_fraction: Number | None = quantity("fill fraction override", unit="1", source="a fraction", ge=0.0, le=1.0, default=None, calibratable=True)
-    eyring_stress_pa: Number | None = quantity("Eyring stress override", unit="Pa", source="EHL films of mineral and ester oils", ge=1e5, le=5e7, default=None, calibratable=True)
+    eyring_stress_pa: Number | None = quantity(
+        "Eyring stress override", unit="Pa", source="EHL films of mineral and ester oils", ge=1e5, le=5e7, default=None, calibratable=True
+    )
     consistency_temperature_exponent: Number | None = quantity(
-        "grease consistency's temperature exponent override", unit="1", source="between the thickener alone (0) and the base oil (1)", ge=0.0, le=1.0, default=None, calibratable=True
+        "grease consistency's temperature exponent override",
+        unit="1",
+        source="between the thickener alone (0) and the base oil (1)",
+        ge=0.0,
+        le=1.0,
+        default=None,
+        calibratable=True,
     )
 
     @model_validator(mode="after")

@@ -1837,9 +1837,7 @@ def stiff_ball_row(
     # times the step's mean sliding (exactly the kinetic energy a linear law takes)
     dsi, dso = -aim * d_wm - aia * d_wa, -aom * d_wm + aoa * d_wa
     pivot = kpiv * r * r * wt * 0.5 * (wt_old + wt)
-    power = ball_power(
-        wm, wa, rb, omega_i, fi + kti * dsi, fo + kto * dso, si + 0.5 * dsi, so + 0.5 * dso, mres, fd, t_inner, m_ring, t_orbit, cb, pivot
-    )
+    power = ball_power(wm, wa, rb, omega_i, fi + kti * dsi, fo + kto * dso, si + 0.5 * dsi, so + 0.5 * dso, mres, fd, t_inner, m_ring, t_orbit, cb, pivot)
     heat += power
     if keep:
         record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)

@@ -57,9 +57,7 @@ def first_stable(times: np.ndarray, states: np.ndarray) -> tuple[float, bool]:
     return float(stable[0]), bool(np.all(states[times >= stable[0]] == SlipState.STABLE))
 
 
-def first_stable_after(
-    settings: MonitorSettings, scenarios: Iterable[BenchScenario], onset: float, *, slipping_expected: bool
-) -> tuple[list[float], set[str]]:
+def first_stable_after(settings: MonitorSettings, scenarios: Iterable[BenchScenario], onset: float, *, slipping_expected: bool) -> tuple[list[float], set[str]]:
     """For each recording, the first STABLE status's delay after ``onset`` (s from the
     recording's start; inf if none), and what went wrong in any of them: a STABLE before the
     onset, a SLIPPING where none is expected (a constant slip), a STABLE not kept, a FAULT."""

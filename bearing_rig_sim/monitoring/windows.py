@@ -464,7 +464,9 @@ class SlipWindows:
         if first + 3 > len(times):
             picks = range(first, len(times))
             return _lagrange(tuple(times[j] for j in picks), tuple(self._angle(spindle, j) for j in picks), t)
-        return _parabola(times[first], times[first + 1], times[first + 2], self._angle(spindle, first), self._angle(spindle, first + 1), self._angle(spindle, first + 2), t)
+        return _parabola(
+            times[first], times[first + 1], times[first + 2], self._angle(spindle, first), self._angle(spindle, first + 1), self._angle(spindle, first + 2), t
+        )
 
     def _angle(self, spindle: _Shaft, j: int) -> float:
         """Angle of the spindle's kept pulse ``j``, revolutions, with its strip's spacing error."""
@@ -581,7 +583,12 @@ def _lagrange(xs: tuple[float, ...], ys: tuple[float, ...], x: float) -> float:
 def _parabola(x0: float, x1: float, x2: float, y0: float, y1: float, y2: float, x: float) -> float:
     """:func:`_lagrange` through three points, with the same operations in the same order (so
     the same value to the bit), without its loops."""
-    return 0.0 + (x - x1) / (x0 - x1) * ((x - x2) / (x0 - x2)) * y0 + (x - x0) / (x1 - x0) * ((x - x2) / (x1 - x2)) * y1 + (x - x0) / (x2 - x0) * ((x - x1) / (x2 - x1)) * y2
+    return (
+        0.0
+        + (x - x1) / (x0 - x1) * ((x - x2) / (x0 - x2)) * y0
+        + (x - x0) / (x1 - x0) * ((x - x2) / (x1 - x2)) * y1
+        + (x - x0) / (x2 - x0) * ((x - x1) / (x2 - x1)) * y2
+    )
 
 
 def _cubic_at(x0: float, x1: float, x2: float, x3: float, xs: list[float]) -> list[float]:

@@ -104,7 +104,20 @@ from bearing_rig_sim.clock_guard import ClockGuard
 from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.load_control import AxialLoadOperation, HealthLevel, LoadControllerSettings, RadialLoad, Reply, SetpointSource
 from bearing_rig_sim.load_control.settings import NODE_NAME, shipped_parameters
-from bearing_rig_sim.nodes.common import ERROR, OK, RELIABLE_QOS, WARN, diagnostic_array, diagnostic_status, drain, from_stamp, node_main, qos_profile, to_stamp, unspun_reader
+from bearing_rig_sim.nodes.common import (
+    ERROR,
+    OK,
+    RELIABLE_QOS,
+    WARN,
+    diagnostic_array,
+    diagnostic_status,
+    drain,
+    from_stamp,
+    node_main,
+    qos_profile,
+    to_stamp,
+    unspun_reader,
+)
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.rig.loading import LoadChainState, LoadingChainConfig
 

@@ -117,9 +117,7 @@ class ShadowNode(ManagedNode):
         self._received = {"spindle": 0, "cage": 0, "force": 0}
         self._estimate_updates = 0
         self._residual_pub = self.publisher(ShadowResidual, TWIN_RESIDUAL.name, qos_profile(TWIN_RESIDUAL))
-        self._sensor_pubs = {
-            t.name: self.publisher(Vector3Stamped, t.name, qos_profile(t)) for t in (TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL)
-        }
+        self._sensor_pubs = {t.name: self.publisher(Vector3Stamped, t.name, qos_profile(t)) for t in (TWIN_TEMPERATURE_RESIDUAL, TWIN_TORQUE_RESIDUAL)}
         self._estimate_pub = self.publisher(ShadowEstimate, TWIN_ESTIMATE.name, qos_profile(TWIN_ESTIMATE))
         self._diag_pub = self.publisher(DiagnosticArray, DIAGNOSTICS.name, qos_profile(DIAGNOSTICS))
         sensor = PULSE_READER_QOS  # best effort: matches a bench counter publishing sensor data, and the twin's reliable streams

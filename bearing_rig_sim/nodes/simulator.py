@@ -90,7 +90,19 @@ from bearing_rig_sim.interfaces import topic as contract_topic
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
 from bearing_rig_sim.errors import RigError
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, STATUS_QOS, UNKNOWN_NODE_NAME, diagnostic_array, diagnostic_status, drain, from_stamp, node_main, qos_profile, to_stamp, unspun_reader
+from bearing_rig_sim.nodes.common import (
+    RELIABLE_QOS,
+    STATUS_QOS,
+    UNKNOWN_NODE_NAME,
+    diagnostic_array,
+    diagnostic_status,
+    drain,
+    from_stamp,
+    node_main,
+    qos_profile,
+    to_stamp,
+    unspun_reader,
+)
 from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, parameter_values, survives_shutdown
 from bearing_rig_sim.instruments.base import Reading
 from bearing_rig_sim.simulation.drive import SpindleCommand, profile_from_code

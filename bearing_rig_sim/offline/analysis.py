@@ -67,7 +67,17 @@ from bearing_rig_sim import interfaces as contract
 from bearing_rig_sim.analysis.stability import LoadSweepVerdict
 from bearing_rig_sim.config import ConfigError, parse_yaml, ros_parameters
 from bearing_rig_sim.monitoring import DIAGNOSTIC_NAME as MONITOR_DIAGNOSTIC_NAME
-from bearing_rig_sim.monitoring import NODE_NAME, PARAMETER_KEY_PREFIX, MonitorSettings, MonitorStatus, SlipMonitor, StampOrder, StatusSchedule, shipped_parameters, unstamped
+from bearing_rig_sim.monitoring import (
+    NODE_NAME,
+    PARAMETER_KEY_PREFIX,
+    MonitorSettings,
+    MonitorStatus,
+    SlipMonitor,
+    StampOrder,
+    StatusSchedule,
+    shipped_parameters,
+    unstamped,
+)
 from bearing_rig_sim.bags.cdr import decode_pulse as pulse_fields
 from bearing_rig_sim.bags.cdr import decode_joint_velocities, decode_pulses, decode_status_fields, decode_truth_speeds, make_decoder, make_field_decoder
 from bearing_rig_sim.bags.errors import BagError, BagWarning
@@ -330,7 +340,9 @@ class _SampledTopics:
     def __init__(self, bag: BagReader, names: list[str]) -> None:
         by_hand = {SPEEDS: decode_joint_velocities, TRUTH: decode_truth_speeds}  # sampled by every row
         self.topics = {
-            name: _Sampled(make_field_decoder(bag.typestore, CONTEXT_TOPICS[name], by_hand[name]) if name in by_hand else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            name: _Sampled(
+                make_field_decoder(bag.typestore, CONTEXT_TOPICS[name], by_hand[name]) if name in by_hand else make_decoder(bag.typestore, CONTEXT_TOPICS[name])
+            )
             for name in names
         }
         self._pending: deque[tuple[int, dict[str, ChunkBatch]]] = deque()  # (first log time, batches)
@@ -430,7 +442,9 @@ class OfflineAnalysis:
         self._rows = RowDecimator(max_points)
         self._on_row, self._on_window = on_row, on_window
         self._latest = {
-            name: _Latest(make_field_decoder(bag.typestore, STATUS_TYPE, decode_status_fields) if name == STATUS else make_decoder(bag.typestore, CONTEXT_TOPICS[name]))
+            name: _Latest(
+                make_field_decoder(bag.typestore, STATUS_TYPE, decode_status_fields) if name == STATUS else make_decoder(bag.typestore, CONTEXT_TOPICS[name])
+            )
             for name in self._context
             if name not in SAMPLED_TOPICS
         }
@@ -499,9 +513,13 @@ class OfflineAnalysis:
         except ConfigError as exc:
             self._report(f"{exc}; using the shipped config/monitor.yaml")
             recorded = None
-        settings, source = (recorded, "the bag's run context (parameters/monitor)") if recorded is not None else (
-            MonitorSettings.from_yaml(),
-            "the shipped config/monitor.yaml (the bag records none)",
+        settings, source = (
+            (recorded, "the bag's run context (parameters/monitor)")
+            if recorded is not None
+            else (
+                MonitorSettings.from_yaml(),
+                "the shipped config/monitor.yaml (the bag records none)",
+            )
         )
         published = monitor_published_parameters(self.bag)
         if published:

@@ -392,7 +392,9 @@ class ProgramRunner:
         plan = self._ahead.pop(index, None) or self._plan(index, start)
         run_up = plan.profile.start_time if plan.profile.kind is SpeedProfileKind.CONSTANT_ACCELERATION and plan.ramp_end > plan.start_time else None
         fixed = index > 0 and self.program.segments[index - 1].dwell is not None
-        self._data = _SegmentData(plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up, min_confidence=self.monitor_settings.stable_confidence), fixed_start=fixed)
+        self._data = _SegmentData(
+            plan, rule=TimeToStable(plan.ramp_end, plan.segment.target_speed, run_up, min_confidence=self.monitor_settings.stable_confidence), fixed_start=fixed
+        )
         early, self._early = self._early, []
         for observe, args in early:  # stamped within this segment, or beyond it (kept again)
             observe(*args)

@@ -281,9 +281,7 @@ class _Session:
         lead = REALTIME_COMMAND_LEAD_S if options.realtime else COMMAND_LEAD_S  # without real time the simulator runs ahead
         # set-points: in real time as the commands (a queue outliving an interrupted session holds
         # at most a second); without real time every fixed start's at once (see the runner)
-        self.runner = ProgramRunner(
-            program, command_lead_s=lead, setpoint_lead_s=lead if options.realtime else math.inf, monitor_guard_s=MONITOR_GUARD_S
-        )
+        self.runner = ProgramRunner(program, command_lead_s=lead, setpoint_lead_s=lead if options.realtime else math.inf, monitor_guard_s=MONITOR_GUARD_S)
         self.view = view
         if view is not None:
             from bearing_rig_sim.live.foxglove import TeeWriter

@@ -34,7 +34,9 @@ class ShadowSettings(NodeSettings):
     calibration_file: OptionalConfigFile = param(
         "calibration laid over the bearing data: a named one ('coupled', 'isothermal') or a file ('' = the uncalibrated bearing file)"
     )
-    rig_file: ConfigFile = param("rig data file: the test bearing's mounting (clearance, misalignment, preload) the twin's engine is built with, as the simulator's")
+    rig_file: ConfigFile = param(
+        "rig data file: the test bearing's mounting (clearance, misalignment, preload) the twin's engine is built with, as the simulator's"
+    )
     model: Annotated[str, one_of(MODELS)] = param("engine model: 'reduced' (runs in real time) or 'stiff' (slow reference)")
     chunk_s: Number = param("engine advance per call (whole steps of the bearing file's model)", unit="s", gt=0.0, le=0.1)
     window_revolutions: Integer = param("whole cage revolutions per slip window (the monitor's)", unit="1", ge=1, le=1000)

@@ -165,9 +165,7 @@ class ShadowTwin:
         """The rig file's outer-ring thermocouple, whose lag the predicted reading follows."""
         self.torque_meter = instruments.on_topic(HOUSING_TORQUE.name, TorqueMeterSettings)
         """The rig file's housing torque meter, whose noise enters the torque band."""
-        self.timing_jitter_std_s = max(
-            instruments.on_topic(topic.name, FibreOpticSettings).timing_jitter_std_s for topic in (SPINDLE_PULSES, CAGE_PULSES)
-        )
+        self.timing_jitter_std_s = max(instruments.on_topic(topic.name, FibreOpticSettings).timing_jitter_std_s for topic in (SPINDLE_PULSES, CAGE_PULSES))
         """Pulse-timing jitter of the bench's fibre-optic sensors (the rig file's, the larger of the two), s."""
         """The test bearing's mounting, from the rig file (as the simulator's engine has it)."""
         self.drive = self._make_drive(self.params)

@@ -295,7 +295,9 @@ class SweepHead(FileSection):
 
     name: Text = Field(description="the sweep's name")
     description: Text | None = Field(None, description="what the sweep is for")
-    model: Annotated[str, one_of(BEARING_MODELS)] = Field("bench", description="the named bearing model: bench (the bench twin) or paper (the paper's own model)")
+    model: Annotated[str, one_of(BEARING_MODELS)] = Field(
+        "bench", description="the named bearing model: bench (the bench twin) or paper (the paper's own model)"
+    )
     bearing: Text | None = Field(None, description="bearing file (absent: the shipped H7006C; bench model only)")
     calibration: Text = Field(
         "shipped", description="shipped (the model's own; the bench twin's isothermal one), none, a named calibration (coupled, isothermal) or a file"

@@ -149,9 +149,7 @@ def departed(run: BenchRun, *, from_s: float, outer_ring_hotter_k: float = 0.0, 
     twin's (the torque meter's 10 ms lag and its 0.2 mN m noise, under 0.3 % of the torque, are
     scaled with it). Pulses and load-cell samples are those of ``run``."""
     tau = shipped_thermocouple().time_constant_s
-    temperatures = [
-        (t, v + (outer_ring_hotter_k * (1.0 - math.exp(-(t - from_s) / tau)) if t > from_s else 0.0)) for t, v in run.temperatures
-    ]
+    temperatures = [(t, v + (outer_ring_hotter_k * (1.0 - math.exp(-(t - from_s) / tau)) if t > from_s else 0.0)) for t, v in run.temperatures]
     torques = [(t, v * torque_factor if t > from_s else v) for t, v in run.torques]
     return BenchRun(list(run.spindle), list(run.cage), list(run.forces), list(run.truth_slip), temperatures, torques)
 

@@ -1,5 +1,5 @@
-"""The style is enforced, not just described: ruff (ruff.toml) and mypy (setup.cfg) pass on the
-tree, ``mypy --strict`` on the interface contract and the parameter model, every remaining ``type: ignore`` says why,
+"""The style is enforced, not just described: ruff's lint and formatter (ruff.toml) and mypy
+(setup.cfg) pass on the tree, ``mypy --strict`` on the interface contract and the parameter model, every remaining ``type: ignore`` says why,
 and no function of the package runs over :data:`MAX_FUNCTION_LINES` lines."""
 
 from __future__ import annotations
@@ -26,6 +26,11 @@ def run(tool: str, *args: str) -> subprocess.CompletedProcess[str]:
 def test_ruff_passes() -> None:
     result = run("ruff", "check", "--no-cache", "bearing_rig_sim", "test")
     assert result.returncode == 0, result.stdout + result.stderr
+
+
+def test_ruff_format_leaves_the_code_as_it_is() -> None:
+    result = run("ruff", "format", "--check", "--no-cache", "bearing_rig_sim", "test", "setup.py", "launch")
+    assert result.returncode == 0, "run `ruff format bearing_rig_sim test setup.py launch`:\n" + result.stdout + result.stderr
 
 
 def test_mypy_passes_on_the_package() -> None:

@@ -167,6 +167,27 @@ def test_measured_and_true_slip_compare_over_the_same_window(program: TestProgra
     assert outcome.measured_slip == 3.49
 
 
+def test_a_window_that_began_in_the_ramp_gives_the_segment_no_slip(program: TestProgram) -> None:
+    """A segment that ends on a status whose window began before its ramp's end (a stop: the last
+    windows close during the deceleration) shows no slip: that slip is the ramp's. The offline
+    analysis leaves such windows out of a segment's means by the same rule."""
+    runner = ProgramRunner(program)
+    runner.start(0.0)
+    runner.update(1.0)  # n0900: ramp 1.0 .. 2.5, dwell to 6.5
+    for k in range(1100):  # truth at 100 Hz, 3.0 %
+        runner.observe_truth(k * 0.01, 3.0)
+    cage = 2.0 * math.pi / 0.5  # 0.5 s windows
+    runner.observe_status(status(2.9, StatusState.SLIPPING, slip=2.7, cage=cage))  # began at 2.4 s: in the ramp
+    runner.update(6.5)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "n0900" and outcome.measured_slip is None and outcome.truth_slip is None
+    runner.observe_status(status(7.1, StatusState.SLIPPING, slip=2.8, cage=cage))  # n1200's ramp: 6.5 .. 7.5
+    runner.observe_status(status(8.1, StatusState.SLIPPING, slip=3.1, cage=cage))  # began at 7.6 s: after it
+    runner.update(7.5 + 3.0)
+    outcome = runner.outcomes[-1]
+    assert outcome.name == "n1200" and outcome.measured_slip == 3.1 and outcome.truth_slip == pytest.approx(3.0)
+
+
 def test_a_status_without_a_window_has_no_true_slip_beside_it(program: TestProgram) -> None:
     """A rig found stopped: the last status has cage speed 0 and no slip; the truth's slip at
     that moment (finite near standstill: 1 - cage / (ratio x inner) of vanishing speeds) is not
@@ -179,7 +200,7 @@ def test_a_status_without_a_window_has_no_true_slip_beside_it(program: TestProgr
     runner.observe_status(SlipObservation(time=3.45, state=StatusState.UNKNOWN, slip_rate=math.nan, inner_ring_speed=0.0, cage_speed=0.0, window_revolutions=1))
     runner.update(2.5 + 4.0)
     outcome = runner.outcomes[-1]
-    assert outcome.truth_slip is None and outcome.measured_slip is not None and math.isnan(outcome.measured_slip)
+    assert outcome.truth_slip is None and outcome.measured_slip is None
 
 
 def test_mean_bearing_force_counts_after_the_ramp(program: TestProgram) -> None:

@@ -238,7 +238,9 @@ class SegmentOutcome:
     time_to_stable: float | None
     """Stable stamp - ramp end (a run-up's: - its start), s; None without a stable verdict."""
     measured_slip: float | None
-    """Monitor's slip rate, %."""
+    """Monitor's slip rate, %: of the status that made the segment stable, else of its last status
+    if that one's window began after the ramp's end; None otherwise (a stop: its last windows
+    are the deceleration's)."""
     truth_slip: float | None
     """Simulator's true slip over the same window, %."""
     bearing_force: float | None
@@ -482,6 +484,8 @@ class ProgramRunner:
         assert data is not None
         plan = data.plan
         decisive = data.stable if data.stable is not None else data.last_status
+        if decisive is not None and decisive is not data.stable and not _window_after(decisive, plan.ramp_end):
+            decisive = None  # its slip is the ramp's (a stop's: the deceleration's), not the segment's speed's
         if data.stable is not None:
             assert data.rule is not None
             time_to_stable: float | None = data.stable.time - data.rule.ramp_end
@@ -651,6 +655,14 @@ class ProgramRunner:
             return sum(inside) / len(inside)
         before = [s for t, s in self._truth if t <= status.time]
         return before[-1] if before else None
+
+
+def _window_after(status: SlipObservation, ramp_end: float) -> bool:
+    """Whether the slip window of ``status`` began at or after ``ramp_end`` (s), so that its slip
+    is one of the segment's commanded speed (the rule the offline analysis applies to its means,
+    :mod:`bearing_rig_sim.offline.segments`); False for a status without a window."""
+    duration = status.window_duration
+    return duration > 0.0 and status.time - duration >= ramp_end
 
 
 def _load_conditions(data: _SegmentData, now: float) -> list[str]:

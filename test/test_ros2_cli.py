@@ -23,6 +23,7 @@ bounded by what is left of the test's timeout (``conftest.time_left``): the set-
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import os
 import shutil
@@ -61,8 +62,6 @@ SHARED_SETUP = Path(os.environ.get("BEARING_RIG_ROS2_SOURCES") or REPO_ROOT.pare
 VALIDATION = REPO_ROOT / "config" / "programs" / "validation.yaml"
 MANAGED = ("simulator", "load_controller", "monitor")
 """The nodes ``rig.launch.py`` starts and brings up."""
-WAIT = 120.0
-"""Longest wait for one answer or state, s (a first configure compiles the engine's kernels)."""
 ATTEMPT_S = 30.0
 """A repeatable ``ros2`` verb that has not ended by then is started again (see ``Ros2.run``)."""
 REPEATABLE = frozenset(
@@ -81,12 +80,25 @@ class StockTools:
 
 
 def _shared_tools() -> StockTools:
+    """The shared sources set up into a venv of this checkout's own. Each pytest-xdist worker
+    makes the module's fixture, and the set-up script is not safe twice at once on one folder
+    (two first builds of one overlay failed each other): a lock file lets one worker set up at a
+    time, and the next finds the work done (the script skips what its stamps say is done)."""
     key = hashlib.sha256(str(REPO_ROOT).encode()).hexdigest()[:12]
     venv = Path(tempfile.gettempdir()) / f"bearing-rig-ros2-{key}"
     env = dict(os.environ, BEARING_RIG_MAIN=str(REPO_ROOT), ROS2CLI_VENV=str(venv))
     for name in ("AMENT_PREFIX_PATH", "_ROS2CLI_HARNESS_BOOT"):
         env.pop(name, None)
-    result = subprocess.run(["bash", str(SHARED_SETUP)], env=env, capture_output=True, text=True, timeout=time_left())
+    with open(venv.parent / f"{venv.name}.lock", "w", encoding="utf-8") as lock:
+        deadline = time.monotonic() + time_left()
+        while True:
+            try:
+                fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                assert time.monotonic() < deadline, f"another worker held {lock.name} past this test's guard"
+                time.sleep(0.2)
+        result = subprocess.run(["bash", str(SHARED_SETUP)], env=env, capture_output=True, text=True, timeout=time_left())
     assert result.returncode == 0, f"{SHARED_SETUP} failed:\n{result.stderr[-4000:]}"
     overlay, install = venv / "overlay", venv / "ws" / "install" / "bearing_rig_sim"
     site = install / "lib" / f"python{sys.version_info.major}.{sys.version_info.minor}" / "site-packages"
@@ -136,7 +148,7 @@ class Ros2:
         self.logs = logs
         self.started: list[subprocess.Popen[str]] = []
 
-    def run(self, *argv: str, timeout: float = WAIT) -> subprocess.CompletedProcess[str]:
+    def run(self, *argv: str, timeout: float | None = None) -> subprocess.CompletedProcess[str]:
         """``ros2 argv...`` to its end; again while it has not discovered the node it names yet
         (``--no-daemon`` verbs discover the graph afresh each time, for ``--spin-time``).
 
@@ -144,7 +156,7 @@ class Ros2:
         hangs for ``ATTEMPT_S``: a fresh ``--no-daemon`` process asks a node's service just after
         discovering it, and Fast DDS may drop the answer before the node's reply writer has
         matched (``ros2 param`` then waits for ever)."""
-        timeout = min(timeout, time_left())
+        timeout = time_left() if timeout is None else min(timeout, time_left())
         deadline = time.monotonic() + timeout
         repeatable = tuple(argv[:2]) in REPEATABLE
         while True:
@@ -162,12 +174,10 @@ class Ros2:
             if not undiscovered or time.monotonic() > deadline:
                 return result
 
-    def until(
-        self, argv: tuple[str, ...], wanted: Callable[[subprocess.CompletedProcess[str]], bool], timeout: float = WAIT
-    ) -> subprocess.CompletedProcess[str]:
+    def until(self, argv: tuple[str, ...], wanted: Callable[[subprocess.CompletedProcess[str]], bool]) -> subprocess.CompletedProcess[str]:
         """``ros2 argv...`` again until its result is ``wanted`` (a node being discovered, a
         state being reached); the last result."""
-        deadline = time.monotonic() + min(timeout, time_left())
+        deadline = time.monotonic() + time_left()
         while True:
             result = self.run(*argv)
             if wanted(result) or time.monotonic() > deadline:
@@ -371,7 +381,7 @@ def test_params_topics_and_services_with_the_stock_tools(ros2_readme: Ros2, tmp_
     assert echoed.returncode == 0 and "slip" in echoed.stdout, echoed.stdout + echoed.stderr
 
     hz = ros2.start("hz", "topic", "hz", "/clock")
-    deadline = time.monotonic() + min(WAIT, time_left())
+    deadline = time.monotonic() + time_left()
     while "average rate" not in ros2.output("hz") and time.monotonic() < deadline and hz.poll() is None:
         time.sleep(0.2)
     assert "average rate" in ros2.output("hz"), ros2.output("hz")[-2000:]

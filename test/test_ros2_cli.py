@@ -68,6 +68,10 @@ REPEATABLE = frozenset(
     {("param", "describe"), ("param", "get"), ("param", "dump"), ("param", "set"), ("param", "load"), ("lifecycle", "get"), ("topic", "echo")}
 )
 """Verbs whose repetition changes nothing: they read, or set a parameter to the same value."""
+UNDISCOVERED = ("Node not found", "does not appear to be published yet", "Wait for service timed out")
+"""What a ``ros2`` verb says when it has not (yet) discovered the node, topic or service it
+names; nothing was done, so it is run again. ``ros2 param`` gives a node's parameter services 5 s
+(ros2param.api), which a fresh ``--no-daemon`` process on a loaded host can miss (CI saw it)."""
 
 
 @dataclass(frozen=True)
@@ -150,7 +154,8 @@ class Ros2:
 
     def run(self, *argv: str, timeout: float | None = None) -> subprocess.CompletedProcess[str]:
         """``ros2 argv...`` to its end; again while it has not discovered the node it names yet
-        (``--no-daemon`` verbs discover the graph afresh each time, for ``--spin-time``).
+        (:data:`UNDISCOVERED`; ``--no-daemon`` verbs discover the graph afresh each time, for
+        ``--spin-time``).
 
         A verb whose repetition changes nothing (:data:`REPEATABLE`) is also started again when it
         hangs for ``ATTEMPT_S``: a fresh ``--no-daemon`` process asks a node's service just after
@@ -170,7 +175,7 @@ class Ros2:
                     raise
                 continue
             said = result.stdout + result.stderr
-            undiscovered = "Node not found" in said or "does not appear to be published yet" in said
+            undiscovered = any(text in said for text in UNDISCOVERED)
             if not undiscovered or time.monotonic() > deadline:
                 return result
 

@@ -34,8 +34,9 @@ Rules (simulation time throughout, s):
 * A **run-up** (a constant-acceleration segment) is judged during its acceleration, as the paper
   judges it (section 4.2, Table 7): its time to stable counts from the run-up's start, and the
   stable status may come before the target speed (the summary says at which speed).
-* Measured slip: the slip rate of the status that decided the verdict (the stable one), else the
-  last status of the segment. Truth slip: the mean of the simulator's true slip over the same
+* Measured slip: the slip rate of the status that decided the verdict (the stable one), else of
+  the last status of the segment when its window began after the ramp end (none otherwise: a
+  stop's last windows are the deceleration's). Truth slip: the mean of the simulator's true slip over the same
   window as that status (``window_revolutions`` cage revolutions ending at its stamp), so the
   two are compared over the same stretch of time; none when that status has no window (a stop
   that stopped: the monitor reports the rig stopped, and neither slip is defined). Bearing force: mean of the load controller's
@@ -191,6 +192,11 @@ class SlipObservation:
         if self.cage_speed <= 0.0 or not math.isfinite(self.cage_speed) or self.window_revolutions <= 0:
             return 0.0
         return self.window_revolutions * 2.0 * math.pi / self.cage_speed
+
+    @property
+    def window_start(self) -> float:
+        """Start of the slip window, s (the stamp when there is no window)."""
+        return self.time - self.window_duration
 
 
 @dataclass(frozen=True)
@@ -483,9 +489,9 @@ class ProgramRunner:
         data = self._data
         assert data is not None
         plan = data.plan
-        decisive = data.stable if data.stable is not None else data.last_status
-        if decisive is not None and decisive is not data.stable and not _window_after(decisive, plan.ramp_end):
-            decisive = None  # its slip is the ramp's (a stop's: the deceleration's), not the segment's speed's
+        decisive = data.stable
+        if decisive is None and data.last_status is not None and _window_after(data.last_status, plan.ramp_end):
+            decisive = data.last_status  # else its slip is the ramp's (a stop's: the deceleration's), not the segment's speed's
         if data.stable is not None:
             assert data.rule is not None
             time_to_stable: float | None = data.stable.time - data.rule.ramp_end
@@ -649,7 +655,7 @@ class ProgramRunner:
         standstill, 1 - cage / (ratio x inner) of vanishing speeds, compares with nothing)."""
         if status.window_duration <= 0.0:
             return None
-        start = status.time - status.window_duration
+        start = status.window_start
         inside = [s for t, s in self._truth if start <= t <= status.time]
         if inside:
             return sum(inside) / len(inside)
@@ -661,8 +667,7 @@ def _window_after(status: SlipObservation, ramp_end: float) -> bool:
     """Whether the slip window of ``status`` began at or after ``ramp_end`` (s), so that its slip
     is one of the segment's commanded speed (the rule the offline analysis applies to its means,
     :mod:`bearing_rig_sim.offline.segments`); False for a status without a window."""
-    duration = status.window_duration
-    return duration > 0.0 and status.time - duration >= ramp_end
+    return status.window_duration > 0.0 and status.window_start >= ramp_end
 
 
 def _load_conditions(data: _SegmentData, now: float) -> list[str]:

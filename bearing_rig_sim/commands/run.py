@@ -36,8 +36,8 @@ def add_foxglove_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
-DEFAULT_PROGRAM = ("programs", "validation.yaml")
-"""The default program, under ``config/``: the validation program (paper Table 3 conditions)."""
+DEFAULT_PROGRAM = "validation"
+"""The shipped program run by default: the validation program (paper Table 3 conditions)."""
 
 
 def register(subparsers: Any) -> None:
@@ -53,7 +53,7 @@ def register(subparsers: Any) -> None:
         nargs="?",
         type=Path,
         default=None,
-        help=f"test program: a YAML file, or the name of a shipped one in config/programs/ (default: {DEFAULT_PROGRAM[-1].removesuffix('.yaml')})",
+        help=f"test program: a YAML file, or the name of a shipped one in config/programs/ (default: {DEFAULT_PROGRAM})",
     )
     parser.add_argument("--no-realtime", action="store_true", help="run the simulator as fast as it goes, not locked to the wall clock")
     parser.add_argument("--bag-dir", type=Path, default=Path("bags"), metavar="DIR", help="folder of the run's bag directory (default: bags)")
@@ -90,10 +90,10 @@ def register(subparsers: Any) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run the session; returns its exit status."""
-    from bearing_rig_sim.rig.program import program_file
+    from bearing_rig_sim.rig.program import PROGRAMS_DIR, program_file
     from bearing_rig_sim.session import SessionOptions, run_session
 
-    program = program_file(args.program) if args.program is not None else config_path(*DEFAULT_PROGRAM)
+    program = program_file(args.program) if args.program is not None else config_path(*PROGRAMS_DIR, f"{DEFAULT_PROGRAM}.yaml")
     if args.model is not None and args.attach:
         raise RigError("--model sets the simulator's bearing_model parameter: attached, set it where the nodes are started (-p bearing_model:=...)")
     options = SessionOptions(

@@ -1,7 +1,7 @@
-"""The running sums of :class:`~bearing_rig_sim.analysis.phase.PhaseSlope` against a batch fit.
+"""The estimates of :class:`~bearing_rig_sim.analysis.phase.PhaseSlope` against a batch fit.
 
-The incremental estimate (normal equations kept pulse by pulse, pulses leaving the kept stretch,
-sums rebuilt on a new reference) must equal a least-squares fit of the same stretch's pulses by
+The estimate of a stream fed pulse by pulse (pulses leaving the kept stretch, the strips' offsets
+eliminated within each strip, u taken about the stretch's middle) must equal a least-squares fit of the same stretch's pulses by
 ``numpy.linalg.lstsq``, on a design matrix built here from the model of the module docstring
 (``theta_c - r theta_i = c0 + c1 u + c2 u^2 + e(strip)``, one offset per strip), and the standard
 error the textbook one from that fit's residuals: ``s^2 = SSE / (n - p)``,
@@ -124,8 +124,8 @@ def compare_with_batch(strips: int, precision: float) -> tuple[int, int]:
     return compared, white
 
 
-def test_the_running_sums_give_the_batch_least_squares_fit() -> None:
-    """The rig's 4 cage strips: the running sums within 1e-9 of the batch fit (see
+def test_the_estimates_give_the_batch_least_squares_fit() -> None:
+    """The rig's 4 cage strips: the estimates within 1e-9 of the batch fit (see
     :func:`compare_with_batch`)."""
     compared, white = compare_with_batch(STRIPS, 1e-9)
     assert compared > 100 and white > 50
@@ -133,13 +133,12 @@ def test_the_running_sums_give_the_batch_least_squares_fit() -> None:
 
 @pytest.mark.parametrize("strips", [1, 3, 8])
 def test_any_number_of_strips_gives_the_batch_fit(strips: int) -> None:
-    """Another bench's cage may carry any number of strips (the sums keep a few numbers per strip
-    and per pair of strips): within 1e-8 of the batch fit. The running sums' reach, not the
-    batch's: their u and u^2 are taken about a reference up to a span behind the stretch, and
-    the normal equations square that design's condition number; both the dense sums this layout
-    replaced and these miss 1e-9 by up to 1.6 times with 1 and 3 strips (1.6e-10 on a slope of
-    0.039 with a standard error of 0.067)."""
-    compared, white = compare_with_batch(strips, 1e-8)
+    """Another bench's cage may carry any number of strips: within 1e-9 of the batch fit, as
+    with 4. (The running sums this fit replaced reached 1e-8 only with 1 and 3 strips: their u
+    and u^2 were taken about a reference up to a span behind the stretch, and the normal
+    equations squared that design's condition number; u is now taken about the stretch's
+    middle and the sums are of the residuals themselves.)"""
+    compared, white = compare_with_batch(strips, 1e-9)
     assert compared > 50 and white > 20
 
 

@@ -323,7 +323,7 @@ class SlipMonitor:
         look = PHASE_LOOKS_PER_STATUS * st.status_rate_hz
         if added is not None and self._latest is not None and self.slope.state is SlipState.UNKNOWN and (added - self._phase_look) * look >= 1.0:
             # no verdict yet: a look at every cage pulse, or PHASE_LOOKS_PER_STATUS per status
-            # period at high speed, not only at every window (O(strips^2) each)
+            # period at high speed, not only at every window (a direct fit of the stretch each)
             self._phase_look = added
             external = self._phase_external(added)
             if external is not None:

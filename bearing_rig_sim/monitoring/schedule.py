@@ -59,9 +59,14 @@ class StatusSchedule:
     def on_pulse(self, shaft: str, pulse: Pulse) -> list[ScheduledStatus]:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
-        t = pulse_stamp(pulse)
+        t = pulse.time
+        if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
+            t = pulse_stamp(pulse)
         if t is not None:
-            self._advance(t, out)
+            if t >= self.clock and self._origin is not None and self._origin + self._tick * self.period > t:
+                self.clock = t  # no tick due, no clock jump: what _advance would do
+            else:
+                self._advance(t, out)
         if self.monitor.add_pulse(shaft, pulse):
             out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
         return out
@@ -254,18 +259,21 @@ class StampOrder:
 
     def __init__(self, max_lead_s: float = ORDER_MAX_LEAD_S) -> None:
         self.max_lead_s = max_lead_s
-        self._held: dict[str, deque[Pulse]] = {"spindle": deque(), "cage": deque()}
+        self._held: dict[str, deque[tuple[float, Pulse]]] = {"spindle": deque(), "cage": deque()}  # (stamp, pulse)
         self._latest: dict[str, float] = {"spindle": -math.inf, "cage": -math.inf}
 
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
-        t = pulse_stamp(pulse)
-        if shaft not in self._held or t is None:
+        t = pulse.time
+        if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
+            t = pulse_stamp(pulse)
+        held = self._held.get(shaft)
+        if held is None or t is None:
             return [(shaft, pulse)]
         latest = self._latest
         if t > latest[shaft]:
             latest[shaft] = t
-        self._held[shaft].append(pulse)
+        held.append((t, pulse))
         return self._release(-math.inf)
 
     @property
@@ -287,13 +295,14 @@ class StampOrder:
         out: list[tuple[str, Pulse]] = []
         spindle, cage = self._held["spindle"], self._held["cage"]
         latest = self._latest
+        lead = self.max_lead_s
         while spindle or cage:
-            if cage and (not spindle or float(cage[0].time) <= float(spindle[0].time)):
+            if cage and (not spindle or cage[0][0] <= spindle[0][0]):
                 name, other, queue = "cage", "spindle", cage
             else:
                 name, other, queue = "spindle", "cage", spindle
-            t = float(queue[0].time)
-            if not (t <= until or latest[other] >= t or latest[name] - t > self.max_lead_s):
+            t = queue[0][0]
+            if not (t <= until or latest[other] >= t or latest[name] - t > lead):
                 break
-            out.append((name, queue.popleft()))
+            out.append((name, queue.popleft()[1]))
         return out

@@ -7,9 +7,10 @@ Here every cage pulse counts. The cage's angle ``theta_c`` (its pulse index, rad
 against the spindle's angle ``theta_i`` at the same instant (interpolated from the spindle's
 pulses, :mod:`~bearing_rig_sim.monitoring.windows`) over a trailing stretch of time:
 
-    theta_c - r theta_i = c0 + c1 u + c2 u^2 + e(strip),    u = theta_i - mean(theta_i)
+    theta_c - r theta_i = c0 + c1 u + c2 u^2 + e(strip),    u = theta_i - theta_m
 
-with ``r`` the epicyclic ratio and ``e(strip)`` the cage strips' own spacing offsets (free
+with ``theta_m`` the middle of the stretch's spindle angles (c2 does not depend on it), ``r`` the
+epicyclic ratio and ``e(strip)`` the cage strips' own spacing offsets (free
 parameters, so no prior measurement of them is needed). Since ``d theta_c / d theta_i = r (1 -
 S / 100)`` (Eq. 11-12 of the paper, docs/paper.md), the slip is ``S = -100 / r d(...)/du`` and
 its slope against the spindle's angle ``dS/d theta_i = -200 c2 / r``; against time it is that

@@ -498,6 +498,25 @@ def test_segments_of_a_program_and_stretches_of_a_bench_run() -> None:
     assert second.start_time == pytest.approx(3.9) and second.end_time == pytest.approx(8.8)
 
 
+def test_a_program_segment_lasts_until_the_next_command() -> None:
+    """A program segment spans the time from its command to the next command, status rows or
+    not: the acceleration program's first segment (load_up, at rest) is commanded before the
+    first pulse, so it had no status row and was reported as ending where it began. The last
+    segment ends at its last status row (nothing commands its end)."""
+    tracker = SegmentTracker(by_program=True, names=["load_up", "run", "stop"])
+    tracker.command(0.0, 0.0, 0, 0.0, 0.0, speed_now=0.0)
+    tracker.command(1.0, 100.0, 0, 0.5, 0.0, speed_now=0.0)
+    for k in range(10, 30):
+        tracker.row(status_row(0.1 * k, k, 100.0))  # 1.0 .. 2.9 s
+    tracker.command(3.0, 0.0, 0, 0.5, 0.0, speed_now=100.0)
+    for k in range(30, 40):
+        tracker.row(status_row(0.1 * k, k, 0.0))  # 3.0 .. 3.9 s
+    load_up, run, stop = tracker.finish()
+    assert (load_up.start_time, load_up.end_time, load_up.rows) == (0.0, 1.0, 0)
+    assert (run.start_time, run.end_time) == (1.0, 3.0)
+    assert (stop.start_time, stop.end_time) == (3.0, pytest.approx(3.9))
+
+
 def test_recorded_stamps_on_another_clock_are_placed_on_the_pulse_clock(tmp_path: Path) -> None:
     """A monitor stamps its status with its own clock before the first window (the system
     clock, about 1.7e9 s): such a stamp is placed at the log time before the first pulse, at the

@@ -50,7 +50,9 @@ class SegmentSummary:
 
     Attributes:
         name: program segment name, ``segment <n>`` or ``stretch <n>``.
-        start_time / ramp_end / end_time: rig time, s (the means cover ``ramp_end .. end_time``).
+        start_time / ramp_end / end_time: rig time, s (the means cover ``ramp_end .. end_time``);
+            a program segment ends where the next one starts (the last one, and a stretch, at
+            its last status row), so one without a status row still spans its time.
         target_speed: commanded inner-ring speed, rad/s (NaN for a stretch).
         inner_ring_speed: mean measured inner-ring speed (monitor windows), rad/s.
         axial_load: mean axial load (:attr:`StatusRow.axial_load`), N.
@@ -228,6 +230,8 @@ class SegmentTracker:
             ramp = max(ramp_time, 0.0)
         self._previous_target = target
         index = len(self.segments) + (self._open is not None)
+        if self._open is not None and start > self._open.end:  # a segment lasts until the next one begins
+            self._open.end = start
         self._close()
         self._open = _Segment(f"segment {index + 1}", start, start + ramp, target, self.settings, run_up)
 

@@ -59,7 +59,7 @@ class StatusSchedule:
     def on_pulse(self, shaft: str, pulse: Pulse) -> list[ScheduledStatus]:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
-        t = pulse.time
+        t: float | None = pulse.time
         if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
             t = pulse_stamp(pulse)
         if t is not None:
@@ -264,7 +264,7 @@ class StampOrder:
 
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
-        t = pulse.time
+        t: float | None = pulse.time
         if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
             t = pulse_stamp(pulse)
         held = self._held.get(shaft)

@@ -114,16 +114,30 @@ not a bound for a hang."""
 
 
 def fixed_waits(source: str) -> list[tuple[int, str]]:
-    """The ``timeout=`` arguments of ``source`` that are a number of seconds (1 s or more)
-    written into the call, as (line, call); lines marked :data:`EXEMPT_WAIT` left out."""
+    """The ``timeout=`` arguments of ``source`` that are a number of seconds (1 s or more),
+    written into the call or a module-level constant holding one (``WAIT = 60.0``), as (line,
+    call); lines marked :data:`EXEMPT_WAIT` left out."""
     lines = source.splitlines()
+    tree = ast.parse(source)
+    numbers: dict[str, float] = {}
+    for statement in tree.body:
+        target = statement.targets[0] if isinstance(statement, ast.Assign) and len(statement.targets) == 1 else getattr(statement, "target", None)
+        value = getattr(statement, "value", None)
+        if isinstance(target, ast.Name) and isinstance(value, ast.Constant) and type(value.value) in (int, float):
+            numbers[target.id] = value.value
     found = []
-    for node in ast.walk(ast.parse(source)):
+    for node in ast.walk(tree):
         if not isinstance(node, ast.Call):
             continue
         for keyword in node.keywords:
             value = keyword.value
-            if keyword.arg == "timeout" and isinstance(value, ast.Constant) and isinstance(value.value, (int, float)) and value.value >= 1:
+            if isinstance(value, ast.Constant) and type(value.value) in (int, float):
+                seconds = value.value
+            elif isinstance(value, ast.Name):
+                seconds = numbers.get(value.id, 0.0)
+            else:
+                continue
+            if keyword.arg == "timeout" and seconds >= 1:
                 span = lines[node.lineno - 1 : (node.end_lineno or node.lineno)]  # the formatter may move a comment to the call's last line
                 if not any(EXEMPT_WAIT in line for line in span):
                     found.append((value.lineno, ast.unparse(node.func)))
@@ -134,8 +148,9 @@ def test_fixed_waits_are_found() -> None:
     source = (
         "p.communicate(timeout=150)\ng.spin_until(f, timeout=time_left())\nq.wait(timeout=0.5)\nr.wait(timeout=20)  # not a hang guard: grace\n"
         "s.wait(\n    f, timeout=1.0\n)  # not a hang guard: watched\nu.wait(\n    timeout=2.0\n)\n"
+        "WAIT = 60.0\nSHORT: float = 0.5\nv.communicate(timeout=WAIT)\nw.wait(timeout=SHORT)\nx.wait(timeout=UNKNOWN)\n"
     )
-    assert fixed_waits(source) == [(1, "p.communicate"), (9, "u.wait")]
+    assert fixed_waits(source) == [(1, "p.communicate"), (9, "u.wait"), (13, "v.communicate")]
 
 
 def test_every_wait_of_the_suite_is_bounded_by_the_tests_guard() -> None:

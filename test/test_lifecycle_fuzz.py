@@ -24,11 +24,9 @@ rclpy = pytest.importorskip("rclpy")
 
 from lifecycle_msgs.msg import Transition  # noqa: E402
 from lifecycle_msgs.srv import ChangeState, GetState  # noqa: E402
+from conftest import time_left  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
-
-WAIT = 60.0
-"""Longest wait for one answer, s (a first configure compiles the engine's kernels)."""
 
 T = Transition
 MACHINE: dict[str, dict[int, str]] = {
@@ -58,12 +56,14 @@ class Lifecycle:
         self.executor = ros_graph.executor([self.node])
         self.get_state = self.node.create_client(GetState, f"/{target}/get_state")
         self.change_state = self.node.create_client(ChangeState, f"/{target}/change_state")
-        ready = ros_graph.spin_until(lambda: self.get_state.service_is_ready() and self.change_state.service_is_ready(), timeout=WAIT, executor=self.executor)
+        ready = ros_graph.spin_until(
+            lambda: self.get_state.service_is_ready() and self.change_state.service_is_ready(), timeout=time_left(), executor=self.executor
+        )
         assert ready, f"no lifecycle services of /{target}"
 
     def _call(self, client: Any, request: Any, resend_after: float | None = None) -> Any:
-        answer = self.graph.call(client, request, self.executor, WAIT, resend_after)
-        assert answer is not None, f"no answer to {request} within {WAIT:g} s"
+        answer = self.graph.call(client, request, self.executor, time_left(), resend_after)  # a first configure compiles the kernels
+        assert answer is not None, f"no answer to {request} within the test's time"
         return answer
 
     def state(self) -> str:
@@ -94,7 +94,7 @@ def test_a_transition_the_state_does_not_offer_is_refused_and_the_node_answers_o
     assert node.change(label="activate") is True
     assert node.state() == "active" and process.poll() is None
     process.terminate()
-    _, err = process.communicate(timeout=WAIT)
+    _, err = process.communicate(timeout=time_left())
     refused = [line for line in err.splitlines() if "change_state refused" in line]
     assert len(refused) == 5, err[-3000:]
     assert "id 3" in refused[0] and "unconfigured" in refused[0] and "configure (1)" in refused[0], refused[0]
@@ -121,5 +121,5 @@ def test_random_lifecycle_requests_leave_the_node_alive_and_answering(ros_graph:
         assert node.state() == state, (wanted, state)
         assert process.poll() is None, f"{name} died after transition id {wanted}"
     process.terminate()
-    _, err = process.communicate(timeout=WAIT)
+    _, err = process.communicate(timeout=time_left())
     assert "Traceback" not in err and "Transition is not registered" not in err, err[-3000:]

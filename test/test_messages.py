@@ -377,7 +377,7 @@ def test_set_axial_load_service_across_processes(ros_graph: Any) -> None:
         guard = time.monotonic() + time_left()
         while peer.poll() is None and time.monotonic() < guard:
             future = client.call_async(SetAxialLoad.Request(axial_load=load))
-            if ros_graph.spin_until(future.done, timeout=SERVICE_RESEND_S, executor=executor):
+            if ros_graph.spin_until(future.done, timeout=SERVICE_RESEND_S, executor=executor):  # not a hang guard: the resend period
                 return future.result()
             client.remove_pending_request(future)
         raise AssertionError(f"no response for {load} N ({'server running' if peer.poll() is None else 'server exited'})")

@@ -21,12 +21,12 @@ from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from rosgraph_msgs.msg import Clock  # noqa: E402
 
 from bearing_rig_sim.nodes.common import from_stamp  # noqa: E402
+from conftest import time_left  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
 CHUNK = 0.001
 """The simulator's chunk in config/simulator.yaml (chunk_s), s."""
-WAIT = 60.0
 
 
 class LifecycleClient:
@@ -43,11 +43,12 @@ class LifecycleClient:
         ready = self.spin_until(lambda: self.get_state_client.service_is_ready() and self.change_client.service_is_ready())
         assert ready, f"no lifecycle services of /{target}"
 
-    def spin_until(self, condition: Any, timeout: float = WAIT) -> bool:
-        return self.graph.spin_until(condition, timeout=timeout, executor=self.executor)
+    def spin_until(self, condition: Any, timeout: float | None = None) -> bool:
+        """Spin until ``condition()``, at most ``timeout`` s (default: the test's time left)."""
+        return self.graph.spin_until(condition, timeout=time_left() if timeout is None else timeout, executor=self.executor)
 
     def call(self, client: Any, request: Any, resend_after: float | None = None) -> Any:
-        answer = self.graph.call(client, request, self.executor, WAIT, resend_after)
+        answer = self.graph.call(client, request, self.executor, time_left(), resend_after)
         assert answer is not None, "no answer"
         return answer
 
@@ -116,13 +117,13 @@ def test_a_failed_configure_is_reported_and_the_node_stays_up(ros_graph: Any) ->
     assert client.node.count_publishers("/rig/slip_status") == 0
     assert process.poll() is None
     process.terminate()
-    _, err = process.communicate(timeout=WAIT)
+    _, err = process.communicate(timeout=time_left())
     failed = [line for line in err.splitlines() if "configure failed:" in line]
     assert len(failed) == 1 and "bearing_file" in failed[0] and "missing.yaml" in failed[0], err[-2000:]
 
 
 def test_autostart_configure_failure_is_one_line_and_exit_2(ros_graph: Any) -> None:
     process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--ros-args", "-p", "model:=no_such_model")
-    _, err = process.communicate(timeout=WAIT)
+    _, err = process.communicate(timeout=time_left())
     assert process.returncode == 2, err[-2000:]
     assert "simulator: error:" in err and "model" in err and "no_such_model" in err and "Traceback" not in err

@@ -34,11 +34,11 @@ from bearing_rig_sim.load_control import settle_time_bound  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, from_stamp, to_stamp  # noqa: E402
 from bearing_rig_sim.nodes.load_controller import DIAGNOSTIC_NAME  # noqa: E402
 from bearing_rig_sim.rig.loading import LoadingChainConfig  # noqa: E402
+from conftest import time_left  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
 TICK = 0.001  # s of sim time per /clock message
-WAIT = 60.0  # s of wall time: a guard against a hang, never part of what is asserted
 RESEND = 0.5  # s of wall time without the force of a tick before the tick is sent again
 DEEP = QoSProfile(depth=1000, reliability=ReliabilityPolicy.RELIABLE)
 
@@ -72,7 +72,6 @@ class Harness:
                 and node.count_publishers("/diagnostics") > 0
                 and all(c.service_is_ready() for c in (self.set_client, self.reset_client, self.param_client))
             ),
-            timeout=WAIT,
         )
         assert ready, self.failure("the load controller did not come up")
         # The first clock reading starts the node's count; it is repeated until the node, active
@@ -91,25 +90,26 @@ class Harness:
     def _on_diagnostics(self, msg: DiagnosticArray) -> None:
         self.diagnostics.extend(s for s in msg.status if s.name == DIAGNOSTIC_NAME)
 
-    def spin_until(self, condition: Any, timeout: float = WAIT) -> bool:
-        return self.graph.spin_until(condition, timeout=timeout, executor=self.executor)
+    def spin_until(self, condition: Any, timeout: float | None = None) -> bool:
+        """Spin until ``condition()``, at most ``timeout`` s (default: the test's time left)."""
+        return self.graph.spin_until(condition, timeout=time_left() if timeout is None else timeout, executor=self.executor)
 
     def tick(self) -> float:
         """One clock tick; returns the bearing force the node published for it.
 
         Waits for that force (the event), sending the tick again every ``RESEND`` s meanwhile: the
         node reads /clock best effort, so a tick may be lost, and a repeated stamp does not step
-        it again. Only a node silent for ``WAIT`` s in all fails the tick.
+        it again. Only a node silent for the rest of the test's time fails the tick.
         """
         self.time += TICK
         key = round(self.time / TICK)
-        deadline = time.monotonic() + WAIT
+        deadline = time.monotonic() + time_left()
         while True:
             self.clock.publish(Clock(clock=to_stamp(self.time)))
             if self.spin_until(lambda: key in self.forces, timeout=min(RESEND, max(deadline - time.monotonic(), 0.0))):
                 return self.forces[key]
             if time.monotonic() >= deadline:
-                raise AssertionError(self.failure(f"no force for t = {self.time:.3f} s within {WAIT:g} s"))
+                raise AssertionError(self.failure(f"no force for t = {self.time:.3f} s within the test's time"))
 
     def run(self, seconds: float) -> list[tuple[float, float]]:
         """Tick for ``seconds`` of sim time; (time, bearing force) per tick."""
@@ -262,7 +262,7 @@ def test_start_up_errors_are_one_line_and_exit_2(ros_graph: Any, tmp_path: Path,
     (tmp_path / "broken.yaml").write_text("load_controller:\n  ros__parameters:\n    state_rate_hz: [1,\n")
     ros_args = [arg.replace("{tmp}", str(tmp_path)) for arg in ros_args]
     process = ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart", "--ros-args", *ros_args)
-    _, err = process.communicate(timeout=WAIT)
+    _, err = process.communicate(timeout=time_left())
     assert process.returncode == 2, err[-2000:]
     assert "load_controller: error:" in err and expected in err and "Traceback" not in err
 

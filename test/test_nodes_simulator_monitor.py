@@ -29,11 +29,9 @@ from sensor_msgs.msg import JointState  # noqa: E402
 
 from bearing_rig_sim.config import config_path  # noqa: E402
 from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS, from_stamp, to_stamp  # noqa: E402
-from conftest import bearing_section  # noqa: E402
+from conftest import bearing_section, time_left  # noqa: E402
 
 RPM = math.pi / 30.0
-WAIT = 60.0
-"""Longest wait for any one condition, wall s (node start-up takes a few seconds)."""
 
 
 def epicyclic_ratio() -> float:
@@ -83,8 +81,9 @@ class Probe:
         for status in msg.status:
             self.diagnostics.setdefault(status.name.split(":")[0], []).append(status)
 
-    def wait(self, condition: Any, what: str, timeout: float = WAIT) -> None:
-        assert self.graph.spin_until(condition, timeout, executor=self.executor), f"timed out waiting for {what}"
+    def wait(self, condition: Any, what: str) -> None:
+        """Spin until ``condition()``, within the test's time left."""
+        assert self.graph.spin_until(condition, time_left(), executor=self.executor), f"timed out waiting for {what}"
 
     def diag(self, node: str) -> list[DiagnosticStatus]:
         return self.diagnostics.get(node, [])
@@ -378,7 +377,7 @@ def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
     probe.wait(lambda: len(windows()) >= 1, "a slip window")
     last_cage = max(index for shaft, index in published if shaft == "cage")
     late = published[("cage", last_cage - 8)]  # two cage revolutions before the last pulse
-    ros_graph.spin_until(lambda: max(windows()) >= late, WAIT, executor=probe.executor)  # the rest, if they come
+    ros_graph.spin_until(lambda: max(windows()) >= late, time_left(), executor=probe.executor)  # the rest, if they come
     assert all(s.state != SlipStatus.STATE_FAULT for s in probe.status)
     reported = windows()
     assert all(begin <= stamp <= arrived for stamp, (arrived, _) in reported.items()), "status stamps are not reception times on this host's clock"
@@ -423,7 +422,7 @@ def test_without_real_time_the_simulator_waits_for_a_reliable_reader_then_goes_o
     start(ros_graph, "simulator", flags=("--no-realtime",))
     probe = Probe(ros_graph)
     assert reader.stdout is not None
-    ready, _, _ = select.select([reader.stdout], [], [], WAIT)
+    ready, _, _ = select.select([reader.stdout], [], [], time_left())
     assert ready and reader.stdout.readline().strip() == "got the clock"
     os.kill(reader.pid, signal.SIGSTOP)
     try:
@@ -431,7 +430,7 @@ def test_without_real_time_the_simulator_waits_for_a_reliable_reader_then_goes_o
         def warned() -> bool:
             return any("went on without a reliable reader: /clock" in s.message for s in probe.diag("simulator"))
 
-        probe.wait(warned, "the simulator to give up on the stopped reader", timeout=ACK_GIVE_UP_S + WAIT)
+        probe.wait(warned, "the simulator to give up on the stopped reader")
         reports = probe.diag("simulator")
         i = next(k for k, s in enumerate(reports) if "went on without a reliable reader" in s.message)
         times = [float({kv.key: kv.value for kv in s.values}["sim_time_s"]) for s in reports[:i]]

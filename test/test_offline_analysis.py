@@ -9,6 +9,7 @@ import shutil
 import struct
 import warnings
 from dataclasses import astuple
+from types import SimpleNamespace
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +21,7 @@ from bearing_rig_sim.config import rpm_to_rad_s
 from bearing_rig_sim.monitoring import MonitorSettings, MonitorState, SlipMonitor
 from bearing_rig_sim.bags import BagError, BagWarning, BagWriter, open_bag, rig_typestore
 from bearing_rig_sim.offline.analysis import analyse_bag, decode_pulse
+from bearing_rig_sim.offline.report import _column
 from bearing_rig_sim.offline.segments import PROFILE_CONSTANT_ACCELERATION, SEGMENTS_CSV, SegmentTracker
 from bearing_rig_sim.offline.series import STATUS_CSV, WINDOWS_CSV, CsvWriter, RowDecimator, SlipWindowRow, StatusRow, csv_columns
 from bearing_rig_sim.synthetic.traffic import NO_BALLS, RIG_TRAFFIC_TOPICS, rig_traffic, sample_message
@@ -515,6 +517,19 @@ def test_a_program_segment_lasts_until_the_next_command() -> None:
     assert (load_up.start_time, load_up.end_time, load_up.rows) == (0.0, 1.0, 0)
     assert (run.start_time, run.end_time) == (1.0, 3.0)
     assert (stop.start_time, stop.end_time) == (3.0, pytest.approx(3.9))
+
+
+def test_a_plotted_series_breaks_where_it_has_no_value() -> None:
+    """A stopped rig has no slip from the sensors (NaN on its rows): the plotted line breaks there
+    (matplotlib leaves a NaN's segments out) instead of joining the slips before and after the
+    stop, as it did when such rows were dropped; a series with no value at all is not drawn."""
+    rows = [status_row(0.1 * k, k, 100.0, slip=math.nan if 3 <= k < 6 else 1.0) for k in range(8)]
+    xs, ys = _column(SimpleNamespace(rows=rows, first_time=0.1), "slip_rate", 2.0)  # type: ignore[arg-type]
+    assert xs == pytest.approx([0.1 * k - 0.1 for k in range(8)])
+    assert [math.isnan(y) for y in ys] == [False, False, False, True, True, True, False, False]
+    assert [y for y in ys if not math.isnan(y)] == [2.0] * 5
+    stopped = [status_row(0.1 * k, k, 100.0, slip=math.nan) for k in range(3)]
+    assert _column(SimpleNamespace(rows=stopped, first_time=0.0), "slip_rate") == ([], [])  # type: ignore[arg-type]
 
 
 def test_recorded_stamps_on_another_clock_are_placed_on_the_pulse_clock(tmp_path: Path) -> None:

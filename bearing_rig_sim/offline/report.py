@@ -94,15 +94,21 @@ def _fixed(value: float | None, decimals: int) -> str:
 # Plots
 # ---------------------------------------------------------------------------------------------
 def _column(result: OfflineResult, attr: str, scale: float = 1.0) -> tuple[list[float], list[float]]:
-    """(time from the first pulse, value * scale) of the rows where the value is finite."""
+    """(time from the first pulse, value * scale) of every row, NaN where the value is not
+    finite, so that a line breaks where there is no value (the sensors' slip of a stopped rig)
+    rather than joining the values on either side; ([], []) when no value is finite."""
     t0 = result.first_time
     xs, ys = [], []
+    finite = False
     for row in result.rows:
         value = getattr(row, attr)
+        xs.append(row.time - t0)
         if math.isfinite(value):
-            xs.append(row.time - t0)
             ys.append(value * scale)
-    return xs, ys
+            finite = True
+        else:
+            ys.append(math.nan)
+    return (xs, ys) if finite else ([], [])
 
 
 def _plot_lines(ax: Any, result: OfflineResult, lines: Sequence[tuple[str, str, float, dict[str, Any]]]) -> bool:

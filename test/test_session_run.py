@@ -126,8 +126,12 @@ def test_short_validation_runs_to_a_stable_verdict_and_records_a_readable_bag(ro
         forces = [m.message.wrench for m in reader.messages(["/rig/bearing/axial_force"])]  # type: ignore[attr-defined]
         commands = [m.message.header.stamp for m in reader.messages(["/rig/spindle/command"])]  # type: ignore[attr-defined]
         setpoints = [m.message for m in reader.messages(["/rig/load/setpoint"])]  # type: ignore[attr-defined]
-    # each segment's set-point stamped with its start, as its command: 100 N axial, nothing radial
-    assert [(s.header.stamp.sec, s.header.stamp.nanosec) for s in setpoints] == [(c.sec, c.nanosec) for c in commands]
+    # each segment's set-point stamped with its start, as its command, but the first: sent before
+    # the program's clock starts, which starts once the load controller shows it in force;
+    # 100 N axial, nothing radial
+    stamp = [s.header.stamp.sec + 1e-9 * s.header.stamp.nanosec for s in setpoints]
+    start = [c.sec + 1e-9 * c.nanosec for c in commands]
+    assert stamp[0] <= start[0] and stamp[1:] == start[1:], (stamp, start)
     assert all((s.wrench.force.z, s.wrench.force.x, s.wrench.force.y) == (100.0, 0.0, 0.0) for s in setpoints)
     assert forces and all((w.force.x, w.force.y, w.torque.x, w.torque.y) == (0.0, 0.0, 0.0, 0.0) for w in forces)
     with open_bag(bag) as reader:
@@ -404,17 +408,20 @@ def check_delivery(bag: Path, out: str) -> None:
 SIMULATOR_NODE = ("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
 
 
-def start_rig_nodes(ros_graph: Any, *simulators: tuple[str, ...]) -> None:
+LOAD_CONTROLLER_NODE = ("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+
+
+def start_rig_nodes(ros_graph: Any, *simulators: tuple[str, ...], load_controller: tuple[str, ...] = LOAD_CONTROLLER_NODE) -> None:
     """Start the rig's nodes on the test's graph as a launch file would, for ``run --attach``:
     each simulator given (``python`` arguments; default: one shipped simulator without real
-    time), the load controller and the monitor. Returns once the graph has each node's output
-    (a publisher of ``/rig/truth`` per simulator, of ``/rig/axial_load/state``, of
+    time), the load controller (likewise) and the monitor. Returns once the graph has each node's
+    output (a publisher of ``/rig/truth`` per simulator, of ``/rig/axial_load/state``, of
     ``/rig/slip_status``), so that a session started then finds every node running, however
     long their start took on a loaded host (the session's start-up bound is not the test's)."""
     simulators = simulators or (SIMULATOR_NODE,)
     for simulator in simulators:
         ros_graph.spawn_python(*simulator)
-    ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.load_controller", "--autostart")
+    ros_graph.spawn_python(*load_controller)
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.monitor", "--autostart")
     observer = ros_graph.node("observer")
     outputs = {"/rig/truth": len(simulators), "/rig/axial_load/state": 1, "/rig/slip_status": 1}
@@ -438,6 +445,40 @@ def test_attached_session_runs_the_program_on_running_nodes(ros_graph: Any, tmp_
     # unrecorded, the log is the session's only record: it ends with how it ended and its summary
     logged = (run / "logs" / "session.log").read_text(encoding="utf-8")
     assert "session ended, exit status 0\n" in logged and summary_rows(logged) == rows, logged[-3000:]
+
+
+SLOW_LOAD_CONTROLLER = """
+import sys, time
+from bearing_rig_sim.nodes import load_controller as node
+HOLD_S = 2.0  # wall s: a slow bench controller, or a loaded host; some 10 s of a free-running simulator
+apply, step, held = node.LoadControllerNode._on_load_setpoint, node.LoadControllerNode._on_step, []
+def hold(self, msg):
+    held.append((time.monotonic(), msg))
+def stepping(self):
+    while held and time.monotonic() - held[0][0] >= HOLD_S:
+        apply(self, held.pop(0)[1])
+    step(self)
+node.LoadControllerNode._on_load_setpoint, node.LoadControllerNode._on_step = hold, stepping
+sys.exit(node.main(["load_controller", "--autostart"]))
+"""
+
+
+def test_an_attached_session_starts_its_program_once_the_first_load_is_in_force(ros_graph: Any, tmp_path: Path) -> None:
+    """Attached to nodes running without real time, the simulator runs ahead of the session (6
+    times the wall clock with no recorder to pace it), so the first set-point reaches the load
+    controller seconds of sim time after the session sent it; here the load controller holds
+    each set-point 2 s of wall time besides. The program starts once the load controller shows
+    the first segment's set-point in force: the 0.3 s load-up, then the 900 rpm segment, run
+    loaded, every segment's conditions ok. Started at once instead, the load-up ended and the
+    900 rpm segment began on an unloaded bearing (exit 3, "load off", as CI once saw without the
+    hold)."""
+    start_rig_nodes(ros_graph, load_controller=("-c", SLOW_LOAD_CONTROLLER))
+    session = start_session(ros_graph, tmp_path, "--attach", "--no-record")
+    out, err = session.communicate(timeout=time_left())
+    assert session.returncode == 0, f"exit {session.returncode}\n{out[-3000:]}\n{err[-3000:]}"
+    rows = summary_rows(out)
+    assert [row[1] for row in rows] == ["load_up", "n0900", "n1500"]
+    assert [row[CONDITIONS] for row in rows] == ["ok"] * 3, out[-3000:]
 
 
 BEST_EFFORT_PULSE_SIMULATOR = """

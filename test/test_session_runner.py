@@ -613,6 +613,12 @@ def test_set_points_of_every_fixed_start_go_at_once_and_stop_at_an_until_stable_
     led.start(0.0)
     assert [p.segment.name for p in led.setpoints_due(0.4)] == ["load_up"]
     assert [p.segment.name for p in led.setpoints_due(0.5)] == ["n0900"]
+    # the session sends the first set-point before the program's clock starts (it starts once the
+    # load controller shows it in force): not given again, the commands all the same
+    loaded = ProgramRunner(program)
+    loaded.start(0.0, setpoint_sent=True)
+    assert [(p.segment.name, p.start_time) for p in loaded.setpoints_due(0.0)] == [("n0900", 1.0)]
+    assert [p.segment.name for p in loaded.commands_due(0.0)] == ["load_up", "n0900"]
 
 
 class WallClock:

@@ -54,6 +54,7 @@ from bearing_rig_sim.session.manager import DIAGNOSTIC_PREFIX
 from bearing_rig_sim.session.readiness import not_ready
 from bearing_rig_sim.session.recorder import RecordedTopic, SessionRecorder, header_stamp_ns
 from bearing_rig_sim.session.runner import ProgramRunner, SegmentPlan, SlipObservation, StatusState
+from bearing_rig_sim.rig.program import Segment
 from bearing_rig_sim.simulation.health import stopped_reason
 
 __all__ = ["DRAIN_PERIOD_S", "ONE_PUBLISHER_TOPICS", "RECORDER_DEPTH", "MESSAGE_TYPES", "UNNAMED_PUBLISHER", "SessionNode", "message_class"]
@@ -180,6 +181,8 @@ class SessionNode(Node):
         ``/diagnostics`` (the session's own, :class:`~.manager.LifecycleManager`), or None."""
         self.simulator_stopped = ""
         """Why the simulator stopped for good (its diagnostics' ``simulation_stopped``), or ""."""
+        self.axial_setpoint: tuple[float, float] | None = None
+        """The load controller's latest state: (stamp s of sim time, axial set-point in force N)."""
         self._pending: list[tuple[str, bytes]] = []
         self.sim_time_ns = 0
         """Stamp of the last ``/clock`` taken, ns."""
@@ -223,9 +226,12 @@ class SessionNode(Node):
         start), so the load controller puts it in force at the start however late the session
         runs: force.z the axial load (N), force.x/y the radial load at the segment's azimuth (N;
         both 0 for an axially loaded program), torque.y the moment (N m)."""
-        segment = plan.segment
+        self.send_load(plan.segment, plan.start_time)
+
+    def send_load(self, segment: Segment, stamp: float) -> None:
+        """``segment``'s load set-point stamped ``stamp`` (s of sim time; see :meth:`send_setpoint`)."""
         setpoint = WrenchStamped()
-        setpoint.header.stamp = to_stamp(plan.start_time)
+        setpoint.header.stamp = to_stamp(stamp)
         setpoint.header.frame_id = "bearing"
         setpoint.wrench.force.z = segment.axial_load
         setpoint.wrench.force.x, setpoint.wrench.force.y = segment.radial_components
@@ -416,6 +422,7 @@ class SessionNode(Node):
         elif name == AXIAL_LOAD_STATE.name:
             msg = deserialize_message(raw, msgtype)
             self.live.state_count += 1
+            self.axial_setpoint = (from_stamp(msg.header.stamp), float(msg.setpoint))
             self.runner.observe_axial_setpoint(from_stamp(msg.header.stamp), msg.setpoint)
             self.runner.observe_load(from_stamp(msg.header.stamp), msg.bearing_force)
         elif name == DIAGNOSTICS.name:

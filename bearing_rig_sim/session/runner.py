@@ -59,7 +59,9 @@ Rules (simulation time throughout, s):
   set-point, stamped with the segment's start, is sent as soon as that start is fixed (without
   real time every set-point of a run of dwell segments at once; in real time
   :data:`REALTIME_COMMAND_LEAD_S` ahead, as a command) and at the start otherwise; the load
-  controller keeps it until its stamp. A lead like the commands' 9 s was not enough: under four
+  controller keeps it until its stamp. The first segment's goes out before the program's clock
+  starts: the session starts the runner once the load controller shows it in force
+  (``start(..., setpoint_sent=True)``). A lead like the commands' 9 s was not enough: under four
   busy loops on two cores the simulator ran more than 9 s ahead of the session (its recorder's
   readers acknowledge from the middleware's thread, so the session's Python may lag far behind),
   and four of 40 load-sweep segments began on the previous set-point.
@@ -381,14 +383,18 @@ class ProgramRunner:
         return any(seg.radial_load != 0.0 or seg.moment != 0.0 for seg in self.program.segments)
 
     # -- driving ----------------------------------------------------------------------------------
-    def start(self, now: float) -> SegmentPlan:
+    def start(self, now: float, setpoint_sent: bool = False) -> SegmentPlan:
         """Start the first segment at ``now`` (s of sim time); returns its plan.
+        ``setpoint_sent``: its load set-point went out before (the session loads the bearing up
+        before the program's clock starts), so :meth:`setpoints_due` does not give it again.
 
         Raises:
             RuntimeError: already started.
         """
         if self.started:
             raise RuntimeError("the program runner was started already")
+        if setpoint_sent:
+            self._setpoints_sent = 0
         return self._begin(0, now)
 
     def _plan(self, index: int, start: float) -> SegmentPlan:

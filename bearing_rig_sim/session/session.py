@@ -22,8 +22,10 @@
    name of the process that did not, and the tail of its output; attached to nodes managed
    elsewhere (``--attach``), also until the recorder has matched the streams the graph has a
    publisher of (read best effort where a publisher offers only that), at most ``MATCH_WAIT_S``;
-5. runs the program (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation
-   clock while recording every rig topic and printing progress;
+5. sends the first segment's load set-point and starts the program once the load controller
+   shows it in force (at most ``LOAD_UP_WAIT_S``), then runs it
+   (:class:`~bearing_rig_sim.session.runner.ProgramRunner`) on the simulation clock while
+   recording every rig topic and printing progress;
 6. at the end, on Ctrl-C (SIGINT) or SIGTERM, or when a node fails or dies: stops the runner,
    deactivates the active nodes in order (the simulator first; at the end of a program run
    through, the monitor once its last status is in) and cleans up the configured ones in
@@ -92,6 +94,12 @@ MATCH_WAIT_S = 10.0
 """Longest wait, after every node is configured, for the recorder to match their streams before
 they are activated; attached (``--attach``), before the program starts (wall s). Only a bound
 against a stream that never matches: the wait ends when the recorder has matched."""
+
+
+LOAD_UP_WAIT_S = 10.0
+"""Longest wait, wall s, for the load controller to show the first segment's set-point in force
+before the program starts anyway (its load then judged from when the load controller shows it):
+a bound against a set-point that never comes, the wait ends when it does."""
 
 
 MONITOR_GUARD_S = 30.0
@@ -302,6 +310,8 @@ class _Session:
         self._activations: list[Any] = []
         """The activations of the bring-up, held back until the recorder has matched the streams."""
         self._match_deadline: float | None = None
+        self._load_up_deadline: float | None = None
+        """Wall time after which the program starts without the first set-point shown in force."""
         self.deadline = 0.0
         logs.mkdir(parents=True, exist_ok=True)
         self.session_log = open(logs / "session.log", "a", encoding="utf-8")
@@ -404,9 +414,12 @@ class _Session:
             if not missing and self.options.attach and self._recorder_unmatched(attached=True):
                 return
             if not missing:
+                start = self._loaded_up(now)
+                if start is None:
+                    return
                 self.phase = _Phase.RUNNING
-                self._start_segment(self.runner.start(now))
-                self._send_commands(now)
+                self._start_segment(self.runner.start(start, setpoint_sent=True))
+                self._send_commands(start)
             elif time.monotonic() > self.deadline:
                 name, what = next(iter(missing.items()))
                 child = next(c for c in self.children if c.name == name)
@@ -563,6 +576,29 @@ class _Session:
         if through < node.sim_time - MONITOR_END_MARGIN_S:
             return f"its statuses reach {through:.3f} s, the clock {node.sim_time:.3f} s"
         return ""
+
+    def _loaded_up(self, now: float) -> float | None:
+        """The program's start, s of sim time, once the load controller shows the first segment's
+        axial set-point in force (sent here, at ``now``, the first time), or after
+        :data:`LOAD_UP_WAIT_S` without it; None meanwhile. A simulator that runs ahead of the
+        session (attached, without real time or a recorder, it ran 6 times faster than the wall
+        clock) would otherwise be in the program by the time the set-point reached the load
+        controller: the first segment's dwell could end, and the next segment begin, with the
+        bearing still unloaded (CI saw 1 N on it 0.3 s into a 900 rpm segment after a 0.3 s
+        load-up)."""
+        node = self.node
+        assert node is not None
+        first = self.runner.program.segments[0]
+        if self._load_up_deadline is None:
+            node.send_load(first, now)
+            self._load_up_deadline = time.monotonic() + LOAD_UP_WAIT_S
+        shown = node.axial_setpoint
+        if shown is not None and shown[1] == first.axial_load:
+            return max(now, shown[0])
+        if time.monotonic() < self._load_up_deadline:
+            return None
+        self._event(f"load controller: {first.axial_load:g} N not shown in force after {LOAD_UP_WAIT_S:g} s; the program starts without it")
+        return now
 
     def _send_commands(self, now: float) -> None:
         """Send the spindle commands and load set-points due (the running segment's and those of

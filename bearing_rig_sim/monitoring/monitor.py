@@ -287,9 +287,7 @@ class SlipMonitor:
             self._take_events()
         if counter.phase or self.phase is None or counter.epoch != self._phase_epoch:
             self._take_phase(shaft, pulse)
-        t: float | None = pulse.time
-        if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
-            t = pulse_stamp(pulse)
+        t = pulse_stamp(pulse)
         if t is not None and (self._now is None or t > self._now):
             self._now = t
         for window in done:

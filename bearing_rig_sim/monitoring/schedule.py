@@ -59,14 +59,9 @@ class StatusSchedule:
     def on_pulse(self, shaft: str, pulse: Pulse) -> list[ScheduledStatus]:
         """The statuses due up to and at this pulse, in order."""
         out: list[ScheduledStatus] = []
-        t: float | None = pulse.time
-        if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
-            t = pulse_stamp(pulse)
+        t = pulse_stamp(pulse)
         if t is not None:
-            if t >= self.clock and self._origin is not None and self._origin + self._tick * self.period > t:
-                self.clock = t  # no tick due, no clock jump: what _advance would do
-            else:
-                self._advance(t, out)
+            self._advance(t, out)
         if self.monitor.add_pulse(shaft, pulse):
             out.append(ScheduledStatus(self.clock, "window", self.monitor.status()))
         return out
@@ -264,9 +259,7 @@ class StampOrder:
 
     def push(self, shaft: str, pulse: Pulse) -> list[tuple[str, Pulse]]:
         """Take one pulse of ``shaft``, in the order received; the pulses that may go on now."""
-        t: float | None = pulse.time
-        if type(t) is not float or not math.isfinite(t):  # the common case first: pulse_stamp's
-            t = pulse_stamp(pulse)
+        t = pulse_stamp(pulse)
         held = self._held.get(shaft)
         if held is None or t is None:
             return [(shaft, pulse)]

@@ -299,22 +299,11 @@ class SlipWindows:
         if s is None:
             self.events.append(("note", None, f"pulse of unknown shaft {shaft!r} ignored"))
             return []
-        t, index, strip_id, strip_count = pulse.time, pulse.pulse_index, pulse.strip_id, pulse.strip_count
-        # the common case first, on exact types (_malformed's own first test, without the call)
-        if not (
-            type(t) is float
-            and type(strip_id) is int
-            and type(strip_count) is int
-            and type(index) is int
-            and math.isfinite(t)
-            and 0 <= strip_id < strip_count
-            and index >= 0
-        ):
-            problem = _malformed(pulse)
-            if problem:
-                self.events.append(("invalid", None, f"{shaft}: invalid pulse discarded ({problem})"))
-                return []
-            t, index = float(t), int(index)
+        problem = _malformed(pulse)
+        if problem:
+            self.events.append(("invalid", None, f"{shaft}: invalid pulse discarded ({problem})"))
+            return []
+        t, index = float(pulse.time), int(pulse.pulse_index)
         last_time, last_index = s.last_time, s.last_index
         if last_time is not None and last_index is not None:
             if t < last_time - self.clock_jump_tolerance_s:
@@ -375,11 +364,7 @@ class SlipWindows:
         self.stopped = ""
         if shaft == "spindle":
             self._add_spindle_pulse(s, t, index)
-            if self._pending or self._phase_pending:
-                return self._process_pending()
-            if len(s.times) >= s.prune_at:  # what _process_pending does with nothing waiting
-                self._prune_spindle()
-            return []
+            return self._process_pending()
         return self._add_cage_pulse(s, t, index)
 
     def _restart_shaft(self, shaft: str) -> None:

@@ -8,7 +8,8 @@
 #                                   (pytest-xdist `-n logical --dist worksteal` unless args give -n)
 #
 # Needs python3.11, cmake, a C and C++ compiler (gcc, g++), make or ninja, network access to
-# PyPI. Every step leaves a stamp (a hash of its inputs) in .venv/.bootstrap-stamps and is
+# PyPI. The C compiler also builds the monitor's compiled pulse path (BEARING_RIG_PURE_PYTHON=1:
+# not built, the sources run). Every step leaves a stamp (a hash of its inputs) in .venv/.bootstrap-stamps and is
 # skipped while its inputs are unchanged, so a second set-up takes seconds. Delete .venv (and
 # build/) to start from nothing. BEARING_RIG_PYTHON overrides the interpreter (default python3.11).
 set -euo pipefail
@@ -186,6 +187,25 @@ for ep in entry_points(group="console_scripts"):
     [[ -x "$lib/simulator" ]] || die "no node executables under $lib"
 }
 
+step_compiled() {
+    # The monitor's pulse path compiled to C by mypyc (bearing_rig_sim/compiled.py) into
+    # build/compiled/, again whenever a source it was compiled from changed (the package
+    # imports the sources instead until then). BEARING_RIG_PURE_PYTHON=1 skips it.
+    if [[ -n "${BEARING_RIG_PURE_PYTHON:-}" && "${BEARING_RIG_PURE_PYTHON}" != 0 ]]; then
+        log "BEARING_RIG_PURE_PYTHON is set: the pulse path is not compiled"
+        return
+    fi
+    local probe='import sys; from bearing_rig_sim.compiled import current; sys.exit(0 if current() else 1)'
+    (cd /tmp && "$PY" -c "$probe") && return
+    log "compiling the monitor's pulse path (mypyc, about a minute)"
+    local build_log="$ROOT/build/compiled-build.log"
+    if ! (cd /tmp && "$PY" -c 'import sys; from bearing_rig_sim.compiled import main; sys.exit(main())') >"$build_log" 2>&1; then
+        tail -n 40 "$build_log" >&2
+        die "compiling the pulse path failed (whole log: $build_log); BEARING_RIG_PURE_PYTHON=1 runs it from its sources"
+    fi
+    (cd /tmp && "$PY" -c "$probe") || die "the compiled pulse path does not match its sources after the build"
+}
+
 setup() {
     mkdir -p "$ROOT/build"
     # One set-up at a time per checkout (two shells, or CI jobs sharing a checkout).
@@ -198,6 +218,7 @@ setup() {
     step_patch_wheels
     step_messages
     step_package
+    step_compiled
     # Release the lock: the command run after set-up (a rig session, pytest) must not hold it.
     if command -v flock >/dev/null; then
         exec 9>&-

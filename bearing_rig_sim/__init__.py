@@ -27,7 +27,12 @@ nodes, the session, replay and the live view runs without ROS.
 * :mod:`bearing_rig_sim.sweep`: operating-map sweeps on Dask.
 * :mod:`bearing_rig_sim.live`: the live view in the Foxglove app.
 * :mod:`bearing_rig_sim.nodes`: thin ROS 2 node shells; :mod:`bearing_rig_sim.session`: ``bearing-rig run``.
+* :mod:`bearing_rig_sim.compiled`: the monitor's pulse path compiled to C (mypyc), its sources the fallback.
 * :mod:`bearing_rig_sim.commands` and :mod:`bearing_rig_sim.benchmarks`: the command line and its benchmarks.
 """
 
 __version__ = "0.1.0"
+
+from bearing_rig_sim import compiled as _compiled
+
+_compiled.install()

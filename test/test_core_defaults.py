@@ -33,7 +33,7 @@ def rig_file() -> dict[str, Any]:
 
 CORES: list[tuple[Callable[..., Any], str, dict[str, str]]] = [
     (
-        RealTimePacer.__init__,
+        RealTimePacer,
         "simulator",
         {
             "chunk": "chunk_s",
@@ -47,7 +47,7 @@ CORES: list[tuple[Callable[..., Any], str, dict[str, str]]] = [
         },
     ),
     (
-        RigTwin.__init__,
+        RigTwin,
         "simulator",
         {
             "chunk": "chunk_s",
@@ -57,9 +57,9 @@ CORES: list[tuple[Callable[..., Any], str, dict[str, str]]] = [
             "max_command_lead": "max_command_lead_s",
         },
     ),
-    (SpindleDrive.__init__, "simulator", {"initial_speed": "initial_speed_rad_s", "max_lead": "max_command_lead_s"}),
+    (SpindleDrive, "simulator", {"initial_speed": "initial_speed_rad_s", "max_lead": "max_command_lead_s"}),
     (
-        TrailingSlope.__init__,
+        TrailingSlope,
         "monitor",
         {
             "span": "slope_span_s",
@@ -68,14 +68,15 @@ CORES: list[tuple[Callable[..., Any], str, dict[str, str]]] = [
             "change_threshold": "change_threshold",
         },
     ),
-    (SlipWindows.__init__, "monitor", {"window_revolutions": "window_revolutions", "min_window_s": "min_window_s"}),
+    (SlipWindows, "monitor", {"window_revolutions": "window_revolutions", "min_window_s": "min_window_s"}),
 ]
-"""Constructor, the node whose shipped file holds its parameters, argument -> key in that file."""
+"""Class (its constructor's signature: also where its module runs compiled, whose ``__init__``
+has none), the node whose shipped file holds its parameters, argument -> key in that file."""
 
 RIG_FACTS: list[tuple[Callable[..., Any], dict[str, str]]] = [
-    (SpindleDrive.__init__, {"max_speed": "spindle.max_speed_rad_s", "max_acceleration": "spindle.max_acceleration_rad_s2"}),
+    (SpindleDrive, {"max_speed": "spindle.max_speed_rad_s", "max_acceleration": "spindle.max_acceleration_rad_s2"}),
     (
-        RigTwin.__init__,
+        RigTwin,
         {
             "max_speed": "spindle.max_speed_rad_s",
             "max_acceleration": "spindle.max_acceleration_rad_s2",
@@ -84,7 +85,7 @@ RIG_FACTS: list[tuple[Callable[..., Any], dict[str, str]]] = [
         },
     ),
 ]
-"""Constructor, argument -> dotted key of config/rig.yaml."""
+"""Class (its constructor's signature), argument -> dotted key of config/rig.yaml."""
 
 
 def _dotted(doc: dict[str, Any], key: str) -> Any:

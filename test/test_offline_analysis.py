@@ -318,8 +318,10 @@ def test_csv_rows_write_floats_exactly_speeds_in_rpm(tmp_path: Path) -> None:
     writer = CsvWriter(tmp_path / "w.csv", columns)
     rows = (
         SlipWindowRow(0.1, 0.30000000000000004, math.pi, 2.0, math.nan),
-        SlipWindowRow(1.0, 2.0, 3, 1.0, None),  # type: ignore[arg-type]
-        SlipWindowRow(np.float64(0.1), 0.2, np.float64(math.pi), 2.0, np.float64(1.5)),  # type: ignore[arg-type]
+        # any object with the columns' attributes: SlipWindowRow's fields are floats (and refuse
+        # None where its module runs compiled)
+        SimpleNamespace(start_time=1.0, end_time=2.0, inner_ring_speed=3, cage_speed=1.0, slip_rate=None),
+        SlipWindowRow(np.float64(0.1), 0.2, np.float64(math.pi), 2.0, np.float64(1.5)),
     )
     for row in rows:
         writer.write(row)

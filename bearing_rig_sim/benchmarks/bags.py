@@ -21,7 +21,9 @@ prints one JSON object per line:
   each step, over and over) is analysed offline as ``bearing-rig analyze`` does, in a fresh
   process: ``analyse_s`` (the monitor run over every pulse, the series and CSV files), of it
   ``monitor_s`` (inside the monitor's own ``add_pulse``, ``check`` and ``status``: its slip
-  windows, trailing slopes and verdicts), ``report_s`` (plots and markdown), ``cpu_s`` (the
+  windows, trailing slopes and verdicts; null when the pulse path runs compiled, where no timer
+  reaches inside it), ``compiled`` and ``compiled_reason`` (:func:`bearing_rig_sim.compiled.status`:
+  whether the pulse path ran compiled, and why), ``report_s`` (plots and markdown), ``cpu_s`` (the
   process's CPU time over both: the figure to trust on a busy machine), ``target_s`` (10 for an
   hour, pro rata), ``peak_rss_mb`` (target 200), ``baseline_rss_mb``, and the counts (pulses,
   windows, status rows). With ``--workdir`` the bags are kept there and a complete one of the
@@ -234,6 +236,7 @@ def measure_analysis(path: str, out: str) -> dict:
     process. Returns seconds of each part, counts, peak and baseline resident memory (MB)."""
     import matplotlib.pyplot  # noqa: F401 - imported before the baseline, as analyse_bag's modules
 
+    from bearing_rig_sim import compiled
     from bearing_rig_sim.monitoring import SlipMonitor
     from bearing_rig_sim.offline.analysis import analyse_bag
     from bearing_rig_sim.offline.report import write_report
@@ -250,8 +253,10 @@ def measure_analysis(path: str, out: str) -> dict:
 
         return wrapper
 
-    for name in ("add_pulse", "check", "status"):
-        setattr(SlipMonitor, name, timed(getattr(SlipMonitor, name)))
+    running = compiled.status()
+    if not running.active:  # a compiled class takes no wrapper, and compiled callers would bypass one
+        for name in ("add_pulse", "check", "status"):
+            setattr(SlipMonitor, name, timed(getattr(SlipMonitor, name)))
     baseline = _current_rss_mb()
     start = time.perf_counter()
     cpu = time.process_time()
@@ -264,7 +269,7 @@ def measure_analysis(path: str, out: str) -> dict:
     return {
         "analyse_s": analysed - start,
         "cpu_s": cpu,
-        "monitor_s": spent[0],
+        "monitor_s": None if running.active else spent[0],
         "report_s": done - analysed,
         "pulses": sum(result.pulses.values()),
         "windows": result.windows,
@@ -273,6 +278,8 @@ def measure_analysis(path: str, out: str) -> dict:
         "complete": result.complete,
         "peak_rss_mb": peak,
         "baseline_rss_mb": baseline,
+        "compiled": running.active,
+        "compiled_reason": running.reason,
     }
 
 
@@ -361,7 +368,8 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                     analyses.append(pool.submit(measure_analysis, str(folder), str(workdir / f"report-{minutes:g}min")).result())
             analysis = {
                 **analyses[0],
-                **{key: statistics.median(r[key] for r in analyses) for key in ("analyse_s", "monitor_s", "report_s", "cpu_s", "baseline_rss_mb")},
+                **{key: statistics.median(r[key] for r in analyses) for key in ("analyse_s", "report_s", "cpu_s", "baseline_rss_mb")},
+                "monitor_s": None if analyses[0]["monitor_s"] is None else statistics.median(r["monitor_s"] for r in analyses),
                 "peak_rss_mb": max(r["peak_rss_mb"] for r in analyses),
             }
             target = TARGET_ANALYSE_S_PER_HOUR * minutes / 60.0
@@ -374,7 +382,9 @@ def run(args: argparse.Namespace) -> Iterator[dict]:
                 "write_s": round(write_s, 2),
                 "bag_reused": kept is not None,
                 "analyse_s": round(analysis["analyse_s"], 2),
-                "monitor_s": round(analysis["monitor_s"], 2),
+                "monitor_s": None if analysis["monitor_s"] is None else round(analysis["monitor_s"], 2),
+                "compiled": analysis["compiled"],
+                "compiled_reason": analysis["compiled_reason"],
                 "report_s": round(analysis["report_s"], 2),
                 "cpu_s": round(analysis["cpu_s"], 2),
                 "target_s": round(target, 2),

@@ -101,6 +101,57 @@ def test_compiled_and_source_give_the_same_analysis_to_the_byte(tmp_path: Path) 
     assert rows["windows"] > 50 and rows["rows"] > 100 and rows["pulses"]["cage"] > 0
 
 
+BAD_PULSES = """
+import json
+import numpy as np
+from bearing_rig_sim.instruments.fibre_optic import Pulse
+from bearing_rig_sim.monitoring import SlipMonitor
+from bearing_rig_sim.monitoring.schedule import StatusSchedule
+from bearing_rig_sim.monitoring.settings import MonitorSettings
+settings = MonitorSettings.from_yaml()
+monitor = SlipMonitor(settings.kinematics(), settings)
+schedule = StatusSchedule(monitor)
+pulses = [Pulse("abc", 0, 4, 0, 0), Pulse(None, 0, 4, 0, 0), Pulse(np.float32(1.0), 0, 4, 0, 0), Pulse(1.0, np.int64(0), 4, 0, 0),
+          Pulse(1.0, 0.5, 4, 0, 0), Pulse(1.0, 0, np.int32(4), 0, 0), Pulse(float("nan"), 0, 4, 0, 0), Pulse(True, 0, 4, 0, 2),
+          Pulse(2, 0, 4, 0, 1), Pulse(3.0, 1, 4, 0, 3)]
+seen = []
+for shaft in ("spindle", "cage"):
+    for pulse in pulses:
+        try:
+            out = schedule.on_pulse(shaft, pulse)
+            seen.append([shaft, repr(pulse), [(s.reason, s.status.detail) for s in out], monitor.status().detail])
+        except Exception as exc:
+            seen.append([shaft, repr(pulse), "raised", repr(exc)])
+print(json.dumps(seen))
+"""
+
+
+def test_bad_pulses_are_refused_the_same_way_compiled_never_raised() -> None:
+    """A compiled module reads a field as the type Pulse declares and would raise on another: the
+    monitor takes a pulse's fields as they come until it has checked them, so a stamp that is
+    text, None or a numpy float32 and an index that is a numpy integer or a float are discarded
+    with the reason, compiled as from the sources (the monitor "never raises on bad data")."""
+    runs = []
+    for pure in (True, False):
+        env = {k: v for k, v in os.environ.items() if k != compiled.PURE_PYTHON_VARIABLE}
+        if pure:
+            env[compiled.PURE_PYTHON_VARIABLE] = "1"
+        done = subprocess.run([sys.executable, "-c", BAD_PULSES], env=env, capture_output=True, text=True, timeout=time_left(), check=True)
+        runs.append(json.loads(done.stdout))
+    from_source, from_build = runs
+    assert from_build == from_source
+    assert not [row for row in from_build if row[2] == "raised"]
+    details = " ".join(row[3] for row in from_build)
+    for reason in (
+        "time 'abc' is not a finite number",
+        "time None is not a finite number",
+        "strip_id np.int64(0) is not an integer >= 0",
+        "strip_count np.int32(4) is not an integer >= 0",
+        "time True is not a finite number",
+    ):
+        assert reason in details
+
+
 @pytest.fixture()
 def package_copy(tmp_path: Path) -> Path:
     """A copy of the package's sources with a build folder whose manifest matches them (its

@@ -308,9 +308,10 @@ class SlipMonitor:
         st = self.settings
         if self.criterion != "time" or self.loaded:
             return
-        if self.phase is None and shaft == "cage" and isinstance(pulse.strip_count, int) and pulse.strip_count >= 1:
+        strips = getattr(pulse, "strip_count", None)  # any type: the pulse may be malformed
+        if self.phase is None and shaft == "cage" and type(strips) is int and strips >= 1:
             span = st.slope_span_s
-            self.phase = PhaseSlope(self._ratio, span, pulse.strip_count, st.slip_resolution_pct, max(st.slope_max_span_s, span))
+            self.phase = PhaseSlope(self._ratio, span, strips, st.slip_resolution_pct, max(st.slope_max_span_s, span))
         if self.phase is None:
             return
         if self.counter.epoch != self._phase_epoch:

@@ -62,6 +62,7 @@ import bisect
 import math
 from collections import deque
 from dataclasses import dataclass, field
+from typing import Any
 
 from bearing_rig_sim.instruments.fibre_optic import TWO_PI, Pulse
 
@@ -295,15 +296,17 @@ class SlipWindows:
 
         Never raises on bad data: what happened goes to :attr:`events`.
         """
+        pulse_fields: Any = pulse  # fields of any type until _malformed has checked them (compiled,
+        # a field read as the type Pulse declares raises on another)
         s = self._shafts.get(shaft)
         if s is None:
             self.events.append(("note", None, f"pulse of unknown shaft {shaft!r} ignored"))
             return []
-        problem = _malformed(pulse)
+        problem = _malformed(pulse_fields)
         if problem:
             self.events.append(("invalid", None, f"{shaft}: invalid pulse discarded ({problem})"))
             return []
-        t, index = float(pulse.time), int(pulse.pulse_index)
+        t, index = float(pulse_fields.time), int(pulse_fields.pulse_index)
         last_time, last_index = s.last_time, s.last_index
         if last_time is not None and last_index is not None:
             if t < last_time - self.clock_jump_tolerance_s:
@@ -324,16 +327,16 @@ class SlipWindows:
                 )
                 self._restart_shaft(shaft)
                 return []
-            elif pulse.strip_count != s.strip_count:
-                self.events.append(("note", t, f"{shaft}: strip_count changed from {s.strip_count} to {pulse.strip_count}; counting restarted"))
+            elif pulse_fields.strip_count != s.strip_count:
+                self.events.append(("note", t, f"{shaft}: strip_count changed from {s.strip_count} to {pulse_fields.strip_count}; counting restarted"))
                 self._restart_shaft(shaft)
                 s = self._shafts[shaft]
-            elif (pulse.strip_id - index) % pulse.strip_count != s.offset:
+            elif (pulse_fields.strip_id - index) % pulse_fields.strip_count != s.offset:
                 self.events.append(
                     (
                         "invalid",
                         t,
-                        f"{shaft}: strip {pulse.strip_id} at pulse_index {index} does not match the earlier strips "
+                        f"{shaft}: strip {pulse_fields.strip_id} at pulse_index {index} does not match the earlier strips "
                         "(strip ids inconsistent with the indices); counting restarted",
                     )
                 )
@@ -352,8 +355,8 @@ class SlipWindows:
             s.previous_period = s.last_period
             s.last_period = (t - s.last_time) / step
         else:
-            s.strip_count = pulse.strip_count
-            s.offset = (pulse.strip_id - index) % pulse.strip_count
+            s.strip_count = pulse_fields.strip_count
+            s.offset = (pulse_fields.strip_id - index) % pulse_fields.strip_count
         s.last_time, s.last_index = t, index
         s.pulses += 1
         s.other_pulses_at_last = self._shafts[OTHER[shaft]].pulses
@@ -608,8 +611,10 @@ def _cubic_at(x0: float, x1: float, x2: float, x3: float, xs: list[float]) -> li
     return values
 
 
-def pulse_stamp(pulse: Pulse) -> float | None:
-    """A pulse's stamp as a float, s; None unless it is a finite number (a bool is none here)."""
+def pulse_stamp(pulse: Any) -> float | None:
+    """A pulse's stamp as a float, s; None unless it is a finite number (a bool is none here).
+    ``pulse``: a :class:`Pulse` whose fields may hold anything (taken as Any: where this module
+    runs compiled, a field read as the type Pulse declares would raise on another)."""
     t = pulse.time
     if type(t) is float:  # the common case first
         return t if math.isfinite(t) else None
@@ -618,8 +623,8 @@ def pulse_stamp(pulse: Pulse) -> float | None:
     return float(t)
 
 
-def _malformed(pulse: Pulse) -> str:
-    """Why a pulse cannot be used ("" if it can)."""
+def _malformed(pulse: Any) -> str:
+    """Why a pulse, its fields of any type (:func:`pulse_stamp`), cannot be used ("" if it can)."""
     t = pulse.time
     strip_id, strip_count, pulse_index = pulse.strip_id, pulse.strip_count, pulse.pulse_index
     # the common case first, on exact types (a bool is no int here); anything else is checked below

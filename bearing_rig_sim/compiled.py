@@ -19,6 +19,13 @@ otherwise, or with :data:`PURE_PYTHON_VARIABLE` set (for a debugger, or a host w
 compiler), every module is imported from its source, as if nothing had been built. All or none:
 the extensions call each other directly, so one changed source sets them all aside. The check
 runs once, when the first of them is imported; :func:`status` says which way it went and why.
+
+**What differs, compiled.** A compiled class is closed: no attribute can be set on it (a method
+wrapped for timing, a monkeypatched method) and its instances do not pickle or deep-copy
+(mypyc's native classes), where the sources' do; a field or argument read as its annotated type
+raises TypeError on another type (the monitor reads a pulse's fields untyped until it has
+checked them, so bad pulses are refused the same way). ``BEARING_RIG_PURE_PYTHON=1`` gives the
+sources' behaviour in all of this.
 """
 
 from __future__ import annotations

@@ -9,9 +9,11 @@ unchanged on the bench's topics. Publishes:
 
 * ``/rig/slip_status`` (bearing_rig_msgs/SlipStatus, reliable, transient local): when the
   schedule says (``status_rate_hz`` per second of pulse time, and as each slip window closes),
-  stamped at the latest window's end; when the pulses stop, at ``status_rate_hz`` of the steady
-  clock, and once the rig is found stopped those statuses (speeds 0, no slip) are stamped at the
-  rig time of the check, so that a stopped rig's statuses follow its clock;
+  stamped at the latest window's end; when the pulses stop, checked on a timer of the steady
+  clock at ``status_rate_hz`` that publishes one status per period of *rig time* passed since the
+  last one (at most :data:`IDLE_CATCH_UP_STATUSES` at a time), and once the rig is found stopped
+  those statuses (speeds 0, no slip) are stamped at the rig time of the check, so that a stopped
+  rig's statuses follow its clock at ``status_rate_hz``, however fast it runs;
 * ``/diagnostics`` (diagnostic_msgs/DiagnosticArray, reliable): ``diagnostics_rate_hz`` (wall) and
   on every change of level: OK stable, WARN slipping, unknown or pulses lost lately (with the
   counts), ERROR sustained sensor loss or invalid data.
@@ -76,6 +78,13 @@ from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, paramete
 from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 
+IDLE_CATCH_UP_STATUSES = 8
+"""Most idle statuses one status timer publishes to catch up with the rig time (0.8 s of it at the
+shipped 10 Hz), below the status publisher's depth (10), so that a reliable reader that falls
+behind for one burst misses none; a longer stretch of rig time between two timer calls (a
+simulator more than 8 times faster than the wall clock, which the session's pacing on the
+statuses does not allow) leaves a gap."""
+
 LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WARN, SlipState.FAULT: ERROR}
 """Diagnostics level of each monitor state (recent lost pulses raise OK to WARN)."""
 
@@ -101,6 +110,8 @@ class MonitorNode(ManagedNode):
         self.merger = PulseMerger()
         self._last_clock: float | None = None
         self._last_pulse_wall: float | None = None
+        self._last_idle: float | None = None
+        """Rig time of the latest idle status while the pulses have stopped, s (None while they drive)."""
         self._last_load_stamp: float | None = None
         """Stamp of the latest load-cell sample, s (None before the first)."""
         self._last_state: SlipState | None = None
@@ -216,29 +227,48 @@ class MonitorNode(ManagedNode):
             self.get_logger().warning(f"rig clock jumped back from {self._last_clock:.6g} s to {clock_now:.6g} s: reset")
             self.monitor.clock_jump(self._last_clock, clock_now)
             self._last_pulse_wall = None
+            self._last_idle = None
         self._last_clock = clock_now
         self._feed(self.merger.expire(time.monotonic()))
-        if self._last_pulse_wall is not None and time.monotonic() - self._last_pulse_wall < 2.0 / self.settings.status_rate_hz:
+        period = 1.0 / self.settings.status_rate_hz
+        if self._last_pulse_wall is not None and time.monotonic() - self._last_pulse_wall < 2.0 * period:
+            self._last_idle = None
             return  # the pulses drive the schedule
         now = self._rig_now(clock_now)
-        self._publish(self.schedule.idle(now).status if now is not None else self.monitor.status())
+        if now is None:
+            self._publish(self.monitor.status())
+            return
+        # One status per period of rig time since the last one (the latest pulse's, or the last
+        # idle status), not per period of the steady clock: a rig time running faster than the
+        # wall clock (a session without real time) is reported at status_rate_hz as well.
+        since = self._last_idle if self._last_idle is not None else self.schedule.clock
+        if math.isfinite(since) and now > since:
+            since = max(since, now - IDLE_CATCH_UP_STATUSES * period)
+            for k in range(1, IDLE_CATCH_UP_STATUSES + 1):
+                if since + k * period >= now:
+                    break
+                self._publish(self.schedule.idle(since + k * period).status, since + k * period)
+        self._publish(self.schedule.idle(now).status, now)
+        self._last_idle = now
 
     @survives_shutdown
     def _on_diagnostics_timer(self) -> None:
         self._publish_diagnostics(self.monitor.status())
 
     # -- outputs -------------------------------------------------------------------------------
-    def _publish(self, status: MonitorStatus) -> None:
+    def _publish(self, status: MonitorStatus, checked_at: float | None = None) -> None:
+        """Publish a status; one with no window of its own (a stopped rig) is stamped at
+        ``checked_at`` (the rig time of its check, s), or else at the rig time now."""
         if status.state != self._last_state:
             self.get_logger().info(f"state {status.state.label}: {status.detail}")
         self._last_state = status.state
-        self._status_pub.publish(self._status_message(status))
+        self._status_pub.publish(self._status_message(status, checked_at))
         if _level(status) != self._last_level:
             self._publish_diagnostics(status)
 
-    def _status_message(self, status: MonitorStatus) -> SlipStatus:
+    def _status_message(self, status: MonitorStatus, checked_at: float | None = None) -> SlipStatus:
         msg = SlipStatus(**status.message_fields())
-        stamp = status.time if status.time is not None else self._stamp_now()
+        stamp = status.time if status.time is not None else checked_at if checked_at is not None else self._stamp_now()
         msg.header.stamp = to_stamp(max(stamp, 0.0))
         msg.header.frame_id = "bearing"
         return msg

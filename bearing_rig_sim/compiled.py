@@ -6,7 +6,7 @@ pinned ``mypy``) compiles the modules of that path (:data:`COMPILED_MODULES`) to
 modules from the very sources the type check reads, so the live monitor and the offline analysis
 share one implementation, compiled or not, and give the same statuses to the bit (tested).
 
-**Build.** ``python -m bearing_rig_sim.compiled`` (run by ``./bootstrap.sh setup``) compiles them
+**Build.** :func:`main` (run by ``./bootstrap.sh setup``) compiles them
 into ``build/compiled/`` beside the package and writes a manifest naming the extension files and
 the digest of every package source they were compiled from (:func:`dependencies`: the compiled
 modules and the package modules they import, transitively). Nothing is written into the source
@@ -139,9 +139,14 @@ class _Finder(MetaPathFinder):
         self.status: Status | None = None
 
     def _check(self) -> dict[str, Path]:
-        """The extension of each module when the build is current, else {} (with :attr:`status`)."""
+        """The extension of each module when the build is current and not set aside by
+        :data:`PURE_PYTHON_VARIABLE`, else {} (with :attr:`status`)."""
         if os.environ.get(PURE_PYTHON_VARIABLE, "") not in ("", "0"):
             return self._set({}, f"{PURE_PYTHON_VARIABLE} is set: the modules run from their sources")
+        return self._inspect_build()
+
+    def _inspect_build(self) -> dict[str, Path]:
+        """The extension of each module when the build is current, else {} (with :attr:`status`)."""
         manifest_path = self.build_dir / MANIFEST_NAME
         try:
             manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
@@ -149,7 +154,7 @@ class _Finder(MetaPathFinder):
             extensions = {name: self.build_dir / file for name, file in manifest["extensions"].items()}
             tag = manifest["cache_tag"]
         except FileNotFoundError:
-            return self._set({}, f"not built ({manifest_path} missing: `python -m {__name__}` builds it)")
+            return self._set({}, f"not built ({manifest_path} missing: `./bootstrap.sh setup` builds it)")
         except (OSError, ValueError, KeyError, TypeError) as exc:
             return self._set({}, f"{manifest_path} unreadable ({exc}): the modules run from their sources")
         if tag != sys.implementation.cache_tag:
@@ -208,13 +213,7 @@ def status() -> Status:
 
 def current(build_dir: Path = BUILD_DIR, package_dir: Path = PACKAGE_DIR) -> bool:
     """Whether ``build_dir`` holds a build of the sources as they are now, for this interpreter."""
-    finder = _Finder(build_dir, package_dir)
-    saved = os.environ.pop(PURE_PYTHON_VARIABLE, None)
-    try:
-        return bool(finder._check())
-    finally:
-        if saved is not None:
-            os.environ[PURE_PYTHON_VARIABLE] = saved
+    return bool(_Finder(build_dir, package_dir)._inspect_build())
 
 
 def build(build_dir: Path = BUILD_DIR, package_dir: Path = PACKAGE_DIR, jobs: int = 2) -> None:
@@ -260,15 +259,9 @@ def build(build_dir: Path = BUILD_DIR, package_dir: Path = PACKAGE_DIR, jobs: in
     manifest_path.write_text(json.dumps(manifest, indent=1) + "\n", encoding="utf-8")
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m bearing_rig_sim.compiled [--if-stale]``: build (or, with ``--if-stale``, only
-    when the build is not current); exit 1 with the compiler's complaint on failure."""
-    args = list(sys.argv[1:] if argv is None else argv)
-    if args and args != ["--if-stale"]:
-        print(f"usage: python -m {__name__} [--if-stale]", file=sys.stderr)
-        return 2
-    if args and current():
-        return 0
+def main() -> int:
+    """Build (``./bootstrap.sh setup`` runs it when :func:`current` says the build is not);
+    exit 1 with the compiler's complaint on failure."""
     try:
         build()
     except RuntimeError as exc:
@@ -276,7 +269,3 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     print(f"{__name__}: {len(COMPILED_MODULES)} modules compiled into {BUILD_DIR}", file=sys.stderr)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -284,6 +284,16 @@ HOUSING_TORQUE = Topic(
     "simulator (bench: torque meter on the housing)",
     note="torque.z, the friction torque about the spindle axis",
 )
+SESSION_PROGRESS = Topic(
+    "/rig/session/progress",
+    "std_msgs/msg/Header",
+    "reliable_stream",
+    "each take of the recorder's queues that found the clock advanced (at most 50 Hz wall)",
+    "s",
+    "session",
+    note="stamp: the latest `/clock` the session has taken and recorded; frame_id: the program's name. "
+    "Without real time the simulator runs at most 2 s of sim time past it",
+)
 DIAGNOSTICS = Topic("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", "reliable", "1 Hz + on change", "-", "every node")
 
 TOPICS: tuple[Topic, ...] = (
@@ -305,6 +315,7 @@ TOPICS: tuple[Topic, ...] = (
     TWIN_TORQUE_RESIDUAL,
     OUTER_RING_TEMPERATURE,
     HOUSING_TORQUE,
+    SESSION_PROGRESS,
     DIAGNOSTICS,
 )
 """Every topic of the contract, in the table's order. The session records all of them."""

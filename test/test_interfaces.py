@@ -40,8 +40,9 @@ def test_every_topic_type_is_known_to_the_bag_typestore() -> None:
 def test_stamped_flag_matches_the_message_definition() -> None:
     store = rig_typestore()
     for topic in interfaces.TOPICS:
-        first_field = store.fielddefs[topic.msgtype][1][0][0]
-        assert topic.stamped == (first_field in ("header", "clock")), topic.name
+        _name, (_kind, first_type) = store.fielddefs[topic.msgtype][1][0]
+        # the message's CDR starts with a time stamp: a std_msgs/Header, or a Time itself (Clock, a Header)
+        assert topic.stamped == (first_type in ("std_msgs/msg/Header", "builtin_interfaces/msg/Time")), topic.name
 
 
 def test_recorder_records_every_contract_topic() -> None:

@@ -45,11 +45,15 @@ the bearing while the load controller's force stream follows the clock (so a sta
 controller's force is never applied late; a deactivated or exited one holds nothing up), and no
 further than :data:`MONITOR_LEAD_S` past the monitor's latest ``/rig/slip_status`` (read reliably,
 transient local) while its statuses follow the clock (so the monitor's verdicts keep up with the
-program under any load). The three bounds, without real time: the recorder's middleware has
-acknowledged every sample but the last :data:`ACK_WINDOW_CHUNKS` chunks' (2 s of simulated time;
-its reader queues, 50000 deep, hold them until the session takes them), the force on the bearing
-lags the clock by at most 0.1 s and the monitor by at most 0.5 s; the force and the monitor's
-statuses are reliable streams, so none of the three waits on a message that can be lost.
+program under any load), and no further than :data:`SESSION_LEAD_S` past the session's latest
+``/rig/session/progress`` (read reliably: the latest ``/clock`` the session has taken and
+recorded) while a session publishes it (so the session's runner and recorder keep up, and the
+commands it sends ahead arrive ahead). The four bounds, without real time: the recorder's
+middleware has acknowledged every sample but the last :data:`ACK_WINDOW_CHUNKS` chunks' (2 s of
+simulated time), the session has taken and recorded every message of the clock but the last 2 s
+(its reader queues, 50000 deep, hold the rest), the force on the bearing lags the clock by at
+most 0.1 s and the monitor by at most 0.5 s; the force, the monitor's statuses and the session's
+progress are reliable streams, so none of the four waits on a message that can be lost.
 ``simulator --no-realtime`` sets the parameter ``realtime`` to false.
 
 Lifecycle (:class:`~bearing_rig_sim.nodes.shell.ManagedNode`): the settings, the twin (engine,
@@ -83,9 +87,10 @@ from rclpy.serialization import deserialize_message
 from rclpy.subscription import Subscription
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
+from std_msgs.msg import Header
 
 from bearing_rig_msgs.msg import SimulatorTruth, SlipStatus, SpindleCommand as SpindleCommandMsg
-from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
+from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS, SESSION_PROGRESS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
 from bearing_rig_sim.interfaces import topic as contract_topic
 from bearing_rig_sim.config import ConfigError
 from bearing_rig_sim.dynamics import MIN_AXIAL_LOAD
@@ -167,6 +172,30 @@ where the monitor cannot yet tell a stop from a silent sensor (its statuses keep
 window's stamp until the silence exceeds ``loss_min_timeout_s``, 0.5 s, and four pulse periods),
 so the simulation goes on, paced by the force stream, until a pulse comes again."""
 
+SESSION_LEAD_S = 2.0
+"""Without real time, how far the simulation may run ahead of the session, s of simulated time:
+past the stamp of its latest ``/rig/session/progress``, the latest ``/clock`` the session has
+taken from its recorder's queues and written to the bag. The recorder's middleware acknowledges
+samples as they arrive in its reader queues, whatever the session's Python has taken, so the
+acknowledgement windows bound only what is in those queues; a session starved on a loaded host
+fell more than 9 s behind the simulator (six busy loops on two cores), and a stop command sent
+:data:`~bearing_rig_sim.session.runner.COMMAND_LEAD_S` (9 s) ahead of its stamp by the session's
+clock reached the simulator 1.1 s after it. Held to this lead, the session's view of the rig is
+never more than 2 s old, so such a command arrives at least 7 s ahead, and its recorder's queues
+(50000 deep) never hold more than some 2 s of each stream. Two seconds is some 40 of the
+session's takes (every 20 ms of wall time) at the 3x of an unloaded host, so the lead holds the
+simulation back only when the session cannot keep up. Paced as the force stream
+(:data:`FORCE_LEAD_S`), with :data:`SESSION_FOLLOW_S` for a stream that follows the clock: not
+before the session's first message, not once its publisher has gone (the session ended), not
+after :data:`FORCE_SILENT_S` of wall time without a new stamp."""
+
+SESSION_FOLLOW_S = 30.0
+"""A session progress stamp this close (s of simulated time) to the simulation when it arrives
+is taken as a session that follows the clock: wide, since a session taking its first ``/clock``
+late (bring-up on a loaded host) is behind by more than the lead, and pacing on it from then on
+is what brings it back within the lead. A stamp off the simulated time by more (a stray
+publisher on another clock) does not pace."""
+
 AT_REST = f"the rig at rest (no pulse for {MONITOR_LEAD_S:g} s of simulated time)"
 """Why the monitor's statuses do not pace the loop while no pulse comes (:data:`MONITOR_LEAD_S`)."""
 
@@ -234,6 +263,7 @@ class SimulatorNode(ManagedNode):
         self._leads = {
             BEARING_AXIAL_FORCE.name: StreamLead("force on the bearing", FORCE_LEAD_S, follow_s=FORCE_FOLLOW_S, silent_s=FORCE_SILENT_S),
             SLIP_STATUS.name: StreamLead("monitor status", MONITOR_LEAD_S, follow_s=MONITOR_FOLLOW_S, silent_s=FORCE_SILENT_S),
+            SESSION_PROGRESS.name: StreamLead("session progress", SESSION_LEAD_S, follow_s=SESSION_FOLLOW_S, silent_s=FORCE_SILENT_S),
         }
         """Without real time, the streams the loop keeps within a lead of (see the module docstring)."""
         self._stream_publishers = {name: -1 for name in self._leads}
@@ -277,6 +307,7 @@ class SimulatorNode(ManagedNode):
         self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
         self._force_sub = unspun_reader(self._force_tap, WrenchStamped, BEARING_AXIAL_FORCE.name, FORCE_QOS)
         self._status_sub = unspun_reader(self._force_tap, SlipStatus, SLIP_STATUS.name, STATUS_QOS)
+        self._progress_sub = unspun_reader(self._force_tap, Header, SESSION_PROGRESS.name, RELIABLE_QOS)
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
@@ -350,11 +381,13 @@ class SimulatorNode(ManagedNode):
 
     def _force_paced(self, chunks: int, now: float) -> int:
         """Without real time, at most the chunks that keep the simulation within
-        :data:`FORCE_LEAD_S` of the force stream and :data:`MONITOR_LEAD_S` of the monitor's
-        statuses, each while it follows the clock (see there)."""
+        :data:`FORCE_LEAD_S` of the force stream, :data:`MONITOR_LEAD_S` of the monitor's
+        statuses and :data:`SESSION_LEAD_S` of the session's progress, each while it follows the
+        clock (see there)."""
         if self.pacer.realtime:
             return chunks
         self._take_statuses()
+        self._take_progress()
         for name in self._leads:
             self._follow_publishers(name)
         at_rest = self.twin.time - self._last_pulse_time > MONITOR_LEAD_S
@@ -377,6 +410,14 @@ class SimulatorNode(ManagedNode):
         if queued:
             message = deserialize_message(queued[-1][0], SlipStatus)
             self._leads[SLIP_STATUS.name].observe(from_stamp(message.header.stamp), self.twin.time, time.monotonic())
+
+    def _take_progress(self) -> None:
+        """Follow the session's progress: the stamp of its latest message (only the last queued
+        is decoded)."""
+        queued = drain(self._progress_sub, Header)
+        if queued:
+            message = deserialize_message(queued[-1][0], Header)
+            self._leads[SESSION_PROGRESS.name].observe(from_stamp(message.stamp), self.twin.time, time.monotonic())
 
     def _follow_publishers(self, name: str) -> None:
         """Count a paced stream's publishers (none: pacing on it stops), read each one's
@@ -594,7 +635,7 @@ class SimulatorNode(ManagedNode):
             "reader_stalls": self.health.reader_stalls,
             **{
                 f"{key}_pacing": "off" if pacer.realtime else (f"off: {lead.off}" if lead.off else "on")
-                for key, lead in zip(("force", "monitor"), self._leads.values())
+                for key, lead in zip(("force", "monitor", "session"), self._leads.values())
             },
             STOPPED_KEY: self.health.halted,
         }

@@ -22,11 +22,13 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bearing_rig_msgs.msg import SpindleCommand
+from builtin_interfaces.msg import Time
 from rclpy.context import Context
 from rclpy.node import Node
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.serialization import deserialize_message
 from geometry_msgs.msg import WrenchStamped
+from std_msgs.msg import Header
 from sensor_msgs.msg import JointState
 
 from bearing_rig_sim.clock_guard import ClockGuard
@@ -43,6 +45,7 @@ from bearing_rig_sim.interfaces import (
     SLIP_STATUS,
     SPEEDS,
     SPINDLE_COMMAND,
+    SESSION_PROGRESS,
     SPINDLE_PULSES,
     TOPICS,
     TRUTH,
@@ -166,6 +169,10 @@ class SessionNode(Node):
         self.live = LiveValues()
         self._spindle = self.create_publisher(SpindleCommand, SPINDLE_COMMAND.name, qos_profile(SPINDLE_COMMAND))
         self._setpoint = self.create_publisher(WrenchStamped, LOAD_SETPOINT.name, qos_profile(LOAD_SETPOINT))
+        self._progress = self.create_publisher(Header, SESSION_PROGRESS.name, qos_profile(SESSION_PROGRESS))
+        self._progress_msg = Header(frame_id=runner.program.name)
+        self.progress_ns = -1
+        """Stamp of the last ``/rig/session/progress`` published, ns (-1: none yet)."""
         self.tap = Node(f"{name}_recorder", context=context)
         self._recorded = [
             (topic, MESSAGE_TYPES[topic.msgtype], self.tap.create_subscription(MESSAGE_TYPES[topic.msgtype], topic.name, _unused, reader_qos(topic), raw=True))
@@ -239,6 +246,20 @@ class SessionNode(Node):
         self._own[LOAD_SETPOINT.name][repr(setpoint)] += 1
         self._setpoint.publish(setpoint)
         self.sent[LOAD_SETPOINT.name] += 1
+
+    def send_progress(self) -> None:
+        """Publish the sim time taken so far (:attr:`sim_time_ns`) on ``/rig/session/progress``
+        when it has advanced since the last: without real time the simulator runs no further
+        than its ``SESSION_LEAD_S`` past it (:mod:`bearing_rig_sim.nodes.simulator`), so the
+        session (its recorder and its runner) never falls further behind the rig than that, and
+        a command sent :data:`~bearing_rig_sim.session.runner.COMMAND_LEAD_S` ahead by the
+        session's clock reaches the simulator before its stamp."""
+        if self.clock_count == 0 or self.sim_time_ns <= self.progress_ns:
+            return
+        self.progress_ns = self.sim_time_ns
+        self._progress_msg.stamp = Time(sec=self.sim_time_ns // 1_000_000_000, nanosec=self.sim_time_ns % 1_000_000_000)
+        self._progress.publish(self._progress_msg)
+        self.sent[SESSION_PROGRESS.name] += 1
 
     # -- readiness --------------------------------------------------------------------------------
     def unmatched_streams(self, *, published_only: bool = False) -> list[str]:

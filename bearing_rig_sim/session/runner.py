@@ -16,10 +16,9 @@ Rules (simulation time throughout, s):
 * **Commands ahead of time** (:meth:`ProgramRunner.commands_due`): the command of a segment whose
   start is fixed (every segment before it a dwell segment) is sent up to :data:`COMMAND_LEAD_S`
   (in real time :data:`REALTIME_COMMAND_LEAD_S`) before that start, stamped with it; the
-  simulator queues it and applies it exactly then. Without real time the simulator runs ahead of the session's clock (it waits
-  only for its readers' acknowledgements, not for the session to take the messages: seconds on
-  a loaded host), and a command stamped with the session's own, older, clock takes effect when it
-  arrives: the spindle's ramp then starts and ends late, the segment's speed is judged against a
+  simulator queues it and applies it exactly then. Without real time the simulator runs ahead of the session's clock (up
+  to its ``SESSION_LEAD_S``, 2 s of sim time, past the session's ``/rig/session/progress``),
+  and a command stamped with the session's own, older, clock takes effect when it arrives: the spindle's ramp then starts and ends late, the segment's speed is judged against a
   plan the spindle does not follow (a stop still turning at its "ramp end"), and a run-up's time
   to stable counts from a start that was not the spindle's. Stamped ahead, the plan, the
   spindle and the recorded command (``analyze`` times segments by its stamp) agree.
@@ -116,10 +115,11 @@ TRUTH_HISTORY = 6000
 
 COMMAND_LEAD_S = 9.0
 """How long before a segment's fixed start its spindle command is sent without real time, s of
-sim time: more than the simulator runs ahead of the session on a loaded host (1.4 s in the runs
-that failed before commands were sent ahead; 4 s once, with the session held up and a
-stretch of the recording lost), and under the simulator's ``max_command_lead_s`` (10 s), which
-it counts from its own clock, later than the session's. In the acceleration program a run-up's
+sim time: more than the simulator runs ahead of the session, which it bounds by its
+``SESSION_LEAD_S`` (2 s) past the session's progress (before that bound, 1.4 s in the runs that
+failed before commands were sent ahead, and over 9 s under six busy loops, where a stop command
+arrived 1.1 s late), and under the simulator's ``max_command_lead_s`` (10 s), which it counts
+from its own clock, later than the session's. In the acceleration program a run-up's
 command goes out 6-9 s ahead (from the start of the run-up before the stop that precedes it)."""
 
 REALTIME_COMMAND_LEAD_S = 1.0

@@ -391,6 +391,7 @@ class _Session:
             self._step(node.sim_time)
         finally:
             node.record_pending()
+            node.send_progress()  # what is taken is recorded: the simulator may run on from it
 
     def _step(self, now: float) -> None:
         """Watch the children; start the program once every node is up; run it."""

@@ -399,6 +399,21 @@ def test_monitor_takes_unstamped_pulses_at_their_reception_time(ros_graph):
 
 
 STOPPABLE_READER = """
+import os, tempfile
+# a participant lease far beyond the test (Fast DDS's default is 20 s): the simulator must give up
+# on the stopped reader by its own ACK_GIVE_UP_S (10 s), not see it dropped by discovery first,
+# after which nothing is left to wait for and no warning comes (a host so loaded that the
+# simulator's window filled late once failed so)
+profile = os.path.join(tempfile.mkdtemp(), "slow_reader.xml")
+with open(profile, "w") as f:
+    f.write(
+        '<?xml version="1.0" encoding="UTF-8"?>'
+        '<profiles xmlns="http://www.eprosima.com/XMLSchemas/fastRTPS_Profiles">'
+        '<participant profile_name="slow_reader" is_default_profile="true"><rtps><builtin><discovery_config>'
+        '<leaseDuration><sec>600</sec><nanosec>0</nanosec></leaseDuration>'
+        '</discovery_config></builtin></rtps></participant></profiles>'
+    )
+os.environ["FASTRTPS_DEFAULT_PROFILES_FILE"] = profile
 import rclpy
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock

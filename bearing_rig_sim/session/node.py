@@ -9,6 +9,11 @@ recorder's subscriptions live on a second node, ``<name>_recorder``, that is *no
 executor, with deep reader queues (:data:`RECORDER_DEPTH`), and a timer of the session node
 takes every queued message every :data:`DRAIN_PERIOD_S` (about 10 us each) and hands them, in
 order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the whole session.
+
+**Progress.** After each take that found the clock advanced, the session publishes the latest
+``/clock`` it has taken and recorded on ``/rig/session/progress`` (:meth:`SessionNode.send_progress`);
+without real time the simulator runs no further than its ``SESSION_LEAD_S`` (2 s of sim time)
+past it, so a session starved of CPU holds the rig back instead of falling behind it.
 """
 
 from __future__ import annotations

@@ -49,7 +49,7 @@ def test_a_table_built_slice_by_slice_is_the_table_at_that_temperature(params: B
     while not build.done:
         build.step()
         steps += 1
-    assert steps == 2 * 12 * 12 * 4  # contacts x loads x speeds x SRR quarters
+    assert steps == 2 * 12 * 14 * 4  # contacts x loads x speeds x SRR quarters
     reference = traction_table(params_at_temperature(params, 45.0))
     assert np.array_equal(build.table(), reference)
     # and the slope the kernels cap with is derive's for that table
@@ -68,7 +68,7 @@ def test_the_grid_blends_its_neighbours_linearly_and_falls_back_to_the_nearer(pa
     assert stands_for == 30.0 and np.array_equal(only, grid.tables[6])
     grid.want(7)
     assert grid.busy
-    finished = sum(grid.work() for _ in range(2 * 12 * 12 * 4))
+    finished = sum(grid.work() for _ in range(2 * 12 * 14 * 4))  # contacts x loads x speeds x SRR quarters
     assert finished == 1 and not grid.busy
     a, b = grid.tables[6], grid.tables[7]
     assert np.array_equal(b, traction_table(params_at_temperature(params, 35.0)))

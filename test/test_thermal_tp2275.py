@@ -64,6 +64,12 @@ EQUAL_ANGLE_SPIN = (
     "force; at 28 000 rpm the angles open to 29.3 / 21.1 deg and outer-raceway control spins the inner contact 2.1 x "
     "faster (docs/thermal.md, The raceway contacts examined): a speed-dependent spin needs a table axis it lacks"
 )
+STEEP_HEAT = (
+    "the heat grows as about n^2.5 between 28 000 and 72 000 rpm against the report's n^1.5 (0.65 to 1.81 x the "
+    "report's), and the outer ring's rise follows it: 36.9 K against 30 +- 5.9 K. It passed at 34.4 K while the "
+    "traction table's speed axis ended at 40 m/s, which clamped the inner contacts' loss at 48 000-72 000 rpm "
+    "(55.6-80.7 m/s): the clamp, not the model, kept the rise within the readings (docs/thermal.md)"
+)
 HOUSING = (
     "the assumed housing and shaft lead heat to 22 degC air; the report's rig (oil at 394 K, outer-ring cooling) "
     "is not described in anything read here (docs/thermal.md, Outer ring)"
@@ -103,7 +109,7 @@ def test_tp2275_heat_is_accounted_for_and_grows_with_speed(predictions: list[dic
 @pytest.mark.xfail(strict=True, reason=MODEL_FORM)
 def test_tp2275_heat_generation_within_30_percent_of_the_report(predictions: list[dict[str, Any]]) -> None:
     """The acceptance of issue 33: the heat within 30 % of the report's at every speed, widened by
-    the reading's +-3 % (:data:`HEAT_DIGITISATION`). Today 0.65 / 1.25 / 1.65 / 1.72 x: expected to
+    the reading's +-3 % (:data:`HEAT_DIGITISATION`). Today 0.65 / 1.27 / 1.71 / 1.81 x: expected to
     fail (strict: a pass is reported, so the marker goes when the model is fixed; :data:`MODEL_FORM`
     says what the published laws tried give)."""
     bound = HEAT_ACCEPTANCE + HEAT_DIGITISATION
@@ -115,7 +121,7 @@ def test_tp2275_heat_generation_within_30_percent_of_the_report(predictions: lis
 @pytest.mark.xfail(strict=True, reason=HOUSING)
 def test_tp2275_outer_ring_temperature_against_the_reports_measurements(predictions: list[dict[str, Any]]) -> None:
     """The outer ring at thermal steady state against the report's 413 / 425 / 435 / 443 K within
-    twice the reading's uncertainty (:data:`TEMPERATURE_READING_K`). The twin's runs 23-29 K
+    twice the reading's uncertainty (:data:`TEMPERATURE_READING_K`). The twin's runs 20-28 K
     cooler: expected to fail (strict)."""
     for r in predictions:
         measured_k = REPORT[r["rpm"]][1]
@@ -123,10 +129,11 @@ def test_tp2275_outer_ring_temperature_against_the_reports_measurements(predicti
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason=STEEP_HEAT)
 def test_tp2275_outer_ring_rises_with_speed_as_the_reports(predictions: list[dict[str, Any]]) -> None:
     """The outer ring's rise from 28 000 to 72 000 rpm, the report's 443 - 413 = 30 K, within the
     two readings' uncertainty (:data:`TREND_K`): a check of the heat's growth reaching the outer
-    ring that the housing's offset does not enter (the twin: 34.4 K)."""
+    ring that the housing's offset does not enter (the twin: 36.9 K, expected to fail, strict)."""
     by_rpm = {r["rpm"]: r["outer_ring_temperature_c"] for r in predictions}
     twin_rise = by_rpm[72000.0] - by_rpm[28000.0]
     report_rise = REPORT[72000.0][1] - REPORT[28000.0][1]

@@ -102,7 +102,7 @@ grid points the engine's table is their linear blend."""
 TABLE_SLICE_S = 0.1
 """Simulated time between two slices of a table under construction, s: a slice
 (:data:`SRR_PER_SLICE` ellipse integrations) costs one to two milliseconds, about five 1 ms
-chunks of the reduced engine, so a table (2 x 12 x 12 x 4 slices) takes about 115 s of
+chunks of the reduced engine, so a table (2 x 12 x 14 x 4 slices) takes about 134 s of
 simulated time and its building adds about 5 % to the engine's time while it lasts (a slice
 every 0.01 s added 40-58 %: ``bearing-rig bench thermal``, ``table_build_pct``). The lubricant
 moves 5 K (:data:`TABLE_STEP_K`) in a few minutes once the bearing's own bodies have warmed

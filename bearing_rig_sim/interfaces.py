@@ -288,7 +288,7 @@ SESSION_PROGRESS = Topic(
     "/rig/session/progress",
     "std_msgs/msg/Header",
     "reliable_stream",
-    "each take of the recorder's queues that found the clock advanced (at most 50 Hz wall)",
+    "each take of the recorder's queues that found a new clock (at most 50 Hz wall)",
     "s",
     "session",
     note="stamp: the latest `/clock` the session has taken and recorded; frame_id: the program's name. "

@@ -623,3 +623,45 @@ def test_a_set_point_from_outside_marks_the_segment_and_the_exit_status(ros_grap
     rows = {row[1]: row for row in summary_rows(out)}
     assert "disturbed" in rows["n0900"][CONDITIONS], out[-3000:]
     assert "conditions not met in segment 2 n0900:" in out
+
+
+def test_the_sessions_progress_is_each_new_clock_it_took(ros_graph: Any, tmp_path: Path) -> None:
+    """``/rig/session/progress`` carries the latest ``/clock`` the session has taken, once per
+    new value: nothing before the first clock, nothing again while it stands, and a clock that
+    went back (one the clock guard accepted as restarted) as it is, so that the simulator's
+    pacing follows the restarted clock instead of waiting for the old one's time to come back.
+    The session's clock is set by hand here (the recorder's take sets it in a session)."""
+    from std_msgs.msg import Header
+
+    from bearing_rig_sim.bags import BagWriter
+    from bearing_rig_sim.interfaces import SESSION_PROGRESS
+    from bearing_rig_sim.nodes.common import from_stamp, qos_profile
+    from bearing_rig_sim.rig.program import load_program
+    from bearing_rig_sim.session.node import SessionNode
+    from bearing_rig_sim.session.recorder import SessionRecorder
+    from bearing_rig_sim.session.runner import ProgramRunner
+
+    program = tmp_path / "program.yaml"
+    program.write_text(SHORT_PROGRAM, encoding="utf-8")
+    context = ros_graph.context()
+    listener = ros_graph.node("progress_listener", context=context)
+    got: list[tuple[float, str]] = []
+    listener.create_subscription(Header, SESSION_PROGRESS.name, lambda msg: got.append((from_stamp(msg.stamp), msg.frame_id)), qos_profile(SESSION_PROGRESS))
+    with BagWriter(tmp_path / "bag") as bag:
+        session = SessionNode(SessionRecorder(bag), ProgramRunner(load_program(program)), context=context, name="progress_session")
+        executor = ros_graph.executor([session, listener])
+        try:
+            assert ros_graph.spin_until(lambda: session.count_subscribers(SESSION_PROGRESS.name) >= 2, time_left(), executor=executor)
+            assert ros_graph.spin_until(lambda: session._progress.get_subscription_count() >= 2, time_left(), executor=executor)
+            session.send_progress()  # no clock taken yet: nothing
+            for seconds in (5.0, 5.0, 6.5, 1.25, 1.25):
+                session.clock_count += 1
+                session.sim_time_ns = round(seconds * 1e9)
+                session.send_progress()
+            assert ros_graph.spin_until(lambda: len(got) >= 3, time_left(), executor=executor), got
+            name = load_program(program).name
+            assert got == [(5.0, name), (6.5, name), (1.25, name)]
+            assert session.sent[SESSION_PROGRESS.name] == 3
+        finally:
+            session.close()
+            session.destroy_node()

@@ -10,7 +10,7 @@ executor, with deep reader queues (:data:`RECORDER_DEPTH`), and a timer of the s
 takes every queued message every :data:`DRAIN_PERIOD_S` (about 10 us each) and hands them, in
 order of arrival, to the recorder. One ``SingleThreadedExecutor`` thus runs the whole session.
 
-**Progress.** After each take that found the clock advanced, the session publishes the latest
+**Progress.** After each take that found a new clock, the session publishes the latest
 ``/clock`` it has taken and recorded on ``/rig/session/progress`` (:meth:`SessionNode.send_progress`);
 without real time the simulator runs no further than its ``SESSION_LEAD_S`` (2 s of sim time)
 past it, so a session starved of CPU holds the rig back instead of falling behind it.
@@ -258,8 +258,10 @@ class SessionNode(Node):
         than its ``SESSION_LEAD_S`` past it (:mod:`bearing_rig_sim.nodes.simulator`), so the
         session (its recorder and its runner) never falls further behind the rig than that, and
         a command sent :data:`~bearing_rig_sim.session.runner.COMMAND_LEAD_S` ahead by the
-        session's clock reaches the simulator before its stamp."""
-        if self.clock_count == 0 or self.sim_time_ns <= self.progress_ns:
+        session's clock reaches the simulator before its stamp. A clock the clock guard accepted
+        as restarted (earlier than the last progress) is published as it is: the simulator's
+        pacing starts again from it."""
+        if self.clock_count == 0 or self.sim_time_ns == self.progress_ns:
             return
         self.progress_ns = self.sim_time_ns
         self._progress_msg.stamp = Time(sec=self.sim_time_ns // 1_000_000_000, nanosec=self.sim_time_ns % 1_000_000_000)

@@ -90,6 +90,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Header
 
 from bearing_rig_msgs.msg import SimulatorTruth, SlipStatus, SpindleCommand as SpindleCommandMsg
+from bearing_rig_sim.bags.cdr import header_stamp_ns
 from bearing_rig_sim.interfaces import BEARING_AXIAL_FORCE, CLOCK, DIAGNOSTICS, SESSION_PROGRESS, SLIP_STATUS, SPEEDS, SPINDLE_COMMAND, TRUTH
 from bearing_rig_sim.interfaces import topic as contract_topic
 from bearing_rig_sim.config import ConfigError
@@ -306,8 +307,12 @@ class SimulatorNode(ManagedNode):
         # instead of one per message), from a reader on a node no executor spins.
         self._force_tap: Node | None = Node(f"{NODE_NAME}_force", context=self.context)
         self._force_sub = unspun_reader(self._force_tap, WrenchStamped, BEARING_AXIAL_FORCE.name, FORCE_QOS)
-        self._status_sub = unspun_reader(self._force_tap, SlipStatus, SLIP_STATUS.name, STATUS_QOS)
-        self._progress_sub = unspun_reader(self._force_tap, Header, SESSION_PROGRESS.name, RELIABLE_QOS)
+        self._stamp_readers = {
+            SLIP_STATUS.name: (unspun_reader(self._force_tap, SlipStatus, SLIP_STATUS.name, STATUS_QOS), SlipStatus),
+            SESSION_PROGRESS.name: (unspun_reader(self._force_tap, Header, SESSION_PROGRESS.name, RELIABLE_QOS), Header),
+        }
+        """The readers of the paced streams whose stamp alone matters (the monitor's statuses, the
+        session's progress), with their message types."""
 
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         period = s.loop_period_s if s.realtime else 0.0
@@ -386,8 +391,7 @@ class SimulatorNode(ManagedNode):
         clock (see there)."""
         if self.pacer.realtime:
             return chunks
-        self._take_statuses()
-        self._take_progress()
+        self._take_stamps()
         for name in self._leads:
             self._follow_publishers(name)
         at_rest = self.twin.time - self._last_pulse_time > MONITOR_LEAD_S
@@ -403,21 +407,14 @@ class SimulatorNode(ManagedNode):
             time.sleep(ACK_POLL_S)  # yield the core to the load controller and the monitor rather than spin
         return max(0, min(chunks, room))
 
-    def _take_statuses(self) -> None:
-        """Follow the monitor's progress: the stamp of its latest status (only the last queued
-        is decoded)."""
-        queued = drain(self._status_sub, SlipStatus)
-        if queued:
-            message = deserialize_message(queued[-1][0], SlipStatus)
-            self._leads[SLIP_STATUS.name].observe(from_stamp(message.header.stamp), self.twin.time, time.monotonic())
-
-    def _take_progress(self) -> None:
-        """Follow the session's progress: the stamp of its latest message (only the last queued
-        is decoded)."""
-        queued = drain(self._progress_sub, Header)
-        if queued:
-            message = deserialize_message(queued[-1][0], Header)
-            self._leads[SESSION_PROGRESS.name].observe(from_stamp(message.stamp), self.twin.time, time.monotonic())
+    def _take_stamps(self) -> None:
+        """Follow the monitor's and the session's progress: the stamp of the latest message queued
+        on each (read from its leading time stamp, no message decoded)."""
+        for name, (reader, msgtype) in self._stamp_readers.items():
+            queued = drain(reader, msgtype)
+            ns = header_stamp_ns(queued[-1][0]) if queued else None
+            if ns is not None:
+                self._leads[name].observe(ns // 1_000_000_000 + (ns % 1_000_000_000) * 1e-9, self.twin.time, time.monotonic())
 
     def _follow_publishers(self, name: str) -> None:
         """Count a paced stream's publishers (none: pacing on it stops), read each one's

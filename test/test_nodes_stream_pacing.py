@@ -126,9 +126,13 @@ def test_the_simulator_runs_no_further_than_its_lead_past_the_sessions_progress(
     ros_graph.spawn_python("-m", "bearing_rig_sim.nodes.simulator", "--autostart", "--no-realtime")
     node, executor, seen = play(ros_graph, "session")
     progress = node.create_publisher(Header, SESSION_PROGRESS.name, qos_profile(SESSION_PROGRESS))
-    held_at_the_lead(ros_graph, executor, seen, lambda stamp: progress.publish(Header(stamp=to_stamp(stamp), frame_id="test")), SESSION_LEAD_S)
+
+    def publish(stamp: float) -> None:
+        progress.publish(Header(stamp=to_stamp(stamp), frame_id="test"))
+
+    held_at_the_lead(ros_graph, executor, seen, publish, SESSION_LEAD_S)
     final = seen["clock"]
-    progress.publish(Header(stamp=to_stamp(final), frame_id="test"))
+    publish(final)
     node.destroy_publisher(progress)
     assert ros_graph.spin_until(lambda: seen["pacing"] == f"off: no publisher of {SESSION_PROGRESS.name}", WAIT, executor=executor), seen
     assert ros_graph.spin_until(lambda: seen["clock"] > final + 4.0 * SESSION_LEAD_S, WAIT, executor=executor), seen

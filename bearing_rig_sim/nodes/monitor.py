@@ -78,12 +78,13 @@ from bearing_rig_sim.nodes.shell import ManagedNode, declare_described, paramete
 from bearing_rig_sim.nodes.sim_clock import guard_sim_clock
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 
-IDLE_CATCH_UP_STATUSES = 8
-"""Most idle statuses one status timer publishes to catch up with the rig time (0.8 s of it at the
-shipped 10 Hz), below the status publisher's depth (10), so that a reliable reader that falls
-behind for one burst misses none; a longer stretch of rig time between two timer calls (a
-simulator more than 8 times faster than the wall clock, which the session's pacing on the
-statuses does not allow) leaves a gap."""
+IDLE_CATCH_UP_STATUSES = 100
+"""Most idle statuses one status timer publishes to catch up with the rig time (10 s of it at the
+shipped 10 Hz), a fiftieth of the status publisher's history (``transient_stream``, 5000), so
+that a reliable reader that falls behind for one burst misses none. Only more rig time than that
+between two timer calls leaves a gap: a clock that jumps, or a monitor held up that long. At 8
+(0.8 s) a monitor whose 10 Hz timer a loaded host held up for 0.3 s of wall time, with the
+simulator at four times the wall clock, left statuses 0.3 s of rig time apart."""
 
 LEVELS = {SlipState.STABLE: OK, SlipState.SLIPPING: WARN, SlipState.UNKNOWN: WARN, SlipState.FAULT: ERROR}
 """Diagnostics level of each monitor state (recent lost pulses raise OK to WARN)."""

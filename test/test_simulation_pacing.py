@@ -149,9 +149,25 @@ def test_stamps_far_from_the_simulated_time_do_not_pace():
     lead.observe(1.0, 1.0, 0.0)
     lead.observe(1.001, 5.0, 0.0)  # 4 s behind when taken: not a stream that follows the clock
     assert lead.room(5.0, 1e-3, 0.0) is None
+    assert lead.off == "force on the bearing stamped 1.001 s, more than 1 s from the simulated time 5.000 s"
     lead.observe(5.0, 5.0, 0.0)  # advancing and near the simulated time: paces from here
     lead.observe(5.0, 5.05, 0.0)  # the same stamp again: nothing new, the hold stays where it was
     assert lead.room(5.05, 1e-3, 0.0) == 50  # (5.0 + 0.1 - 5.05) / 1e-3: a repeated stamp releases nothing
+
+
+def test_the_reason_a_stream_stops_pacing_is_the_latest_one():
+    lead = StreamLead("session progress", 2.0, follow_s=30.0)
+    lead.stop("no publisher of /rig/session/progress")
+    lead.observe(1.8e9, 5.0, 0.0)  # a publisher on another clock: the reason is no longer "no publisher"
+    assert lead.room(5.0, 1e-3, 0.0) is None and "stamped 1800000000.000 s" in lead.off
+    lead.observe(5.0, 5.0, 0.0)
+    lead.observe(5.1, 5.1, 0.0)
+    assert lead.room(5.1, 1e-3, 0.0) == 2000 and lead.off == ""
+    lead.observe(4.0, 5.1, 0.0)  # a restarted publisher: back by 1.1 s, within the follow window
+    assert lead.room(5.1, 1e-3, 0.0) is None and lead.off == "session progress went back to 4.000 s from 5.100 s"
+    lead.stop("/session left the active state (inactive)", paused=True)
+    lead.observe(1.8e9, 5.1, 0.0)  # while paused, the pause is the reason that stands
+    assert lead.room(5.1, 1e-3, 0.0) is None and "left the active state" in lead.off
 
 
 def test_a_paused_or_silent_stream_stops_pacing_until_it_advances_again():

@@ -239,11 +239,19 @@ class StreamLead:
         """A message stamped ``stamp`` (s) taken at the simulated time ``sim_time`` (s), wall
         time ``wall`` (s). The same stamp again (a status with no newer rig time behind it)
         changes nothing: the pacing stays where the last advance put it, and the silence guard
-        counts from that advance."""
+        counts from that advance. A stamp that does not follow the clock (off by more than
+        ``follow_s``, or earlier than the last) stops the pacing, and :attr:`off` says which it
+        was, unless the publisher is paused (its reason stands)."""
         if stamp == self.stamp:
             return
-        advancing = stamp > self.stamp and abs(stamp - sim_time) <= self.follow_s
+        near = abs(stamp - sim_time) <= self.follow_s
+        advancing = stamp > self.stamp and near
         self.pace = stamp if advancing and self.stamp > -math.inf else None
+        if not advancing and not self.paused:
+            if near:
+                self.off = f"{self.name} went back to {stamp:.3f} s from {self.stamp:.3f} s"
+            else:
+                self.off = f"{self.name} stamped {stamp:.3f} s, more than {self.follow_s:g} s from the simulated time {sim_time:.3f} s"
         self.stamp = stamp
         self.seen = wall
 

@@ -21,11 +21,12 @@ the extensions call each other directly, so one changed source sets them all asi
 runs once, when the first of them is imported; :func:`status` says which way it went and why.
 
 **What differs, compiled.** A compiled class is closed: no attribute can be set on it (a method
-wrapped for timing, a monkeypatched method) and its instances do not pickle or deep-copy
-(mypyc's native classes), where the sources' do; a field or argument read as its annotated type
+wrapped for timing, a monkeypatched method); a field or argument read as its annotated type
 raises TypeError on another type (the monitor reads a pulse's fields untyped until it has
-checked them, so bad pulses are refused the same way). ``BEARING_RIG_PURE_PYTHON=1`` gives the
-sources' behaviour in all of this.
+checked them, so bad pulses are refused the same way). The records these modules return (an
+analysis's result, statuses, windows, segments, rows) pickle and deep-copy either way
+(:mod:`bearing_rig_sim.picklable`); their stateful classes (a monitor part-way through a stream)
+do not, compiled. ``BEARING_RIG_PURE_PYTHON=1`` gives the sources' behaviour in all of this.
 """
 
 from __future__ import annotations

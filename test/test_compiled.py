@@ -126,6 +126,42 @@ print(json.dumps(seen))
 """
 
 
+ROUND_TRIP = """
+import copy, json, pickle, sys
+from bearing_rig_sim import compiled
+from bearing_rig_sim.offline.analysis import analyse_bag
+r = analyse_bag(sys.argv[1], csv_dir=sys.argv[2])
+records = [r, r.final_status, *r.segments]
+back = [pickle.loads(pickle.dumps(x)) for x in records]
+copies = [copy.deepcopy(x) for x in records]
+print(json.dumps({"active": compiled.status().active, "segments": len(r.segments),
+                  "pickled": [repr(b) == repr(x) and type(b) is type(x) for b, x in zip(back, records)],
+                  "copied": [repr(c) == repr(x) and c is not x for c, x in zip(copies, records)]}))
+"""
+
+
+@pytest.mark.parametrize("pure", [False, True], ids=["compiled", "sources"])
+def test_an_analysis_result_pickles_and_deep_copies_compiled_or_not(tmp_path: Path, pure: bool) -> None:
+    """A result, its final status and its segments come back from pickle and ``copy.deepcopy``
+    equal in every field (compared by repr, as NaN fields are not equal to themselves), whether
+    the analysis ran compiled (frozen dataclasses without a ``__dict__``) or from the sources."""
+    bench = BenchScenario(
+        duration_s=8.0, spindle_speed=lambda t: np.minimum(40.0 * np.asarray(t), 160.0), slip_pct=lambda t: 0.8 + 0.0 * np.asarray(t), seed=11
+    )
+    bag = write_bench_bag(tmp_path / "bench", bench)
+    env = {k: v for k, v in os.environ.items() if k != compiled.PURE_PYTHON_VARIABLE}
+    if pure:
+        env[compiled.PURE_PYTHON_VARIABLE] = "1"
+    done = subprocess.run(
+        [sys.executable, "-c", ROUND_TRIP, str(bag), str(tmp_path / "csv")], env=env, capture_output=True, text=True, timeout=time_left(), check=False
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    out = json.loads(done.stdout.splitlines()[-1])
+    assert out["active"] is not pure
+    assert out["segments"] >= 1  # a held speed: at least one segment record to carry
+    assert all(out["pickled"]) and all(out["copied"]), out
+
+
 def test_bad_pulses_are_refused_the_same_way_compiled_never_raised() -> None:
     """A compiled module reads a field as the type Pulse declares and would raise on another: the
     monitor takes a pulse's fields as they come until it has checked them, so a stamp that is
@@ -229,6 +265,7 @@ def test_the_build_covers_what_the_compiled_modules_import() -> None:
         "instruments/__init__.py",
         "analysis/stability.py",  # schedule: from bearing_rig_sim.analysis.stability import SlipState
         "offline/analysis.py",
+        "picklable.py",  # analysis: from bearing_rig_sim import picklable
         "bags/cdr.py",
         "__init__.py",
     }

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from bearing_rig_sim.analysis.inputs import FloatArray
+from bearing_rig_sim import picklable
 
 MIN_PHASE_REVOLUTIONS = 2.0
 """A stretch covers at least this many cage revolutions (reaching back beyond the span if need
@@ -265,3 +266,6 @@ class PhaseSlope:
         white = w2 * float(row @ row)
         variance = white + q * walk
         return variance, (white / variance if variance > 0.0 else 1.0)
+
+
+picklable.by_fields(PhaseEstimate)

@@ -27,6 +27,7 @@ from scipy.special import stdtrit
 
 from bearing_rig_sim.analysis.inputs import AnalysisError, FloatArray, finite_number, positive_int
 from bearing_rig_sim.analysis.stability import SlipState
+from bearing_rig_sim import picklable
 
 
 @functools.lru_cache(maxsize=256)
@@ -469,3 +470,6 @@ class TrailingSlope:
     def verdict(self) -> SlopeVerdict:
         """The verdict after the latest point (cached; microseconds)."""
         return self._verdict
+
+
+picklable.by_fields(SlopeVerdict)

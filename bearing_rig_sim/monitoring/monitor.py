@@ -45,6 +45,7 @@ from bearing_rig_sim.monitoring.load_sweep import LoadSweep
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.monitoring.windows import SHAFTS, SlipWindow, SlipWindows, pulse_stamp
 from bearing_rig_sim.instruments.fibre_optic import Pulse
+from bearing_rig_sim import picklable
 
 MonitorState = SlipState
 """The monitor's state: the project's one state enum (values are SlipStatus.msg's)."""
@@ -559,3 +560,6 @@ class SlipMonitor:
             stable = latest.axial_load >= sweep.stable_from - 0.5 * self.settings.load_step_n
             return (SlipState.STABLE if stable else SlipState.SLIPPING), f"load sweep: {sweep.describe()}"
         return (SlipState.SLIPPING if sweep.fitted else SlipState.UNKNOWN), f"load sweep: {sweep.describe()}"
+
+
+picklable.by_fields(MonitorStatus, MonitorWindow)

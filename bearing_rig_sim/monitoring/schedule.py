@@ -33,6 +33,7 @@ from bearing_rig_sim.analysis.stability import SlipState
 from bearing_rig_sim.monitoring.monitor import MonitorStatus, SlipMonitor
 from bearing_rig_sim.monitoring.windows import pulse_stamp
 from bearing_rig_sim.instruments.fibre_optic import Pulse
+from bearing_rig_sim import picklable
 
 
 @dataclass(frozen=True)
@@ -299,3 +300,6 @@ class StampOrder:
                 break
             out.append((name, queue.popleft()[1]))
         return out
+
+
+picklable.by_fields(ScheduledStatus)

@@ -65,6 +65,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bearing_rig_sim.instruments.fibre_optic import TWO_PI, Pulse
+from bearing_rig_sim import picklable
 
 SHAFTS = ("spindle", "cage")
 OTHER = {"spindle": "cage", "cage": "spindle"}
@@ -642,3 +643,6 @@ def _malformed(pulse: Any) -> str:
     if pulse.strip_id >= pulse.strip_count:
         return f"strip_id {pulse.strip_id} is not below strip_count {pulse.strip_count}"
     return ""
+
+
+picklable.by_fields(LossRules, SlipWindow, LossBooks)

@@ -102,6 +102,7 @@ from bearing_rig_sim.offline.series import (
 )
 from bearing_rig_sim.instruments.fibre_optic import Pulse
 from bearing_rig_sim.monitoring.load_sweep import sweep_key
+from bearing_rig_sim import picklable
 
 PULSE_TYPE = contract.CAGE_PULSES.msgtype
 STATUS_TYPE = contract.SLIP_STATUS.msgtype
@@ -836,3 +837,6 @@ def analyse_bag(
             on_window=on_window,
         )
         return analysis.run()
+
+
+picklable.by_fields(OfflineResult)

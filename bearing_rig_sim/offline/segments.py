@@ -32,6 +32,7 @@ from bearing_rig_sim.config import ConfigError, parse_yaml
 from bearing_rig_sim.monitoring.schedule import TimeToStable, evidence_start
 from bearing_rig_sim.monitoring.settings import MonitorSettings
 from bearing_rig_sim.offline.series import CsvWriter, StatusRow, csv_columns
+from bearing_rig_sim import picklable
 
 SEGMENTS_CSV = "segments.csv"
 STRETCH_TOLERANCE = 0.01
@@ -305,3 +306,6 @@ class SegmentTracker:
             segment.name = f"stretch {len(self.segments) + 1}"
         self.segments.append(segment.summary())
         self._last_closed = segment
+
+
+picklable.by_fields(SegmentSummary)

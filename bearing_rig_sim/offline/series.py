@@ -20,6 +20,7 @@ from typing import Any
 
 from bearing_rig_sim.config import RPM_TO_RAD_S
 from bearing_rig_sim.bags.errors import BagError
+from bearing_rig_sim import picklable
 
 STATUS_CSV = "status_rows.csv"
 WINDOWS_CSV = "slip_windows.csv"
@@ -181,3 +182,6 @@ def csv_column(name: str) -> tuple[str, str, float]:
 def csv_columns(cls: type) -> list[tuple[str, str, float]]:
     """The CSV columns of a dataclass, one per field (see :func:`csv_column`)."""
     return [csv_column(f.name) for f in fields(cls)]
+
+
+picklable.by_fields(StatusRow, SlipWindowRow)

@@ -20,7 +20,22 @@ PACKAGE = "bearing_rig_sim"
 FLOORS: tuple[tuple[str, frozenset[str]], ...] = (
     (
         "foundation: the contract, configuration, errors and plumbing",
-        frozenset({"", "errors", "config", "interfaces", "health", "clock_guard", "dds_profile", "executors", "settings_model", "numba_cache", "compiled"}),
+        frozenset(
+            {
+                "",
+                "errors",
+                "config",
+                "interfaces",
+                "health",
+                "clock_guard",
+                "dds_profile",
+                "executors",
+                "settings_model",
+                "numba_cache",
+                "compiled",
+                "picklable",
+            }
+        ),
     ),
     ("bearing: the bearing's shared facts (kinematics, Hertz contact, materials)", frozenset({"bearing"})),
     ("measurement: the slip analysis, the rig's models and instruments, bag files", frozenset({"analysis", "rig", "instruments", "bags"})),

@@ -137,8 +137,12 @@ def test_traction_is_odd_bounded_and_tabulated_faithfully(bearing: BearingParame
 def test_traction_table_returns_the_direct_integral_at_its_nodes(bearing: BearingParameters, contact: int) -> None:
     """At a node of the table (load, speed, SRR) the lookup equals the ellipse integral with the
     contact's film, spin and Heathcote coefficients (checks the layout and the interpolation);
-    half-way between two SRR nodes it lies between them."""
+    half-way between two SRR nodes it lies between them. The node's angles: the outer contact's,
+    the thrust angle of its load (Harris and Kotzalas' equation); the inner contact's, those of
+    the ball balance at that load and speed (checked against the ring's load distribution in
+    test_dynamics_quasi_static.py)."""
     from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
+    from bearing_rig_sim.dynamics.parameters import table_contact_angles
     from bearing_rig_sim.dynamics.traction import ContactKinematics, spin_and_heathcote, table_power
 
     lub = bearing.lubricant
@@ -157,7 +161,12 @@ def test_traction_table_returns_the_direct_integral_at_its_nodes(bearing: Bearin
     k_n = 1.0 / (inner.stiffness ** (-2.0 / 3.0) + outer.stiffness ** (-2.0 / 3.0)) ** 1.5
     a = harris_thrust_angle(q * Z * math.sin(A0), Z, A0, FI + FO - 1, DW, k_n)
     a = harris_thrust_angle(q * Z * math.sin(a), Z, A0, FI + FO - 1, DW, k_n)
-    spin, kh = spin_and_heathcote(ContactKinematics(hz, rx, (FI if contact == 0 else FO) * DW, contact == 0), a, DW, DM)
+    kinematics = ContactKinematics(hz, rx, (FI if contact == 0 else FO) * DW, contact == 0)
+    if contact == 0:
+        ai, ao = table_contact_angles(bearing)[iq, iu]
+        spin, kh = spin_and_heathcote(kinematics, ai, DW, DM, ao)
+    else:
+        spin, kh = spin_and_heathcote(kinematics, a, DW, DM)
     semi_a, semi_b = hz.semi_axes(q)
     film = film_thickness(lub, bearing.lubricant_temperature, hz.reduced_modulus, rx, hz.ellipticity, semi_b, hz.max_pressure(q), u, q)
     args = (

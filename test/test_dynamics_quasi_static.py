@@ -165,3 +165,32 @@ def test_the_gyroscopic_moment_shifts_the_angles_slightly(bearing: QuasiStaticBe
 def test_bad_cases_are_refused(bearing: QuasiStaticBearing, case: LoadCase) -> None:
     with pytest.raises(LoadDistributionError):
         bearing.solve(case)
+
+
+def test_the_traction_tables_node_angles_are_the_rings_at_the_same_load_and_speed() -> None:
+    """The angles the traction table takes its spin from (a thrust-loaded ball whose inner
+    contact carries a given load at a given entrainment speed) are the ring solution's: at
+    10 000 rpm / 100 N and 9000 rpm / 300 N (angles validated by hand above), the inner load and
+    inner entrainment speed (omega_i - omega_m)(d_m - Dw cos a_i)/2 of the ring's solution,
+    given to :func:`thrust_contact_angles`, give back its angles within 0.01 deg. At a crawl
+    (0.05 m/s) both are the thrust angle of the load at rest, Harris and Kotzalas' equation with
+    F_a = Z Q sin a: cos a = cos a0 / (1 + (Q / (K_n (B Dw)^1.5))^(2/3))."""
+    from bearing_rig_sim.dynamics.ball_balance import thrust_contact_angles
+    from bearing_rig_sim.dynamics.quasi_static import solve
+
+    params = BearingParameters.from_yaml()
+    r, rm = 0.5 * DW, 0.5 * DM
+    for rpm, axial in ((10_000, 100.0), (9000, 300.0)):
+        omega = rpm * RPM
+        ring = solve(params, LoadCase(axial, inner_ring_speed=omega))
+        ai, ao, q = ring.inner_angles[0], ring.outer_angles[0], ring.inner_loads[0]
+        orbit = omega * (rm - r * math.cos(ai)) / (rm * (1.0 + math.cos(ai - ao)))
+        entrainment = (omega - orbit) * (rm - r * math.cos(ai))
+        got = thrust_contact_angles(params, np.array([q]), np.array([entrainment]))[0, 0]
+        np.testing.assert_allclose(got, [ai, ao], atol=math.radians(0.01))
+        assert got[1] < got[0]  # opened apart by the centrifugal force
+    loads = np.array([5.0, 50.0, 500.0])
+    crawl = thrust_contact_angles(params, loads, np.array([0.05]))[:, 0]
+    rest = np.arccos(math.cos(A0) / (1.0 + (loads / (K_N * (B * DW) ** 1.5)) ** (2.0 / 3.0)))
+    np.testing.assert_allclose(crawl[:, 0], rest, atol=math.radians(0.01))
+    np.testing.assert_allclose(crawl[:, 1], rest, atol=math.radians(0.01))

@@ -46,7 +46,8 @@ from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.bearing.file_record import file_field, file_keys, file_record, file_values
 from bearing_rig_sim.bearing.hertz import HertzContact, point_contact, raceway_contacts
 from bearing_rig_sim.dynamics.lubrication import Lubricant, rolling_force
-from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes
+from bearing_rig_sim.dynamics.ball_balance import thrust_contact_angles
+from bearing_rig_sim.dynamics.traction import SRR_REF, ContactKinematics, build_table, mu_nodes, table_axes
 from bearing_rig_sim.settings_model import read_file, validate_mapping
 
 GRAVITY = 9.80665
@@ -280,21 +281,47 @@ def overlay_calibration(bearing: Mapping[str, Any], calibration: CalibrationFile
     return merged
 
 
+_TABLE_ANGLES: dict[tuple[float, ...], np.ndarray] = {}
+
+
+def table_contact_angles(p: BearingParameters) -> np.ndarray:
+    """The contact angles (alpha_i, alpha_o), rad, at the traction table's load and speed nodes
+    (:func:`.ball_balance.thrust_contact_angles`), shape (N_LOAD, N_SPEED, 2). They depend on
+    the geometry, the Hertz constants and the balls' density alone, so they are computed once per
+    such bearing (about half a second) and shared by its tables at every temperature; a
+    read-only array."""
+    inner, outer = p.raceway_contacts()
+    key = (
+        float(p.ball_count),
+        p.ball_diameter,
+        p.pitch_diameter,
+        p.contact_angle,
+        p.inner_curvature_ratio,
+        p.outer_curvature_ratio,
+        p.ball_density,
+        inner.stiffness,
+        outer.stiffness,
+    )
+    angles = _TABLE_ANGLES.get(key)
+    if angles is None:
+        lu, lq = table_axes()
+        angles = thrust_contact_angles(p, np.exp(lq), np.exp(lu))
+        angles.setflags(write=False)
+        _TABLE_ANGLES[key] = angles
+    return angles
+
+
 @functools.lru_cache(maxsize=8)
 def _traction_table(p: BearingParameters) -> np.ndarray:
     lub = p.lubricant
     assert lub is not None
-    dw, dm, a0 = p.ball_diameter, p.pitch_diameter, p.contact_angle
     return build_table(
         p.contact_kinematics(),
         lub,
         p.lubricant_temperature,
-        ball_count=p.ball_count,
-        free_angle=a0,
-        ball_diameter=dw,
-        pitch_diameter=dm,
-        total_curvature=p.inner_curvature_ratio + p.outer_curvature_ratio - 1.0,
-        combined_constant=p.combined_constant,
+        angles=table_contact_angles(p),
+        ball_diameter=p.ball_diameter,
+        pitch_diameter=p.pitch_diameter,
     )
 
 

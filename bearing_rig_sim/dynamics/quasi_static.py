@@ -54,23 +54,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import root
 
+from bearing_rig_sim.dynamics.ball_balance import BallBalance, LoadDistributionError
 from bearing_rig_sim.dynamics.parameters import BearingParameters
-from bearing_rig_sim.errors import RigError
 from bearing_rig_sim.bearing.materials import BEARING_STEEL
 
 
-class LoadDistributionError(RigError):
-    """The quasi-static equilibrium could not be found (or a bad input)."""
-
-
-GYROSCOPIC_FRICTION = 0.1
-"""Friction coefficient, 1, bounding the gyroscopic moment a ball's contacts can hold:
-M <= mu Q_i Dw / 2 (the couple of two opposed tangential forces at the raceways, the inner
-contact the weaker; the usual estimate of Harris and Kotzalas, high-speed operation: about
-7 mN m at 100 N here against M_g of 1.25 mN m at 9000 rpm). Above it the ball pivots and the
-contacts hold only that much; a ball that barely touches the inner raceway holds next to none,
-so the load passes continuously from the loaded balls to those resting on the outer raceway.
-Range 0.05-0.15 (lubricated to boundary)."""
 METHOD_NEWTON = "newton"
 """Newton (Powell's hybrid method) from the thrust-only start converged."""
 METHOD_SPEED_CONTINUATION = "speed continuation"
@@ -83,10 +71,6 @@ _MIN_STEP = 1.0 / 1024.0
 """Smallest step of a continuation path, fraction of the way."""
 _RING_TOL = 1e-8
 """The ring's balance: largest unbalanced load relative to the largest applied one."""
-_ANGLE_ITERATIONS = 12
-"""Fixed-point passes of a ball's speeds on its contact angles (they settle to 1e-12 rad in 3-5)."""
-_ANGLE_TOL = 1e-12
-"""rad: the contact angles' change below which a ball's speeds are taken as settled."""
 
 
 def thermal_clearance_change(
@@ -199,125 +183,14 @@ class LoadDistribution:
         return float(self.inner_angles[int(np.argmax(self.inner_loads))])
 
 
-class QuasiStaticBearing:
-    """The bearing's geometry and Hertz constants for :meth:`solve`."""
+class QuasiStaticBearing(BallBalance):
+    """The bearing's geometry and Hertz constants for :meth:`solve` (each ball's balance:
+    :class:`~.ball_balance.BallBalance`)."""
 
     def __init__(self, params: BearingParameters) -> None:
-        p = params
-        self.z = p.ball_count
-        self.dw = p.ball_diameter
-        self.dm = p.pitch_diameter
-        self.a0 = p.contact_angle
-        self.gi = (p.inner_curvature_ratio - 0.5) * p.ball_diameter
-        self.go = (p.outer_curvature_ratio - 0.5) * p.ball_diameter
-        self.big_a = self.gi + self.go
+        super().__init__(params)
         self.ri = 0.5 * self.dm + self.gi * math.cos(self.a0)
-        inner, outer = p.raceway_contacts()
-        self.ki, self.ko = inner.stiffness, outer.stiffness
-        self.kn = p.combined_constant
-        self.mass = p.ball_density * math.pi * self.dw**3 / 6.0
-        self.inertia = p.ball_density * math.pi * self.dw**5 / 60.0
         self.psi = 2.0 * math.pi * np.arange(self.z) / self.z
-
-    # -- one ball ----------------------------------------------------------------------------
-    def _speeds(self, omega: float, ai: float, ao: float) -> tuple[float, float, float]:
-        """Orbit speed, rolling speed (rad/s) and pitch angle beta of outer-raceway control
-        (Harris and Kotzalas) at contact angles ai, ao."""
-        g = self.dw / self.dm
-        beta = math.atan2(math.sin(ao), math.cos(ao) + g)
-        orbit = omega * (1.0 - g * math.cos(ai)) / (1.0 + math.cos(ai - ao))
-        tb = math.tan(beta)
-        den = (
-            ((math.cos(ao) + tb * math.sin(ao)) / (1.0 + g * math.cos(ao)) + (math.cos(ai) + tb * math.sin(ai)) / (1.0 - g * math.cos(ai))) * g * math.cos(beta)
-        )
-        return orbit, omega / den, beta
-
-    def _ball(self, a1: float, a2: float, omega: float, gyro: bool, x0: np.ndarray | None) -> tuple[float, float, float, float, float, np.ndarray]:
-        """Contact loads and angles (Q_i, Q_o, a_i, a_o), orbit speed and the ball centre
-        (X1, X2) for curvature-centre offsets a1 (axial) and a2 (radial), m."""
-        if omega == 0.0:
-            d = math.hypot(a1, a2)
-            q = self.kn * (d - self.big_a) ** 1.5 if d > self.big_a else 0.0
-            a = math.atan2(a1, a2)
-            x = np.array([self.go * math.sin(a), self.go * math.cos(a)])
-            return q, q, a, a, 0.0, x
-        # Resting on the outer raceway under F_c alone (a_o = 0), its speeds at its own angles.
-        ai_rest = math.atan2(a1, a2 - self.go)
-        for _ in range(_ANGLE_ITERATIONS):
-            orbit, _, _ = self._speeds(omega, ai_rest, 0.0)
-            fc = 0.5 * self.mass * self.dm * orbit * orbit
-            rest = self.go + (fc / self.ko) ** (2.0 / 3.0)
-            previous, ai_rest = ai_rest, math.atan2(a1, a2 - rest)
-            if abs(ai_rest - previous) < _ANGLE_TOL:
-                break
-        if math.hypot(a1, a2 - rest) <= self.gi:  # the inner raceway out of reach
-            return 0.0, fc, ai_rest, 0.0, orbit, np.array([0.0, rest])
-        # Both contacts: wedged between the raceways (the curvature centres closer than A, the
-        # loads of the order of F_c) or loaded by the ring.
-        d = math.hypot(a1, a2)
-        # starts: the last solution, on the centre line with the approach split by Hertz, and on
-        # the outer raceway where it meets the inner one nearest a_o = 0 (where F_c pushes it)
-        reach = self.go + ((self.kn * max(d - self.big_a, 0.0) ** 1.5) / self.ko) ** (2.0 / 3.0)
-        starts = [np.array([reach * a1 / d, reach * a2 / d]), self._wedge(a1, a2, rest)]
-        if d <= self.big_a:
-            starts.reverse()
-        if x0 is not None:
-            starts.insert(0, x0)
-        x = starts[0]
-        ai, ao = math.atan2(a1 - x[0], a2 - x[1]), math.atan2(x[0], x[1])
-        for _ in range(_ANGLE_ITERATIONS):  # the speeds depend on the angles
-            orbit, roll, beta = self._speeds(omega, ai, ao)
-            fc = 0.5 * self.mass * self.dm * orbit * orbit
-            mg = self.inertia * roll * orbit * math.sin(beta) if gyro else 0.0
-
-            def residual(v: np.ndarray, fc: float = fc, mg: float = mg) -> np.ndarray:
-                qi, qo, si, ci, so, co = self._contacts(a1, a2, v)
-                held = math.copysign(min(abs(mg), GYROSCOPIC_FRICTION * qi * 0.5 * self.dw), mg)
-                return np.array([qi * si - qo * so + 2.0 * held * co / self.dw, qi * ci - qo * co - 2.0 * held * so / self.dw + fc])
-
-            x = self._ball_root(residual, [x, *starts[1:]], fc, a1, a2)
-            qi, qo, si, ci, so, co = self._contacts(a1, a2, x)
-            change = max(abs(math.atan2(si, ci) - ai), abs(math.atan2(so, co) - ao))
-            ai, ao = math.atan2(si, ci), math.atan2(so, co)
-            if change < _ANGLE_TOL:
-                break
-        return qi, qo, ai, ao, orbit, x
-
-    def _ball_root(self, residual: Callable[[np.ndarray], np.ndarray], starts: list[np.ndarray], fc: float, a1: float, a2: float) -> np.ndarray:
-        """The ball centre where ``residual`` (N) vanishes, from the first start that converges
-        (to 1e-9 of the largest of F_c, the contact loads and 1 N; Powell's hybrid method, then
-        Levenberg-Marquardt)."""
-        message = ""
-        for method in ("hybr", "lm"):
-            for start in starts:
-                sol = root(residual, start, method=method, options={"xtol": 1e-13})
-                if not np.all(np.isfinite(sol.x)):
-                    continue
-                qi, qo, *_ = self._contacts(a1, a2, sol.x)
-                if np.max(np.abs(residual(sol.x))) <= 1e-9 * max(fc, qi, qo, 1.0):
-                    return np.asarray(sol.x, dtype=float)
-                message = str(sol.message)
-        raise LoadDistributionError(f"ball equilibrium not found at curvature-centre offsets ({a1:.4g}, {a2:.4g}) m: {message}")
-
-    def _wedge(self, a1: float, a2: float, reach: float) -> np.ndarray:
-        """Where the circle of radius ``reach`` about the outer curvature centre meets the
-        circle of radius (f_i - 1/2) Dw about the inner one (a1, a2), on the side of the smaller
-        outer contact angle in magnitude, further out radially where F_c pushes the ball (m)."""
-        d = math.hypot(a1, a2)
-        along = (d * d + reach * reach - self.gi * self.gi) / (2.0 * d)
-        across = math.sqrt(max(reach * reach - along * along, 0.0))
-        ux, uy = a1 / d, a2 / d
-        # of the two points along * u +- across * (-uy, ux), the one further out radially
-        side = 1.0 if ux >= 0.0 else -1.0
-        return np.array([along * ux - side * across * uy, along * uy + side * across * ux])
-
-    def _contacts(self, a1: float, a2: float, x: np.ndarray) -> tuple[float, float, float, float, float, float]:
-        """Q_i, Q_o and the sines/cosines of a_i, a_o for the ball centre x = (X1, X2)."""
-        do = math.hypot(x[0], x[1])
-        di = math.hypot(a1 - x[0], a2 - x[1])
-        qo = self.ko * (do - self.go) ** 1.5 if do > self.go else 0.0
-        qi = self.ki * (di - self.gi) ** 1.5 if di > self.gi else 0.0
-        return qi, qo, (a1 - x[0]) / di, (a2 - x[1]) / di, x[0] / do, x[1] / do
 
     # -- the ring ----------------------------------------------------------------------------
     def _offsets(self, u: np.ndarray, case: LoadCase) -> tuple[np.ndarray, np.ndarray]:

@@ -13,14 +13,18 @@ Sliding across the ellipse: u_x = u_e (SRR + kappa_H y^2) - omega_s y, u_y = ome
 SRR is the slide-to-roll ratio at the contact centre, kappa_H y^2 Heathcote's differential
 slip of a conforming groove (the contact surface, of transverse radius R_c = 2 r_g R/(r_g + R),
 lies nearer the ball centre and farther from the ring axis away from y = 0) and omega_s the spin
-about the contact normal (outer-raceway control: omega_s = omega_i sin(alpha) at the inner
-contact, zero at the outer; Harris and Kotzalas). The film is the Hamrock-Dowson central film
+about the contact normal (outer-raceway control, Harris and Kotzalas: zero at the outer contact,
+omega_i sin(alpha_i) + omega_m (r_m / r) sin(alpha_i - alpha_o) at the inner one, omega_i sin(alpha)
+at equal angles; :func:`spin_and_heathcote`). The film is the Hamrock-Dowson central film
 (uniform; thermal and starvation reductions applied).
 
 Integrated: rolling-direction traction coefficient mu = F_x / Q and dissipated power
 P / (Q u_e) (sliding, spin and Heathcote losses together). The engine tabulates both per
-contact at start-up over SRR x entrainment speed x load (the contact angle, hence spin and
-Heathcote, taken from the thrust-load equilibrium at each load) and interpolates in the kernels.
+contact at start-up over SRR x entrainment speed x load and interpolates in the kernels. The
+inner contact's spin and Heathcote slip at a node follow from the contact angles of a
+thrust-loaded ball whose inner contact carries the node's load at the node's entrainment speed,
+centrifugal force in (:func:`~bearing_rig_sim.dynamics.ball_balance.thrust_contact_angles`); the
+outer contact's Heathcote slip from its load's thrust angle at rest (:func:`node_spin_and_heathcote`).
 """
 
 from __future__ import annotations
@@ -32,7 +36,7 @@ import numpy as np
 from numba import njit
 
 from bearing_rig_sim.bearing.hertz import HertzContact
-from bearing_rig_sim.dynamics.lubrication import Lubricant, film_thickness, harris_thrust_angle
+from bearing_rig_sim.dynamics.lubrication import Lubricant, film_thickness
 
 GRID = 24
 """Points per semi-axis direction of the ellipse quadrature (midpoint rule on the unit disc)."""
@@ -128,19 +132,47 @@ class ContactKinematics:
     inner: bool
 
 
-def spin_and_heathcote(contact: ContactKinematics, alpha: float, ball_diameter: float, pitch_diameter: float) -> tuple[float, float]:
+def spin_and_heathcote(
+    contact: ContactKinematics, alpha: float, ball_diameter: float, pitch_diameter: float, alpha_outer: float | None = None
+) -> tuple[float, float]:
     """(omega_s / u_e in 1/m, kappa_H in 1/m^2) of a contact at the contact angle ``alpha``
-    (rad), outer-raceway control (see module doc)."""
+    (rad), outer-raceway control (see module doc). For the inner contact ``alpha_outer`` is the
+    outer contact's angle (default ``alpha``: equal angles); the ball's angular velocity is
+    normal to the outer contact's normal, and with the orbit speed
+    omega_m = omega_i (r_m - r cos alpha_i) / (r_m (1 + cos(alpha_i - alpha_o))) the inner contact
+    spins at omega_i sin(alpha_i) + omega_m (r_m / r) sin(alpha_i - alpha_o), entrained at
+    (omega_i - omega_m)(r_m - r cos alpha_i); at equal angles omega_s = omega_i sin(alpha)."""
     r = 0.5 * ball_diameter
     rm = 0.5 * pitch_diameter
     rc = 2.0 * contact.groove_radius * r / (contact.groove_radius + r)
-    ratio = 0.5 * (1.0 - ball_diameter * math.cos(alpha) / pitch_diameter)  # omega_m / omega_i
     if contact.inner:
+        ao = alpha if alpha_outer is None else alpha_outer
         r_race = rm - r * math.cos(alpha)
-        spin = math.sin(alpha) / ((1.0 - ratio) * r_race)
-        return spin, (1.0 / r + math.cos(alpha) / r_race) / (2.0 * rc)
+        orbit = r_race / (rm * (1.0 + math.cos(alpha - ao)))  # omega_m / omega_i
+        spin = math.sin(alpha) + orbit * rm / r * math.sin(alpha - ao)  # omega_s / omega_i
+        return spin / ((1.0 - orbit) * r_race), (1.0 / r + math.cos(alpha) / r_race) / (2.0 * rc)
     r_race = rm + r * math.cos(alpha)
     return 0.0, -(1.0 / r - math.cos(alpha) / r_race) / (2.0 * rc)
+
+
+def table_axes() -> tuple[np.ndarray, np.ndarray]:
+    """The logarithms of the table's entrainment speeds (m/s) and contact loads (N), ascending."""
+    lu = np.linspace(math.log(SPEED_RANGE[0]), math.log(SPEED_RANGE[1]), N_SPEED)
+    lq = np.linspace(math.log(LOAD_RANGE[0]), math.log(LOAD_RANGE[1]), N_LOAD)
+    return lu, lq
+
+
+def node_spin_and_heathcote(
+    contact: ContactKinematics, angles: np.ndarray, iq: int, iu: int, ball_diameter: float, pitch_diameter: float
+) -> tuple[float, float]:
+    """:func:`spin_and_heathcote` of ``contact`` at the table node (load ``iq``, speed ``iu``):
+    an inner-contact node at the angles (alpha_i, alpha_o) = ``angles[iq, iu]`` (rad) of the
+    ball whose inner contact carries that load at that entrainment speed; an outer-contact node
+    (no spin under outer-raceway control; its Heathcote slip varies as cos(alpha)) at the thrust
+    angle of its load at rest, ``angles[iq, 0, 1]``."""
+    if contact.inner:
+        return spin_and_heathcote(contact, float(angles[iq, iu, 0]), ball_diameter, pitch_diameter, float(angles[iq, iu, 1]))
+    return spin_and_heathcote(contact, float(angles[iq, 0, 1]), ball_diameter, pitch_diameter)
 
 
 def build_table(
@@ -148,32 +180,31 @@ def build_table(
     lub: Lubricant,
     temperature_c: float,
     *,
-    ball_count: int,
-    free_angle: float,
+    angles: np.ndarray,
     ball_diameter: float,
     pitch_diameter: float,
-    total_curvature: float,
-    combined_constant: float,
 ) -> np.ndarray:
-    """The traction table of both raceway contacts as a flat float64 array (layout: HEADER)."""
+    """The traction table of both raceway contacts as a flat float64 array (layout: HEADER).
+
+    ``angles``: the contact angles (alpha_i, alpha_o), rad, of the ball whose inner contact
+    carries each node's load at each node's entrainment speed, shape (N_LOAD, N_SPEED, 2)
+    (:func:`bearing_rig_sim.dynamics.ball_balance.thrust_contact_angles` at the nodes of
+    :func:`table_axes`); the spin and Heathcote slip of each node follow from them
+    (:func:`node_spin_and_heathcote`)."""
     xi_max = math.asinh(SRR_MAX / SRR_REF)
     xis = np.linspace(-xi_max, xi_max, N_SRR)
     srrs = SRR_REF * np.sinh(xis)
-    lu = np.linspace(math.log(SPEED_RANGE[0]), math.log(SPEED_RANGE[1]), N_SPEED)
-    lq = np.linspace(math.log(LOAD_RANGE[0]), math.log(LOAD_RANGE[1]), N_LOAD)
+    lu, lq = table_axes()
     eta0 = lub.dynamic_viscosity(temperature_c)
     z = lub.roelands_index(temperature_c)
     mu = np.zeros((2, N_LOAD, N_SPEED, N_SRR))
     pw = np.zeros_like(mu)
     for c, contact in enumerate(contacts):
         for iq, q in enumerate(np.exp(lq)):
-            # contact angle at this load from the thrust equilibrium (no centrifugal force)
-            alpha = harris_thrust_angle(q * ball_count * math.sin(free_angle), ball_count, free_angle, total_curvature, ball_diameter, combined_constant)
-            alpha = harris_thrust_angle(q * ball_count * math.sin(alpha), ball_count, free_angle, total_curvature, ball_diameter, combined_constant)
-            spin, kh = spin_and_heathcote(contact, alpha, ball_diameter, pitch_diameter)
             a, b = contact.hertz.semi_axes(q)
             ph = contact.hertz.max_pressure(q)
             for iu, u in enumerate(np.exp(lu)):
+                spin, kh = node_spin_and_heathcote(contact, angles, iq, iu, ball_diameter, pitch_diameter)
                 film = film_thickness(lub, temperature_c, contact.hertz.reduced_modulus, contact.rx, contact.hertz.ellipticity, b, ph, u, q)
                 h = max(film.central, 1e-9)
                 for k, s in enumerate(srrs):

@@ -35,22 +35,21 @@ from numba import njit
 
 from bearing_rig_sim.dynamics import kernels as kn
 from bearing_rig_sim.dynamics.engine import BearingDynamics
-from bearing_rig_sim.dynamics.lubrication import film_thickness, harris_thrust_angle
-from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, traction_table
+from bearing_rig_sim.dynamics.lubrication import film_thickness
+from bearing_rig_sim.dynamics.parameters import BearingParameters, derive, table_contact_angles, traction_table
 from bearing_rig_sim.dynamics.quasi_static import thermal_clearance_change
 from bearing_rig_sim.dynamics.steady import SteadyState, SteadySolver
 from bearing_rig_sim.dynamics.step_limit import StepLimitError
 from bearing_rig_sim.dynamics.traction import (
     HEADER,
-    LOAD_RANGE,
     N_LOAD,
     N_SPEED,
     N_SRR,
-    SPEED_RANGE,
     SRR_MAX,
     SRR_REF,
     ellipse_traction,
-    spin_and_heathcote,
+    node_spin_and_heathcote,
+    table_axes,
 )
 from bearing_rig_sim.thermal.bearing import HeatLedger, HeatSources, ThermalConfig, build_network, heat_sources, node_heat
 from bearing_rig_sim.thermal.network import ThermalNetwork
@@ -132,28 +131,20 @@ class TableBuild:
         if lub is None:
             raise ValueError(f"{params.source}: no lubricant file, no traction table")
         self.temperature = float(temperature_c)
-        dw, dm, a0 = warm.ball_diameter, warm.pitch_diameter, warm.contact_angle
         self._contacts = warm.contact_kinematics()
         self._lub = lub
-        self._geometry = (
-            warm.ball_count,
-            a0,
-            warm.inner_curvature_ratio + warm.outer_curvature_ratio - 1.0,
-            dw,
-            dm,
-            warm.combined_constant,
-        )
+        self._ball_diameter, self._pitch_diameter = warm.ball_diameter, warm.pitch_diameter
+        self._angles = table_contact_angles(warm)  # computed once per bearing (the start-up's table)
         self._xi_max = math.asinh(SRR_MAX / SRR_REF)
         self._srrs = SRR_REF * np.sinh(np.linspace(-self._xi_max, self._xi_max, N_SRR))
-        self._lu = np.linspace(math.log(SPEED_RANGE[0]), math.log(SPEED_RANGE[1]), N_SPEED)
-        self._lq = np.linspace(math.log(LOAD_RANGE[0]), math.log(LOAD_RANGE[1]), N_LOAD)
+        self._lu, self._lq = table_axes()
         self._eta0 = lub.dynamic_viscosity(self.temperature)
         self._z = lub.roelands_index(self.temperature)
         self._mu = np.zeros((2, N_LOAD, N_SPEED, N_SRR))
         self._pw = np.zeros_like(self._mu)
         self._todo = [_Slice(c, iq, iu, k) for c in range(2) for iq in range(N_LOAD) for iu in range(N_SPEED) for k in range(0, N_SRR, SRR_PER_SLICE)]
         self._next = 0
-        self._contact_at_load: dict[tuple[int, int], tuple[float, float, float, float, float, float]] = {}
+        self._contact_at_load: dict[tuple[int, int], tuple[float, float, float, float]] = {}
         self._film = 0.0
 
     @property
@@ -172,13 +163,10 @@ class TableBuild:
         q = float(np.exp(self._lq)[iq])
         got = self._contact_at_load.get((c, iq))
         if got is None:
-            z, a0, b_total, dw, dm, k_n = self._geometry
-            alpha = harris_thrust_angle(q * z * math.sin(a0), z, a0, b_total, dw, k_n)
-            alpha = harris_thrust_angle(q * z * math.sin(alpha), z, a0, b_total, dw, k_n)
-            spin, kh = spin_and_heathcote(contact, alpha, dw, dm)
             a, b = contact.hertz.semi_axes(q)
-            got = self._contact_at_load[(c, iq)] = (spin, kh, a, b, contact.hertz.max_pressure(q), q)
-        spin, kh, a, b, ph, q = got
+            got = self._contact_at_load[(c, iq)] = (a, b, contact.hertz.max_pressure(q), q)
+        a, b, ph, q = got
+        spin, kh = node_spin_and_heathcote(contact, self._angles, iq, iu, self._ball_diameter, self._pitch_diameter)
         u = float(np.exp(self._lu)[iu])
         if k0 == 0:
             film = film_thickness(lub, self.temperature, contact.hertz.reduced_modulus, contact.rx, contact.hertz.ellipticity, b, ph, u, q)

@@ -28,7 +28,8 @@ from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 
 from bearing_rig_sim.config import config_path  # noqa: E402
-from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS, from_stamp, to_stamp  # noqa: E402
+from bearing_rig_sim.interfaces import SLIP_STATUS  # noqa: E402
+from bearing_rig_sim.nodes.common import RELIABLE_QOS, SENSOR_QOS, STATUS_QOS, from_stamp, qos_profile, to_stamp  # noqa: E402
 from conftest import bearing_section, time_left  # noqa: E402
 
 RPM = math.pi / 30.0
@@ -72,7 +73,10 @@ class Probe:
         n.create_subscription(FibreOpticPulse, "/rig/spindle/pulses", self.pulses["spindle"].append, SENSOR_QOS)
         n.create_subscription(FibreOpticPulse, "/rig/cage/pulses", self.pulses["cage"].append, SENSOR_QOS)
         n.create_subscription(SimulatorTruth, "/rig/truth", self.truth.append, SENSOR_QOS)
-        n.create_subscription(SlipStatus, "/rig/slip_status", self.status.append, STATUS_QOS)
+        # the monitor's own history (depth 5000): a reader of depth 10 loses the oldest statuses
+        # of a burst it has not taken yet (a loaded host holds up this executor, and a stopped
+        # rig's catch-up publishes several periods at once), which would read as gaps
+        n.create_subscription(SlipStatus, SLIP_STATUS.name, self.status.append, qos_profile(SLIP_STATUS))
         n.create_subscription(DiagnosticArray, "/diagnostics", self._on_diagnostics, RELIABLE_QOS)
         self.command = n.create_publisher(SpindleCommand, "/rig/spindle/command", STATUS_QOS)
         self.force = n.create_publisher(WrenchStamped, "/rig/bearing/axial_force", RELIABLE_QOS)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Protocol, cast
+from typing import Protocol
 
 import numpy as np
 from scipy.optimize import root
@@ -209,29 +209,29 @@ def thrust_contact_angles(ball: BallGeometry, loads: np.ndarray, speeds: np.ndar
         omega = 0.0
         centre: np.ndarray | None = None
         for iu, u in enumerate(np.asarray(speeds, dtype=float)):
-            if omega == 0.0:
-                omega = u / ((1.0 - 0.5 * (1.0 - b.dw * math.cos(alpha) / b.dm)) * (rm - r * math.cos(alpha)))
+            if omega == 0.0:  # the first speed: the rolling kinematics at the rest angle
+                orbit_ratio = b._speeds(1.0, alpha, alpha)[0]
+                omega = u / ((1.0 - orbit_ratio) * (rm - r * math.cos(alpha)))
             else:
                 omega *= u / float(speeds[iu - 1])
-            state: dict[str, object] = {}
 
-            def residual(
-                v: np.ndarray, q: float = q, u: float = u, omega: float = omega, centre: np.ndarray | None = centre, state: dict[str, object] = state
-            ) -> np.ndarray:
+            def balance(
+                v: np.ndarray, q: float = q, u: float = u, omega: float = omega, centre: np.ndarray | None = centre
+            ) -> tuple[np.ndarray, tuple[float, float], np.ndarray]:
+                """Relative misfits of the inner load and the entrainment speed at the axial
+                offset v[0] A and the shaft speed v[1] omega; the angles and the ball centre."""
                 qi, _, ai, ao, orbit, x = b._ball(v[0] * b.big_a, a2, v[1] * omega, True, centre)
-                state.update(angles=(ai, ao), centre=x)
                 entrainment = (v[1] * omega - orbit) * (rm - r * math.cos(ai))
-                return np.array([qi / q - 1.0, entrainment / u - 1.0])
+                return np.array([qi / q - 1.0, entrainment / u - 1.0]), (ai, ao), x
 
             try:
                 with np.errstate(all="ignore"):  # trial points of the root finder that fling the ball off
-                    sol = root(residual, np.array([a1 / b.big_a, 1.0]), method="hybr", options={"xtol": 1e-12})
-                    good = bool(sol.success) and float(np.max(np.abs(residual(sol.x)))) < 1e-8
+                    sol = root(lambda v: balance(v)[0], np.array([a1 / b.big_a, 1.0]), method="hybr", options={"xtol": 1e-12})
+                    misfit, found, x = balance(sol.x)
+                if sol.success and float(np.max(np.abs(misfit))) < 1e-8:
+                    a1, omega = float(sol.x[0]) * b.big_a, float(sol.x[1]) * omega
+                    angles, centre = found, x
             except LoadDistributionError:
-                good = False
-            if good:
-                a1, omega = float(sol.x[0]) * b.big_a, float(sol.x[1]) * omega
-                angles = cast(tuple[float, float], state["angles"])
-                centre = cast(np.ndarray, state["centre"])
+                pass
             out[iq, iu] = angles
     return out

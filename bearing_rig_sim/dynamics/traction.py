@@ -162,6 +162,22 @@ def table_axes() -> tuple[np.ndarray, np.ndarray]:
     return lu, lq
 
 
+def srr_axis() -> np.ndarray:
+    """The table's slide-to-roll ratios, ascending: uniform in asinh(SRR / SRR_REF) from -SRR_MAX
+    to SRR_MAX, N_SRR of them."""
+    xi_max = math.asinh(SRR_MAX / SRR_REF)
+    return SRR_REF * np.sinh(np.linspace(-xi_max, xi_max, N_SRR))
+
+
+def pack_table(mu: np.ndarray, power: np.ndarray) -> np.ndarray:
+    """A table's flat array (layout: HEADER) from its traction coefficients and dissipations
+    P / (Q u_e) at the nodes, each of shape (2, N_LOAD, N_SPEED, N_SRR) (contact, load, speed,
+    SRR; axes of :func:`table_axes` and :func:`srr_axis`)."""
+    lu, lq = table_axes()
+    head = np.array([N_SRR, N_SPEED, N_LOAD, math.asinh(SRR_MAX / SRR_REF), lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
+    return np.concatenate([head, np.stack([mu, power], axis=-1).ravel()])
+
+
 def node_spin_and_heathcote(
     contact: ContactKinematics, angles: np.ndarray, iq: int, iu: int, ball_diameter: float, pitch_diameter: float
 ) -> tuple[float, float]:
@@ -191,9 +207,7 @@ def build_table(
     (:func:`bearing_rig_sim.dynamics.ball_balance.thrust_contact_angles` at the nodes of
     :func:`table_axes`); the spin and Heathcote slip of each node follow from them
     (:func:`node_spin_and_heathcote`)."""
-    xi_max = math.asinh(SRR_MAX / SRR_REF)
-    xis = np.linspace(-xi_max, xi_max, N_SRR)
-    srrs = SRR_REF * np.sinh(xis)
+    srrs = srr_axis()
     lu, lq = table_axes()
     eta0 = lub.dynamic_viscosity(temperature_c)
     z = lub.roelands_index(temperature_c)
@@ -211,8 +225,7 @@ def build_table(
                     mu[c, iq, iu, k], pw[c, iq, iu, k] = ellipse_traction(
                         ph, a, b, h, eta0, z, lub.eyring_stress, lub.limiting_shear_coefficient, lub.shear_modulus, u, s, spin, kh
                     )
-    head = np.array([N_SRR, N_SPEED, N_LOAD, xi_max, lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
-    return np.concatenate([head, np.stack([mu, pw], axis=-1).ravel()])
+    return pack_table(mu, pw)
 
 
 def mu_nodes(t: np.ndarray, base: int) -> np.ndarray:

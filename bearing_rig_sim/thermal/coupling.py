@@ -45,10 +45,11 @@ from bearing_rig_sim.dynamics.traction import (
     N_LOAD,
     N_SPEED,
     N_SRR,
-    SRR_MAX,
     SRR_REF,
     ellipse_traction,
     node_spin_and_heathcote,
+    pack_table,
+    srr_axis,
     table_axes,
 )
 from bearing_rig_sim.thermal.bearing import HeatLedger, HeatSources, ThermalConfig, build_network, heat_sources, node_heat
@@ -135,8 +136,7 @@ class TableBuild:
         self._lub = lub
         self._ball_diameter, self._pitch_diameter = warm.ball_diameter, warm.pitch_diameter
         self._angles = table_contact_angles(warm)  # computed once per bearing (the start-up's table)
-        self._xi_max = math.asinh(SRR_MAX / SRR_REF)
-        self._srrs = SRR_REF * np.sinh(np.linspace(-self._xi_max, self._xi_max, N_SRR))
+        self._srrs = srr_axis()
         self._lu, self._lq = table_axes()
         self._eta0 = lub.dynamic_viscosity(self.temperature)
         self._z = lub.roelands_index(self.temperature)
@@ -182,9 +182,7 @@ class TableBuild:
         """The finished table (layout of :data:`bearing_rig_sim.dynamics.traction.HEADER`)."""
         if not self.done:
             raise RuntimeError(f"traction table at {self.temperature:g} degC: {len(self._todo) - self._next} slices still to build")
-        lu, lq = self._lu, self._lq
-        head = np.array([N_SRR, N_SPEED, N_LOAD, self._xi_max, lu[0], lu[1] - lu[0], lq[0], lq[1] - lq[0]])
-        return np.concatenate([head, np.stack([self._mu, self._pw], axis=-1).ravel()])  # as traction.build_table lays it out
+        return pack_table(self._mu, self._pw)
 
 
 class TractionTableGrid:

@@ -98,16 +98,13 @@ def test_drive_work_is_heat_plus_mechanical_energy(twin: object, rpm: float, loa
     assert engine.drive_torque() == pytest.approx(engine.friction_torque(), rel=CLOSURE)
 
 
-@pytest.mark.xfail(strict=True, reason="at a steady hold the drive power exceeds the dissipated power by 6.7e-4 of it, at any step (BOOKING_GAP)")
-def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power() -> None:
-    """Oil-air twin held at 2700 rpm / 700 N after its run-up: the bodies' energy no longer
-    changes, so over 0.2 s the drive's work is the heat, to rounding: each of the 5000 steps adds
-    its work and heat to sums of at most the total, and the energy is read twice (a relative
-    error of eps each, on the largest term)."""
-    params = oil_air_twin()
+def steady_hold(params: BearingParameters, rpm: float, load: float, seconds: float) -> tuple[float, float, float, int, BearingDynamics]:
+    """Run-up from rest at 500 rad/s^2 to ``rpm`` under ``load`` (N), 0.1 s of settling, then
+    ``seconds`` held: (drive work, heat, mechanical energy change) over the hold in J, its
+    number of steps and the engine."""
     engine = BearingDynamics(params)
-    engine.initialise(0.0, 700.0)
-    target = rpm_to_rad_s(2700.0)
+    engine.initialise(0.0, load)
+    target = rpm_to_rad_s(rpm)
     n_up = int(round(target / 500.0 / CHUNK_S))
     for k in range(n_up + 100):
         accel = 500.0 if k < n_up else 0.0
@@ -115,12 +112,59 @@ def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power() -> None:
             accel = (target - engine.inner_ring_speed) / CHUNK_S
         engine.advance(CHUNK_S, inner_ring_acceleration=accel)
     e0, d0 = engine.energy(), engine.dissipated
-    steps = int(round(0.2 / engine.time_step))
-    work = sum(engine.advance(CHUNK_S).drive_work for _ in range(int(round(0.2 / CHUNK_S))))
-    heat, gained = engine.dissipated - d0, engine.energy() - e0
+    work = sum(engine.advance(CHUNK_S).drive_work for _ in range(int(round(seconds / CHUNK_S))))
+    return work, engine.dissipated - d0, engine.energy() - e0, int(round(seconds / engine.time_step)), engine
+
+
+def pitch_moment_power(engine: BearingDynamics) -> float:
+    """Power (W) of the rolling-direction tractions' moment about each ball's pitch axis
+    w = (cos beta, sin beta) at the raceway-control pitch rate omega_m sin(beta), summed over the
+    balls: omega_m (F_i (A_im - r_b) + F_o (A_om - r_b)), from the recorded tractions and contact
+    angles and the kinematics' lever arms (``kernels.ball_kinematics``: a ball's material point at
+    a contact moves at A_m omega_m + A_a omega_a, and A_im - r_b = r sin(beta) sin(alpha_i - beta)
+    is that pitch rotation's share; the ball's orbit takes the tractions at its centre, lever r_b)."""
+    v, out, ball = engine.vector, engine.out, engine.ball
+    total = 0.0
+    for j in range(ball.shape[0]):
+        ai, ao = out[j, kn.O_AI], out[j, kn.O_AO]
+        rb, wm = ball[j, kn.B_R], ball[j, kn.B_OMEGA]
+        _, _, _, _, aim, _, aom, _, _ = kn.ball_kinematics(v, -math.cos(ai), -math.sin(ai), math.cos(ao), math.sin(ao), rb)
+        total += wm * (out[j, kn.O_FI] * (aim - rb) + out[j, kn.O_FO] * (aom - rb))
+    return float(total)
+
+
+@pytest.mark.xfail(strict=True, reason="at a steady hold the drive power exceeds the dissipated power by 6.7e-4 of it, at any step (BOOKING_GAP)")
+def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power() -> None:
+    """Oil-air twin held at 2700 rpm / 700 N after its run-up: the bodies' energy no longer
+    changes, so over 0.2 s the drive's work is the heat, to rounding: each of the 5000 steps adds
+    its work and heat to sums of at most the total, and the energy is read twice (a relative
+    error of eps each, on the largest term)."""
+    work, heat, gained, steps, engine = steady_hold(oil_air_twin(), 2700.0, 700.0, 0.2)
+    e0 = engine.energy() - gained
     eps = float(np.finfo(float).eps)
     assert abs(gained) < 1e-9 * work  # steady: the balls and cage hold their energy
     assert abs(heat + gained - work) <= steps * eps * (work + heat) + 2 * eps * abs(e0), (work, heat, gained)
+
+
+@pytest.mark.parametrize(("twin", "rpm", "load"), [(oil_air_twin, 2700.0, 700.0), (grease_twin, 900.0, 100.0)], ids=["oil_air_2700_700", "grease_900_100"])
+def test_the_steady_holds_booking_gap_is_the_tractions_pitch_moment_power(twin: object, rpm: float, load: float) -> None:
+    """What :data:`BOOKING_GAP` is, at a steady hold (0.1 s): the drive's work less the heat is
+    the work of the rolling-direction tractions' moment about the balls' pitch axes at the
+    raceway-control pitch rate (:func:`pitch_moment_power` times the hold). The heat books each
+    traction times the sliding of the ball's material point, whose speed includes that pitch
+    rotation; the ball's equations take the traction at the ball centre and leave the pitch rate
+    to the raceway-control assumption, so nothing in them spends that work. Within 1e-6 of it:
+    the sums' rounding is of the order of steps x eps x work / gap, 1e-9. Where the work goes in
+    the bearing (handed back to the inner ring by its contact's spin moment, the outer contact's
+    doing no work at zero spin) is not booked: booked so at every step, the hold closes exactly
+    but a run-up from rest then closes to +2e-3 of its work (0.05 s hold, 40 us; 1.3e-3 at 10 us),
+    so the account in transients is not understood yet."""
+    assert callable(twin)
+    work, heat, gained, _, engine = steady_hold(twin(), rpm, load, 0.1)
+    assert work > 0.0 and abs(gained) < 1e-9 * work
+    gap = work - heat - gained
+    assert gap > 0.0
+    assert gap == pytest.approx(0.1 * pitch_moment_power(engine), rel=1e-6), (gap, work)
 
 
 def test_energy_closes_with_the_cage_whirling_under_a_radial_load() -> None:

@@ -32,19 +32,20 @@ BEARING = CONFIG / "bearings" / "h7006c.yaml"
 CHUNK_S = 1e-3
 """Chunk and thermal interval, s: the network takes the engine's heat after every chunk."""
 
-BOOKING_GAP = 7.5e-4
-"""A loss the engine does not book as heat, as a fraction of the drive work: at a steady hold the
-drive power exceeds the dissipated power by 6.6e-5 (grease, 900 rpm / 100 N) to 6.7e-4 (oil-air,
-2700 rpm / 700 N), and a run-up with the cage whirling under 200 N radial closes to -7.3e-4; the
-same at steps of 40, 20 and 10 us, so it is not the step's error.
-:func:`test_at_a_steady_hold_the_drive_power_is_the_dissipated_power` states the law exactly
-and fails until the loss is found (strict: it says so when it passes)."""
-STEP_ERROR = 1e-4
-"""The account's dependence on the step, as a fraction of the drive work: halving the 40 us step
-(an independent reference: the same run, the contact state twice as fresh) moves the closure by
-at most 8.7e-5 (oil-air, 2700 rpm / 700 N) and a further halving by 3.2e-5 (first order)."""
-CLOSURE = BOOKING_GAP + STEP_ERROR
-"""Closure of a run-up and hold, relative to the drive work: the known gap plus the step's error
+TRANSIENT_GAP = 6.5e-4
+"""What the account leaves open beyond the step's error, as a fraction of the drive work. A steady
+hold closes exactly (:func:`test_at_a_steady_hold_the_drive_power_is_the_dissipated_power`), a
+run-up and hold not quite, in the step's limit: +4.5e-4 for oil-air at 2700 rpm / 700 N (7.37,
+5.71 and 5.00e-4 at steps of 40, 20 and 10 us, extrapolated to first order) and -6.3e-4 with the
+cage whirling under 200 N radial (-6.36, -6.35 and -6.28e-4): terms of the speed's ramp and of the
+whirl not found yet."""
+STEP_ERROR = 3e-4
+"""The first-order error of the 40 us step, as a fraction of the drive work (an independent
+reference: the same run, the contact state twice and four times as fresh): the oil-air run-up to
+2700 rpm / 700 N closes to 7.37e-4 at 40 us and tends to 4.5e-4; the others' closures halve
+with the step (grease 900 rpm / 100 N: 3.1, 1.2, 0.5e-6)."""
+CLOSURE = TRANSIENT_GAP + STEP_ERROR
+"""Closure of a run-up and hold, relative to the drive work: the open terms plus the step's error
 (before: 1 %, 14 times the largest closure measured)."""
 
 
@@ -116,61 +117,29 @@ def steady_hold(params: BearingParameters, rpm: float, load: float, seconds: flo
     return work, engine.dissipated - d0, engine.energy() - e0, int(round(seconds / engine.time_step)), engine
 
 
-def pitch_moment_power(engine: BearingDynamics) -> float:
-    """Power (W) of the rolling-direction tractions' moment about each ball's pitch axis
-    w = (cos beta, sin beta) at the raceway-control pitch rate omega_m sin(beta), summed over the
-    balls: omega_m (F_i (A_im - r_b) + F_o (A_om - r_b)), from the recorded tractions and contact
-    angles and the kinematics' lever arms (``kernels.ball_kinematics``: a ball's material point at
-    a contact moves at A_m omega_m + A_a omega_a, and A_im - r_b = r sin(beta) sin(alpha_i - beta)
-    is that pitch rotation's share; the ball's orbit takes the tractions at its centre, lever r_b)."""
-    v, out, ball = engine.vector, engine.out, engine.ball
-    total = 0.0
-    for j in range(ball.shape[0]):
-        ai, ao = out[j, kn.O_AI], out[j, kn.O_AO]
-        rb, wm = ball[j, kn.B_R], ball[j, kn.B_OMEGA]
-        _, _, _, _, aim, _, aom, _, _ = kn.ball_kinematics(v, -math.cos(ai), -math.sin(ai), math.cos(ao), math.sin(ao), rb)
-        total += wm * (out[j, kn.O_FI] * (aim - rb) + out[j, kn.O_FO] * (aom - rb))
-    return float(total)
-
-
-@pytest.mark.xfail(strict=True, reason="at a steady hold the drive power exceeds the dissipated power by 6.7e-4 of it, at any step (BOOKING_GAP)")
-def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power() -> None:
-    """Oil-air twin held at 2700 rpm / 700 N after its run-up: the bodies' energy no longer
-    changes, so over 0.2 s the drive's work is the heat, to rounding: each of the 5000 steps adds
-    its work and heat to sums of at most the total, and the energy is read twice (a relative
-    error of eps each, on the largest term)."""
-    work, heat, gained, steps, engine = steady_hold(oil_air_twin(), 2700.0, 700.0, 0.2)
+@pytest.mark.parametrize(("twin", "rpm", "load"), [(oil_air_twin, 2700.0, 700.0), (grease_twin, 900.0, 100.0)], ids=["oil_air_2700_700", "grease_900_100"])
+def test_at_a_steady_hold_the_drive_power_is_the_dissipated_power(twin: object, rpm: float, load: float) -> None:
+    """Held after the run-up, the bodies' energy no longer changes, so over 0.2 s the drive's
+    work is the heat, to rounding: each of the 5000 steps adds its work and heat to sums of at
+    most the total, and the energy is read twice (a relative error of eps each, on the largest
+    term). It failed by 6.6e-5 (grease, 900 rpm / 100 N) to 6.7e-4 (oil-air, 2700 rpm / 700 N)
+    of the work, at any step, until the drive's torque stopped paying the power the tractions
+    put into the balls' pitch rotation (``kernels.pitch_hold_torque``): that power, the tractions'
+    moment about each ball's pitch axis at the raceway-control pitch rate omega_m sin(beta),
+    was the whole gap, to 1e-10 of it."""
+    assert callable(twin)
+    work, heat, gained, steps, engine = steady_hold(twin(), rpm, load, 0.2)
     e0 = engine.energy() - gained
     eps = float(np.finfo(float).eps)
+    assert work > 0.0
     assert abs(gained) < 1e-9 * work  # steady: the balls and cage hold their energy
     assert abs(heat + gained - work) <= steps * eps * (work + heat) + 2 * eps * abs(e0), (work, heat, gained)
-
-
-@pytest.mark.parametrize(("twin", "rpm", "load"), [(oil_air_twin, 2700.0, 700.0), (grease_twin, 900.0, 100.0)], ids=["oil_air_2700_700", "grease_900_100"])
-def test_the_steady_holds_booking_gap_is_the_tractions_pitch_moment_power(twin: object, rpm: float, load: float) -> None:
-    """What :data:`BOOKING_GAP` is, at a steady hold (0.1 s): the drive's work less the heat is
-    the work of the rolling-direction tractions' moment about the balls' pitch axes at the
-    raceway-control pitch rate (:func:`pitch_moment_power` times the hold). The heat books each
-    traction times the sliding of the ball's material point, whose speed includes that pitch
-    rotation; the ball's equations take the traction at the ball centre and leave the pitch rate
-    to the raceway-control assumption, so nothing in them spends that work. Within 1e-6 of it:
-    the sums' rounding is of the order of steps x eps x work / gap, 1e-9. Where the work goes in
-    the bearing (handed back to the inner ring by its contact's spin moment, the outer contact's
-    doing no work at zero spin) is not booked: booked so at every step, the hold closes exactly
-    but a run-up from rest then closes to +2e-3 of its work (0.05 s hold, 40 us; 1.3e-3 at 10 us),
-    so the account in transients is not understood yet."""
-    assert callable(twin)
-    work, heat, gained, _, engine = steady_hold(twin(), rpm, load, 0.1)
-    assert work > 0.0 and abs(gained) < 1e-9 * work
-    gap = work - heat - gained
-    assert gap > 0.0
-    assert gap == pytest.approx(0.1 * pitch_moment_power(engine), rel=1e-6), (gap, work)
 
 
 def test_energy_closes_with_the_cage_whirling_under_a_radial_load() -> None:
     """Grease twin, 100 N axial and 200 N radial: the radial load pushes the cage centre off the
     axis and it whirls in its land clearance. Run-up to 900 rpm and a 0.3 s hold close within
-    :data:`CLOSURE` (measured -0.073 %, at 20 and 10 us too). Before the land's work on the moving centre was heat and the stored
+    :data:`CLOSURE` (measured -0.064 %, -0.063 % at 10 us). Before the land's work on the moving centre was heat and the stored
     energy moved the pockets' gaps by the centre's offset, the same run gave +2.4 %: the whirling
     centre's offset read as a pocket penetration of tens of micrometres."""
     params = grease_twin()

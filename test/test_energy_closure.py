@@ -35,14 +35,14 @@ CHUNK_S = 1e-3
 TRANSIENT_GAP = 6.5e-4
 """What the account leaves open beyond the step's error, as a fraction of the drive work. A steady
 hold closes exactly (:func:`test_at_a_steady_hold_the_drive_power_is_the_dissipated_power`), a
-run-up and hold not quite, in the step's limit: +4.5e-4 for oil-air at 2700 rpm / 700 N (7.37,
-5.71 and 5.00e-4 at steps of 40, 20 and 10 us, extrapolated to first order) and -6.3e-4 with the
+run-up and hold not quite, in the step's limit: +4.4e-4 for oil-air at 2700 rpm / 700 N (7.37,
+5.71, 5.00, 4.68 and 4.52e-4 at steps of 40, 20, 10, 5 and 2.5 us) and -6.3e-4 with the
 cage whirling under 200 N radial (-6.36, -6.35 and -6.28e-4): terms of the speed's ramp and of the
 whirl not found yet."""
 STEP_ERROR = 3e-4
 """The first-order error of the 40 us step, as a fraction of the drive work (an independent
 reference: the same run, the contact state twice and four times as fresh): the oil-air run-up to
-2700 rpm / 700 N closes to 7.37e-4 at 40 us and tends to 4.5e-4; the others' closures halve
+2700 rpm / 700 N closes to 7.37e-4 at 40 us and tends to 4.4e-4; the others' closures halve
 with the step (grease 900 rpm / 100 N: 3.1, 1.2, 0.5e-6)."""
 CLOSURE = TRANSIENT_GAP + STEP_ERROR
 """Closure of a run-up and hold, relative to the drive work: the open terms plus the step's error

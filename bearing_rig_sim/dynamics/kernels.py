@@ -1173,27 +1173,6 @@ def contact_moments(
     return t_inner, m_outer, m_ring * sg, t_orbit
 
 
-@njit(cache=True, inline="always")
-def pitch_hold_torque(wm: float, fi: float, fo: float, aim: float, aom: float, rb: float, inner_scale: float) -> float:
-    """Torque (N m, about the bearing axis) by which the drive's torque is less than the inner
-    contact's traction and loss moments: the power the rolling-direction tractions put into the
-    ball's pitch rotation, which the inner contact's spin moment hands back to the ring.
-
-    At raceway control the ball turns about its pitch axis w = (cos beta, sin beta) at
-    omega_m sin(beta) (:func:`ball_kinematics`: its material point at a contact moves at
-    A_m omega_m + A_a omega_a, and A_im - r_b = r sin(beta) sin(alpha_i - beta) is that
-    rotation's share), and a traction F at a contact has the moment r F sin(alpha - beta) about
-    w. The ball's equations impose that pitch rate and take the tractions on the orbit at the
-    ball centre (lever r_b), so the moment's power, omega_m (F_i (A_im - r_b) + F_o (A_om - r_b)),
-    goes through the contacts' spin moments: the outer contact's does no work (no spin there
-    under outer-raceway control), so it is the inner contact's, whose loss the table books in
-    full (:func:`contact_moments`' ``t_inner``) while the ball pays this much of it and the ring
-    the rest. Without it the drive's work exceeded the heat by 6.6e-5 to 6.7e-4 of it at a
-    steady hold (``test/test_energy_closure.py``). ``inner_scale``: :func:`inner_speed_scale`
-    of the inner ring's speed."""
-    return wm * (fi * (aim - rb) + fo * (aom - rb)) * inner_scale
-
-
 @njit(cache=True)
 def inner_speed_scale(omega_i: float) -> float:
     """1 / omega_i (s/rad) for :func:`contact_moments`, smoothed to omega_i / (1 rad/s)^2 below
@@ -1419,14 +1398,16 @@ def reduced_ball_row(
     t_inner, m_outer, m_ring, t_orbit = contact_moments(
         p, inner_scale, wa, omega_roll, sg, rb, r_ci, aom + r * co * cb, fi, fo, si, so, pi, po, fri, froll - fri, qi, qo, geo[j, G_DI]
     )
-    t_pitch = pitch_hold_torque(wm, fi, fo, aim, aom, rb, inner_scale)
-    drive += t_inner + m_ring * cb - t_pitch
+    drive += t_inner + m_ring * cb
     mres = spin_resistance(p, geo[j, G_DI], geo[j, G_DO], fs, omega_roll) + r * froll * sg + m_outer
     kres = implicit_slope(mres, 0.0, omega_roll)  # secant: a damper on the rolling speed
-    gm = rb * (fi + fo - fd) - rm * fs + t_orbit
+    # the tractions' generalised forces on orbit and spin are their levers in the contact
+    # points' speeds (A_m, A_a; :func:`ball_kinematics`): the orbit's lever A_m is the ball
+    # centre's r_b plus the raceway-control pitch rotation's share r sin(beta) sin(alpha - beta)
+    gm = aim * fi + aom * fo - rb * fd - rm * fs + t_orbit
     ga = r * (ci * fi - co * fo) - mres
-    jmm = rb * (-kti * aim - kto * aom - dfd * rb)
-    jma = rb * (-kti * aia + kto * aoa)
+    jmm = -kti * aim * aim - kto * aom * aom - dfd * rb * rb
+    jma = -kti * aim * aia + kto * aom * aoa
     jam = r * (-ci * kti * aim + co * kto * aom) - kres * cb
     jaa = r * (-ci * kti * aia - co * kto * aoa) - kres
     ee = cu + dt * ku
@@ -1506,7 +1487,7 @@ def reduced_ball_row(
     if keep:
         record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
         out[j, O_POWER] = power
-        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - t_pitch
+        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb
     return drive, heat + power, damp, d11, d12, d21, d22, dcx, dcy
 
 
@@ -1818,8 +1799,7 @@ def stiff_ball_row(
         qo,
         di,
     )
-    t_pitch = pitch_hold_torque(wm, fi, fo, aim, aom, rb, inner_speed_scale(omega_i))
-    drive += t_inner + m_ring * cb - t_pitch
+    drive += t_inner + m_ring * cb
     mres = spin_resistance(p, di, do, fs, wa + cb * wm) + r * froll * smooth_sign(wa + cb * wm) + m_outer
     # momenta at the current positions (p_theta first: p_r's update needs it)
     # the pivot first: its gyroscopic coupling then acts on orbit and spin with the new
@@ -1832,10 +1812,10 @@ def stiff_ball_row(
     wt_old = wt
     wt = (ib * wt - dt * g * (wa + cb * wm)) / (ib + dt * r * r * kpiv)
     ball[j, B_PIVOT] = wt
-    gm = rb * (fi + fo - fd) - rm * fs + t_orbit + g * cb * wt
+    gm = aim * fi + aom * fo - rb * fd - rm * fs + t_orbit + g * cb * wt  # levers as step_reduced
     ga = r * (ci * fi - co * fo) - mres + g * wt
-    b11 = m * rb * rb + dt * rb * (kti * aim + kto * aom)
-    b12 = dt * rb * (kti * aia - kto * aoa)
+    b11 = m * rb * rb + dt * (kti * aim * aim + kto * aom * aom)
+    b12 = dt * (kti * aim * aia - kto * aom * aoa)
     b21 = dt * r * (ci * kti * aim - co * kto * aom)
     b22 = ib + dt * r * (ci * kti * aia + co * kto * aoa)
     det = b11 * b22 - b12 * b21
@@ -1865,7 +1845,7 @@ def stiff_ball_row(
     if keep:
         record(out, j, qi, qo, nir, niz, nor, noz, fs, si, so, fi, fo)
         out[j, O_POWER] = power
-        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - t_pitch - d_drive
+        out[j, O_DRIVE] = fi * r_ci + t_inner + m_ring * cb - d_drive
     return drive, heat, damp, contact_damp, ring_force
 
 

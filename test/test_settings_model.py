@@ -185,12 +185,12 @@ def test_load_controller_reads_the_shipped_file_and_refuses_sim_time_off(tmp_pat
 
 def test_shadow_settings_bounds_that_depend_on_another_value() -> None:
     """error_after_s is checked against warn_after_s, and a negative calibration RMS is read from
-    the calibration file (0.1085 pp in the shipped h7006c_table3.yaml, calibration.rms_slip_pct)."""
+    the calibration file (0.1084 pp in the shipped h7006c_table3.yaml, calibration.rms_slip_pct)."""
     shipped = ShadowSettings.shipped_parameters()
     with pytest.raises(ConfigError, match=r"error_after_s: must be > 2.0 \(warn_after_s\), got 1.5"):
         ShadowSettings.from_values({**shipped, "warn_after_s": 2.0, "error_after_s": 1.5})
     settings = ShadowSettings.from_values({**shipped, "calibration_file": "calibration/h7006c_table3.yaml", "calibration_rms_slip_pct": -1.0})
-    assert settings.calibration_rms_slip_pct == pytest.approx(0.1085)
+    assert settings.calibration_rms_slip_pct == pytest.approx(0.1084)
     with pytest.raises(ConfigError, match="calibration_rms_slip_pct: negative means .* no calibration file is given"):
         ShadowSettings.from_values({**shipped, "calibration_file": "", "calibration_rms_slip_pct": -1.0})
     with pytest.raises(ConfigError, match="model: must be one of reduced, stiff, got 'fast'"):

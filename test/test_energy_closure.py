@@ -14,6 +14,8 @@ radial load, and for the heat of damping alone: the guiding land's work on a kno
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from itertools import chain, repeat
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +45,7 @@ CLOSURE = STEP_ERROR
 (before: 1 %, then 8.5e-4 while the tractions' orbit lever left a gap of up to 6.7e-4 open)."""
 WHIRL_GAP = 6.5e-4
 """What the account leaves open with the cage whirling under 200 N radial, as a fraction of the
-drive work: -6.36e-4, -6.36e-4 and -6.29e-4 at steps of 40, 20 and 10 us, so not the step's
+drive work: -6.38e-4, -6.36e-4 and -6.29e-4 at steps of 40, 20 and 10 us, so not the step's
 error; a term of the whirl not found yet. What is known: it is a steady power while the centre
 whirls (900 rpm / 100 N, grease: -3.3, -8.9 and -13.5 mW of about 10.8 W under 50, 200 and
 400 N radial, the same at 10 us; oil-air -0.25 mW of 0.88 W), the pocket friction, the EHL
@@ -65,6 +67,16 @@ def oil_air_twin() -> BearingParameters:
     return bearing.replace(lubricant=lub, oil_viscosity=lub.dynamic_viscosity(t), oil_density=lub.density(t), oil_volume_fraction=lub.oil_volume_fraction)
 
 
+def ramp(engine: BearingDynamics, rpm: float, acceleration: float) -> Iterator[float]:
+    """The inner ring's acceleration (rad/s^2) for each :data:`CHUNK_S` chunk of a run-up from
+    rest to ``rpm`` at ``acceleration``, the last chunk's landing on the speed exactly (read from
+    ``engine`` when that chunk comes)."""
+    target = rpm_to_rad_s(rpm)
+    n_up = int(round(target / acceleration / CHUNK_S))
+    for k in range(n_up):
+        yield acceleration if k < n_up - 1 else (target - engine.inner_ring_speed) / CHUNK_S
+
+
 def run_up_and_hold(
     params: BearingParameters, rpm: float, load: float, acceleration: float, hold: float, radial: float = 0.0
 ) -> tuple[float, float, float, BearingDynamics]:
@@ -76,15 +88,10 @@ def run_up_and_hold(
     coupling = ThermalCoupling(engine, ThermalConfig.from_yaml(BEARING), interval=CHUNK_S)
     e0 = engine.energy()
     work = 0.0
-    target = rpm_to_rad_s(rpm)
-    n_up = int(round(target / acceleration / CHUNK_S))
-    for k in range(n_up + int(round(hold / CHUNK_S))):
-        accel = acceleration if k < n_up else 0.0
-        if k == n_up - 1:
-            accel = (target - engine.inner_ring_speed) / CHUNK_S  # land on the speed exactly
+    for accel in chain(ramp(engine, rpm, acceleration), repeat(0.0, int(round(hold / CHUNK_S)))):
         work += engine.advance(CHUNK_S, inner_ring_acceleration=accel, radial_load=radial).drive_work
         assert coupling.advance(CHUNK_S)
-    assert engine.inner_ring_speed == pytest.approx(target, rel=1e-9)
+    assert engine.inner_ring_speed == pytest.approx(rpm_to_rad_s(rpm), rel=1e-9)
     return work, coupling.network.heat_in, engine.energy() - e0, engine
 
 
@@ -108,12 +115,7 @@ def steady_hold(params: BearingParameters, rpm: float, load: float, seconds: flo
     number of steps and the engine."""
     engine = BearingDynamics(params)
     engine.initialise(0.0, load)
-    target = rpm_to_rad_s(rpm)
-    n_up = int(round(target / 500.0 / CHUNK_S))
-    for k in range(n_up + 100):
-        accel = 500.0 if k < n_up else 0.0
-        if k == n_up - 1:
-            accel = (target - engine.inner_ring_speed) / CHUNK_S
+    for accel in chain(ramp(engine, rpm, 500.0), repeat(0.0, 100)):
         engine.advance(CHUNK_S, inner_ring_acceleration=accel)
     e0, d0 = engine.energy(), engine.dissipated
     work = sum(engine.advance(CHUNK_S).drive_work for _ in range(int(round(seconds / CHUNK_S))))
